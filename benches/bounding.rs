@@ -1,0 +1,2 @@
+//! Bounding-volume benches (placeholder until the foundation work lands).
+fn main() {}

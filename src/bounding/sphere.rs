@@ -1,0 +1,5 @@
+//! Placeholder: replaced by the foundation work (issue #2).
+
+/// Placeholder.
+#[derive(Debug, Clone, Copy)]
+pub struct BoundingSphere;

@@ -1,0 +1,69 @@
+//! Shapes, in their own local frames. No poses here: a shape is placed by a body's pose.
+//!
+//! Axis conventions (shared with FCL and Coal): capsule, cylinder and cone are aligned with
+//! the local **Z** axis and centred on the origin (the cone's apex at `+half_height`).
+//! Every convex shape implements [`SupportMap`], which is all GJK needs.
+//!
+//! Constructors come in two doors (STYLE.md §3): `new` for trusted input, checked with
+//! `debug_assert!`, and `try_new`, which returns [`ShapeError`] and is what the IPC boundary
+//! calls.
+
+mod capsule;
+mod cone;
+pub mod convex;
+mod cuboid;
+mod cylinder;
+mod error;
+pub mod mesh;
+mod segment;
+mod sphere;
+mod triangle;
+
+pub use capsule::Capsule;
+pub use cone::Cone;
+pub use convex::{ConvexHullError, ConvexPolyhedron};
+pub use cuboid::Cuboid;
+pub use cylinder::Cylinder;
+pub use error::ShapeError;
+pub use mesh::{MeshError, MeshReport, TriMesh};
+pub use segment::Segment;
+pub use sphere::Sphere;
+pub use triangle::Triangle;
+
+use crate::math::DVec3;
+
+/// The kinds of shape, in canonical pair order: a narrow-phase pair function is written only
+/// for `(a, b)` with `a <= b` in this order; the dispatcher flips the rest.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ShapeKind {
+    /// [`Sphere`].
+    Sphere,
+    /// [`Capsule`].
+    Capsule,
+    /// [`Cuboid`].
+    Cuboid,
+    /// [`Cylinder`].
+    Cylinder,
+    /// [`Cone`].
+    Cone,
+    /// [`Segment`].
+    Segment,
+    /// [`Triangle`].
+    Triangle,
+    /// [`ConvexPolyhedron`].
+    Convex,
+    /// [`TriMesh`].
+    Mesh,
+}
+
+/// The support mapping of a convex shape: the point of the shape farthest along a direction.
+///
+/// # Contract
+/// `support(d)` returns a point `p` of the shape with `p · d = max over the shape of x · d`,
+/// in the shape's local frame. `d` need not be unit length; for `d = 0` any point of the
+/// shape is returned. Never NaN for finite `d`.
+pub trait SupportMap {
+    /// The farthest point of the shape along `direction` (local frame).
+    #[must_use]
+    fn support(&self, direction: DVec3) -> DVec3;
+}
