@@ -1,0 +1,144 @@
+//! Shared generators for integration tests: a seeded PRNG, random rotations and poses, and
+//! point sets that include the degenerate cases every geometric test must survive.
+//!
+//! Include with `mod support;` from a test file. Items unused by one test file are allowed.
+#![allow(dead_code)]
+
+use proxima::math::{DQuat, DVec3, Isometry, Pose};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+/// The PRNG every test uses, always seeded explicitly.
+pub type TestRng = Pcg64Mcg;
+
+/// A PRNG from a seed.
+pub fn rng(seed: u64) -> TestRng {
+    TestRng::seed_from_u64(seed)
+}
+
+/// A uniform point in the cube `[-half, half]³`.
+pub fn point_in_cube(rng: &mut TestRng, half: f64) -> DVec3 {
+    DVec3::new(
+        rng.random_range(-half..=half),
+        rng.random_range(-half..=half),
+        rng.random_range(-half..=half),
+    )
+}
+
+/// A uniformly distributed rotation (Shoemake's method).
+pub fn rotation(rng: &mut TestRng) -> DQuat {
+    let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
+    let (s1, s2) = ((1.0 - u1).sqrt(), u1.sqrt());
+    let tau = std::f64::consts::TAU;
+    DQuat::from_xyzw(
+        s1 * (tau * u2).sin(),
+        s1 * (tau * u2).cos(),
+        s2 * (tau * u3).sin(),
+        s2 * (tau * u3).cos(),
+    )
+    .normalize()
+}
+
+/// A random pose with its translation in `[-half, half]³`.
+pub fn pose(rng: &mut TestRng, half: f64) -> Pose {
+    Pose::new(point_in_cube(rng, half), rotation(rng))
+}
+
+/// A random isometry with its translation in `[-half, half]³`.
+pub fn isometry(rng: &mut TestRng, half: f64) -> Isometry {
+    pose(rng, half).to_isometry()
+}
+
+/// The shapes of point cloud every fit and hull test runs over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CloudKind {
+    /// Uniform in a box with random proportions.
+    Box,
+    /// On a sphere's surface.
+    Sphere,
+    /// One point.
+    Single,
+    /// A few distinct points, each repeated many times.
+    Duplicates,
+    /// All on one line.
+    Collinear,
+    /// All on one plane.
+    Coplanar,
+    /// A needle: long along one axis, thin across.
+    Needle,
+}
+
+impl CloudKind {
+    /// Every kind.
+    pub const ALL: [CloudKind; 7] = [
+        CloudKind::Box,
+        CloudKind::Sphere,
+        CloudKind::Single,
+        CloudKind::Duplicates,
+        CloudKind::Collinear,
+        CloudKind::Coplanar,
+        CloudKind::Needle,
+    ];
+}
+
+/// `n ≥ 1` points of the given kind, around `center`, of size about `scale`, randomly
+/// rotated.
+pub fn cloud(
+    rng: &mut TestRng,
+    kind: CloudKind,
+    n: usize,
+    center: DVec3,
+    scale: f64,
+) -> Vec<DVec3> {
+    let n = n.max(1);
+    let rot = rotation(rng);
+    let local: Vec<DVec3> = match kind {
+        CloudKind::Box => {
+            let half = DVec3::new(
+                rng.random_range(0.1..1.0),
+                rng.random_range(0.1..1.0),
+                rng.random_range(0.1..1.0),
+            );
+            (0..n).map(|_| point_in_cube(rng, 1.0) * half).collect()
+        }
+        CloudKind::Sphere => (0..n)
+            .map(|_| point_in_cube(rng, 1.0).normalize_or(DVec3::X))
+            .collect(),
+        CloudKind::Single => vec![DVec3::ZERO; 1],
+        CloudKind::Duplicates => {
+            let distinct: Vec<DVec3> = (0..4).map(|_| point_in_cube(rng, 1.0)).collect();
+            (0..n).map(|i| distinct[i % distinct.len()]).collect()
+        }
+        CloudKind::Collinear => (0..n)
+            .map(|_| DVec3::X * rng.random_range(-1.0..1.0))
+            .collect(),
+        CloudKind::Coplanar => (0..n)
+            .map(|_| {
+                DVec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    0.0,
+                )
+            })
+            .collect(),
+        CloudKind::Needle => (0..n)
+            .map(|_| {
+                DVec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1e-3..1e-3),
+                    rng.random_range(-1e-3..1e-3),
+                )
+            })
+            .collect(),
+    };
+    local
+        .into_iter()
+        .map(|p| center + rot * (p * scale))
+        .collect()
+}
+
+/// The offsets and scales of the degenerate-input matrix: centres up to 1e6 from the origin,
+/// sizes from 1e-4 to 1e4.
+pub const CENTERS: [f64; 4] = [0.0, 1.0, 1e3, 1e6];
+/// See [`CENTERS`].
+pub const SCALES: [f64; 5] = [1e-4, 1e-2, 1.0, 1e2, 1e4];
