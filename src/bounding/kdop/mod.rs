@@ -29,7 +29,7 @@ mod polytope;
 use self::directions::{Layout, Signed};
 use super::BoundingVolume;
 use crate::geometry::Triangle;
-use crate::math::{DVec3, Isometry, conservative_slack};
+use crate::math::{DMat3, DVec3, Isometry, conservative_slack};
 
 /// A k-DOP with `N` slab directions: `{x : min[k] <= d_k · x <= max[k] for every k}`, local
 /// frame, slab values in metres times `|d_k|` (directions are unnormalised integers).
@@ -161,6 +161,23 @@ impl<const N: usize> Kdop<N> {
         (lo_axes.max(lo_cone), hi_axes.min(hi_cone))
     }
 
+    /// The slack of a refit of `self` under a pose with translation `t`: every term of the
+    /// refit is at most `|d|_1 <= 3` times a slab value or a translation component.
+    #[inline]
+    fn refit_pad(&self, t: DVec3) -> f64 {
+        conservative_slack(4.0 * (3.0 * self.magnitude() + t.abs().max_element()))
+    }
+
+    /// Slot `k` of the refit of `self` under the pose `(Rᵀ = r_t, t)`: bounds on `d_k · x`
+    /// over the moved DOP, padded by `pad`.
+    #[inline]
+    fn refit_slab(&self, k: usize, r_t: &DMat3, t: DVec3, pad: f64) -> (f64, f64) {
+        let d = Self::DIRECTIONS[k];
+        let (lo, hi) = self.support_interval(*r_t * d);
+        let offset = d.dot(t);
+        (lo + offset - pad, hi + offset + pad)
+    }
+
     /// The fitted DOP of `points`, padded.
     fn fit_iter(points: impl Iterator<Item = DVec3>) -> Self {
         let mut min = [f64::INFINITY; N];
@@ -217,24 +234,27 @@ impl<const N: usize> BoundingVolume for Kdop<N> {
     #[inline]
     fn transformed(&self, pose: &Isometry) -> Self {
         let r_t = pose.rotation.transpose();
-        let t = pose.translation;
-        // Every term is at most |d|_1 (<= 3) times a slab value or |t|.
-        let pad = conservative_slack(4.0 * (3.0 * self.magnitude() + t.abs().max_element()));
+        let pad = self.refit_pad(pose.translation);
         let mut out = *self;
         for k in 0..N {
-            let d = Self::DIRECTIONS[k];
-            let (lo, hi) = self.support_interval(r_t * d);
-            let offset = d.dot(t);
-            out.min[k] = lo + offset - pad;
-            out.max[k] = hi + offset + pad;
+            (out.min[k], out.max[k]) = self.refit_slab(k, &r_t, pose.translation, pad);
         }
         out
     }
 
-    /// `other` refitted into A's frame, then the slab interval test.
+    /// `other` refitted into A's frame, then the slab interval test; stops at the first
+    /// separating slab (same answer as `self.intersects(&other.transformed(pose_ab))`).
     #[inline]
     fn overlaps(&self, other: &Self, pose_ab: &Isometry) -> bool {
-        self.intersects(&other.transformed(pose_ab))
+        let r_t = pose_ab.rotation.transpose();
+        let pad = other.refit_pad(pose_ab.translation);
+        for k in 0..N {
+            let (lo, hi) = other.refit_slab(k, &r_t, pose_ab.translation, pad);
+            if lo > self.max[k] || hi < self.min[k] {
+                return false;
+            }
+        }
+        true
     }
 
     /// The widest slab gap between A and B refitted into A's frame, over `|d_k|`, less a

@@ -240,21 +240,25 @@ fn volume_matches_monte_carlo<const N: usize>() {
     for case in 0..40 {
         let kind = test_clouds::KINDS[case % 2];
         let points = test_clouds::cloud(&mut rng, kind, 12, DVec3::splat(1e3), 2.0);
-        let dop = Kdop::<N>::fit_points(&points);
-        let (lo, hi) = (dop.aabb_min(), dop.aabb_max());
-        let samples = 20_000;
-        let inside = (0..samples)
-            .filter(|_| {
-                let t = DVec3::new(rng.random(), rng.random(), rng.random());
-                dop.contains_point(lo + (hi - lo) * t)
-            })
-            .count();
-        let estimate = (hi - lo).element_product() * inside as f64 / samples as f64;
-        let volume = dop.volume();
-        assert!(
-            (volume - estimate).abs() <= 0.03 * estimate,
-            "N {N} case {case}: {volume} vs ≈ {estimate}"
-        );
+        let fitted = Kdop::<N>::fit_points(&points);
+        // A refitted DOP has redundant (non-touching) slabs: its volume must still be right.
+        let refitted = fitted.transformed(&test_clouds::isometry(&mut rng, 5.0));
+        for dop in [fitted, refitted] {
+            let (lo, hi) = (dop.aabb_min(), dop.aabb_max());
+            let samples = 20_000;
+            let inside = (0..samples)
+                .filter(|_| {
+                    let t = DVec3::new(rng.random(), rng.random(), rng.random());
+                    dop.contains_point(lo + (hi - lo) * t)
+                })
+                .count();
+            let estimate = (hi - lo).element_product() * inside as f64 / samples as f64;
+            let volume = dop.volume();
+            assert!(
+                (volume - estimate).abs() <= 0.03 * estimate,
+                "N {N} case {case}: {volume} vs ≈ {estimate}"
+            );
+        }
     }
 }
 
