@@ -354,15 +354,22 @@ mod tests {
         let mut rng = test_clouds::rng(15);
         for &offset in &test_clouds::CENTERS {
             for &scale in &test_clouds::SCALES {
-                for _ in 0..100 {
+                for case in 0..200 {
                     let h = DVec3::splat(scale);
                     let a = Aabb::from_center_half_extents(DVec3::splat(offset), h);
-                    // B's box touches A's +x face exactly, under a pure translation.
-                    let b = Aabb::from_center_half_extents(DVec3::ZERO, h);
+                    // B's box touches A's +x face exactly, under a pure translation; every
+                    // other case puts B's box far from B's origin too, so its centre in A's
+                    // frame comes out of a cancellation of two large numbers.
+                    let b_center = if case % 2 == 0 {
+                        DVec3::ZERO
+                    } else {
+                        DVec3::splat(-offset)
+                    };
+                    let b = Aabb::from_center_half_extents(b_center, h);
                     let lateral =
                         test_clouds::point_in_cube(&mut rng, scale) * DVec3::new(0.0, 1.0, 1.0);
                     let pose = Isometry::from_translation(
-                        DVec3::splat(offset) + DVec3::X * (2.0 * scale) + lateral,
+                        DVec3::splat(offset) - b_center + DVec3::X * (2.0 * scale) + lateral,
                     );
                     assert!(a.overlaps(&b, &pose), "offset {offset} scale {scale}");
                     assert_eq!(a.distance_lower_bound(&b, &pose), 0.0);
@@ -371,7 +378,7 @@ mod tests {
                     let apart = Isometry::from_translation(pose.translation + DVec3::X * gap);
                     assert!(!a.overlaps(&b, &apart), "offset {offset} scale {scale}");
                     let d = a.distance_lower_bound(&b, &apart);
-                    assert!(d <= gap && d > 0.9 * gap, "{d} vs {gap}");
+                    assert!(d <= gap && d > 0.8 * gap, "{d} vs {gap}");
                 }
             }
         }
