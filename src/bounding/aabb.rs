@@ -9,7 +9,7 @@
 
 use super::BoundingVolume;
 use crate::geometry::Triangle;
-use crate::math::{DVec3, Isometry, conservative_slack, tolerance};
+use crate::math::{DMat3, DVec3, Isometry, conservative_slack, tolerance};
 
 /// A box `{x : min <= x <= max}` (componentwise, local frame, metres).
 ///
@@ -111,18 +111,19 @@ impl Aabb {
         }
     }
 
-    /// Centre and half-extents of `other` (frame B) enclosed in A's axes, plus the slack
-    /// (per axis) that covers the rounding of the whole comparison.
+    /// Per axis of A: the signed gap between A and the AABB (A's axes) enclosing `other`
+    /// (frame B), negative when the intervals overlap; and the magnitude of the quantities
+    /// involved, whose `BV_RELATIVE` multiple covers the rounding of the whole comparison.
     #[inline]
     fn enclose_in_a(&self, other: &Self, pose_ab: &Isometry) -> (DVec3, DVec3) {
         let (ca, ha) = (self.center(), self.half_extents());
         let (cb, hb) = (other.center(), other.half_extents());
         let r = &pose_ab.rotation;
-        let abs_r = crate::math::DMat3::from_cols(r.x_axis.abs(), r.y_axis.abs(), r.z_axis.abs());
+        let abs_r = DMat3::from_cols(r.x_axis.abs(), r.y_axis.abs(), r.z_axis.abs());
         let cb_in_a = pose_ab.transform_point(cb);
         let hb_in_a = abs_r * hb;
         let gap = (ca - cb_in_a).abs() - (ha + hb_in_a);
-        // Rounding is a few ulps of the largest magnitude in play on each axis.
+        // Rounding is a few ulps of the largest magnitude in play on each axis;
         // |R c_b| <= |c_b|_1 on every axis.
         let magnitude = ca.abs()
             + ha
@@ -158,7 +159,7 @@ impl BoundingVolume for Aabb {
     #[inline]
     fn transformed(&self, pose: &Isometry) -> Self {
         let r = &pose.rotation;
-        let abs_r = crate::math::DMat3::from_cols(r.x_axis.abs(), r.y_axis.abs(), r.z_axis.abs());
+        let abs_r = DMat3::from_cols(r.x_axis.abs(), r.y_axis.abs(), r.z_axis.abs());
         let center = pose.transform_point(self.center());
         let half = abs_r * self.half_extents();
         let magnitude = (center.abs() + half + pose.translation.abs()).max_element()
