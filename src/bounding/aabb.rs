@@ -75,13 +75,6 @@ impl Aabb {
         }
     }
 
-    /// Whether two boxes of the same frame share a point (closed intervals, no slack).
-    #[must_use]
-    #[inline]
-    pub fn intersects(&self, other: &Self) -> bool {
-        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
-    }
-
     /// The smallest box containing `self` and `point` (no padding).
     #[must_use]
     #[inline]
@@ -165,6 +158,12 @@ impl BoundingVolume for Aabb {
         let magnitude = (center.abs() + half + pose.translation.abs()).max_element()
             + self.min.abs().max(self.max.abs()).max_element();
         Self::from_center_half_extents(center, half + DVec3::splat(conservative_slack(magnitude)))
+    }
+
+    /// Whether two boxes of the same frame share a point (closed intervals, no slack).
+    #[inline]
+    fn intersects(&self, other: &Self) -> bool {
+        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
     }
 
     /// A against the AABB (A's axes) enclosing B: three interval tests with slack.

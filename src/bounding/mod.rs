@@ -80,6 +80,15 @@ pub trait BoundingVolume: Copy + std::fmt::Debug + Send + Sync + 'static {
     #[must_use]
     fn overlaps(&self, other: &Self, pose_ab: &Isometry) -> bool;
 
+    /// Overlap of two volumes in the same frame. Conservative like
+    /// [`overlaps`](Self::overlaps); for every type,
+    /// `a.overlaps(b, pose_ab) == a.intersects(&b.transformed(pose_ab))` up to rounding slack.
+    #[must_use]
+    #[inline]
+    fn intersects(&self, other: &Self) -> bool {
+        self.overlaps(other, &Isometry::IDENTITY)
+    }
+
     /// A lower bound on the distance between `self` (frame A) and `other` (frame B), metres;
     /// `0` when they may overlap.
     #[must_use]

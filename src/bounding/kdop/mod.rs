@@ -108,18 +108,6 @@ impl<const N: usize> Kdop<N> {
         (self.aabb_max() - self.aabb_min()).length()
     }
 
-    /// Whether two k-DOPs of the same frame share a point as far as the slabs tell (closed
-    /// intervals, no slack): false only when some slab separates them.
-    #[must_use]
-    #[inline]
-    pub fn intersects(&self, other: &Self) -> bool {
-        let mut overlap = true;
-        for k in 0..N {
-            overlap &= self.min[k] <= other.max[k] && other.min[k] <= self.max[k];
-        }
-        overlap
-    }
-
     /// Largest magnitude of any slab value.
     #[inline]
     fn magnitude(&self) -> f64 {
@@ -240,6 +228,17 @@ impl<const N: usize> BoundingVolume for Kdop<N> {
             (out.min[k], out.max[k]) = self.refit_slab(k, &r_t, pose.translation, pad);
         }
         out
+    }
+
+    /// Whether two k-DOPs of the same frame share a point as far as the slabs tell (closed
+    /// intervals, no slack): false only when some slab separates them.
+    #[inline]
+    fn intersects(&self, other: &Self) -> bool {
+        let mut overlap = true;
+        for k in 0..N {
+            overlap &= self.min[k] <= other.max[k] && other.min[k] <= self.max[k];
+        }
+        overlap
     }
 
     /// `other` refitted into A's frame, then the slab interval test; stops at the first
