@@ -338,3 +338,25 @@ fn bad_points_are_rejected_with_their_index() {
     assert_eq!(err, ConvexHullError::TooLarge { index: 1 });
     assert!(err.to_string().contains("point 1"));
 }
+
+#[test]
+fn hulls_of_the_real_meshes_contain_every_vertex() {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
+    if !dir.is_dir() {
+        eprintln!("skipped: ../shared/data/meshes not found");
+        return;
+    }
+    let mut r = rng(23);
+    for name in [
+        "env.obj",
+        "rob.obj",
+        "spot.obj",
+        "fandisk.obj",
+        "stanford-bunny.obj",
+    ] {
+        let mesh = proxima::geometry::TriMesh::load(dir.join(name)).unwrap();
+        let hull = check_hull(mesh.vertices(), &mut r, name);
+        assert_eq!(hull.dimension(), 3, "{name}");
+        assert!(hull.volume() > 0.0, "{name}");
+    }
+}
