@@ -360,3 +360,34 @@ fn hulls_of_the_real_meshes_contain_every_vertex() {
         assert!(hull.volume() > 0.0, "{name}");
     }
 }
+
+#[test]
+fn hill_climbing_support_matches_a_scan_of_the_vertices() {
+    let mut r = rng(31);
+    let mut climbed = 0;
+    for case in 0..400 {
+        let kind = [CloudKind::Sphere, CloudKind::Box, CloudKind::Needle][case % 3];
+        let center = offset(&mut r, CENTERS[(case / 3) % CENTERS.len()]);
+        let scale = SCALES[(case / 12) % SCALES.len()];
+        let pts = cloud(&mut r, kind, 200, center, scale);
+        let hull = ConvexPolyhedron::try_from_points(&pts).unwrap();
+        climbed += usize::from(hull.vertices().len() >= 32);
+        for _ in 0..200 {
+            let d = point_in_cube(&mut r, 1.0);
+            let best = hull
+                .vertices()
+                .iter()
+                .map(|v| (*v - center).dot(d))
+                .fold(f64::MIN, f64::max);
+            let got = (hull.support(d) - center).dot(d);
+            assert!(
+                best - got <= hull.tolerance() * d.length(),
+                "case {case}: {got} < {best}"
+            );
+        }
+    }
+    assert!(
+        climbed > 200,
+        "only {climbed} hulls were large enough to climb"
+    );
+}

@@ -68,6 +68,8 @@ fn build(world: &[DVec3], local: &[DVec3], origin: DVec3, eps: f64) -> ConvexPol
         origin,
         planes: Vec::new(),
         eps,
+        neighbour_start: Vec::new(),
+        neighbours: Vec::new(),
     };
     let centre = local.iter().sum::<DVec3>() / local.len() as f64;
     // The farthest point from the centroid, and the farthest from it, are hull vertices.
@@ -95,10 +97,12 @@ fn build(world: &[DVec3], local: &[DVec3], origin: DVec3, eps: f64) -> ConvexPol
             return hull;
         }
         finish_flat(&mut hull, world, local, &outline, normal);
+        hull.build_adjacency();
         return hull;
     }
     let tris = quickhull::quickhull(local, [i0, i1, i2, i3], eps);
     finish_solid(&mut hull, world, local, &tris);
+    hull.build_adjacency();
     hull
 }
 

@@ -99,6 +99,8 @@ const CONTAINMENT_FACTOR: f64 = 8.0;
 ///   non-degenerate and counter-clockwise seen from outside.
 /// - Dimension 2: the polygon is triangulated on both sides (closed, zero volume).
 /// - Dimensions 0 and 1: no triangles and no faces.
+/// - Dimensions 2 and 3: the vertex adjacency (used by the support map) is symmetric and
+///   every vertex has a neighbour.
 ///
 /// [`validate`](Self::validate) checks all of these.
 #[derive(Debug, Clone)]
@@ -113,7 +115,16 @@ pub struct ConvexPolyhedron {
     planes: Vec<(DVec3, f64)>,
     /// Construction tolerance, metres.
     eps: f64,
+    /// Vertex adjacency in compressed rows: the neighbours of vertex `i` are
+    /// `neighbours[neighbour_start[i]..neighbour_start[i + 1]]`. Empty below dimension 2.
+    neighbour_start: Vec<u32>,
+    /// See `neighbour_start`.
+    neighbours: Vec<u32>,
 }
+
+/// Below this many vertices [`SupportMap::support`] scans them all; above, it climbs the
+/// vertex graph.
+const HILL_CLIMB_MIN_VERTICES: usize = 32;
 
 impl ConvexPolyhedron {
     /// The convex hull of `points` (local frame, metres).
@@ -310,17 +321,63 @@ impl ConvexPolyhedron {
 }
 
 impl SupportMap for ConvexPolyhedron {
-    /// Linear scan over the vertices.
+    /// Hill climbing over the vertex graph (a local maximum of a linear function on a convex
+    /// polytope is global), or a linear scan for small hulls. On a hull that is convex only
+    /// to tolerance, the result's `p · d` is within `tolerance() · |d|` of the maximum.
     #[inline]
     fn support(&self, direction: DVec3) -> DVec3 {
-        let mut best = (f64::NEG_INFINITY, self.vertices[0]);
-        for v in &self.vertices {
-            let d = (*v - self.origin).dot(direction);
-            if d > best.0 {
-                best = (d, *v);
+        let score = |i: usize| (self.vertices[i] - self.origin).dot(direction);
+        let mut best = (score(0), 0);
+        if self.vertices.len() < HILL_CLIMB_MIN_VERTICES || self.neighbours.is_empty() {
+            for i in 1..self.vertices.len() {
+                let s = score(i);
+                if s > best.0 {
+                    best = (s, i);
+                }
+            }
+            return self.vertices[best.1];
+        }
+        loop {
+            let (from, to) = (
+                self.neighbour_start[best.1] as usize,
+                self.neighbour_start[best.1 + 1] as usize,
+            );
+            let before = best.1;
+            for &n in &self.neighbours[from..to] {
+                let s = score(n as usize);
+                if s > best.0 {
+                    best = (s, n as usize);
+                }
+            }
+            if best.1 == before {
+                return self.vertices[best.1];
             }
         }
-        best.1
+    }
+}
+
+impl ConvexPolyhedron {
+    /// Fills the vertex adjacency from the triangles.
+    fn build_adjacency(&mut self) {
+        let n = self.vertices.len();
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for t in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                for (x, y) in [(a, b), (b, a)] {
+                    if !lists[x as usize].contains(&y) {
+                        lists[x as usize].push(y);
+                    }
+                }
+            }
+        }
+        self.neighbour_start = Vec::with_capacity(n + 1);
+        self.neighbours.clear();
+        for list in lists {
+            self.neighbour_start.push(self.neighbours.len() as u32);
+            self.neighbours.extend(list);
+        }
+        self.neighbour_start.push(self.neighbours.len() as u32);
     }
 }
 

@@ -47,6 +47,22 @@ impl ConvexPolyhedron {
                 return Err(format!("vertex {i} is {worst:e} m outside a face plane"));
             }
         }
+        for i in 0..self.vertices.len() {
+            let row = |v: usize| {
+                let (a, b) = (
+                    self.neighbour_start[v] as usize,
+                    self.neighbour_start[v + 1] as usize,
+                );
+                &self.neighbours[a..b]
+            };
+            if row(i).is_empty()
+                || row(i)
+                    .iter()
+                    .any(|&n| !row(n as usize).contains(&(i as u32)))
+            {
+                return Err(format!("vertex {i} has a missing or one-sided neighbour"));
+            }
+        }
         self.validate_triangles(tol)?;
         self.validate_faces(tol)?;
         validate_closed(&self.triangles, self.vertices.len(), self.dimension == 3)
