@@ -32,7 +32,7 @@ pub enum ConvexHullError {
         index: usize,
     },
     /// The point at this index has a coordinate above
-    /// [`tolerance::MAX_COORDINATE`](crate::math::tolerance::MAX_COORDINATE).
+    /// [`tolerance::MAX_COORDINATE`].
     TooLarge {
         /// Index of the offending point in the input.
         index: usize,
