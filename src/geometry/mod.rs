@@ -25,7 +25,7 @@ pub use convex::{ConvexHullError, ConvexPolyhedron};
 pub use cuboid::Cuboid;
 pub use cylinder::Cylinder;
 pub use error::ShapeError;
-pub use mesh::{MeshError, MeshReport, TriMesh};
+pub use mesh::{MeshError, MeshLimits, MeshReport, TriMesh};
 pub use segment::Segment;
 pub use sphere::Sphere;
 pub use triangle::Triangle;
