@@ -19,3 +19,4 @@
 pub mod bounding;
 pub mod geometry;
 pub mod math;
+pub mod narrow;

@@ -15,6 +15,7 @@ mod cuboid;
 mod cylinder;
 mod error;
 pub mod mesh;
+pub mod predicates;
 mod segment;
 mod sphere;
 mod triangle;

@@ -1,0 +1,20 @@
+//! Narrow phase: exact queries between pairs of primitives.
+//!
+//! So far the triangle–triangle primitives that exact mesh–mesh queries are built on:
+//! [`intersects_triangle_triangle`] (an exact boolean, decided by robust orientation
+//! predicates), [`intersection_segment_triangle_triangle`] and
+//! [`distance_triangle_triangle`] (distance with witness points). Both triangles are given in
+//! the same frame; a mesh–mesh query transforms one mesh's triangles into the other's frame
+//! first.
+//!
+//! Closed sets throughout: touching counts as intersecting, and zero-area triangles are the
+//! segment or point they span.
+
+mod closest_points;
+mod triangle_overlap;
+pub mod triangle_triangle;
+
+pub use triangle_triangle::{
+    TriangleDistance, distance_triangle_triangle, intersection_segment_triangle_triangle,
+    intersects_triangle_triangle,
+};

@@ -1,0 +1,288 @@
+//! The exact triangle–triangle overlap decision, with a common point as witness.
+//!
+//! Every branch is decided by the signs of [`orient3d`] and [`orient2d_projected`], which
+//! are exact, so the answer is the exact answer for the floating-point input. Only the
+//! witness point is computed in rounded arithmetic.
+//!
+//! Each triangle is first reduced, exactly, to the convex hull of its vertices: a proper
+//! [`Hull::Triangle`], a [`Hull::Segment`] (collinear vertices; end points by lexicographic
+//! order, which is exact along a line) or a [`Hull::Point`]. Pairs of hulls are then decided
+//! by these facts about closed convex sets:
+//! - two triangles meet iff an edge of one meets the other (their intersection is convex, so
+//!   an extreme point of it lies on the boundary of one of them);
+//! - a segment crossing a triangle's plane meets it iff the line through it passes through
+//!   the triangle: the three `orient3d(p, q, edge)` signs do not disagree (Plücker test);
+//! - coplanar sets are decided in a coordinate projection that is one-to-one on their plane
+//!   (the one where the reference triangle keeps a non-zero area); a segment's plane is not
+//!   known, so coplanar segments must meet in all three coordinate projections: disjoint
+//!   convex sets of one plane stay disjoint in every one-to-one projection of it.
+
+use super::closest_points::closest_points_segment_segment;
+use crate::geometry::Triangle;
+use crate::geometry::predicates::{orient2d_projected, orient3d, project};
+use crate::math::DVec3;
+
+/// A proper triangle with the projection that keeps its area.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ProperTriangle {
+    /// The vertices.
+    pub v: [DVec3; 3],
+    /// The coordinate axis dropped by the one-to-one projection of its plane.
+    pub drop_axis: usize,
+    /// `±1`: the sign of the projected orientation.
+    pub winding: f64,
+}
+
+/// The exact convex hull of a triangle's three vertices.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Hull {
+    Point(DVec3),
+    Segment(DVec3, DVec3),
+    Triangle(ProperTriangle),
+}
+
+impl Hull {
+    /// Reduces `t` exactly: collinear vertices give a segment, coincident ones a point.
+    #[must_use]
+    #[inline]
+    pub(crate) fn of(t: &Triangle) -> Self {
+        let n = t.scaled_normal().abs();
+        let order = if n.x >= n.y && n.x >= n.z {
+            [0, 1, 2]
+        } else if n.y >= n.z {
+            [1, 2, 0]
+        } else {
+            [2, 0, 1]
+        };
+        for drop_axis in order {
+            let o = orient2d_projected(drop_axis, t.a, t.b, t.c);
+            if o != 0.0 {
+                return Hull::Triangle(ProperTriangle {
+                    v: [t.a, t.b, t.c],
+                    drop_axis,
+                    winding: o.signum(),
+                });
+            }
+        }
+        let (mut lo, mut hi) = (t.a, t.a);
+        for p in [t.b, t.c] {
+            if lex_less(p, lo) {
+                lo = p;
+            }
+            if lex_less(hi, p) {
+                hi = p;
+            }
+        }
+        if lo == hi {
+            Hull::Point(lo)
+        } else {
+            Hull::Segment(lo, hi)
+        }
+    }
+}
+
+/// A point common to both hulls (to rounding), or `None` when they are exactly disjoint.
+#[must_use]
+pub(crate) fn common_point(a: &Hull, b: &Hull) -> Option<DVec3> {
+    match (*a, *b) {
+        (Hull::Triangle(ta), Hull::Triangle(tb)) => triangle_triangle(&ta, &tb),
+        (Hull::Triangle(t), Hull::Segment(p, q)) | (Hull::Segment(p, q), Hull::Triangle(t)) => {
+            let [a, b, c] = t.v;
+            segment_triangle(
+                p,
+                q,
+                sign(orient3d(a, b, c, p)),
+                sign(orient3d(a, b, c, q)),
+                &t,
+            )
+        }
+        (Hull::Triangle(t), Hull::Point(p)) | (Hull::Point(p), Hull::Triangle(t)) => {
+            let [a, b, c] = t.v;
+            (orient3d(a, b, c, p) == 0.0 && point_in_triangle(p, &t)).then_some(p)
+        }
+        (Hull::Segment(p, q), Hull::Segment(r, s)) => segment_segment(p, q, r, s),
+        (Hull::Segment(p, q), Hull::Point(r)) | (Hull::Point(r), Hull::Segment(p, q)) => {
+            segment_segment(p, q, r, r)
+        }
+        (Hull::Point(p), Hull::Point(q)) => (p == q).then_some(p),
+    }
+}
+
+/// Exact signs of `t`'s vertices relative to the plane of `plane`, with the approximate
+/// determinants (proportional to signed distances).
+#[must_use]
+#[inline]
+pub(crate) fn plane_sides(plane: &ProperTriangle, t: &ProperTriangle) -> ([i8; 3], [f64; 3]) {
+    let [a, b, c] = plane.v;
+    let d = t.v.map(|p| orient3d(a, b, c, p));
+    (d.map(sign), d)
+}
+
+/// `true` when all three signs are strictly positive or all strictly negative.
+#[must_use]
+#[inline]
+pub(crate) fn strictly_one_side(s: [i8; 3]) -> bool {
+    (s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0)
+}
+
+fn triangle_triangle(ta: &ProperTriangle, tb: &ProperTriangle) -> Option<DVec3> {
+    let (sb, _) = plane_sides(ta, tb);
+    if strictly_one_side(sb) {
+        return None;
+    }
+    if sb == [0, 0, 0] {
+        return coplanar_triangle_triangle(ta, tb);
+    }
+    let (sa, _) = plane_sides(tb, ta);
+    if strictly_one_side(sa) {
+        return None;
+    }
+    for (i, j) in EDGES {
+        if sa[i] * sa[j] <= 0
+            && let Some(p) = segment_triangle(ta.v[i], ta.v[j], sa[i], sa[j], tb)
+        {
+            return Some(p);
+        }
+    }
+    for (i, j) in EDGES {
+        if sb[i] * sb[j] <= 0
+            && let Some(p) = segment_triangle(tb.v[i], tb.v[j], sb[i], sb[j], ta)
+        {
+            return Some(p);
+        }
+    }
+    None
+}
+
+/// The closed segment `p q` against a proper triangle, given the exact plane sides of `p`
+/// and `q`.
+fn segment_triangle(p: DVec3, q: DVec3, sp: i8, sq: i8, t: &ProperTriangle) -> Option<DVec3> {
+    if sp == 0 && sq == 0 {
+        return coplanar_segment_triangle(p, q, t);
+    }
+    if sp * sq > 0 {
+        return None;
+    }
+    let [a, b, c] = t.v;
+    let s = [
+        sign(orient3d(p, q, a, b)),
+        sign(orient3d(p, q, b, c)),
+        sign(orient3d(p, q, c, a)),
+    ];
+    if s.contains(&1) && s.contains(&-1) {
+        return None;
+    }
+    if sp == 0 {
+        return Some(p);
+    }
+    if sq == 0 {
+        return Some(q);
+    }
+    let n = (b - a).cross(c - a);
+    let (dp, dq) = (n.dot(p - a), n.dot(q - a));
+    let along = if dp != dq {
+        (dp / (dp - dq)).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    Some(p + (q - p) * along)
+}
+
+fn coplanar_triangle_triangle(ta: &ProperTriangle, tb: &ProperTriangle) -> Option<DVec3> {
+    if let Some(&p) = tb.v.iter().find(|&&p| point_in_triangle(p, ta)) {
+        return Some(p);
+    }
+    if let Some(&p) = ta.v.iter().find(|&&p| point_in_triangle(p, tb)) {
+        return Some(p);
+    }
+    for (i, j) in EDGES {
+        for (k, l) in EDGES {
+            let (p, q, r, s) = (ta.v[i], ta.v[j], tb.v[k], tb.v[l]);
+            if segments_meet_projected(ta.drop_axis, p, q, r, s) {
+                return Some(segment_witness(p, q, r, s));
+            }
+        }
+    }
+    None
+}
+
+fn coplanar_segment_triangle(p: DVec3, q: DVec3, t: &ProperTriangle) -> Option<DVec3> {
+    if point_in_triangle(p, t) {
+        return Some(p);
+    }
+    if point_in_triangle(q, t) {
+        return Some(q);
+    }
+    for (i, j) in EDGES {
+        let (r, s) = (t.v[i], t.v[j]);
+        if segments_meet_projected(t.drop_axis, p, q, r, s) {
+            return Some(segment_witness(p, q, r, s));
+        }
+    }
+    None
+}
+
+/// Two closed segments (either may be a point) in 3D.
+fn segment_segment(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> Option<DVec3> {
+    if orient3d(p, q, r, s) != 0.0 {
+        return None;
+    }
+    (0..3)
+        .all(|axis| segments_meet_projected(axis, p, q, r, s))
+        .then(|| segment_witness(p, q, r, s))
+}
+
+/// `p` in the closed proper triangle `t`, for `p` in `t`'s plane.
+#[inline]
+fn point_in_triangle(p: DVec3, t: &ProperTriangle) -> bool {
+    let [a, b, c] = t.v;
+    let axis = t.drop_axis;
+    orient2d_projected(axis, a, b, p) * t.winding >= 0.0
+        && orient2d_projected(axis, b, c, p) * t.winding >= 0.0
+        && orient2d_projected(axis, c, a, p) * t.winding >= 0.0
+}
+
+/// Whether the projections of the closed segments `p q` and `r s` (either may be a point)
+/// meet, exactly.
+fn segments_meet_projected(axis: usize, p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> bool {
+    let o1 = sign(orient2d_projected(axis, p, q, r));
+    let o2 = sign(orient2d_projected(axis, p, q, s));
+    let o3 = sign(orient2d_projected(axis, r, s, p));
+    let o4 = sign(orient2d_projected(axis, r, s, q));
+    if o1 * o2 < 0 && o3 * o4 < 0 {
+        return true;
+    }
+    let within = |a: DVec3, b: DVec3, x: DVec3| {
+        let (a, b, x) = (project(axis, a), project(axis, b), project(axis, x));
+        a.min(b).cmple(x).all() && x.cmple(a.max(b)).all()
+    };
+    (o1 == 0 && within(p, q, r))
+        || (o2 == 0 && within(p, q, s))
+        || (o3 == 0 && within(r, s, p))
+        || (o4 == 0 && within(r, s, q))
+}
+
+/// A common point of two segments known to meet: the midpoint of their closest pair.
+#[inline]
+fn segment_witness(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> DVec3 {
+    let (x, y) = closest_points_segment_segment(p, q, r, s);
+    (x + y) * 0.5
+}
+
+const EDGES: [(usize, usize); 3] = [(0, 1), (1, 2), (2, 0)];
+
+#[inline]
+fn sign(x: f64) -> i8 {
+    if x > 0.0 {
+        1
+    } else if x < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+#[inline]
+fn lex_less(a: DVec3, b: DVec3) -> bool {
+    (a.x, a.y, a.z) < (b.x, b.y, b.z)
+}
