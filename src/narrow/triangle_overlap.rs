@@ -178,6 +178,18 @@ fn segment_triangle(p: DVec3, q: DVec3, sp: i8, sq: i8, t: &ProperTriangle) -> O
     if sq == 0 {
         return Some(q);
     }
+    Some(crossing_point(p, q, t))
+}
+
+/// Where the segment `p q`, known to cross the proper triangle `t` with `p` and `q` strictly
+/// on opposite sides of its plane, meets it (rounded).
+///
+/// The plane crossing `p + (q - p) dp / (dp - dq)` is ill-conditioned when `p q` is nearly
+/// parallel to the plane, so the parameter is clamped to the part of `p q` inside the prism
+/// over `t` (the three edge half-spaces that contain the normal): the result is then on
+/// `p q`, over `t`, and as close to its plane as the segment gets.
+fn crossing_point(p: DVec3, q: DVec3, t: &ProperTriangle) -> DVec3 {
+    let [a, b, c] = t.v;
     let n = (b - a).cross(c - a);
     let (dp, dq) = (n.dot(p - a), n.dot(q - a));
     let along = if dp != dq {
@@ -185,7 +197,18 @@ fn segment_triangle(p: DVec3, q: DVec3, sp: i8, sq: i8, t: &ProperTriangle) -> O
     } else {
         0.5
     };
-    Some(p + (q - p) * along)
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    for (i, j) in EDGES {
+        let inward = n.cross(t.v[j] - t.v[i]);
+        let (fp, fq) = (inward.dot(p - t.v[i]), inward.dot(q - t.v[i]));
+        if fp < 0.0 && fq > fp {
+            lo = lo.max(fp / (fp - fq));
+        } else if fq < 0.0 && fp > fq {
+            hi = hi.min(fp / (fp - fq));
+        }
+    }
+    let along = if lo <= hi { along.clamp(lo, hi) } else { along };
+    p + (q - p) * along
 }
 
 fn coplanar_triangle_triangle(ta: &ProperTriangle, tb: &ProperTriangle) -> Option<DVec3> {
