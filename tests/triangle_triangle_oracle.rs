@@ -561,11 +561,61 @@ fn nearly_parallel_edges_keep_their_exact_gap() {
             [[-c, -sn, g], [c, sn, g], [0.0, -0.3, 1.0 + g]],
         );
         let d = distance_triangle_triangle(&a, &b);
-        let tol = 1e-9 * gap + 1e-14 * 1e5 * ((case / 4) % 2) as f64 + 1e-15 * s;
+        let tol = 1e-12 * gap + 1e-15 * 1e5 * ((case / 4) % 2) as f64 + 1e-15 * s;
         assert!(
             (d.distance - gap).abs() <= tol,
             "case {case} angle {angle}: {d:?} vs {gap}"
         );
         check_distance(&a, &b, &d, s, &format!("parallel {case}"));
+    }
+}
+
+#[test]
+fn edges_crossing_at_tiny_angles_touch() {
+    let mut r = rng(0xc4055);
+    for case in 0..4_000 {
+        let s = SCALES[case % 4];
+        let angle = 10f64.powf(-r.random_range(3.0..9.0));
+        let (c, sn) = (angle.cos(), angle.sin());
+        // Both edges pass exactly through the origin (their end points are negatives of
+        // each other), the bodies on opposite sides of z = 0: they touch at one point.
+        let a = placed(
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            s,
+            [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.3, -1.0]],
+        );
+        let b = placed(
+            DQuat::IDENTITY,
+            DVec3::ZERO,
+            s,
+            [[-c, -sn, 0.0], [c, sn, 0.0], [0.0, -0.3, 1.0]],
+        );
+        assert!(
+            intersects_triangle_triangle(&a, &b),
+            "case {case} angle {angle}"
+        );
+        let d = distance_triangle_triangle(&a, &b);
+        assert!(d.point_a.length() <= 1e-15 * s, "case {case}: {d:?}");
+        check_distance(&a, &b, &d, s, "crossing");
+        // Lifted by one part in 1e12 of the size: apart, by exactly that gap to rounding.
+        let lift = DVec3::Z * (1e-12 * s);
+        let up = Triangle::new(b.a + lift, b.b + lift, b.c + lift);
+        assert!(!intersects_triangle_triangle(&a, &up), "lifted {case}");
+        let d = distance_triangle_triangle(&a, &up);
+        // NOTE: the witnesses' in-plane rounding (~eps·s) adds in quadrature: relative
+        // error about (1e-16 / 1e-12)².
+        assert!(
+            (d.distance - 1e-12 * s).abs() <= 1e-6 * 1e-12 * s,
+            "lifted {case}: {d:?}"
+        );
+        // The same at a pose far from the origin: decided either way, distance ~ 0.
+        let (q, offset) = (rotation(&mut r), DVec3::new(1e5, -1e5, 1e5));
+        let pose =
+            |t: &Triangle| Triangle::new(offset + q * t.a, offset + q * t.b, offset + q * t.c);
+        let (fa, fb) = (pose(&a), pose(&b));
+        let d = distance_triangle_triangle(&fa, &fb);
+        assert!(d.distance <= 1e-15 * 1e5 * 4.0, "posed {case}: {d:?}");
+        check_distance(&fa, &fb, &d, s, "posed crossing");
     }
 }

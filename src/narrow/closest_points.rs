@@ -86,9 +86,13 @@ pub(crate) fn closest_point_segment(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
 
 /// Closest points `(on_pq, on_rs)` of the closed segments `p, q` and `r, s`.
 ///
-/// Ericson §5.1.9, with exact zero tests for degenerate segments (so no tolerance decides
-/// what is a point) and one extra alternating projection, which keeps the pair mutually
-/// closest when the segments are nearly parallel and the 2×2 system is ill-conditioned.
+/// The parameter on `p q` of the closest pair of the two *lines* is the triple-product
+/// ratio `((r - p) × d₂) · n / |n|²` with `n = d₁ × d₂` (Ericson's `(bf - ce) / (ae - b²)`
+/// in a form that does not cancel: `ae - b² = |n|²`, but the cross product keeps its relative
+/// accuracy near `eps / sin θ` for segments at angle `θ`, where the dot-product form loses
+/// everything below `θ ≈ 1e-8`). Then, as in Ericson §5.1.9, the parameter is clamped and
+/// the points are projected on each other's segment alternately (clamped), which handles
+/// the end-point regions and, with `n = 0`, parallel and zero-length segments.
 #[must_use]
 #[inline]
 pub(crate) fn closest_points_segment_segment(
@@ -99,31 +103,19 @@ pub(crate) fn closest_points_segment_segment(
 ) -> (DVec3, DVec3) {
     let d1 = q - p;
     let d2 = s - r;
-    let w = p - r;
     let a = d1.length_squared();
     let e = d2.length_squared();
-    let f = d2.dot(w);
-    if a <= 0.0 {
-        return (p, r + d2 * ratio(f, e));
-    }
-    let c = d1.dot(w);
-    if e <= 0.0 {
-        return (p + d1 * ratio(-c, a), r);
-    }
-    let b = d1.dot(d2);
-    let denom = a * e - b * b;
-    let t1 = if denom > 0.0 {
-        ratio(b * f - c * e, denom)
+    let n = d1.cross(d2);
+    let nn = n.length_squared();
+    let t1 = if nn > 0.0 {
+        ratio((r - p).cross(d2).dot(n), nn)
     } else {
         0.0
     };
-    // Ericson clamps t2 and then recomputes t1 from it; projecting the point on `rs` back
-    // onto `pq` does exactly that, and also refines t1 when the system is ill-conditioned.
-    let t2 = ((b * t1 + f) / e).clamp(0.0, 1.0);
-    let on_rs = r + d2 * t2;
+    let on_pq = p + d1 * t1;
+    let on_rs = r + d2 * ratio((on_pq - r).dot(d2), e);
     let on_pq = p + d1 * ratio((on_rs - p).dot(d1), a);
-    let t2 = ratio((on_pq - r).dot(d2), e);
-    (on_pq, r + d2 * t2)
+    (on_pq, r + d2 * ratio((on_pq - r).dot(d2), e))
 }
 
 /// `num / den` clamped to `[0, 1]`; `0` when `den <= 0` (a degenerate feature).

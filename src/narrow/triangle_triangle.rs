@@ -35,7 +35,9 @@ use crate::math::DVec3;
 /// The distance between two triangles and a closest pair of points.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriangleDistance {
-    /// Euclidean distance, metres; `0.0` exactly when the triangles intersect.
+    /// Euclidean distance, metres; `0.0` when the triangles intersect (decided exactly).
+    /// Disjoint triangles closer than rounding (about `1e-16` of their coordinates) may
+    /// round to `0.0` as well.
     pub distance: f64,
     /// The point of the first triangle closest to the second (same frame as the input).
     pub point_a: DVec3,
@@ -98,10 +100,12 @@ pub fn intersection_segment_triangle_triangle(
 
 /// The distance between the closed triangles `a` and `b` (same frame), with witnesses.
 ///
-/// `distance` is `0.0` exactly when [`intersects_triangle_triangle`] is `true`, and then
+/// When [`intersects_triangle_triangle`] is `true`, `distance` is `0.0` and
 /// `point_a == point_b` is a common point (to rounding). Otherwise the witnesses lie on
-/// their triangles and `distance == point_a.distance(point_b)`. Parallel, coplanar and
-/// zero-area triangles are handled.
+/// their triangles (to rounding), `distance == point_a.distance(point_b)`, and the pair is
+/// optimal to rounding; a gap below rounding may come out as `0.0`. Parallel, nearly
+/// parallel (edges at angles down to rounding), coplanar and zero-area triangles are
+/// handled. Distances below about `1e-150` m underflow when squared and may lose accuracy.
 ///
 /// # Allocation
 /// Never allocates.
