@@ -9,14 +9,23 @@
 //! data flow of one frame:
 //!
 //! ```text
-//! poses in ─▶ math (Pose, Isometry) ─▶ geometry (shapes, meshes, hulls)
+//! poses in ─▶ math (Pose, Isometry) ─▶ geometry (shapes, meshes, hulls, predicates)
 //!          ─▶ bounding (sphere, AABB, OBB, k-DOP, PSS/LSS/RSS) ─▶ BVH traversal
-//!          ─▶ broad phase ─▶ narrow phase ─▶ contacts out
+//!          ─▶ broad phase ─▶ narrow phase (triangle–triangle, …) ─▶ contacts out
 //! ```
 //!
 //! A module uses only modules listed above it.
 
-pub mod bounding;
-pub mod geometry;
+// Stages in data-flow order (kept apart so rustfmt does not sort them).
+
+/// Poses, isometries, tolerances.
 pub mod math;
+
+/// Shapes, meshes, convex hulls, exact predicates.
+pub mod geometry;
+
+/// Bounding volumes.
+pub mod bounding;
+
+/// Exact primitive queries: triangle–triangle overlap, intersection and distance.
 pub mod narrow;
