@@ -25,7 +25,7 @@ use super::BoundingVolume;
 use super::fit::{
     Moments, frame_about, point_moments, principal_axes, principal_frame, triangle_moments,
 };
-use crate::geometry::Triangle;
+use crate::geometry::{ConvexPolyhedron, Triangle};
 use crate::math::{DMat3, DVec3, Isometry, conservative_slack, tolerance};
 
 /// An oriented box: `center + axes · x` for `|x_k| ≤ half_extents_k`.
@@ -202,9 +202,21 @@ impl BoundingVolume for Obb {
     /// Gottschalk's fit over the area-weighted facets of the points' convex hull.
     fn fit_points(points: &[DVec3]) -> Self {
         debug_assert!(!points.is_empty());
-        // TODO(#2): PCA of the convex hull's facets once `ConvexPolyhedron` lands; the point
-        // covariance stands in meanwhile.
-        Self::fit_with(points, &point_moments(points), &[])
+        // Hull facets; a flat hull's two-sided triangles still give the planar covariance.
+        // Dimension 0 or 1 (or a rejected cloud) falls back to the point covariance.
+        let facets: Vec<Triangle> = match ConvexPolyhedron::try_from_points(points) {
+            Ok(hull) if hull.dimension() >= 2 => {
+                let v = hull.vertices();
+                hull.triangles()
+                    .iter()
+                    .map(|t| Triangle::new(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]))
+                    .collect()
+            }
+            _ => Vec::new(),
+        };
+        let moments = triangle_moments(&facets).unwrap_or_else(|| point_moments(points));
+        // Extents over the input itself: every point must be contained, hull or not.
+        Self::fit_with(points, &moments, &facets)
     }
 
     fn fit_triangles(triangles: &[Triangle]) -> Self {

@@ -1,4 +1,5 @@
 //! Seeded generators for the unit tests of the oriented volumes (a small in-crate mirror of
+#![allow(dead_code)]
 //! `tests/support`, which unit tests cannot include).
 
 use crate::math::{DQuat, DVec3, Isometry, Pose};
