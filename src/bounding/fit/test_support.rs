@@ -1,6 +1,6 @@
 //! Seeded generators for the unit tests of the oriented volumes (a small in-crate mirror of
-#![allow(dead_code)]
 //! `tests/support`, which unit tests cannot include).
+#![allow(dead_code)]
 
 use crate::math::{DQuat, DVec3, Isometry, Pose};
 use rand::{Rng, SeedableRng};
