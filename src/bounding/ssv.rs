@@ -943,4 +943,234 @@ mod tests {
         assert!(touching > 1000 && apart > 1000, "{touching} / {apart}");
         eprintln!("worst relative error {worst:e}");
     }
+
+    #[test]
+    fn overlap_and_distance_are_conservative_against_sampled_points() {
+        let mut rng = rng(35);
+        let (mut overlapping, mut apart) = ([0; 2], [0; 2]);
+        for case in 0..3000 {
+            let (center, scale) = (CENTERS[case % 4], SCALES[case % 5]);
+            let mut pose = isometry(&mut rng, 0.5 * scale);
+            pose.translation += DVec3::splat(center);
+            let (la, lb) = (
+                random_lss(&mut rng, center, scale),
+                random_lss(&mut rng, 0.0, scale),
+            );
+            let (ra, rb) = (
+                random_rss(&mut rng, center, scale),
+                random_rss(&mut rng, 0.0, scale),
+            );
+            // LSS: the bound is the exact capsule distance, never above the sampled one.
+            let (o, d) = (la.overlaps(&lb, &pose), la.distance_lower_bound(&lb, &pose));
+            let pa: Vec<DVec3> = (0..200).map(|_| in_lss(&mut rng, &la)).collect();
+            let pb: Vec<DVec3> = (0..200)
+                .map(|_| pose.transform_point(in_lss(&mut rng, &lb)))
+                .collect();
+            check(case, o, d, &pa, &pb, |p| la.contains_point(p));
+            if o {
+                overlapping[0] += 1
+            } else {
+                apart[0] += 1
+            }
+            // RSS: also against the exact oracle.
+            let (o, d) = (ra.overlaps(&rb, &pose), ra.distance_lower_bound(&rb, &pose));
+            let pa: Vec<DVec3> = (0..200).map(|_| in_rss(&mut rng, &ra)).collect();
+            let pb: Vec<DVec3> = (0..200)
+                .map(|_| pose.transform_point(in_rss(&mut rng, &rb)))
+                .collect();
+            check(case, o, d, &pa, &pb, |p| ra.contains_point(p));
+            let to_a = ra.axes.transpose();
+            let r = to_a * (pose.rotation * rb.axes);
+            let c = to_a * (pose.transform_point(rb.center) - ra.center);
+            let exact = (rectangle_oracle(ra.half_lengths, c, r.x_axis, r.y_axis, rb.half_lengths)
+                - ra.radius
+                - rb.radius)
+                .max(0.0);
+            let tolerance = 1e-9 * exact + 1e-11 * (center + scale);
+            assert!(d <= exact + 1e-12 * scale, "case {case}: {d} > {exact}");
+            assert!(d >= exact - tolerance, "case {case}: {d} < {exact}");
+            if o {
+                overlapping[1] += 1
+            } else {
+                apart[1] += 1
+            }
+        }
+        for k in 0..2 {
+            assert!(
+                overlapping[k] > 300 && apart[k] > 300,
+                "{overlapping:?} / {apart:?}"
+            );
+        }
+    }
+
+    /// Overlap is reported when a sampled point of B lies in A; the bound never exceeds
+    /// the sampled distance, and is positive whenever overlap is denied.
+    fn check(
+        case: usize,
+        overlaps: bool,
+        bound: f64,
+        pa: &[DVec3],
+        pb: &[DVec3],
+        in_a: impl Fn(DVec3) -> bool,
+    ) {
+        assert!(bound >= 0.0);
+        if pb.iter().any(|p| in_a(*p)) {
+            assert!(overlaps, "case {case}: false negative");
+            assert_eq!(bound, 0.0, "case {case}");
+        }
+        if !overlaps {
+            assert!(bound > 0.0, "case {case}: apart but bound 0");
+        }
+        let sampled = pa
+            .iter()
+            .flat_map(|p| pb.iter().map(move |q| p.distance(*q)))
+            .fold(f64::INFINITY, f64::min);
+        assert!(bound <= sampled, "case {case}: {bound} > {sampled}");
+    }
+
+    #[test]
+    fn transformed_volumes_move_their_points_and_keep_overlap() {
+        let mut rng = rng(36);
+        for case in 0..3000 {
+            let (center, scale) = (CENTERS[case % 4], SCALES[case % 5]);
+            let mut pose = isometry(&mut rng, scale);
+            pose.translation += DVec3::splat(center);
+            let (la, lb) = (
+                random_lss(&mut rng, 0.0, scale),
+                random_lss(&mut rng, 0.0, scale),
+            );
+            let (ra, rb) = (
+                random_rss(&mut rng, 0.0, scale),
+                random_rss(&mut rng, 0.0, scale),
+            );
+            let (lm, rm) = (lb.transformed(&pose), rb.transformed(&pose));
+            let id = Isometry::IDENTITY;
+            let tolerance = 1e-9 * scale + 1e-12 * center;
+            let (d1, d2) = (
+                la.distance_lower_bound(&lb, &pose),
+                la.distance_lower_bound(&lm, &id),
+            );
+            assert!((d1 - d2).abs() <= tolerance, "case {case}: {d1} vs {d2}");
+            let (d1, d2) = (
+                ra.distance_lower_bound(&rb, &pose),
+                ra.distance_lower_bound(&rm, &id),
+            );
+            assert!((d1 - d2).abs() <= tolerance, "case {case}: {d1} vs {d2}");
+            assert_eq!(
+                la.overlaps(&lb, &pose),
+                la.overlaps(&lm, &id),
+                "case {case}"
+            );
+            assert_eq!(
+                ra.overlaps(&rb, &pose),
+                ra.overlaps(&rm, &id),
+                "case {case}"
+            );
+            // Points at least this deep inside survive the rounding of the move.
+            let depth = 1e-10 * (center + scale);
+            let (shrunk_r, shrunk_l) = (
+                Rss {
+                    radius: rb.radius - depth,
+                    ..rb
+                },
+                Lss {
+                    radius: lb.radius - depth,
+                    ..lb
+                },
+            );
+            for _ in 0..10 {
+                let p = in_rss(&mut rng, &rb);
+                if shrunk_r.radius > 0.0 && shrunk_r.contains_point(p) {
+                    assert!(rm.contains_point(pose.transform_point(p)), "case {case}");
+                }
+                let p = in_lss(&mut rng, &lb);
+                if shrunk_l.radius > 0.0 && shrunk_l.contains_point(p) {
+                    assert!(lm.contains_point(pose.transform_point(p)), "case {case}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn touching_volumes_overlap_with_zero_distance() {
+        let mut rng = rng(37);
+        for case in 0..3000 {
+            let (center, scale) = (CENTERS[case % 4], SCALES[case % 5]);
+            let ra = random_rss(&mut rng, center, scale);
+            let rb = random_rss(&mut rng, 0.0, scale);
+            // A point on A's surface, and B's corner ball placed to touch it from outside.
+            let dir = point_in_cube(&mut rng, 1.0).normalize_or(DVec3::Z);
+            let (s, t) = (rng.random_range(-1.0..=1.0), rng.random_range(-1.0..=1.0));
+            let core_a = ra.center
+                + ra.axes.x_axis * (s * ra.half_lengths[0])
+                + ra.axes.y_axis * (t * ra.half_lengths[1]);
+            let (dir, core_a) = if dir.dot(ra.axes.z_axis).abs() > 0.0 {
+                (ra.axes.z_axis * dir.dot(ra.axes.z_axis).signum(), core_a)
+            } else {
+                (dir, core_a)
+            };
+            let target = core_a + dir * (ra.radius + rb.radius);
+            let rot = DMat3::from_quat(rotation(&mut rng));
+            let corner = rb.corners()[case % 4];
+            let pose = Isometry::new(rot, target - rot * corner);
+            assert!(ra.overlaps(&rb, &pose), "case {case}");
+            assert_eq!(ra.distance_lower_bound(&rb, &pose), 0.0, "case {case}");
+            let la = Lss::new(Segment::new(ra.corners()[0], ra.corners()[2]), ra.radius);
+            let lb = Lss::new(Segment::new(rb.corners()[0], rb.corners()[2]), rb.radius);
+            let on_a = la.core.point_at(rng.random()) + dir * (la.radius + lb.radius);
+            let pose = Isometry::new(rot, on_a - rot * lb.core.b);
+            assert!(la.overlaps(&lb, &pose), "case {case}");
+            assert_eq!(la.distance_lower_bound(&lb, &pose), 0.0, "case {case}");
+        }
+    }
+
+    #[test]
+    fn volumes_match_monte_carlo_estimates() {
+        let mut rng = rng(38);
+        for case in 0..6 {
+            let rss = random_rss(&mut rng, 0.0, 1.0);
+            let lss = random_lss(&mut rng, 0.0, 1.0);
+            for (volume, center, reach, inside) in [
+                (
+                    rss.volume(),
+                    rss.center,
+                    rss.size(),
+                    &(|p| rss.contains_point(p)) as &dyn Fn(DVec3) -> bool,
+                ),
+                (lss.volume(), lss.center(), lss.size(), &|p| {
+                    lss.contains_point(p)
+                }),
+            ] {
+                let n = 200_000;
+                let hits = (0..n)
+                    .filter(|_| inside(center + point_in_cube(&mut rng, 0.5 * reach)))
+                    .count();
+                let estimate = hits as f64 / n as f64 * reach.powi(3);
+                let sigma = reach.powi(3) * (hits as f64).sqrt() / n as f64;
+                assert!(
+                    (estimate - volume).abs() <= 4.0 * sigma + 1e-12,
+                    "case {case}: {estimate} vs {volume}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_inputs_give_small_valid_volumes() {
+        for center in CENTERS {
+            let p = DVec3::new(center, -center, 0.3 * center);
+            for points in [vec![p], vec![p; 7], vec![p, p + DVec3::X * 1e-4]] {
+                let (lss, rss) = (Lss::fit_points(&points), Rss::fit_points(&points));
+                for q in &points {
+                    assert!(lss.contains_point(*q) && rss.contains_point(*q));
+                }
+                assert!(lss.size() <= 1e-4 + 1e-9 * (1.0 + center), "{lss:?}");
+                assert!(rss.size() <= 2e-4 + 1e-9 * (1.0 + center), "{rss:?}");
+                assert!(lss.stand_off() == lss.size() && rss.stand_off() == rss.size());
+            }
+        }
+        // A zero-radius RSS of a flat set has zero volume.
+        let flat = Rss::new(DVec3::ZERO, DMat3::IDENTITY, [1.0, 2.0], 0.0);
+        assert_eq!(flat.volume(), 0.0);
+    }
 }
