@@ -293,12 +293,18 @@ impl BoundingVolume for Obb {
         let mut best = 0.0f64;
         for i in 0..3 {
             let rb = b[0] * abs[i][0] + b[1] * abs[i][1] + b[2] * abs[i][2];
-            best = best.max(t[i].abs() - a[i] - rb - slack);
+            let gap = t[i].abs() - a[i] - rb - slack;
+            if gap > best {
+                best = gap;
+            }
         }
         for j in 0..3 {
             let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
             let ra = a[0] * abs[0][j] + a[1] * abs[1][j] + a[2] * abs[2][j];
-            best = best.max(tj.abs() - ra - b[j] - slack);
+            let gap = tj.abs() - ra - b[j] - slack;
+            if gap > best {
+                best = gap;
+            }
         }
         for i in 0..3 {
             let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
