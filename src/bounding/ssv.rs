@@ -14,11 +14,15 @@
 //! by the conservative slack.
 //!
 //! **Distance.** Exact distance between the cores minus both radii. Segment–segment is
-//! closed form. Rectangle–rectangle enumerates the candidate closest features (16 edge
-//! pairs, 8 vertex–face pairs) and then *certifies* the answer: the returned core distance is
-//! the separation of the two rectangles along the direction between the closest pair found,
-//! computed from their support functions. That separation never exceeds the true distance
-//! whatever the enumeration found, and equals it when the pair is the closest one.
+//! closed form. Rectangle–rectangle enumerates the candidate closest features (edge
+//! pairs; a vertex over the other's face, where only each rectangle's support vertex along
+//! the other's normal can be closest) and then *certifies* the answer: the returned core
+//! distance is the separation of the two rectangles along the direction between the closest
+//! pair found, computed from their support functions. That separation never exceeds the
+//! true distance whatever the enumeration found, and equals it when the pair is the closest
+//! one. The certificate also ends the search early: the four pairs of edges that face the
+//! other rectangle's centre are tried first, and the other twelve only when the certified
+//! separation falls short of the best pair's distance (about 5% of random pairs).
 //!
 //! Citation: E. Larsen, S. Gottschalk, M. C. Lin, D. Manocha, "Fast Proximity Queries with
 //! Swept Sphere Volumes", UNC TR99-018 (1999), the fit idea of PQP's RSS; Ericson,
@@ -462,7 +466,8 @@ impl Rss {
 /// `|t| ≤ b[1]`, `u, v` orthonormal), all in A's frame. 0 when they touch or cross.
 ///
 /// The closest pair of two rectangles lies on an edge pair or is a vertex over the other's
-/// face; all 16 + 8 candidates are tried. The direction between the best pair is then
+/// face (16 edge pairs, 2 support vertices; facing edges first, see the module doc). The
+/// direction between the best pair is then
 /// snapped to the exact normal of the features it lies on (the cross product of two edges
 /// met in their interiors, a face normal, or the direction with an edge's component
 /// removed) and certified by the support functions (see the module doc).
