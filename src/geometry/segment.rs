@@ -50,8 +50,11 @@ impl Segment {
         self.a + (self.b - self.a) * t
     }
 
-    /// The closest points between `self` and `other`; see
-    /// [`closest_points_segment_segment`].
+    /// The closest points between `self` and `other`: `(s, t, on_self, on_other)` with
+    /// `on_self = self.point_at(s)`, `on_other = other.point_at(t)`, `s, t ∈ [0, 1]`.
+    /// Robust for zero-length and parallel segments (Ericson, *Real-Time Collision
+    /// Detection*, §5.1.9). The free function `closest_points_segment_segment` in this
+    /// module is the same query.
     #[must_use]
     #[inline]
     pub fn closest_points(&self, other: &Segment) -> (f64, f64, DVec3, DVec3) {
