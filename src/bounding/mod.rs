@@ -122,3 +122,15 @@ pub trait BoundingVolume: Copy + std::fmt::Debug + Send + Sync + 'static {
     #[must_use]
     fn stand_off(&self) -> f64;
 }
+
+/// Padding (metres) that keeps a volume moved by `pose` conservative: moving a centre `c`
+/// rounds each coordinate by a few ulps of `|c|₁ + |t|`, and rotating the axes moves the
+/// surface by a few ulps of the volume's `size`. Exact types (OBB, LSS, RSS) grow by this
+/// so that every point of the original volume, moved, stays inside the moved volume.
+#[must_use]
+#[inline]
+pub(crate) fn transform_slack(center: DVec3, pose: &Isometry, size: f64) -> f64 {
+    crate::math::conservative_slack(
+        center.abs().element_sum() + pose.translation.abs().max_element() + size,
+    )
+}

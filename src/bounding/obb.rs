@@ -248,10 +248,11 @@ impl BoundingVolume for Obb {
 
     #[inline]
     fn transformed(&self, pose: &Isometry) -> Self {
+        let pad = super::transform_slack(self.center, pose, self.size());
         Self {
             center: pose.transform_point(self.center),
             axes: pose.rotation * self.axes,
-            half_extents: self.half_extents,
+            half_extents: self.half_extents + DVec3::splat(pad),
         }
     }
 

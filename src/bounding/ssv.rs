@@ -288,9 +288,10 @@ impl BoundingVolume for Lss {
 
     #[inline]
     fn transformed(&self, pose: &Isometry) -> Self {
+        let pad = super::transform_slack(self.center(), pose, self.size());
         Self {
             core: self.moved_core(pose),
-            radius: self.radius,
+            radius: self.radius + pad,
         }
     }
 
@@ -718,11 +719,12 @@ impl BoundingVolume for Rss {
 
     #[inline]
     fn transformed(&self, pose: &Isometry) -> Self {
+        let pad = super::transform_slack(self.center, pose, self.size());
         Self {
             center: pose.transform_point(self.center),
             axes: pose.rotation * self.axes,
             half_lengths: self.half_lengths,
-            radius: self.radius,
+            radius: self.radius + pad,
         }
     }
 
