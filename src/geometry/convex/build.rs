@@ -1,7 +1,7 @@
 //! Building a hull: the dimension test, then quickhull (solid) or the polygon (flat), and
 //! the corner pass.
 
-use super::{ConvexPolyhedron, Face, faces, flat, quickhull};
+use super::{ConvexPolyhedron, Face, ROUNDING_ULPS, faces, flat, quickhull};
 use crate::math::DVec3;
 
 impl ConvexPolyhedron {
@@ -100,7 +100,14 @@ fn build(world: &[DVec3], local: &[DVec3], origin: DVec3, eps: f64) -> ConvexPol
         hull.build_adjacency();
         return hull;
     }
-    let tris = quickhull::quickhull(local, [i0, i1, i2, i3], eps);
+    // How far rounding the input coordinates can move a point off a plane: the level below
+    // which an eye's height above a face is noise.
+    let magnitude = world
+        .iter()
+        .map(|p| p.abs().max_element())
+        .fold(0.0, f64::max);
+    let noise = ROUNDING_ULPS * f64::EPSILON * magnitude;
+    let tris = quickhull::quickhull(local, [i0, i1, i2, i3], eps, noise);
     finish_solid(&mut hull, world, local, &tris);
     hull.build_adjacency();
     hull

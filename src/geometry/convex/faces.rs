@@ -62,12 +62,13 @@ pub(super) fn merge_coplanar(pts: &[DVec3], triangles: &[[u32; 3]], eps: f64) ->
             }
         }
         match outline(triangles, &members, &group, &across) {
-            Some(loop_) => faces.push(make_face(pts, loop_, &members, triangles)),
+            Some(loop_) => faces.push(make_face(pts, normal, loop_, &members, triangles)),
             None => {
                 for &t in &members {
                     let id = faces.len();
                     group[t] = id;
-                    faces.push(make_face(pts, triangles[t].to_vec(), &[t], triangles));
+                    let (own, _) = triangle_plane(pts, idx(triangles[t]));
+                    faces.push(make_face(pts, own, triangles[t].to_vec(), &[t], triangles));
                 }
             }
         }
@@ -107,14 +108,20 @@ fn outline(
     (loop_.len() == next.len()).then_some(loop_)
 }
 
-/// A face with a Newell normal of its outline and the largest offset among its vertices.
-fn make_face(pts: &[DVec3], outline: Vec<u32>, members: &[usize], tris: &[[u32; 3]]) -> LocalFace {
-    let mut newell = DVec3::ZERO;
-    for (i, &a) in outline.iter().enumerate() {
-        let b = outline[(i + 1) % outline.len()];
-        newell += pts[a as usize].cross(pts[b as usize]);
-    }
-    let normal = newell.normalize_or_zero();
+/// A face with the normal of its seed (largest) triangle and the largest offset among its
+/// vertices.
+///
+/// Every member vertex is within `eps` of the seed's plane (that is how the group grew), so
+/// with this normal every outline vertex is within `2 eps` of the face plane. A normal fitted
+/// to the outline (Newell's) would tilt towards a long sliver member and could leave the
+/// small members' vertices farther off.
+fn make_face(
+    pts: &[DVec3],
+    normal: DVec3,
+    outline: Vec<u32>,
+    members: &[usize],
+    tris: &[[u32; 3]],
+) -> LocalFace {
     let offset = members
         .iter()
         .flat_map(|&t| tris[t])

@@ -7,6 +7,9 @@
 //! - a visible set whose boundary is not one simple loop (possible when rounding makes the
 //!   hull slightly non-convex) is retried with a looser visibility threshold, and the eye
 //!   point is dropped only if every threshold fails;
+//! - a face the eye sees by less than `eps` is still made visible when the new cone face
+//!   next to it would fold inward by more than `eps` at its far vertex (a small cone face
+//!   beside a long sliver), unless the eye is within the input's rounding of its plane;
 //! - vertices swallowed by a new cone go back into the pool, so they are re-added if they
 //!   still lie outside.
 
@@ -54,10 +57,16 @@ pub(super) fn triangle_plane(pts: &[DVec3], v: [usize; 3]) -> (DVec3, f64) {
 
 /// The hull triangles (indices into `pts`, outward counter-clockwise) of the points, started
 /// from the non-degenerate tetrahedron `simplex`.
-pub(super) fn quickhull(pts: &[DVec3], simplex: [usize; 4], eps: f64) -> Vec<[usize; 3]> {
+pub(super) fn quickhull(
+    pts: &[DVec3],
+    simplex: [usize; 4],
+    eps: f64,
+    noise: f64,
+) -> Vec<[usize; 3]> {
     let mut hull = Builder {
         pts,
         eps,
+        noise,
         faces: Vec::new(),
         epoch: 0,
     };
@@ -82,6 +91,9 @@ pub(super) fn quickhull(pts: &[DVec3], simplex: [usize; 4], eps: f64) -> Vec<[us
 struct Builder<'a> {
     pts: &'a [DVec3],
     eps: f64,
+    /// Rounding level of the input coordinates, metres: heights above a plane below this
+    /// are noise, not geometry.
+    noise: f64,
     faces: Vec<HullFace>,
     epoch: u32,
 }
@@ -221,13 +233,40 @@ impl Builder<'_> {
             i += 1;
             for k in 0..3 {
                 let g = self.faces[f].adj[k];
-                if self.faces[g].visible_epoch != epoch && self.distance(g, eye) > threshold {
+                if self.faces[g].visible_epoch != epoch
+                    && (self.distance(g, eye) > threshold || self.folds_in(f, k, g, eye))
+                {
                     self.faces[g].visible_epoch = epoch;
                     visible.push(g);
                 }
             }
         }
         visible
+    }
+
+    /// Whether the cone face `[a, b, eye]` over the edge `a → b` (edge `k` of face `f`) would
+    /// leave the far vertex of `g` (the face across that edge) more than `eps` in front of
+    /// it: a concave fold that must not be built.
+    ///
+    /// The eye may be up to `eps` in front of `g` and still not see it; the fold's angle is
+    /// then about `eps / h`, `h` the eye's distance from the edge, and the far vertex of a
+    /// long sliver `g` ends up `eps · L / h` in front of the new face (`L` its distance
+    /// from the edge), far beyond tolerance. Measuring at the far vertex catches this,
+    /// while a coplanar neighbour (far vertex on the new plane) is left alone.
+    fn folds_in(&self, f: usize, k: usize, g: usize, eye: usize) -> bool {
+        // Only an eye truly in front of `g` makes a concave fold. Within the input's rounding
+        // of `g`'s plane the eye is coplanar with it: a far vertex in front of the new plane
+        // then comes from that rounding (amplified when the eye is near the edge's line),
+        // and making `g` visible would fold a coplanar cone over it instead.
+        if self.distance(g, eye) <= self.noise {
+            return false;
+        }
+        let (a, b) = (self.faces[f].v[k], self.faces[f].v[(k + 1) % 3]);
+        let Some(&far) = self.faces[g].v.iter().find(|&&v| v != a && v != b) else {
+            return false;
+        };
+        let (normal, offset) = triangle_plane(self.pts, [a, b, eye]);
+        normal.dot(self.pts[far]) - offset > self.eps
     }
 
     /// The boundary of the visible set as one loop of edges `(a, b, face beyond)`, in the
