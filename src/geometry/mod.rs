@@ -27,7 +27,7 @@ pub use cuboid::Cuboid;
 pub use cylinder::Cylinder;
 pub use error::ShapeError;
 pub use mesh::{MeshError, MeshLimits, MeshReport, TriMesh};
-pub use segment::Segment;
+pub use segment::{Segment, closest_points_segment_segment};
 pub use sphere::Sphere;
 pub use triangle::Triangle;
 
