@@ -11,7 +11,7 @@
 #[path = "../tests/support/mod.rs"]
 mod support;
 
-use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, criterion_group, criterion_main};
 use proxima::bounding::{
     Aabb, BoundingSphere, BoundingVolume, Kdop14, Kdop18, Kdop26, Lss, Obb, Rss,
 };
@@ -47,42 +47,45 @@ fn inputs<B: BoundingVolume>() -> Inputs<B> {
 fn bench_type<B: BoundingVolume>(c: &mut Criterion) {
     let Inputs { pairs, clouds_1000 } = inputs::<B>();
 
-    c.bench_with_input(
-        BenchmarkId::new("bounding/overlap", B::NAME),
+    ring_bench(c, "bounding/overlap", B::NAME, &pairs, |(a, b, pose)| {
+        f64::from(u8::from(
+            black_box(a).overlaps(black_box(b), black_box(pose)),
+        ))
+    });
+    ring_bench(
+        c,
+        "bounding/distance_lower_bound",
+        B::NAME,
         &pairs,
-        |bench, pairs| {
-            let mut i = 0;
-            bench.iter(|| {
-                let (a, b, pose) = &pairs[i & (RING - 1)];
-                i += 1;
-                black_box(black_box(a).overlaps(black_box(b), black_box(pose)))
-            });
-        },
+        |(a, b, pose)| black_box(a).distance_lower_bound(black_box(b), black_box(pose)),
     );
-    c.bench_with_input(
-        BenchmarkId::new("bounding/distance_lower_bound", B::NAME),
-        &pairs,
-        |bench, pairs| {
-            let mut i = 0;
-            bench.iter(|| {
-                let (a, b, pose) = &pairs[i & (RING - 1)];
-                i += 1;
-                black_box(black_box(a).distance_lower_bound(black_box(b), black_box(pose)))
-            });
-        },
-    );
-    c.bench_with_input(
-        BenchmarkId::new("bounding/fit_1000_points", B::NAME),
+    ring_bench(
+        c,
+        "bounding/fit_1000_points",
+        B::NAME,
         &clouds_1000,
-        |bench, clouds| {
-            let mut i = 0;
-            bench.iter(|| {
-                let points = &clouds[i & 15];
-                i += 1;
-                black_box(B::fit_points(black_box(points)))
-            });
-        },
+        |points| B::fit_points(black_box(points)).volume(),
     );
+}
+
+/// Times `query` on the next input of a power-of-two ring at each iteration.
+fn ring_bench<T>(
+    c: &mut Criterion,
+    group: &str,
+    name: &str,
+    inputs: &[T],
+    query: impl Fn(&T) -> f64,
+) {
+    assert!(inputs.len().is_power_of_two());
+    let mask = inputs.len() - 1;
+    c.bench_function(&format!("{group}/{name}"), |bench| {
+        let mut i = 0;
+        bench.iter(|| {
+            let input = &inputs[i & mask];
+            i += 1;
+            black_box(query(input))
+        });
+    });
 }
 
 fn bounding(c: &mut Criterion) {
