@@ -27,5 +27,8 @@ pub mod geometry;
 /// Bounding volumes.
 pub mod bounding;
 
-/// Exact primitive queries: triangle–triangle overlap, intersection and distance.
+/// Bounding-volume hierarchies and their tandem traversal.
+pub mod bvh;
+
+/// Exact queries: triangle–triangle overlap, intersection and distance; mesh–mesh queries.
 pub mod narrow;

@@ -1,0 +1,151 @@
+//! Tandem traversal: descend two BVHs together under their relative pose.
+//!
+//! A pair of nodes is tested with a caller-given volume test; when it passes, the larger
+//! node (by [`BvhNode::size`]; the internal one when the other is a leaf) is replaced by its
+//! two children. Pairs of leaves that pass go to a visitor, which may stop the traversal.
+//! This is the depth-first mid phase every exact mesh–mesh query uses; the budgeted
+//! breadth-first variant of the frame pipeline is built on the same descent rule.
+//!
+//! Two drivers:
+//! - [`for_each_leaf_pair`]: every leaf pair whose node pairs all pass a boolean test
+//!   (overlap, or "within distance d"), in depth-first order;
+//! - [`nearest_leaf_pairs`]: branch and bound for a minimum, visiting the nearer child pair
+//!   first and pruning pairs whose lower bound cannot beat the best value found so far.
+//!
+//! Both keep their stack in a caller-owned `Vec` and allocate only while it grows to the
+//! deepest descent (at most the sum of the two trees' depths, plus one).
+
+use super::{Bvh, BvhNode};
+use std::ops::ControlFlow;
+
+/// Which side of a node pair to descend: A's node when B's is a leaf or A's is at least as
+/// large (both internal); B's otherwise.
+#[must_use]
+#[inline]
+pub fn descend_a<B>(a: &BvhNode<B>, b: &BvhNode<B>) -> bool {
+    b.is_leaf() || (!a.is_leaf() && a.size >= b.size)
+}
+
+/// Visits every pair of leaves `(leaf_a, leaf_b)` (node indices) reached through node pairs
+/// that all pass `passes(bv_a, bv_b)`, depth first, until `visit` returns `Break`.
+///
+/// Returns `Break` when the visitor stopped the traversal.
+pub fn for_each_leaf_pair<B, T, V>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    stack: &mut Vec<[u32; 2]>,
+    passes: T,
+    mut visit: V,
+) -> ControlFlow<()>
+where
+    T: Fn(&B, &B) -> bool,
+    V: FnMut(usize, usize) -> ControlFlow<()>,
+{
+    let (na, nb) = (a.nodes(), b.nodes());
+    stack.clear();
+    if !passes(&na[0].bv, &nb[0].bv) {
+        return ControlFlow::Continue(());
+    }
+    stack.push([0, 0]);
+    while let Some([ia, ib]) = stack.pop() {
+        let (x, y) = (&na[ia as usize], &nb[ib as usize]);
+        if x.is_leaf() && y.is_leaf() {
+            visit(ia as usize, ib as usize)?;
+        } else if descend_a(x, y) {
+            // Push the second child first so the first is visited first.
+            for c in x.children().into_iter().rev() {
+                if passes(&na[c].bv, &y.bv) {
+                    stack.push([c as u32, ib]);
+                }
+            }
+        } else {
+            for c in y.children().into_iter().rev() {
+                if passes(&x.bv, &nb[c].bv) {
+                    stack.push([ia, c as u32]);
+                }
+            }
+        }
+    }
+    ControlFlow::Continue(())
+}
+
+/// A node pair waiting on the branch-and-bound stack, with its lower bound.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RankedPair {
+    /// Lower bound of the value over the pair's leaves (e.g. metres of distance).
+    pub bound: f64,
+    /// Node of A.
+    pub a: u32,
+    /// Node of B.
+    pub b: u32,
+}
+
+/// Branch and bound for the smallest leaf-pair value.
+///
+/// `bound(bv_a, bv_b)` must never exceed the value of any leaf pair beneath the two nodes.
+/// `visit(leaf_a, leaf_b)` evaluates a leaf pair and returns its value; `prune(bound, best)`
+/// says whether a pair with that lower bound can be skipped given the best value so far
+/// (for an exact answer: `bound >= best`). Starts from `best` (a known upper bound, or
+/// `f64::INFINITY`) and returns the best value found; stops early once `best <= floor`.
+pub fn nearest_leaf_pairs<B, L, P, V>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    stack: &mut Vec<RankedPair>,
+    mut best: f64,
+    floor: f64,
+    bound: L,
+    prune: P,
+    mut visit: V,
+) -> f64
+where
+    L: Fn(&B, &B) -> f64,
+    P: Fn(f64, f64) -> bool,
+    V: FnMut(usize, usize) -> f64,
+{
+    let (na, nb) = (a.nodes(), b.nodes());
+    stack.clear();
+    stack.push(RankedPair {
+        bound: bound(&na[0].bv, &nb[0].bv),
+        a: 0,
+        b: 0,
+    });
+    while let Some(pair) = stack.pop() {
+        if best <= floor {
+            break;
+        }
+        if prune(pair.bound, best) {
+            continue;
+        }
+        let (x, y) = (&na[pair.a as usize], &nb[pair.b as usize]);
+        if x.is_leaf() && y.is_leaf() {
+            best = best.min(visit(pair.a as usize, pair.b as usize));
+            continue;
+        }
+        let [first, second] = if descend_a(x, y) {
+            x.children().map(|c| RankedPair {
+                bound: bound(&na[c].bv, &y.bv),
+                a: c as u32,
+                b: pair.b,
+            })
+        } else {
+            y.children().map(|c| RankedPair {
+                bound: bound(&x.bv, &nb[c].bv),
+                a: pair.a,
+                b: c as u32,
+            })
+        };
+        // Nearer pair on top, so it is searched first and tightens `best` soonest.
+        let (near, far) = if first.bound <= second.bound {
+            (first, second)
+        } else {
+            (second, first)
+        };
+        if !prune(far.bound, best) {
+            stack.push(far);
+        }
+        if !prune(near.bound, best) {
+            stack.push(near);
+        }
+    }
+    best
+}

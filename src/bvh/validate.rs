@@ -1,0 +1,140 @@
+//! The invariant check of [`Bvh`], run by tests after every build and refit.
+
+use super::Bvh;
+use crate::bounding::BoundingVolume;
+use std::fmt;
+
+/// An invariant of a [`Bvh`] that does not hold (see the [module docs](super)).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum BvhError {
+    /// The tree has no nodes or no triangles.
+    Empty,
+    /// Node `node` names a child at `child`, out of range or not after its parent.
+    BadChild { node: usize, child: usize },
+    /// Node `node` is reached from the root more than once, or never.
+    NotATree { node: usize },
+    /// Leaf `node` holds `count` triangles: zero, more than the leaf size, or out of range.
+    BadLeaf { node: usize, count: usize },
+    /// Triangle slot `slot` is owned by no leaf or by several.
+    SlotCoverage { slot: usize },
+    /// The slot → triangle map is not a permutation (triangle `id` is missing or repeated).
+    NotAPermutation { id: usize },
+    /// A node's recorded span disagrees with the slots of the leaves beneath it.
+    BadSpan { node: usize },
+    /// Node `node`'s volume misses a vertex of triangle slot `slot` of its subtree.
+    Escapes { node: usize, slot: usize },
+    /// Node `node`'s cached size differs from its volume's.
+    StaleSize { node: usize },
+}
+
+impl fmt::Display for BvhError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::Empty => write!(f, "BVH has no nodes or no triangles"),
+            Self::BadChild { node, child } => write!(f, "node {node} has bad child index {child}"),
+            Self::NotATree { node } => {
+                write!(f, "node {node} is not reached exactly once from the root")
+            }
+            Self::BadLeaf { node, count } => write!(f, "leaf {node} holds {count} triangles"),
+            Self::SlotCoverage { slot } => {
+                write!(f, "triangle slot {slot} is not in exactly one leaf")
+            }
+            Self::NotAPermutation { id } => write!(f, "triangle {id} is missing or repeated"),
+            Self::BadSpan { node } => {
+                write!(f, "node {node} has a span that disagrees with its leaves")
+            }
+            Self::Escapes { node, slot } => {
+                write!(
+                    f,
+                    "node {node}'s volume misses a vertex of triangle slot {slot}"
+                )
+            }
+            Self::StaleSize { node } => write!(f, "node {node} caches a stale size"),
+        }
+    }
+}
+
+impl std::error::Error for BvhError {}
+
+impl<B: BoundingVolume> Bvh<B> {
+    /// Checks every invariant listed in the [module docs](super); `O(n · depth)`.
+    ///
+    /// # Errors
+    /// The first broken invariant found.
+    pub fn validate(&self) -> Result<(), BvhError> {
+        let n_nodes = self.nodes.len();
+        let n_slots = self.triangles.len();
+        if n_nodes == 0
+            || n_slots == 0
+            || self.spans.len() != n_nodes
+            || self.triangle_ids.len() != n_slots
+        {
+            return Err(BvhError::Empty);
+        }
+        let mut seen = vec![false; self.triangle_ids.len()];
+        for &id in &self.triangle_ids {
+            let id = id as usize;
+            if id >= n_slots || std::mem::replace(&mut seen[id], true) {
+                return Err(BvhError::NotAPermutation { id });
+            }
+        }
+        let mut reached = vec![0u32; n_nodes];
+        reached[0] = 1;
+        let mut owner = vec![0u32; n_slots];
+        for (index, node) in self.nodes.iter().enumerate() {
+            if node.size != node.bv.size() {
+                return Err(BvhError::StaleSize { node: index });
+            }
+            if node.is_leaf() {
+                let slots = node.slots();
+                if node.count > self.leaf_size || slots.end > n_slots {
+                    return Err(BvhError::BadLeaf {
+                        node: index,
+                        count: node.count as usize,
+                    });
+                }
+                if self.spans[index] != [slots.start as u32, slots.end as u32] {
+                    return Err(BvhError::BadSpan { node: index });
+                }
+                for slot in slots {
+                    owner[slot] += 1;
+                }
+            } else {
+                for child in node.children() {
+                    if child <= index || child >= n_nodes {
+                        return Err(BvhError::BadChild { node: index, child });
+                    }
+                    reached[child] += 1;
+                }
+                let [left, right] = node.children();
+                let [start, end] = self.spans[index];
+                if self.spans[left][0] != start
+                    || self.spans[left][1] != self.spans[right][0]
+                    || self.spans[right][1] != end
+                {
+                    return Err(BvhError::BadSpan { node: index });
+                }
+            }
+        }
+        if let Some(node) = reached.iter().position(|&r| r != 1) {
+            return Err(BvhError::NotATree { node });
+        }
+        if let Some(slot) = owner.iter().position(|&o| o != 1) {
+            return Err(BvhError::SlotCoverage { slot });
+        }
+        for (index, node) in self.nodes.iter().enumerate() {
+            let [start, end] = self.spans[index];
+            for slot in start as usize..end as usize {
+                if !self.triangles[slot]
+                    .vertices()
+                    .iter()
+                    .all(|&v| node.bv.contains_point(v))
+                {
+                    return Err(BvhError::Escapes { node: index, slot });
+                }
+            }
+        }
+        Ok(())
+    }
+}
