@@ -85,14 +85,14 @@ pub struct RankedPair {
 /// `bound(bv_a, bv_b)` must never exceed the value of any leaf pair beneath the two nodes.
 /// `visit(leaf_a, leaf_b)` evaluates a leaf pair and returns its value; `prune(bound, best)`
 /// says whether a pair with that lower bound can be skipped given the best value so far
-/// (for an exact answer: `bound >= best`). Starts from `best` (a known upper bound, or
-/// `f64::INFINITY`) and returns the best value found; stops early once `best <= floor`.
+/// (for an exact answer: `bound >= best`; a `prune` that returns `true` for everything once
+/// `best` is as small as possible ends the search). Starts from `best` (a known upper bound,
+/// or `f64::INFINITY`) and returns the best value found.
 pub fn nearest_leaf_pairs<B, L, P, V>(
     a: &Bvh<B>,
     b: &Bvh<B>,
     stack: &mut Vec<RankedPair>,
     mut best: f64,
-    floor: f64,
     bound: L,
     prune: P,
     mut visit: V,
@@ -110,9 +110,6 @@ where
         b: 0,
     });
     while let Some(pair) = stack.pop() {
-        if best <= floor {
-            break;
-        }
         if prune(pair.bound, best) {
             continue;
         }
