@@ -2,7 +2,7 @@
 
 use super::SupportMap;
 use super::error::{ShapeError, check_point};
-use crate::math::DVec3;
+use crate::math::{DVec3, Isometry};
 
 /// The triangle `a, b, c` (local frame); counter-clockwise seen from the side its
 /// [`normal`](Self::normal) points to. Zero-area triangles are allowed and handled by every
@@ -60,6 +60,20 @@ impl Triangle {
     #[inline]
     pub fn area(&self) -> f64 {
         0.5 * self.scaled_normal().length()
+    }
+
+    /// The triangle moved by `pose` (each vertex through [`Isometry::transform_point`]).
+    ///
+    /// Mesh–mesh queries map B's triangles into A's frame with exactly this function, so an
+    /// oracle that does the same sees bit-identical triangles.
+    #[must_use]
+    #[inline]
+    pub fn transformed(&self, pose: &Isometry) -> Self {
+        Self {
+            a: pose.transform_point(self.a),
+            b: pose.transform_point(self.b),
+            c: pose.transform_point(self.c),
+        }
     }
 
     /// Centroid.

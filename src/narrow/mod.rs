@@ -7,10 +7,14 @@
 //! the same frame; a mesh–mesh query transforms one mesh's triangles into the other's frame
 //! first.
 //!
+//! [`mesh_mesh`] builds the exact mesh–mesh queries (collision, contacts, distance,
+//! tolerance) on them by tandem traversal of two BVHs.
+//!
 //! Closed sets throughout: touching counts as intersecting, and zero-area triangles are the
 //! segment or point they span.
 
 mod closest_points;
+pub mod mesh_mesh;
 mod triangle_overlap;
 pub mod triangle_triangle;
 

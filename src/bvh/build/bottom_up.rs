@@ -5,7 +5,10 @@ use crate::bounding::BoundingVolume;
 use crate::geometry::Triangle;
 
 /// Builds the topology by agglomerative clustering.
-#[expect(clippy::extra_unused_type_parameters, reason = "placeholder until clustering lands")]
+#[expect(
+    clippy::extra_unused_type_parameters,
+    reason = "placeholder until clustering lands"
+)]
 pub(super) fn build<B: BoundingVolume>(
     _triangles: &[Triangle],
     primitives: &[BuildPrimitive],

@@ -1,0 +1,90 @@
+//! Collision queries: does any triangle pair intersect, and which ones do.
+
+use super::{FALLBACK_NORMAL, MeshMeshWorkspace, TriangleContact};
+use crate::bounding::BoundingVolume;
+use crate::bvh::Bvh;
+use crate::bvh::tandem::for_each_leaf_pair;
+use crate::math::Pose;
+use crate::narrow::{intersection_segment_triangle_triangle, intersects_triangle_triangle};
+use std::ops::ControlFlow;
+
+/// Whether any triangle of `a` intersects any triangle of `b` placed at `pose_ab` (closed
+/// triangles: touching counts). Stops at the first intersecting pair.
+///
+/// # Allocation
+/// None once `workspace` has grown to the deepest descent.
+#[must_use]
+pub fn intersects_mesh_mesh<B: BoundingVolume>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    workspace: &mut MeshMeshWorkspace,
+) -> bool {
+    let iso = pose_ab.to_isometry();
+    let (ta, tb) = (a.triangles(), b.triangles());
+    let flow = for_each_leaf_pair(
+        a,
+        b,
+        &mut workspace.pairs,
+        |x, y| x.overlaps(y, &iso),
+        |la, lb| {
+            for sb in b.nodes()[lb].slots() {
+                let tri_b = tb[sb].transformed(&iso);
+                for sa in a.nodes()[la].slots() {
+                    if intersects_triangle_triangle(&ta[sa], &tri_b) {
+                        return ControlFlow::Break(());
+                    }
+                }
+            }
+            ControlFlow::Continue(())
+        },
+    );
+    flow.is_break()
+}
+
+/// Reports every intersecting triangle pair of `a` and `b` placed at `pose_ab` to `sink`, in
+/// A's frame, until `sink` returns `Break`. Each pair is reported once; the order is the
+/// traversal's (deterministic for the same input).
+///
+/// # Allocation
+/// None once `workspace` has grown to the deepest descent (the sink may allocate).
+pub fn contacts_mesh_mesh<B, S>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    workspace: &mut MeshMeshWorkspace,
+    mut sink: S,
+) where
+    B: BoundingVolume,
+    S: FnMut(TriangleContact) -> ControlFlow<()>,
+{
+    let iso = pose_ab.to_isometry();
+    let (ta, tb) = (a.triangles(), b.triangles());
+    let _ = for_each_leaf_pair(
+        a,
+        b,
+        &mut workspace.pairs,
+        |x, y| x.overlaps(y, &iso),
+        |la, lb| {
+            for sb in b.nodes()[lb].slots() {
+                let tri_b = tb[sb].transformed(&iso);
+                for sa in a.nodes()[la].slots() {
+                    let tri_a = &ta[sa];
+                    if let Some((p, q)) = intersection_segment_triangle_triangle(tri_a, &tri_b) {
+                        let normal = tri_a
+                            .normal()
+                            .or_else(|| tri_b.normal().map(|n| -n))
+                            .unwrap_or(FALLBACK_NORMAL);
+                        sink(TriangleContact {
+                            triangles: [a.triangle_id(sa), b.triangle_id(sb)],
+                            segment: [p, q],
+                            point: p.midpoint(q),
+                            normal,
+                        })?;
+                    }
+                }
+            }
+            ControlFlow::Continue(())
+        },
+    );
+}

@@ -1,0 +1,125 @@
+//! Distance queries: the smallest triangle–triangle distance, and "within distance d?".
+
+use super::{DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace};
+use crate::bounding::BoundingVolume;
+use crate::bvh::Bvh;
+use crate::bvh::tandem::{for_each_leaf_pair, nearest_leaf_pairs};
+use crate::math::{Isometry, Pose, conservative_slack};
+use crate::narrow::{TriangleDistance, distance_triangle_triangle};
+use std::ops::ControlFlow;
+
+/// The smallest distance between the triangles of `a` and of `b` placed at `pose_ab`, with
+/// witness points in A's frame, by branch and bound over the two trees.
+///
+/// With [`DistanceParams::EXACT`] the distance is the brute-force minimum over all
+/// triangle pairs (to rounding, stated in `error_bound`); looser params let the search stop
+/// once nothing untried can improve the answer by more than the tolerance. `cache` holds the
+/// last closest pair of this mesh pair: its distance under the new pose is the first bound
+/// (warm start), and the new closest pair is stored back.
+///
+/// # Allocation
+/// None once `workspace` has grown to the deepest descent.
+pub fn distance_mesh_mesh<B: BoundingVolume>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    params: &DistanceParams,
+    cache: &mut DistanceCache,
+    workspace: &mut MeshMeshWorkspace,
+) -> MeshDistance {
+    let iso = pose_ab.to_isometry();
+    let (ta, tb) = (a.triangles(), b.triangles());
+    let pair_distance =
+        |sa: usize, sb: usize| distance_triangle_triangle(&ta[sa], &tb[sb].transformed(&iso));
+
+    // Start from the cached pair when it still names triangles of these meshes, else from
+    // the first slots: any pair gives a valid first upper bound.
+    let [start_a, start_b] = match cache.slots {
+        Some([sa, sb]) if (sa as usize) < ta.len() && (sb as usize) < tb.len() => {
+            [sa as usize, sb as usize]
+        }
+        _ => [0, 0],
+    };
+    let mut closest = (pair_distance(start_a, start_b), [start_a, start_b]);
+    let best = nearest_leaf_pairs(
+        a,
+        b,
+        &mut workspace.ranked,
+        closest.0.distance,
+        |x, y| x.distance_lower_bound(y, &iso),
+        |bound, best| params.can_skip(bound, best),
+        |la, lb| {
+            for sb in b.nodes()[lb].slots() {
+                for sa in a.nodes()[la].slots() {
+                    let d = pair_distance(sa, sb);
+                    if d.distance < closest.0.distance {
+                        closest = (d, [sa, sb]);
+                    }
+                }
+            }
+            closest.0.distance
+        },
+    );
+    let (
+        TriangleDistance {
+            distance,
+            point_a,
+            point_b,
+        },
+        [sa, sb],
+    ) = closest;
+    debug_assert_eq!(best, distance);
+    cache.slots = Some([sa as u32, sb as u32]);
+    MeshDistance {
+        distance,
+        point_a,
+        point_b,
+        triangles: [a.triangle_id(sa), b.triangle_id(sb)],
+        error_bound: params.abs_err.max(params.rel_err * distance) + rounding_bound(a, b, &iso),
+    }
+}
+
+/// Whether some triangle of `a` and some triangle of `b` placed at `pose_ab` are at most
+/// `max_distance` metres apart (`max_distance ≥ 0`; `0` is [`intersects_mesh_mesh`](super::intersects_mesh_mesh)
+/// with distances instead of exact predicates). Stops at the first such pair.
+///
+/// # Allocation
+/// None once `workspace` has grown to the deepest descent.
+#[must_use]
+pub fn within_distance_mesh_mesh<B: BoundingVolume>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    max_distance: f64,
+    workspace: &mut MeshMeshWorkspace,
+) -> bool {
+    let iso = pose_ab.to_isometry();
+    let (ta, tb) = (a.triangles(), b.triangles());
+    let flow = for_each_leaf_pair(
+        a,
+        b,
+        &mut workspace.pairs,
+        |x, y| x.distance_lower_bound(y, &iso) <= max_distance,
+        |la, lb| {
+            for sb in b.nodes()[lb].slots() {
+                let tri_b = tb[sb].transformed(&iso);
+                for sa in a.nodes()[la].slots() {
+                    if distance_triangle_triangle(&ta[sa], &tri_b).distance <= max_distance {
+                        return ControlFlow::Break(());
+                    }
+                }
+            }
+            ControlFlow::Continue(())
+        },
+    );
+    flow.is_break()
+}
+
+/// Rounding error of a triangle–triangle distance between these meshes at this pose: a few
+/// ulps of the largest coordinate involved.
+fn rounding_bound<B: BoundingVolume>(a: &Bvh<B>, b: &Bvh<B>, iso: &Isometry) -> f64 {
+    let reach = |bv: &B| bv.center().abs().max_element() + bv.size();
+    conservative_slack(
+        reach(a.root_bv()) + reach(b.root_bv()) + iso.translation.abs().max_element(),
+    )
+}
