@@ -179,6 +179,14 @@ fn check_distance_bound_and_outcomes<B: BoundingVolume>(seed: u64) {
             "{} case {case}: distance bound {bound} exceeds the true distance {truth}",
             B::NAME
         );
+        // The early-out form: the full bound below the limit, a valid bound at or past it.
+        let limit = truth * rng.random_range(0.0..2.0);
+        let within = bv_a.distance_lower_bound_within(&bv_b, &pose_ab, limit);
+        assert!(
+            within <= truth && (within == bound || (within >= limit && bound >= limit)),
+            "{} case {case}: bound within {limit} is {within} (full {bound}, true {truth})",
+            B::NAME
+        );
         let overlaps = bv_a.overlaps(&bv_b, &pose_ab);
         let moved = bv_b.transformed(&pose_ab);
         if overlaps != bv_a.intersects(&moved) {

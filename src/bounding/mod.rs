@@ -94,6 +94,17 @@ pub trait BoundingVolume: Copy + std::fmt::Debug + Send + Sync + 'static {
     #[must_use]
     fn distance_lower_bound(&self, other: &Self, pose_ab: &Isometry) -> f64;
 
+    /// [`distance_lower_bound`](Self::distance_lower_bound) for a search that only cares
+    /// whether the bound reaches `limit`: when it does, any lower bound `≥ limit` may be
+    /// returned (a cheaper, looser one); below `limit` the result is the full bound.
+    /// Branch-and-bound distance queries call this with the best distance found so far.
+    #[must_use]
+    #[inline]
+    fn distance_lower_bound_within(&self, other: &Self, pose_ab: &Isometry, limit: f64) -> f64 {
+        let _ = limit;
+        self.distance_lower_bound(other, pose_ab)
+    }
+
     /// Whether `point` (same frame) lies inside or on the volume. Exact up to rounding; no
     /// slack is added here (fits add it).
     #[must_use]

@@ -9,13 +9,16 @@
 //! Two drivers:
 //! - [`for_each_leaf_pair`]: every leaf pair whose node pairs all pass a boolean test
 //!   (overlap, or "within distance d"), in depth-first order;
-//! - [`nearest_leaf_pairs`]: branch and bound for a minimum, visiting the nearer child pair
-//!   first and pruning pairs whose lower bound cannot beat the best value found so far.
+//! - [`nearest_leaf_pairs`]: best-first branch and bound for a minimum, expanding the pair
+//!   with the smallest lower bound first and stopping when no waiting pair can beat the best
+//!   value found so far.
 //!
-//! Both keep their stack in a caller-owned `Vec` and allocate only while it grows to the
-//! deepest descent (at most the sum of the two trees' depths, plus one).
+//! Both keep their stack or queue in caller-owned storage and allocate only while it grows
+//! (the stack to the deepest descent, at most the sum of the two trees' depths plus one).
 
 use super::{Bvh, BvhNode};
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
 use std::ops::ControlFlow;
 
 /// Which side of a node pair to descend: A's node when B's is a leaf or A's is at least as
@@ -69,7 +72,9 @@ where
     ControlFlow::Continue(())
 }
 
-/// A node pair waiting on the branch-and-bound stack, with its lower bound.
+/// A node pair waiting in the branch-and-bound queue, with its lower bound. Ordered so that
+/// a [`BinaryHeap`] pops the *smallest* bound first (ties by node indices, for
+/// determinism).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RankedPair {
     /// Lower bound of the value over the pair's leaves (e.g. metres of distance).
@@ -80,68 +85,86 @@ pub struct RankedPair {
     pub b: u32,
 }
 
-/// Branch and bound for the smallest leaf-pair value.
+impl Eq for RankedPair {}
+
+impl Ord for RankedPair {
+    fn cmp(&self, other: &Self) -> Ordering {
+        other
+            .bound
+            .total_cmp(&self.bound)
+            .then_with(|| (other.a, other.b).cmp(&(self.a, self.b)))
+    }
+}
+
+impl PartialOrd for RankedPair {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+/// Best-first branch and bound for the smallest leaf-pair value.
 ///
-/// `bound(bv_a, bv_b)` must never exceed the value of any leaf pair beneath the two nodes.
-/// `visit(leaf_a, leaf_b)` evaluates a leaf pair and returns its value; `prune(bound, best)`
-/// says whether a pair with that lower bound can be skipped given the best value so far
-/// (for an exact answer: `bound >= best`; a `prune` that returns `true` for everything once
-/// `best` is as small as possible ends the search). Starts from `best` (a known upper bound,
-/// or `f64::INFINITY`) and returns the best value found.
+/// `bound(bv_a, bv_b, best)` must never exceed the value of any leaf pair beneath the two
+/// nodes; once it reaches `best` (the best value so far) it may return any such bound that
+/// is `≥ best` (a cheaper one: the pair is pruned either way). `visit(leaf_a, leaf_b)`
+/// evaluates a leaf pair and returns its value. `prune(bound, best)` says whether a pair with
+/// that lower bound can be skipped given the best value so far (for an exact answer:
+/// `bound >= best`); it must be monotone in `bound`. Starts from `best` (a known upper
+/// bound, or `f64::INFINITY`) and returns the best value found.
+///
+/// Pairs are expanded in increasing order of their bound, so the search stops as soon as
+/// the smallest waiting bound is pruned, and expands no pair whose bound is above the final
+/// answer (a depth-first search can, before its best value has come down).
 pub fn nearest_leaf_pairs<B, L, P, V>(
     a: &Bvh<B>,
     b: &Bvh<B>,
-    stack: &mut Vec<RankedPair>,
+    queue: &mut BinaryHeap<RankedPair>,
     mut best: f64,
     bound: L,
     prune: P,
     mut visit: V,
 ) -> f64
 where
-    L: Fn(&B, &B) -> f64,
+    L: Fn(&B, &B, f64) -> f64,
     P: Fn(f64, f64) -> bool,
     V: FnMut(usize, usize) -> f64,
 {
     let (na, nb) = (a.nodes(), b.nodes());
-    stack.clear();
-    stack.push(RankedPair {
-        bound: bound(&na[0].bv, &nb[0].bv),
+    queue.clear();
+    queue.push(RankedPair {
+        bound: bound(&na[0].bv, &nb[0].bv, best),
         a: 0,
         b: 0,
     });
-    while let Some(pair) = stack.pop() {
+    while let Some(pair) = queue.pop() {
         if prune(pair.bound, best) {
-            continue;
+            break;
         }
         let (x, y) = (&na[pair.a as usize], &nb[pair.b as usize]);
         if x.is_leaf() && y.is_leaf() {
             best = best.min(visit(pair.a as usize, pair.b as usize));
-            continue;
-        }
-        let [first, second] = if descend_a(x, y) {
-            x.children().map(|c| RankedPair {
-                bound: bound(&na[c].bv, &y.bv),
-                a: c as u32,
-                b: pair.b,
-            })
+        } else if descend_a(x, y) {
+            for c in x.children() {
+                let child = RankedPair {
+                    bound: bound(&na[c].bv, &y.bv, best),
+                    a: c as u32,
+                    b: pair.b,
+                };
+                if !prune(child.bound, best) {
+                    queue.push(child);
+                }
+            }
         } else {
-            y.children().map(|c| RankedPair {
-                bound: bound(&x.bv, &nb[c].bv),
-                a: pair.a,
-                b: c as u32,
-            })
-        };
-        // Nearer pair on top, so it is searched first and tightens `best` soonest.
-        let (near, far) = if first.bound <= second.bound {
-            (first, second)
-        } else {
-            (second, first)
-        };
-        if !prune(far.bound, best) {
-            stack.push(far);
-        }
-        if !prune(near.bound, best) {
-            stack.push(near);
+            for c in y.children() {
+                let child = RankedPair {
+                    bound: bound(&x.bv, &nb[c].bv, best),
+                    a: pair.a,
+                    b: c as u32,
+                };
+                if !prune(child.bound, best) {
+                    queue.push(child);
+                }
+            }
         }
     }
     best

@@ -46,7 +46,7 @@ pub fn distance_mesh_mesh<B: BoundingVolume>(
         b,
         &mut workspace.ranked,
         closest.0.distance,
-        |x, y| x.distance_lower_bound(y, &iso),
+        |x, y, limit| x.distance_lower_bound_within(y, &iso, limit),
         |bound, best| params.can_skip(bound, best),
         |la, lb| {
             for sb in b.nodes()[lb].slots() {
@@ -99,7 +99,7 @@ pub fn within_distance_mesh_mesh<B: BoundingVolume>(
         a,
         b,
         &mut workspace.pairs,
-        |x, y| x.distance_lower_bound(y, &iso) <= max_distance,
+        |x, y| x.distance_lower_bound_within(y, &iso, max_distance) <= max_distance,
         |la, lb| {
             for sb in b.nodes()[lb].slots() {
                 let tri_b = tb[sb].transformed(&iso);

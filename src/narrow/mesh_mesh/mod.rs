@@ -35,12 +35,13 @@ pub use distance::{distance_mesh_mesh, within_distance_mesh_mesh};
 
 use crate::bvh::tandem::RankedPair;
 use crate::math::DVec3;
+use std::collections::BinaryHeap;
 
 /// Scratch space of the mesh–mesh queries; reuse one per thread.
 #[derive(Debug, Default, Clone)]
 pub struct MeshMeshWorkspace {
     pairs: Vec<[u32; 2]>,
-    ranked: Vec<RankedPair>,
+    ranked: BinaryHeap<RankedPair>,
 }
 
 impl MeshMeshWorkspace {
