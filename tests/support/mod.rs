@@ -142,3 +142,113 @@ pub fn cloud(
 pub const CENTERS: [f64; 4] = [0.0, 1.0, 1e3, 1e6];
 /// See [`CENTERS`].
 pub const SCALES: [f64; 5] = [1e-4, 1e-2, 1.0, 1e2, 1e4];
+
+// ---- Procedural triangle meshes (BVH tests) ----
+
+use proxima::geometry::Triangle;
+
+/// A UV sphere of `radius` about the origin: `rings ≥ 2` bands from pole to pole, `segments
+/// ≥ 3` around; the pole bands are fans, so there are `2 · segments · (rings - 1)`
+/// triangles and none has zero area.
+pub fn uv_sphere(rings: usize, segments: usize, radius: f64) -> Vec<Triangle> {
+    let (rings, segments) = (rings.max(2), segments.max(3));
+    let point = |ring: usize, seg: usize| {
+        let theta = std::f64::consts::PI * ring as f64 / rings as f64;
+        let phi = std::f64::consts::TAU * (seg % segments) as f64 / segments as f64;
+        DVec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        ) * radius
+    };
+    let mut triangles = Vec::new();
+    for ring in 0..rings {
+        for seg in 0..segments {
+            let (a, b) = (point(ring, seg), point(ring, seg + 1));
+            let (c, d) = (point(ring + 1, seg), point(ring + 1, seg + 1));
+            if ring != 0 {
+                triangles.push(Triangle::new(a, c, b));
+            }
+            if ring != rings - 1 {
+                triangles.push(Triangle::new(b, c, d));
+            }
+        }
+    }
+    triangles
+}
+
+/// A torus about the z axis: tube of radius `minor` around a circle of radius `major`,
+/// `2 · around · across` triangles.
+pub fn torus(around: usize, across: usize, major: f64, minor: f64) -> Vec<Triangle> {
+    let (around, across) = (around.max(3), across.max(3));
+    let point = |i: usize, j: usize| {
+        let u = std::f64::consts::TAU * (i % around) as f64 / around as f64;
+        let v = std::f64::consts::TAU * (j % across) as f64 / across as f64;
+        let r = major + minor * v.cos();
+        DVec3::new(r * u.cos(), r * u.sin(), minor * v.sin())
+    };
+    let mut triangles = Vec::with_capacity(2 * around * across);
+    for i in 0..around {
+        for j in 0..across {
+            let (a, b) = (point(i, j), point(i + 1, j));
+            let (c, d) = (point(i, j + 1), point(i + 1, j + 1));
+            triangles.push(Triangle::new(a, b, d));
+            triangles.push(Triangle::new(a, d, c));
+        }
+    }
+    triangles
+}
+
+/// `n` independent random triangles: centres uniform in `[-half, half]³`, vertices within
+/// `size` of their centre (an unwelded soup with overlaps and slivers).
+pub fn triangle_soup(rng: &mut TestRng, n: usize, half: f64, size: f64) -> Vec<Triangle> {
+    (0..n)
+        .map(|_| {
+            let c = point_in_cube(rng, half);
+            Triangle::new(
+                c + point_in_cube(rng, size),
+                c + point_in_cube(rng, size),
+                c + point_in_cube(rng, size),
+            )
+        })
+        .collect()
+}
+
+/// A flat `nx × ny` grid of unit cells in the plane `z = 0`, two triangles per cell: every
+/// triangle coplanar, many merged volumes of exactly equal size.
+pub fn flat_grid(nx: usize, ny: usize) -> Vec<Triangle> {
+    let p = |x: usize, y: usize| DVec3::new(x as f64, y as f64, 0.0);
+    let mut triangles = Vec::with_capacity(2 * nx * ny);
+    for x in 0..nx {
+        for y in 0..ny {
+            triangles.push(Triangle::new(p(x, y), p(x + 1, y), p(x + 1, y + 1)));
+            triangles.push(Triangle::new(p(x, y), p(x + 1, y + 1), p(x, y + 1)));
+        }
+    }
+    triangles
+}
+
+/// `n` zero-area triangles in the cube `[-half, half]³`: alternately all three vertices at
+/// one point, and three collinear points (one repeated every third time).
+pub fn zero_area_triangles(rng: &mut TestRng, n: usize, half: f64) -> Vec<Triangle> {
+    (0..n)
+        .map(|i| {
+            let p = point_in_cube(rng, half);
+            let d = point_in_cube(rng, half * 0.1);
+            match i % 3 {
+                0 => Triangle::new(p, p, p),
+                1 => Triangle::new(p, p + d, p + 2.5 * d),
+                _ => Triangle::new(p, p + d, p),
+            }
+        })
+        .collect()
+}
+
+/// `triangles` scaled by `scale` about the origin, then moved by `offset`.
+pub fn scaled_and_moved(triangles: &[Triangle], scale: f64, offset: DVec3) -> Vec<Triangle> {
+    let f = |p: DVec3| p * scale + offset;
+    triangles
+        .iter()
+        .map(|t| Triangle::new(f(t.a), f(t.b), f(t.c)))
+        .collect()
+}
