@@ -30,6 +30,7 @@ pub mod tandem;
 mod validate;
 
 pub use build::{BuildParams, BuildStrategy};
+pub use refit::RefitMode;
 pub use validate::BvhError;
 
 use crate::bounding::BoundingVolume;

@@ -50,13 +50,9 @@ pub(super) const SEARCH_RADIUS: usize = 16;
 const MORTON_BITS: u32 = 21;
 
 /// Builds the topology by agglomerative clustering of `triangles` (`primitives` are their
-/// centroids and boxes, index for index). The shape does not depend on `B` (see the
-/// [module docs](self)).
-#[expect(
-    clippy::extra_unused_type_parameters,
-    reason = "clustering on boxes is faster and better for every B, measured in the module docs"
-)]
-pub(super) fn build<B: BoundingVolume>(
+/// centroids and boxes, index for index). The shape does not depend on the volume type the
+/// tree will be fitted with (see the [module docs](self)).
+pub(super) fn build(
     triangles: &[Triangle],
     primitives: &[BuildPrimitive],
     leaf_size: u32,
@@ -360,7 +356,7 @@ mod tests {
     }
 
     fn topology(triangles: &[Triangle], leaf_size: u32) -> Topology {
-        build::<Aabb>(triangles, &primitives(triangles), leaf_size)
+        build(triangles, &primitives(triangles), leaf_size)
     }
 
     /// Asserts the [`Topology`] contract, independently of [`Bvh::validate`].
