@@ -3,13 +3,15 @@
 //! ```text
 //! cargo run --release --example pair_queries -- MESH1.obj MESH2.obj TRANSFORMS.txt \
 //!     [--scale1 S] [--scale2 S] [--center] [--dump DIR] [--repeats K]
+//!     [--collide-bv obb] [--distance-bv rss] [--build sah] [--leaf-size 1]
 //! ```
 //!
 //! Mesh 1 takes each transform of TRANSFORMS.txt (`#` comment lines, then the count N, then
 //! N lines of a row-major 3×3 rotation and a translation); mesh 2 stays at identity.
 //! `--scale1/--scale2` multiply a mesh's vertices; `--center` then moves each mesh's
-//! bounding-box centre to the origin. BVHs are built once, outside the timing: OBB trees for
-//! the collision queries, RSS trees for distance. Per transform, each query runs twice to warm
+//! bounding-box centre to the origin. BVHs are built once, outside the timing: by default
+//! binned-SAH trees of OBBs for the collision queries and of RSSs for distance (the fastest
+//! combination measured; other volume types, builders and leaf sizes by option). Per transform, each query runs twice to warm
 //! up and is then timed over K runs (default 5); its time is the mean of those runs.
 //!
 //! stdout: one TSV row per query, `query n mean_us median_us p95_us max_us colliding tri_pairs
@@ -17,7 +19,7 @@
 //! pair's cache between runs, as a simulation querying the same pair every frame would.
 //! `--dump DIR` writes `DIR/proxima.tsv`: `i collide_bool collide_all contacts tri_pairs distance`.
 
-use proxima::bounding::{Obb, Rss};
+use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, Rss};
 use proxima::bvh::{BuildParams, Bvh};
 use proxima::geometry::TriMesh;
 use proxima::math::{DMat3, DQuat, DVec3, Pose};
@@ -40,11 +42,16 @@ struct Args {
     center: bool,
     dump: Option<String>,
     repeats: usize,
+    /// Volume types of the collision trees and of the distance trees.
+    volumes: [String; 2],
+    build: BuildParams,
 }
 
 fn parse_args() -> Result<Args, Box<dyn Error>> {
     let mut positional = Vec::new();
     let (mut scales, mut center, mut dump, mut repeats) = ([1.0, 1.0], false, None, 5);
+    let mut volumes = ["obb".to_string(), "rss".to_string()];
+    let (mut build, mut leaf_size) = (BuildParams::BINNED_SAH, 1);
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
         let mut value = || it.next().ok_or_else(|| format!("{arg} needs a value"));
@@ -54,6 +61,23 @@ fn parse_args() -> Result<Args, Box<dyn Error>> {
             "--center" => center = true,
             "--dump" => dump = Some(value()?),
             "--repeats" => repeats = value()?.parse::<usize>()?.max(1),
+            "--collide-bv" => volumes[0] = value()?,
+            "--distance-bv" => volumes[1] = value()?,
+            "--build" => {
+                build = match value()?.as_str() {
+                    "sah" => BuildParams::BINNED_SAH,
+                    "mean" => BuildParams::MEAN_VARIANCE,
+                    "median" => BuildParams::MEDIAN,
+                    "agglomerative" => BuildParams::AGGLOMERATIVE,
+                    other => {
+                        return Err(format!(
+                            "unknown builder {other} (sah, mean, median, agglomerative)"
+                        )
+                        .into());
+                    }
+                }
+            }
+            "--leaf-size" => leaf_size = value()?.parse()?,
             _ if arg.starts_with("--") => return Err(format!("unknown option {arg}").into()),
             _ => positional.push(arg),
         }
@@ -68,6 +92,8 @@ fn parse_args() -> Result<Args, Box<dyn Error>> {
         center,
         dump,
         repeats,
+        volumes,
+        build: build.with_leaf_size(leaf_size),
     })
 }
 
@@ -145,94 +171,147 @@ fn summary(
     )
 }
 
-fn main() -> Result<(), Box<dyn Error>> {
-    let args = parse_args()?;
-    let transforms = read_transforms(&args.transforms)?;
-    let m1 = load(&args.meshes[0], args.scales[0], args.center)?;
-    let m2 = load(&args.meshes[1], args.scales[1], args.center)?;
-    let build = Instant::now();
-    let (obb1, obb2) = (
-        Bvh::<Obb>::from_mesh(&m1, &BuildParams::MEAN_VARIANCE),
-        Bvh::<Obb>::from_mesh(&m2, &BuildParams::MEAN_VARIANCE),
-    );
-    let (rss1, rss2) = (
-        Bvh::<Rss>::from_mesh(&m1, &BuildParams::MEAN_VARIANCE),
-        Bvh::<Rss>::from_mesh(&m2, &BuildParams::MEAN_VARIANCE),
-    );
-    eprintln!(
-        "built 4 BVHs over {} + {} triangles in {:.2} s",
-        m1.triangle_count(),
-        m2.triangle_count(),
-        build.elapsed().as_secs_f64()
-    );
+/// Per-pose results of the two collision queries.
+#[derive(Default)]
+struct CollideRuns {
+    time_bool: Vec<f64>,
+    time_all: Vec<f64>,
+    hit: Vec<bool>,
+    pairs: Vec<usize>,
+}
 
+fn collide_runs<C: BoundingVolume>(
+    meshes: [&TriMesh; 2],
+    build: &BuildParams,
+    poses: &[Pose],
+    repeats: usize,
+) -> CollideRuns {
+    let (a, b) = (
+        Bvh::<C>::from_mesh(meshes[0], build),
+        Bvh::<C>::from_mesh(meshes[1], build),
+    );
     let mut ws = MeshMeshWorkspace::new();
-    let (mut t_bool, mut t_all, mut t_dist, mut t_warm) = (vec![], vec![], vec![], vec![]);
-    let (mut n_bool, mut n_all, mut n_dist, mut total_pairs, mut dist_sum) = (0, 0, 0, 0usize, 0.0);
-    let mut dump = String::from("i\tcollide_bool\tcollide_all\tcontacts\ttri_pairs\tdistance\n");
-    for (i, transform) in transforms.iter().enumerate() {
-        let pose_ab = transform.inverse(); // mesh 2 (at identity) in mesh 1's frame
-        let (t, hit) = time_us(args.repeats, || {
-            intersects_mesh_mesh(&obb1, &obb2, &pose_ab, &mut ws)
-        });
-        t_bool.push(t);
-        let (t, pairs) = time_us(args.repeats, || {
+    let mut runs = CollideRuns::default();
+    for pose_ab in poses {
+        let (t, hit) = time_us(repeats, || intersects_mesh_mesh(&a, &b, pose_ab, &mut ws));
+        runs.time_bool.push(t);
+        runs.hit.push(hit);
+        let (t, pairs) = time_us(repeats, || {
             let mut count = 0usize;
-            contacts_mesh_mesh(&obb1, &obb2, &pose_ab, &mut ws, |_| {
+            contacts_mesh_mesh(&a, &b, pose_ab, &mut ws, |_| {
                 count += 1;
                 ControlFlow::Continue(())
             });
             count
         });
-        t_all.push(t);
-        let (t, d) = time_us(args.repeats, || {
-            distance_mesh_mesh(
-                &rss1,
-                &rss2,
-                &pose_ab,
-                &DistanceParams::EXACT,
-                &mut DistanceCache::new(),
-                &mut ws,
-            )
-        });
-        t_dist.push(t);
-        let mut cache = DistanceCache::new();
-        let (t, _) = time_us(args.repeats, || {
-            distance_mesh_mesh(
-                &rss1,
-                &rss2,
-                &pose_ab,
-                &DistanceParams::EXACT,
-                &mut cache,
-                &mut ws,
-            )
-        });
-        t_warm.push(t);
-        n_bool += usize::from(hit);
-        n_all += usize::from(pairs > 0);
-        n_dist += usize::from(d.distance == 0.0);
-        total_pairs += pairs;
-        dist_sum += d.distance;
-        writeln!(
-            dump,
-            "{i}\t{}\t{}\t{pairs}\t{pairs}\t{:.16e}",
-            u8::from(hit),
-            u8::from(pairs > 0),
-            d.distance
-        )?;
+        runs.time_all.push(t);
+        runs.pairs.push(pairs);
     }
-    let n = transforms.len() as f64;
+    runs
+}
+
+/// Per-pose results of the distance query, cold and warm.
+#[derive(Default)]
+struct DistanceRuns {
+    time_cold: Vec<f64>,
+    time_warm: Vec<f64>,
+    distance: Vec<f64>,
+}
+
+fn distance_runs<D: BoundingVolume>(
+    meshes: [&TriMesh; 2],
+    build: &BuildParams,
+    poses: &[Pose],
+    repeats: usize,
+) -> DistanceRuns {
+    let (a, b) = (
+        Bvh::<D>::from_mesh(meshes[0], build),
+        Bvh::<D>::from_mesh(meshes[1], build),
+    );
+    let mut ws = MeshMeshWorkspace::new();
+    let mut runs = DistanceRuns::default();
+    let exact = DistanceParams::EXACT;
+    for pose_ab in poses {
+        let (t, d) = time_us(repeats, || {
+            distance_mesh_mesh(&a, &b, pose_ab, &exact, &mut DistanceCache::new(), &mut ws)
+        });
+        runs.time_cold.push(t);
+        runs.distance.push(d.distance);
+        let mut cache = DistanceCache::new();
+        let (t, _) = time_us(repeats, || {
+            distance_mesh_mesh(&a, &b, pose_ab, &exact, &mut cache, &mut ws)
+        });
+        runs.time_warm.push(t);
+    }
+    runs
+}
+
+/// Calls `$run::<T>($args)` with the volume type named by `$name`.
+macro_rules! with_volume {
+    ($name:expr, $run:ident($($args:expr),*)) => {
+        match $name {
+            "obb" => $run::<Obb>($($args),*),
+            "rss" => $run::<Rss>($($args),*),
+            "aabb" => $run::<Aabb>($($args),*),
+            "sphere" => $run::<BoundingSphere>($($args),*),
+            "kdop18" => $run::<Kdop18>($($args),*),
+            "lss" => $run::<Lss>($($args),*),
+            other => return Err(format!("unknown volume type {other} (obb, rss, aabb, sphere, kdop18, lss)").into()),
+        }
+    };
+}
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let args = parse_args()?;
+    let transforms = read_transforms(&args.transforms)?;
+    let m1 = load(&args.meshes[0], args.scales[0], args.center)?;
+    let m2 = load(&args.meshes[1], args.scales[1], args.center)?;
+    // Mesh 2 (at identity) in mesh 1's frame.
+    let poses: Vec<Pose> = transforms.iter().map(Pose::inverse).collect();
+    let meshes = [&m1, &m2];
+    let started = Instant::now();
+    let collide = with_volume!(
+        args.volumes[0].as_str(),
+        collide_runs(meshes, &args.build, &poses, args.repeats)
+    );
+    let distance = with_volume!(
+        args.volumes[1].as_str(),
+        distance_runs(meshes, &args.build, &poses, args.repeats)
+    );
+    eprintln!(
+        "{} + {} triangles; {} / {} trees, {:?}; {:.1} s in all",
+        m1.triangle_count(),
+        m2.triangle_count(),
+        args.volumes[0],
+        args.volumes[1],
+        args.build.strategy,
+        started.elapsed().as_secs_f64()
+    );
+    let colliding = collide.hit.iter().filter(|&&h| h).count();
+    let touching = collide.pairs.iter().filter(|&&p| p > 0).count();
+    let total_pairs: usize = collide.pairs.iter().sum();
+    let zero = distance.distance.iter().filter(|&&d| d == 0.0).count();
+    let mean_dist = format!(
+        "{:.6}",
+        distance.distance.iter().sum::<f64>() / poses.len() as f64
+    );
     println!("query\tn\tmean_us\tmedian_us\tp95_us\tmax_us\tcolliding\ttri_pairs\tmean_dist");
     println!(
         "{}",
-        summary("collide_bool", t_bool, n_bool, "-".into(), "-".into())
+        summary(
+            "collide_bool",
+            collide.time_bool,
+            colliding,
+            "-".into(),
+            "-".into()
+        )
     );
     println!(
         "{}",
         summary(
             "collide_all",
-            t_all,
-            n_all,
+            collide.time_all,
+            touching,
             total_pairs.to_string(),
             "-".into()
         )
@@ -241,23 +320,35 @@ fn main() -> Result<(), Box<dyn Error>> {
         "{}",
         summary(
             "distance",
-            t_dist,
-            n_dist,
+            distance.time_cold,
+            zero,
             "-".into(),
-            format!("{:.6}", dist_sum / n)
+            mean_dist.clone()
         )
     );
     println!(
         "{}",
         summary(
             "distance_warm",
-            t_warm,
-            n_dist,
+            distance.time_warm,
+            zero,
             "-".into(),
-            format!("{:.6}", dist_sum / n)
+            mean_dist
         )
     );
     if let Some(dir) = args.dump {
+        let mut dump =
+            String::from("i\tcollide_bool\tcollide_all\tcontacts\ttri_pairs\tdistance\n");
+        for i in 0..poses.len() {
+            let pairs = collide.pairs[i];
+            writeln!(
+                dump,
+                "{i}\t{}\t{}\t{pairs}\t{pairs}\t{:.16e}",
+                u8::from(collide.hit[i]),
+                u8::from(pairs > 0),
+                distance.distance[i]
+            )?;
+        }
         std::fs::create_dir_all(&dir)?;
         std::fs::write(format!("{dir}/proxima.tsv"), dump)?;
     }
