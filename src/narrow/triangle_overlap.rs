@@ -338,3 +338,64 @@ fn sign(x: f64) -> i8 {
 fn lex_less(a: DVec3, b: DVec3) -> bool {
     (a.x, a.y, a.z) < (b.x, b.y, b.z)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A tiny seeded generator (this module has no access to the test support crate).
+    fn next(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn filtered_plane_sides_match_the_exact_predicate_on_and_near_the_plane() {
+        let mut state = 7u64;
+        let (mut on, mut off) = (0, 0);
+        for case in 0..20_000 {
+            let scale = [1e-3, 1.0, 1e3, 1e6][case % 4];
+            let point = |state: &mut u64| DVec3::new(next(state), next(state), next(state)) * scale;
+            let (a, b, c) = (point(&mut state), point(&mut state), point(&mut state));
+            let plane = ProperTriangle {
+                v: [a, b, c],
+                drop_axis: 2,
+                winding: 1.0,
+            };
+            // Dyadic combinations of integer-valued corners lie exactly on the plane; a
+            // nudge by one ulp moves them off it.
+            let (ai, bi, ci) = (a.round(), b.round(), c.round());
+            let exact_plane = ProperTriangle {
+                v: [ai, bi, ci],
+                drop_axis: 2,
+                winding: 1.0,
+            };
+            let (s, t) = (
+                (next(&mut state) * 8.0).floor() / 8.0,
+                (next(&mut state) * 8.0).floor() / 8.0,
+            );
+            let on_plane = ai + (bi - ai) * s + (ci - ai) * t;
+            let nudged = DVec3::new(
+                on_plane.x,
+                on_plane.y,
+                f64::from_bits(on_plane.z.to_bits() + 1),
+            );
+            let other = ProperTriangle {
+                v: [on_plane, nudged, point(&mut state)],
+                drop_axis: 2,
+                winding: 1.0,
+            };
+            for (p, t) in [(&plane, &other), (&exact_plane, &other)] {
+                let (signs, _) = plane_sides(p, t);
+                let [x, y, z] = p.v;
+                let exact = t.v.map(|q| sign(orient3d(x, y, z, q)));
+                assert_eq!(signs, exact, "case {case}");
+                on += exact.iter().filter(|&&e| e == 0).count();
+                off += exact.iter().filter(|&&e| e != 0).count();
+            }
+        }
+        assert!(on > 1_000 && off > 1_000, "on the plane {on}, off {off}");
+    }
+}
