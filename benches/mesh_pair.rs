@@ -31,6 +31,12 @@
 //! printed; parry's count may differ at touching pairs, since GJK decides them with a
 //! tolerance).
 //!
+//! A mean covers every pose only when the run makes at least one lap of the poses (criterion
+//! prints the iteration count): query cost varies a lot from pose to pose (hit or miss, deep
+//! or grazing), so a run of fewer iterations than poses averages over the first poses only.
+//! parry's `distance` takes about 0.5 s per query on `bunny-fandisk`, so one lap there needs
+//! `--measurement-time` of about 120 s.
+//!
 //! `cargo bench --bench mesh_pair`; names are `mesh_pair/<query>/<engine>/<scene>`.
 
 #[path = "../tests/support/mod.rs"]
