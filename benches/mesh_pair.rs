@@ -8,7 +8,7 @@
 //! - `tori`: two tori of 10,000 triangles each under 64 random poses from a fixed seed,
 //!   exactly half of them intersecting (see [`common::mesh_scenes::tori`]).
 //!
-//! Everything is built before timing: Proxima's BVHs with [`BuildParams::MEAN_VARIANCE`]
+//! Everything is built before timing: Proxima's BVHs with [`BuildParams::BINNED_SAH`]
 //! (one triangle per leaf), parry's `TriMesh` shapes from the very same `f64` vertices and
 //! index triples, and the poses (parry gets the same quaternion and translation, as
 //! `pos1 = identity`, `pos2 = pose_ab`, so its `pos12` is Proxima's `pose_ab`). Each timed
@@ -76,8 +76,8 @@ struct ProximaPair<B> {
 impl<B: BoundingVolume> ProximaPair<B> {
     fn new(a: &TriMesh, b: &TriMesh) -> Self {
         Self {
-            a: Bvh::from_mesh(a, &BuildParams::MEAN_VARIANCE),
-            b: Bvh::from_mesh(b, &BuildParams::MEAN_VARIANCE),
+            a: Bvh::from_mesh(a, &BuildParams::BINNED_SAH),
+            b: Bvh::from_mesh(b, &BuildParams::BINNED_SAH),
         }
     }
 
