@@ -8,6 +8,8 @@ use proxima::math::{DQuat, DVec3, Isometry, Pose};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
+pub mod meshes;
+
 /// The PRNG every test uses, always seeded explicitly.
 pub type TestRng = Pcg64Mcg;
 

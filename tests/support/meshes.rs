@@ -1,0 +1,259 @@
+//! Procedural meshes for the mesh–mesh tests, and the real meshes kept in `tests/data`.
+//!
+//! Closed solids ([`uv_sphere`], [`torus`], [`cuboid`], [`subdivided_cuboid`]) are welded
+//! (neighbouring triangles share vertex indices) and oriented counter-clockwise seen from
+//! outside. [`grid`] is an open surface of many coplanar triangles, [`triangle_soup`] an
+//! unwelded set of random triangles, and [`with_zero_area_triangles`] a closed box with
+//! segment- and point-like triangles mixed in. Everything random takes the caller's seeded
+//! [`TestRng`].
+
+use super::{TestRng, point_in_cube};
+use proxima::geometry::{TriMesh, Triangle};
+use proxima::math::DVec3;
+use rand::Rng;
+use rand::seq::SliceRandom;
+use std::collections::HashMap;
+use std::f64::consts::{PI, TAU};
+use std::path::PathBuf;
+
+/// A mesh from vertices and index triples the generators made (valid by construction).
+pub fn mesh(vertices: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> TriMesh {
+    TriMesh::try_new(vertices, triangles).expect("procedural mesh is valid")
+}
+
+/// The triangles of `mesh`, in its own order (index `i` is triangle id `i`).
+pub fn triangles(mesh: &TriMesh) -> Vec<Triangle> {
+    (0..mesh.triangle_count())
+        .map(|i| mesh.triangle(i))
+        .collect()
+}
+
+/// Largest distance of a vertex of `mesh` from its frame's origin, metres.
+pub fn reach(mesh: &TriMesh) -> f64 {
+    mesh.vertices()
+        .iter()
+        .map(|v| v.length())
+        .fold(0.0, f64::max)
+}
+
+/// Closed UV sphere of `radius` about the origin: `segments ≥ 3` around the z axis,
+/// `rings ≥ 2` bands from pole to pole; `2 · segments · (rings − 1)` triangles.
+pub fn uv_sphere(radius: f64, segments: u32, rings: u32) -> TriMesh {
+    assert!(segments >= 3 && rings >= 2);
+    let mut vertices = vec![DVec3::new(0.0, 0.0, radius)];
+    for k in 1..rings {
+        let theta = PI * f64::from(k) / f64::from(rings);
+        for j in 0..segments {
+            let phi = TAU * f64::from(j) / f64::from(segments);
+            vertices.push(
+                radius
+                    * DVec3::new(
+                        theta.sin() * phi.cos(),
+                        theta.sin() * phi.sin(),
+                        theta.cos(),
+                    ),
+            );
+        }
+    }
+    let south = vertices.len() as u32;
+    vertices.push(DVec3::new(0.0, 0.0, -radius));
+    let ring = |k: u32, j: u32| 1 + (k - 1) * segments + j % segments;
+    let mut tris = Vec::new();
+    for j in 0..segments {
+        tris.push([0, ring(1, j), ring(1, j + 1)]);
+    }
+    for k in 1..rings - 1 {
+        for j in 0..segments {
+            let (a, b) = (ring(k, j), ring(k + 1, j));
+            let (c, d) = (ring(k + 1, j + 1), ring(k, j + 1));
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    for j in 0..segments {
+        tris.push([ring(rings - 1, j), south, ring(rings - 1, j + 1)]);
+    }
+    mesh(vertices, tris)
+}
+
+/// Closed torus about the z axis: tube centre line of radius `major`, tube radius
+/// `minor < major`; `around` steps along the centre line, `across` around the tube;
+/// `2 · around · across` triangles.
+pub fn torus(major: f64, minor: f64, around: u32, across: u32) -> TriMesh {
+    assert!(minor < major && around >= 3 && across >= 3);
+    let mut vertices = Vec::new();
+    for i in 0..around {
+        let u = TAU * f64::from(i) / f64::from(around);
+        for j in 0..across {
+            let v = TAU * f64::from(j) / f64::from(across);
+            let r = major + minor * v.cos();
+            vertices.push(DVec3::new(r * u.cos(), r * u.sin(), minor * v.sin()));
+        }
+    }
+    let at = |i: u32, j: u32| (i % around) * across + j % across;
+    let mut tris = Vec::new();
+    for i in 0..around {
+        for j in 0..across {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    mesh(vertices, tris)
+}
+
+/// The box `[-half, half]` with 12 triangles (8 vertices).
+pub fn cuboid(half: DVec3) -> TriMesh {
+    subdivided_cuboid(half, 1)
+}
+
+/// The box `[-half, half]` with each face cut into `n × n` squares of two triangles
+/// (`12 n²` triangles), welded along the box's edges. Vertices lie on an exact lattice:
+/// coordinate `−h + 2h · i / n`.
+pub fn subdivided_cuboid(half: DVec3, n: u32) -> TriMesh {
+    assert!(n >= 1);
+    let mut index: HashMap<[u32; 3], u32> = HashMap::new();
+    let mut vertices = Vec::new();
+    let mut vertex = |lattice: [u32; 3]| -> u32 {
+        *index.entry(lattice).or_insert_with(|| {
+            let at = |axis: usize| {
+                let h = half[axis];
+                -h + 2.0 * h * f64::from(lattice[axis]) / f64::from(n)
+            };
+            vertices.push(DVec3::new(at(0), at(1), at(2)));
+            (vertices.len() - 1) as u32
+        })
+    };
+    let mut tris = Vec::new();
+    for axis in 0..3 {
+        // (u, v, axis) is a right-handed cycle, so u × v points along +axis.
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        for side in [0, n] {
+            for i in 0..n {
+                for j in 0..n {
+                    let mut corner = |di: u32, dj: u32| {
+                        let mut l = [0; 3];
+                        l[axis] = side;
+                        l[u] = i + di;
+                        l[v] = j + dj;
+                        vertex(l)
+                    };
+                    let (a, b, c, d) = (corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1));
+                    if side == n {
+                        tris.push([a, b, c]);
+                        tris.push([a, c, d]);
+                    } else {
+                        tris.push([a, c, b]);
+                        tris.push([a, d, c]);
+                    }
+                }
+            }
+        }
+    }
+    mesh(vertices, tris)
+}
+
+/// A flat open grid in the plane `z = 0`: `[-half, half]²` cut into `n × n` squares of
+/// two triangles (`2 n²` coplanar triangles), welded.
+pub fn grid(half: f64, n: u32) -> TriMesh {
+    assert!(n >= 1);
+    let at = |i: u32| -half + 2.0 * half * f64::from(i) / f64::from(n);
+    let vertices = (0..=n)
+        .flat_map(|i| (0..=n).map(move |j| DVec3::new(at(i), at(j), 0.0)))
+        .collect();
+    let id = |i: u32, j: u32| i * (n + 1) + j;
+    let mut tris = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    mesh(vertices, tris)
+}
+
+/// `count` random unwelded triangles: centres uniform in `[-half, half]³`, vertices within
+/// `size` of their centre.
+pub fn triangle_soup(rng: &mut TestRng, count: usize, half: f64, size: f64) -> TriMesh {
+    let mut vertices = Vec::with_capacity(3 * count);
+    let mut tris = Vec::with_capacity(count);
+    for t in 0..count {
+        let centre = point_in_cube(rng, half);
+        for _ in 0..3 {
+            vertices.push(centre + point_in_cube(rng, size));
+        }
+        let first = 3 * t as u32;
+        tris.push([first, first + 1, first + 2]);
+    }
+    mesh(vertices, tris)
+}
+
+/// A closed box (`subdivided_cuboid(half, 3)`) with `extra` zero-area triangles mixed in,
+/// then the triangle order shuffled: segment-like triangles with a repeated index (a mesh
+/// edge, a chord through the box or a new segment), exactly collinear triples (the three
+/// points differ in one coordinate only) and point triangles, on the surface and inside.
+pub fn with_zero_area_triangles(rng: &mut TestRng, half: DVec3, extra: usize) -> TriMesh {
+    let base = subdivided_cuboid(half, 3);
+    let mut vertices = base.vertices().to_vec();
+    let mut tris = base.triangles().to_vec();
+    let n_surface = vertices.len() as u32;
+    for k in 0..extra {
+        let any = |rng: &mut TestRng| rng.random_range(0..n_surface);
+        match k % 4 {
+            0 => {
+                let (i, j) = (any(rng), any(rng));
+                tris.push([i, j, i]);
+            }
+            1 => {
+                let i = any(rng);
+                tris.push([i, i, i]);
+            }
+            2 => {
+                // Collinear along one axis: only that coordinate changes.
+                let p = point_in_cube(rng, 1.0) * half;
+                let axis = rng.random_range(0..3);
+                let mut q = p;
+                let mut m = p;
+                q[axis] = rng.random_range(-half[axis]..=half[axis]);
+                m[axis] = 0.5 * (p[axis] + q[axis]);
+                let first = vertices.len() as u32;
+                vertices.extend([p, m, q]);
+                tris.push([first, first + 1, first + 2]);
+            }
+            _ => {
+                // A point inside the box, as a triangle of one repeated new vertex.
+                let first = vertices.len() as u32;
+                vertices.push(point_in_cube(rng, 1.0) * half);
+                tris.push([first, first, first]);
+            }
+        }
+    }
+    tris.shuffle(rng);
+    mesh(vertices, tris)
+}
+
+/// The triangles of `mesh` split in two meshes by the sign of their centroid's `x`, both
+/// keeping every vertex (so the halves share the vertices along the cut exactly).
+pub fn halves(mesh: &TriMesh) -> (TriMesh, TriMesh) {
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    for (i, &t) in mesh.triangles().iter().enumerate() {
+        if mesh.triangle(i).centroid().x < 0.0 {
+            left.push(t);
+        } else {
+            right.push(t);
+        }
+    }
+    let vertices = mesh.vertices().to_vec();
+    (
+        self::mesh(vertices.clone(), left),
+        self::mesh(vertices, right),
+    )
+}
+
+/// A mesh of `tests/data` (see its README for origin and licence).
+pub fn data_mesh(file: &str) -> TriMesh {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(file);
+    TriMesh::load(&path).unwrap_or_else(|e| panic!("cannot load {}: {e}", path.display()))
+}
