@@ -1,6 +1,6 @@
 //! Collision queries: does any triangle pair intersect, and which ones do.
 
-use super::{FALLBACK_NORMAL, MeshMeshWorkspace, TriangleContact};
+use super::{FALLBACK_NORMAL, MeshMeshWorkspace, TriangleContact, for_each_triangle_pair};
 use crate::bounding::BoundingVolume;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::for_each_leaf_pair;
@@ -21,22 +21,19 @@ pub fn intersects_mesh_mesh<B: BoundingVolume>(
     workspace: &mut MeshMeshWorkspace,
 ) -> bool {
     let iso = pose_ab.to_isometry();
-    let (ta, tb) = (a.triangles(), b.triangles());
     let flow = for_each_leaf_pair(
         a,
         b,
         &mut workspace.pairs,
         |x, y| x.overlaps(y, &iso),
         |la, lb| {
-            for sb in b.nodes()[lb].slots() {
-                let tri_b = tb[sb].transformed(&iso);
-                for sa in a.nodes()[la].slots() {
-                    if intersects_triangle_triangle(&ta[sa], &tri_b) {
-                        return ControlFlow::Break(());
-                    }
+            for_each_triangle_pair(a, b, [la, lb], &iso, |_, tri_a, _, tri_b| {
+                if intersects_triangle_triangle(tri_a, tri_b) {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
                 }
-            }
-            ControlFlow::Continue(())
+            })
         },
     );
     flow.is_break()
@@ -59,32 +56,27 @@ pub fn contacts_mesh_mesh<B, S>(
     S: FnMut(TriangleContact) -> ControlFlow<()>,
 {
     let iso = pose_ab.to_isometry();
-    let (ta, tb) = (a.triangles(), b.triangles());
     let _ = for_each_leaf_pair(
         a,
         b,
         &mut workspace.pairs,
         |x, y| x.overlaps(y, &iso),
         |la, lb| {
-            for sb in b.nodes()[lb].slots() {
-                let tri_b = tb[sb].transformed(&iso);
-                for sa in a.nodes()[la].slots() {
-                    let tri_a = &ta[sa];
-                    if let Some((p, q)) = intersection_segment_triangle_triangle(tri_a, &tri_b) {
-                        let normal = tri_a
-                            .normal()
-                            .or_else(|| tri_b.normal().map(|n| -n))
-                            .unwrap_or(FALLBACK_NORMAL);
-                        sink(TriangleContact {
-                            triangles: [a.triangle_id(sa), b.triangle_id(sb)],
-                            segment: [p, q],
-                            point: p.midpoint(q),
-                            normal,
-                        })?;
-                    }
-                }
-            }
-            ControlFlow::Continue(())
+            for_each_triangle_pair(a, b, [la, lb], &iso, |sa, tri_a, sb, tri_b| {
+                let Some((p, q)) = intersection_segment_triangle_triangle(tri_a, tri_b) else {
+                    return ControlFlow::Continue(());
+                };
+                let normal = tri_a
+                    .normal()
+                    .or_else(|| tri_b.normal().map(|n| -n))
+                    .unwrap_or(FALLBACK_NORMAL);
+                sink(TriangleContact {
+                    triangles: [a.triangle_id(sa), b.triangle_id(sb)],
+                    segment: [p, q],
+                    point: p.midpoint(q),
+                    normal,
+                })
+            })
         },
     );
 }

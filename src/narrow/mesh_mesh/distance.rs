@@ -1,6 +1,8 @@
 //! Distance queries: the smallest triangle–triangle distance, and "within distance d?".
 
-use super::{DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace};
+use super::{
+    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, for_each_triangle_pair,
+};
 use crate::bounding::BoundingVolume;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::{for_each_leaf_pair, nearest_leaf_pairs};
@@ -94,22 +96,19 @@ pub fn within_distance_mesh_mesh<B: BoundingVolume>(
     workspace: &mut MeshMeshWorkspace,
 ) -> bool {
     let iso = pose_ab.to_isometry();
-    let (ta, tb) = (a.triangles(), b.triangles());
     let flow = for_each_leaf_pair(
         a,
         b,
         &mut workspace.pairs,
         |x, y| x.distance_lower_bound_within(y, &iso, max_distance) <= max_distance,
         |la, lb| {
-            for sb in b.nodes()[lb].slots() {
-                let tri_b = tb[sb].transformed(&iso);
-                for sa in a.nodes()[la].slots() {
-                    if distance_triangle_triangle(&ta[sa], &tri_b).distance <= max_distance {
-                        return ControlFlow::Break(());
-                    }
+            for_each_triangle_pair(a, b, [la, lb], &iso, |_, tri_a, _, tri_b| {
+                if distance_triangle_triangle(tri_a, tri_b).distance <= max_distance {
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
                 }
-            }
-            ControlFlow::Continue(())
+            })
         },
     );
     flow.is_break()

@@ -33,9 +33,12 @@ mod distance;
 pub use collide::{contacts_mesh_mesh, intersects_mesh_mesh};
 pub use distance::{distance_mesh_mesh, within_distance_mesh_mesh};
 
+use crate::bvh::Bvh;
 use crate::bvh::tandem::RankedPair;
-use crate::math::DVec3;
+use crate::geometry::Triangle;
+use crate::math::{DVec3, Isometry};
 use std::collections::BinaryHeap;
+use std::ops::ControlFlow;
 
 /// Scratch space of the mesh–mesh queries; reuse one per thread.
 #[derive(Debug, Default, Clone)]
@@ -138,4 +141,27 @@ impl DistanceCache {
     pub fn new() -> Self {
         Self::default()
     }
+}
+
+/// Calls `visit(slot_a, triangle_a, slot_b, triangle_b)` for every triangle pair of leaf
+/// `leaf_a` of `a` and leaf `leaf_b` of `b`, with B's triangle mapped into A's frame by
+/// `iso` (once per triangle of B), until `visit` breaks.
+#[inline]
+fn for_each_triangle_pair<B, V>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    [leaf_a, leaf_b]: [usize; 2],
+    iso: &Isometry,
+    mut visit: V,
+) -> ControlFlow<()>
+where
+    V: FnMut(usize, &Triangle, usize, &Triangle) -> ControlFlow<()>,
+{
+    for sb in b.nodes()[leaf_b].slots() {
+        let tri_b = b.triangles()[sb].transformed(iso);
+        for sa in a.nodes()[leaf_a].slots() {
+            visit(sa, &a.triangles()[sa], sb, &tri_b)?;
+        }
+    }
+    ControlFlow::Continue(())
 }
