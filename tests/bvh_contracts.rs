@@ -22,10 +22,8 @@ use proxima::bvh::{BuildParams, BuildStrategy, Bvh};
 use proxima::geometry::{TriMesh, Triangle};
 use proxima::math::DVec3;
 use rand::Rng;
-use support::{
-    CENTERS, SCALES, flat_grid, rng, scaled_and_moved, torus, triangle_soup, uv_sphere,
-    zero_area_triangles,
-};
+use support::meshes::{self, grid, torus, triangle_soup, uv_sphere, zero_area_triangles};
+use support::{CENTERS, SCALES, rng};
 
 /// Every preset; each is built with leaf sizes 1 and 4.
 const PRESETS: [BuildParams; 4] = [
@@ -51,12 +49,12 @@ macro_rules! for_each_volume {
 }
 
 /// The procedural meshes, named for failure messages.
-fn meshes() -> Vec<(&'static str, Vec<Triangle>)> {
+fn named_meshes() -> Vec<(&'static str, Vec<Triangle>)> {
     let mut rng = rng(401);
     let p = DVec3::new(0.3, -0.2, 0.7);
     let one = Triangle::new(p, p + DVec3::X, p + DVec3::new(0.2, 0.9, 0.1));
-    let sphere = uv_sphere(8, 12, 1.0);
-    let ring = torus(16, 6, 2.0, 0.5);
+    let sphere = uv_sphere(1.0, 12, 8);
+    let ring = torus(2.0, 0.5, 16, 6);
     let soup = triangle_soup(&mut rng, 150, 1.0, 0.3);
     let far = DVec3::new(1e5, -1e5, 1e5);
     vec![
@@ -64,27 +62,28 @@ fn meshes() -> Vec<(&'static str, Vec<Triangle>)> {
         ("identical triangles", vec![one; 40]),
         (
             "zero-area triangles",
-            zero_area_triangles(&mut rng, 90, 1.0),
+            meshes::triangles(&zero_area_triangles(&mut rng, 90, 1.0)),
         ),
-        ("uv sphere", sphere.clone()),
-        ("torus", ring.clone()),
-        ("soup", soup.clone()),
-        ("flat grid", flat_grid(9, 8)),
+        ("uv sphere", meshes::triangles(&sphere)),
+        ("torus", meshes::triangles(&ring)),
+        ("soup", meshes::triangles(&soup)),
+        // 9 × 9 unit cells: 162 coplanar triangles, a count that is no power of two.
+        ("flat grid", meshes::triangles(&grid(4.5, 9))),
         (
             "sphere 1e5 from origin",
-            scaled_and_moved(&sphere, 1.0, far),
+            meshes::triangles(&sphere.translated(far)),
         ),
+        ("torus at scale 1e-3", meshes::triangles(&ring.scaled(1e-3))),
         (
-            "torus at scale 1e-3",
-            scaled_and_moved(&ring, 1e-3, DVec3::ZERO),
+            "soup at scale 1e3, far",
+            meshes::triangles(&soup.scaled(1e3).translated(far)),
         ),
-        ("soup at scale 1e3, far", scaled_and_moved(&soup, 1e3, far)),
     ]
 }
 
 /// Calls `check(name, triangles, params)` for every mesh, preset and leaf size.
 fn for_each_case(mut check: impl FnMut(&str, &[Triangle], BuildParams)) {
-    for (name, triangles) in meshes() {
+    for (name, triangles) in named_meshes() {
         for preset in PRESETS {
             for leaf_size in LEAF_SIZES {
                 check(name, &triangles, preset.with_leaf_size(leaf_size));
@@ -210,11 +209,11 @@ fn random_cases<B: BoundingVolume>(seed: u64) {
         let base = match case % 3 {
             0 => triangle_soup(&mut rng, n, 1.0, size),
             1 => zero_area_triangles(&mut rng, n, 1.0),
-            _ => uv_sphere(2 + n % 7, 3 + n % 11, 1.0),
+            _ => uv_sphere(1.0, 3 + (n % 11) as u32, 2 + (n % 7) as u32),
         };
         let center = support::rotation(&mut rng) * DVec3::X * CENTERS[case % CENTERS.len()];
         let scale = SCALES[rng.random_range(0..SCALES.len())];
-        let triangles = scaled_and_moved(&base, scale, center);
+        let triangles = meshes::triangles(&base.scaled(scale).translated(center));
         let preset = PRESETS[rng.random_range(0..PRESETS.len())];
         let params = preset.with_leaf_size(rng.random_range(1..9));
         let bvh = Bvh::<B>::from_triangles(&triangles, &params);

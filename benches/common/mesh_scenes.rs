@@ -3,10 +3,10 @@
 //! A [`MeshScene`] is two meshes, each in its own local frame, and a list of `pose_ab` (B's
 //! frame expressed in A's), so every engine is handed exactly the same relative placements.
 
+use crate::support::meshes::torus;
 use crate::support::{point_in_cube, rng, rotation};
 use proxima::geometry::TriMesh;
 use proxima::math::{DMat3, DQuat, DVec3, Pose};
-use std::f64::consts::TAU;
 use std::path::Path;
 
 /// Two meshes and the relative poses to query them under.
@@ -137,36 +137,4 @@ pub fn tori<C: FnMut(&Pose) -> bool>(
         b,
         poses_ab,
     }
-}
-
-/// A closed torus about the z axis: `major` radius of the centre circle, `minor` radius of
-/// the tube, metres, `rings × sides` quads split in two triangles each (outward winding).
-#[must_use]
-pub fn torus(major: f64, minor: f64, rings: u32, sides: u32) -> TriMesh {
-    debug_assert!(major > minor && minor > 0.0 && rings >= 3 && sides >= 3);
-    let vertices: Vec<DVec3> = (0..rings)
-        .flat_map(|i| {
-            let u = TAU * f64::from(i) / f64::from(rings);
-            (0..sides).map(move |j| {
-                let v = TAU * f64::from(j) / f64::from(sides);
-                let r = major + minor * v.cos();
-                DVec3::new(r * u.cos(), r * u.sin(), minor * v.sin())
-            })
-        })
-        .collect();
-    let index = |i: u32, j: u32| (i % rings) * sides + (j % sides);
-    let triangles: Vec<[u32; 3]> = (0..rings)
-        .flat_map(|i| {
-            (0..sides).flat_map(move |j| {
-                let (p, q, r, s) = (
-                    index(i, j),
-                    index(i + 1, j),
-                    index(i + 1, j + 1),
-                    index(i, j + 1),
-                );
-                [[p, q, r], [p, r, s]]
-            })
-        })
-        .collect();
-    TriMesh::try_new(vertices, triangles).expect("a torus is a valid mesh")
 }

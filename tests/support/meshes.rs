@@ -1,11 +1,14 @@
-//! Procedural meshes for the mesh–mesh tests, and the real meshes kept in `tests/data`.
+//! Procedural meshes for the integration tests and benches (the single home of them), and
+//! the real meshes kept in `tests/data`.
 //!
 //! Closed solids ([`uv_sphere`], [`torus`], [`cuboid`], [`subdivided_cuboid`]) are welded
 //! (neighbouring triangles share vertex indices) and oriented counter-clockwise seen from
 //! outside. [`grid`] is an open surface of many coplanar triangles, [`triangle_soup`] an
-//! unwelded set of random triangles, and [`with_zero_area_triangles`] a closed box with
-//! segment- and point-like triangles mixed in. Everything random takes the caller's seeded
-//! [`TestRng`].
+//! unwelded set of random triangles, [`zero_area_triangles`] a set of nothing but point- and
+//! segment-like triangles, and [`with_zero_area_triangles`] a closed box with such triangles
+//! mixed in. Everything random takes the caller's seeded [`TestRng`]. Where a test needs
+//! bare triangles, [`triangles`] lists a mesh's; move or scale a mesh with
+//! `TriMesh::translated` and `TriMesh::scaled`.
 
 use super::{TestRng, point_in_cube};
 use proxima::geometry::{TriMesh, Triangle};
@@ -184,6 +187,35 @@ pub fn triangle_soup(rng: &mut TestRng, count: usize, half: f64, size: f64) -> T
         }
         let first = 3 * t as u32;
         tris.push([first, first + 1, first + 2]);
+    }
+    mesh(vertices, tris)
+}
+
+/// `count` zero-area triangles in the cube `[-half, half]³` and nothing else, unwelded, in
+/// turn: a point (one vertex, index repeated three times); three collinear points `p`,
+/// `p + d`, `p + 2.5 d` (collinear up to the rounding of the sums); a segment with a
+/// repeated end (`[p, p + d, p]`), with `|dᵢ| ≤ half / 10`.
+pub fn zero_area_triangles(rng: &mut TestRng, count: usize, half: f64) -> TriMesh {
+    let mut vertices = Vec::with_capacity(3 * count);
+    let mut tris = Vec::with_capacity(count);
+    for k in 0..count {
+        let p = point_in_cube(rng, half);
+        let d = point_in_cube(rng, half * 0.1);
+        let first = vertices.len() as u32;
+        match k % 3 {
+            0 => {
+                vertices.push(p);
+                tris.push([first; 3]);
+            }
+            1 => {
+                vertices.extend([p, p + d, p + 2.5 * d]);
+                tris.push([first, first + 1, first + 2]);
+            }
+            _ => {
+                vertices.extend([p, p + d]);
+                tris.push([first, first + 1, first]);
+            }
+        }
     }
     mesh(vertices, tris)
 }
