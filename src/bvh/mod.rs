@@ -27,6 +27,8 @@
 pub mod build;
 mod refit;
 pub mod tandem;
+#[cfg(test)]
+mod test_support;
 mod validate;
 
 pub use build::{BuildParams, BuildStrategy};

@@ -52,3 +52,63 @@ impl<B: BoundingVolume> Bvh<B> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bounding::fit::test_support::{point_in_cube, rng};
+    use crate::bvh::test_support::{PRESETS, for_each_volume, soup};
+    use crate::math::DVec3;
+
+    /// Builds with every preset and leaf sizes 1 and 4, then checks refit in both modes.
+    fn refit_contracts<B: BoundingVolume + PartialEq>(seed: u64) {
+        let mut rng = rng(seed);
+        for case in 0..6 {
+            let n = [1, 2, 7, 60, 150, 150][case];
+            let (half, size) = [(1.0, 0.1), (1e3, 20.0), (1e-3, 1e-4)][case % 3];
+            let offset = if case == 5 {
+                DVec3::splat(1e5)
+            } else {
+                DVec3::ZERO
+            };
+            let triangles: Vec<Triangle> = soup(&mut rng, n, half, size)
+                .into_iter()
+                .map(|t| Triangle::new(t.a + offset, t.b + offset, t.c + offset))
+                .collect();
+            for params in PRESETS {
+                for leaf_size in [1, 4] {
+                    let params = params.with_leaf_size(leaf_size);
+                    let built = Bvh::<B>::from_triangles(&triangles, &params);
+                    let what = format!("{} {params:?} case {case}", B::NAME);
+                    assert_eq!(built.validate(), Ok(()), "{what}");
+                    let mut same = built.clone();
+                    same.refit(&triangles, RefitMode::Fit);
+                    assert_eq!(
+                        same.nodes, built.nodes,
+                        "{what}: fit refit of unmoved triangles"
+                    );
+                    let moved: Vec<Triangle> = triangles
+                        .iter()
+                        .map(|t| {
+                            let mut jiggle = || point_in_cube(&mut rng, 2.0 * half);
+                            Triangle::new(t.a + jiggle(), t.b + jiggle(), t.c + jiggle())
+                        })
+                        .collect();
+                    for mode in [RefitMode::Merge, RefitMode::Fit] {
+                        let mut refitted = built.clone();
+                        refitted.refit(&moved, mode);
+                        assert_eq!(refitted.validate(), Ok(()), "{what} {mode:?}");
+                        // The tree's shape and slot map are unchanged.
+                        assert_eq!(refitted.spans, built.spans);
+                        assert_eq!(refitted.triangle_ids, built.triangle_ids);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn refit_keeps_every_tree_valid_and_fit_refit_of_unmoved_triangles_is_the_build() {
+        for_each_volume!(refit_contracts(306));
+    }
+}

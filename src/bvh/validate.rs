@@ -138,3 +138,71 @@ impl<B: BoundingVolume> Bvh<B> {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bounding::Aabb;
+    use crate::bounding::fit::test_support::rng;
+    use crate::bvh::test_support::soup;
+    use crate::bvh::{BuildParams, BvhNode};
+    use crate::geometry::Triangle;
+    use crate::math::DVec3;
+
+    /// An 8-triangle median tree with one triangle per leaf, and one of its leaves.
+    fn small_tree() -> (Bvh<Aabb>, usize) {
+        let triangles = soup(&mut rng(307), 8, 1.0, 0.1);
+        let bvh = Bvh::<Aabb>::from_triangles(&triangles, &BuildParams::MEDIAN);
+        assert_eq!(bvh.validate(), Ok(()));
+        let leaf = bvh.nodes.iter().rposition(BvhNode::is_leaf).unwrap();
+        (bvh, leaf)
+    }
+
+    #[test]
+    fn validate_catches_each_kind_of_corruption() {
+        let (bvh, leaf) = small_tree();
+        let (mut bad, far) = (bvh.clone(), DVec3::splat(50.0));
+        bad.nodes[leaf].bv = Aabb::fit_points(&[far]);
+        bad.nodes[leaf].size = bad.nodes[leaf].bv.size();
+        assert!(matches!(bad.validate(), Err(BvhError::Escapes { node, .. }) if node == leaf));
+
+        let mut bad = bvh.clone();
+        let slot = bad.nodes[leaf].slots().start;
+        bad.triangles[slot] = Triangle::new(far, far, far);
+        assert!(matches!(bad.validate(), Err(BvhError::Escapes { slot: s, .. }) if s == slot));
+
+        let mut bad = bvh.clone();
+        bad.nodes[3].size *= 2.0;
+        assert_eq!(bad.validate(), Err(BvhError::StaleSize { node: 3 }));
+
+        let mut bad = bvh.clone();
+        bad.triangle_ids[1] = bad.triangle_ids[0];
+        let id = bad.triangle_ids[0] as usize;
+        assert_eq!(bad.validate(), Err(BvhError::NotAPermutation { id }));
+
+        let mut bad = bvh.clone();
+        bad.nodes[0].first = 0;
+        assert_eq!(
+            bad.validate(),
+            Err(BvhError::BadChild { node: 0, child: 0 })
+        );
+
+        let mut bad = bvh.clone();
+        bad.nodes[leaf].count = 2;
+        assert!(
+            matches!(bad.validate(), Err(BvhError::BadLeaf { node, count: 2 }) if node == leaf)
+        );
+
+        let mut bad = bvh.clone();
+        bad.spans[leaf][1] += 1;
+        // Found at the leaf's parent, which is checked first.
+        assert!(matches!(bad.validate(), Err(BvhError::BadSpan { .. })));
+
+        let mut bad = bvh.clone();
+        bad.spans.pop();
+        assert_eq!(bad.validate(), Err(BvhError::Empty));
+
+        // And the uncorrupted tree passes.
+        assert_eq!(bvh.validate(), Ok(()));
+    }
+}

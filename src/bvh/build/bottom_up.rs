@@ -312,44 +312,11 @@ fn collect_triangles(tree: &ClusterTree, cluster: u32, stack: &mut Vec<u32>, out
 mod tests {
     use super::super::{BuildParams, BuildStrategy, fit_topology};
     use super::*;
-    use crate::bounding::fit::test_support::{TestRng, point_in_cube, rng};
-    use crate::bounding::{BoundingSphere, Kdop18, Lss, Obb, Rss};
-    use crate::bvh::refit::RefitMode;
-    use crate::bvh::{Bvh, BvhError, BvhNode};
+    use crate::bounding::Obb;
+    use crate::bounding::fit::test_support::{point_in_cube, rng};
+    use crate::bvh::Bvh;
+    use crate::bvh::test_support::{for_each_volume, soup};
     use rand::Rng;
-
-    /// Runs `$check::<B>($args)` for every volume type a BVH is built with in tests.
-    macro_rules! for_each_volume {
-        ($check:ident($($arg:expr),*)) => {
-            $check::<Aabb>($($arg),*);
-            $check::<Obb>($($arg),*);
-            $check::<BoundingSphere>($($arg),*);
-            $check::<Kdop18>($($arg),*);
-            $check::<Lss>($($arg),*);
-            $check::<Rss>($($arg),*);
-        };
-    }
-
-    const PRESETS: [BuildParams; 4] = [
-        BuildParams::MEDIAN,
-        BuildParams::MEAN_VARIANCE,
-        BuildParams::BINNED_SAH,
-        BuildParams::AGGLOMERATIVE,
-    ];
-
-    /// `n` random triangles of size about `size` in a cube of half side `half`.
-    fn soup(rng: &mut TestRng, n: usize, half: f64, size: f64) -> Vec<Triangle> {
-        (0..n)
-            .map(|_| {
-                let c = point_in_cube(rng, half);
-                Triangle::new(
-                    c + point_in_cube(rng, size),
-                    c + point_in_cube(rng, size),
-                    c + point_in_cube(rng, size),
-                )
-            })
-            .collect()
-    }
 
     fn primitives(triangles: &[Triangle]) -> Vec<BuildPrimitive> {
         triangles.iter().map(BuildPrimitive::of).collect()
@@ -545,117 +512,6 @@ mod tests {
             let triangles = soup(&mut rng, n, 1.0, 0.1);
             for_each_volume!(cluster_with(&triangles));
         }
-    }
-
-    /// Builds with every preset and leaf sizes 1 and 4, then checks refit in both modes.
-    fn refit_contracts<B: BoundingVolume + PartialEq>(seed: u64) {
-        let mut rng = rng(seed);
-        for case in 0..6 {
-            let n = [1, 2, 7, 60, 150, 150][case];
-            let (half, size) = [(1.0, 0.1), (1e3, 20.0), (1e-3, 1e-4)][case % 3];
-            let offset = if case == 5 {
-                DVec3::splat(1e5)
-            } else {
-                DVec3::ZERO
-            };
-            let triangles: Vec<Triangle> = soup(&mut rng, n, half, size)
-                .into_iter()
-                .map(|t| Triangle::new(t.a + offset, t.b + offset, t.c + offset))
-                .collect();
-            for params in PRESETS {
-                for leaf_size in [1, 4] {
-                    let params = params.with_leaf_size(leaf_size);
-                    let built = Bvh::<B>::from_triangles(&triangles, &params);
-                    let what = format!("{} {params:?} case {case}", B::NAME);
-                    assert_eq!(built.validate(), Ok(()), "{what}");
-                    let mut same = built.clone();
-                    same.refit(&triangles, RefitMode::Fit);
-                    assert_eq!(
-                        same.nodes, built.nodes,
-                        "{what}: fit refit of unmoved triangles"
-                    );
-                    let moved: Vec<Triangle> = triangles
-                        .iter()
-                        .map(|t| {
-                            let mut jiggle = || point_in_cube(&mut rng, 2.0 * half);
-                            Triangle::new(t.a + jiggle(), t.b + jiggle(), t.c + jiggle())
-                        })
-                        .collect();
-                    for mode in [RefitMode::Merge, RefitMode::Fit] {
-                        let mut refitted = built.clone();
-                        refitted.refit(&moved, mode);
-                        assert_eq!(refitted.validate(), Ok(()), "{what} {mode:?}");
-                        // The tree's shape and slot map are unchanged.
-                        assert_eq!(refitted.spans, built.spans);
-                        assert_eq!(refitted.triangle_ids, built.triangle_ids);
-                    }
-                }
-            }
-        }
-    }
-
-    // NOTE: these refit contracts belong in tests/bvh_contracts.rs, but `RefitMode` is not
-    // reachable from outside the crate (`bvh::refit` is private and not re-exported).
-    #[test]
-    fn refit_keeps_every_tree_valid_and_fit_refit_of_unmoved_triangles_is_the_build() {
-        for_each_volume!(refit_contracts(306));
-    }
-
-    /// An 8-triangle median tree with one triangle per leaf, and one of its leaves.
-    fn small_tree() -> (Bvh<Aabb>, usize) {
-        let triangles = soup(&mut rng(307), 8, 1.0, 0.1);
-        let bvh = Bvh::<Aabb>::from_triangles(&triangles, &BuildParams::MEDIAN);
-        assert_eq!(bvh.validate(), Ok(()));
-        let leaf = bvh.nodes.iter().rposition(BvhNode::is_leaf).unwrap();
-        (bvh, leaf)
-    }
-
-    #[test]
-    fn validate_catches_each_kind_of_corruption() {
-        let (bvh, leaf) = small_tree();
-        let (mut bad, far) = (bvh.clone(), DVec3::splat(50.0));
-        bad.nodes[leaf].bv = Aabb::fit_points(&[far]);
-        bad.nodes[leaf].size = bad.nodes[leaf].bv.size();
-        assert!(matches!(bad.validate(), Err(BvhError::Escapes { node, .. }) if node == leaf));
-
-        let mut bad = bvh.clone();
-        let slot = bad.nodes[leaf].slots().start;
-        bad.triangles[slot] = Triangle::new(far, far, far);
-        assert!(matches!(bad.validate(), Err(BvhError::Escapes { slot: s, .. }) if s == slot));
-
-        let mut bad = bvh.clone();
-        bad.nodes[3].size *= 2.0;
-        assert_eq!(bad.validate(), Err(BvhError::StaleSize { node: 3 }));
-
-        let mut bad = bvh.clone();
-        bad.triangle_ids[1] = bad.triangle_ids[0];
-        let id = bad.triangle_ids[0] as usize;
-        assert_eq!(bad.validate(), Err(BvhError::NotAPermutation { id }));
-
-        let mut bad = bvh.clone();
-        bad.nodes[0].first = 0;
-        assert_eq!(
-            bad.validate(),
-            Err(BvhError::BadChild { node: 0, child: 0 })
-        );
-
-        let mut bad = bvh.clone();
-        bad.nodes[leaf].count = 2;
-        assert!(
-            matches!(bad.validate(), Err(BvhError::BadLeaf { node, count: 2 }) if node == leaf)
-        );
-
-        let mut bad = bvh.clone();
-        bad.spans[leaf][1] += 1;
-        // Found at the leaf's parent, which is checked first.
-        assert!(matches!(bad.validate(), Err(BvhError::BadSpan { .. })));
-
-        let mut bad = bvh.clone();
-        bad.spans.pop();
-        assert_eq!(bad.validate(), Err(BvhError::Empty));
-
-        // And the uncorrupted tree passes.
-        assert_eq!(bvh.validate(), Ok(()));
     }
 
     #[test]
