@@ -16,6 +16,9 @@
 //!
 //! A module uses only modules listed above it.
 
+// So test support written against the public crate name compiles inside the crate's unit tests.
+extern crate self as proxima;
+
 // Stages in data-flow order (kept apart so rustfmt does not sort them).
 
 /// Poses, isometries, tolerances.
@@ -32,3 +35,7 @@ pub mod bvh;
 
 /// Exact queries: triangle–triangle overlap, intersection and distance; mesh–mesh queries.
 pub mod narrow;
+
+#[cfg(test)]
+#[path = "../tests/support/mod.rs"]
+pub(crate) mod test_support;

@@ -20,19 +20,13 @@ use proxima::bounding::{
 use proxima::geometry::Triangle;
 use proxima::math::DVec3;
 use rand::Rng;
-use support::{CENTERS, CloudKind, SCALES, TestRng, cloud, isometry, rng};
+use support::{isometry, min_distance, random_cloud, rng};
 
 /// Cases per contract and volume type.
 const CASES: usize = 3000;
 
-/// One random cloud from the degenerate-input matrix, with its scale (metres).
-fn random_cloud(rng: &mut TestRng) -> (Vec<DVec3>, f64) {
-    let kind = CloudKind::ALL[rng.random_range(0..CloudKind::ALL.len())];
-    let center = support::rotation(rng) * DVec3::X * CENTERS[rng.random_range(0..CENTERS.len())];
-    let scale = SCALES[rng.random_range(0..SCALES.len())];
-    let n = rng.random_range(1..64);
-    (cloud(rng, kind, n, center, scale), scale)
-}
+/// Most points in one random cloud.
+const MAX_POINTS: usize = 63;
 
 /// Triangles over consecutive point triples (wrapping), so degenerate clouds give
 /// degenerate triangles.
@@ -49,16 +43,10 @@ fn triangles_of(points: &[DVec3]) -> Vec<Triangle> {
         .collect()
 }
 
-fn min_distance(a: &[DVec3], b: &[DVec3]) -> f64 {
-    a.iter()
-        .flat_map(|p| b.iter().map(move |q| p.distance(*q)))
-        .fold(f64::INFINITY, f64::min)
-}
-
 fn check_containment<B: BoundingVolume>(seed: u64) {
     let mut rng = rng(seed);
     for case in 0..CASES {
-        let (points, _) = random_cloud(&mut rng);
+        let (points, _) = random_cloud(&mut rng, MAX_POINTS);
         let bv = B::fit_points(&points);
         for p in &points {
             assert!(
@@ -94,8 +82,8 @@ fn check_containment<B: BoundingVolume>(seed: u64) {
 fn check_merge_and_transform<B: BoundingVolume>(seed: u64) {
     let mut rng = rng(seed);
     for case in 0..CASES {
-        let (a, _) = random_cloud(&mut rng);
-        let (b, _) = random_cloud(&mut rng);
+        let (a, _) = random_cloud(&mut rng, MAX_POINTS);
+        let (b, _) = random_cloud(&mut rng, MAX_POINTS);
         let (bv_a, bv_b) = (B::fit_points(&a), B::fit_points(&b));
         let merged = bv_a.merged(&bv_b);
         let mut merged_in_place = bv_a;
@@ -130,8 +118,8 @@ fn check_merge_and_transform<B: BoundingVolume>(seed: u64) {
 fn check_shared_point_overlaps<B: BoundingVolume>(seed: u64) {
     let mut rng = rng(seed);
     for case in 0..CASES {
-        let (a, scale) = random_cloud(&mut rng);
-        let (mut b, _) = random_cloud(&mut rng);
+        let (a, scale) = random_cloud(&mut rng, MAX_POINTS);
+        let (mut b, _) = random_cloud(&mut rng, MAX_POINTS);
         let pose_ab = isometry(&mut rng, 1e3 * scale);
         let shared_a = a[rng.random_range(0..a.len())];
         b.push(pose_ab.inverse_transform_point(shared_a));
@@ -161,8 +149,8 @@ fn check_distance_bound_and_outcomes<B: BoundingVolume>(seed: u64) {
     let mut rng = rng(seed);
     let (mut overlapping, mut separated, mut positive_bounds, mut borderline) = (0, 0, 0, 0);
     for case in 0..CASES {
-        let (a, scale) = random_cloud(&mut rng);
-        let (b_local, _) = random_cloud(&mut rng);
+        let (a, scale) = random_cloud(&mut rng, MAX_POINTS);
+        let (b_local, _) = random_cloud(&mut rng, MAX_POINTS);
         // Put B near A: its centre within a few scales of A's first point.
         let mut pose_ab = isometry(&mut rng, 3.0 * scale);
         pose_ab.translation += a[0] - pose_ab.transform_point(b_local[0])

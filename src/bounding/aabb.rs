@@ -216,12 +216,12 @@ impl BoundingVolume for Aabb {
 
 #[cfg(test)]
 mod tests {
-    use super::super::sphere::test_clouds::{self, Kind};
     use super::*;
+    use crate::test_support::{self as support, CloudKind};
     use rand::Rng;
 
     /// Random point in the box (corners and faces included now and then).
-    fn point_in(rng: &mut test_clouds::TestRng, b: &Aabb) -> DVec3 {
+    fn point_in(rng: &mut support::TestRng, b: &Aabb) -> DVec3 {
         let t = DVec3::new(
             rng.random_range(-0.2..1.2_f64).clamp(0.0, 1.0),
             rng.random_range(-0.2..1.2_f64).clamp(0.0, 1.0),
@@ -233,9 +233,9 @@ mod tests {
 
     #[test]
     fn fitted_boxes_contain_every_point_and_triangle_vertex() {
-        let mut rng = test_clouds::rng(11);
+        let mut rng = support::rng(11);
         for case in 0..3000 {
-            let (points, _) = test_clouds::any_cloud(&mut rng, 50);
+            let (points, _) = support::random_cloud(&mut rng, 50);
             let b = Aabb::fit_points(&points);
             assert!(points.iter().all(|p| b.contains_point(*p)), "case {case}");
             let tris: Vec<Triangle> = points
@@ -267,10 +267,10 @@ mod tests {
 
     #[test]
     fn merged_contains_both() {
-        let mut rng = test_clouds::rng(12);
+        let mut rng = support::rng(12);
         for case in 0..2000 {
-            let (p, _) = test_clouds::any_cloud(&mut rng, 10);
-            let (q, _) = test_clouds::any_cloud(&mut rng, 10);
+            let (p, _) = support::random_cloud(&mut rng, 10);
+            let (q, _) = support::random_cloud(&mut rng, 10);
             let (a, b) = (Aabb::fit_points(&p), Aabb::fit_points(&q));
             let m = a.merged(&b);
             let mut grown = a;
@@ -286,10 +286,10 @@ mod tests {
 
     #[test]
     fn transformed_contains_the_moved_points_and_the_moved_box() {
-        let mut rng = test_clouds::rng(13);
+        let mut rng = support::rng(13);
         for case in 0..3000 {
-            let (points, scale) = test_clouds::any_cloud(&mut rng, 30);
-            let pose = test_clouds::isometry(&mut rng, 100.0 * scale);
+            let (points, scale) = support::random_cloud(&mut rng, 30);
+            let pose = support::isometry(&mut rng, 100.0 * scale);
             let b = Aabb::fit_points(&points);
             let moved = b.transformed(&pose);
             for p in &points {
@@ -307,12 +307,12 @@ mod tests {
 
     #[test]
     fn overlap_and_distance_bound_are_conservative_against_brute_force() {
-        let mut rng = test_clouds::rng(14);
+        let mut rng = support::rng(14);
         let (mut overlapping, mut apart) = (0, 0);
         for case in 0..4000 {
-            let (a_points, scale) = test_clouds::any_cloud(&mut rng, 20);
-            let (mut b_points, _) = test_clouds::any_cloud(&mut rng, 20);
-            let pose_ab = test_clouds::isometry(&mut rng, 2.0 * scale);
+            let (a_points, scale) = support::random_cloud(&mut rng, 20);
+            let (mut b_points, _) = support::random_cloud(&mut rng, 20);
+            let pose_ab = support::isometry(&mut rng, 2.0 * scale);
             let shared = case % 3 == 0;
             if shared {
                 b_points.push(pose_ab.inverse_transform_point(a_points[0]));
@@ -323,7 +323,7 @@ mod tests {
                 .iter()
                 .map(|p| pose_ab.transform_point(*p))
                 .collect();
-            let truth = test_clouds::min_distance(&a_points, &b_in_a);
+            let truth = support::min_distance(&a_points, &b_in_a);
             let bound = a.distance_lower_bound(&b, &pose_ab);
             let overlap = a.overlaps(&b, &pose_ab);
             assert!(bound <= truth, "case {case}: bound {bound} > truth {truth}");
@@ -351,9 +351,9 @@ mod tests {
 
     #[test]
     fn touching_boxes_overlap_at_every_offset_and_scale() {
-        let mut rng = test_clouds::rng(15);
-        for &offset in &test_clouds::CENTERS {
-            for &scale in &test_clouds::SCALES {
+        let mut rng = support::rng(15);
+        for &offset in &support::CENTERS {
+            for &scale in &support::SCALES {
                 for case in 0..200 {
                     let h = DVec3::splat(scale);
                     let a = Aabb::from_center_half_extents(DVec3::splat(offset), h);
@@ -367,7 +367,7 @@ mod tests {
                     };
                     let b = Aabb::from_center_half_extents(b_center, h);
                     let lateral =
-                        test_clouds::point_in_cube(&mut rng, scale) * DVec3::new(0.0, 1.0, 1.0);
+                        support::point_in_cube(&mut rng, scale) * DVec3::new(0.0, 1.0, 1.0);
                     let pose = Isometry::from_translation(
                         DVec3::splat(offset) - b_center + DVec3::X * (2.0 * scale) + lateral,
                     );
@@ -386,18 +386,18 @@ mod tests {
 
     #[test]
     fn transform_then_overlap_agrees_with_overlap_under_the_pose() {
-        let mut rng = test_clouds::rng(16);
+        let mut rng = support::rng(16);
         let mut agree = 0;
         for case in 0..3000 {
             let a = Aabb::from_center_half_extents(
-                test_clouds::point_in_cube(&mut rng, 1.5),
-                test_clouds::point_in_cube(&mut rng, 1.0).abs(),
+                support::point_in_cube(&mut rng, 1.5),
+                support::point_in_cube(&mut rng, 1.0).abs(),
             );
             let b = Aabb::from_center_half_extents(
-                test_clouds::point_in_cube(&mut rng, 1.5),
-                test_clouds::point_in_cube(&mut rng, 1.0).abs(),
+                support::point_in_cube(&mut rng, 1.5),
+                support::point_in_cube(&mut rng, 1.0).abs(),
             );
-            let pose = test_clouds::isometry(&mut rng, 1.5);
+            let pose = support::isometry(&mut rng, 1.5);
             let moved = b.transformed(&pose);
             let direct = a.overlaps(&b, &pose);
             let via_moved = a.overlaps(&moved, &Isometry::IDENTITY);
@@ -429,9 +429,9 @@ mod tests {
         let u = b.union_point(DVec3::splat(20.0));
         assert!(u.contains_point(DVec3::splat(20.0)) && u.contains_point(b.min));
         assert_eq!(Aabb::NAME, "aabb");
-        let flat = Aabb::fit_points(&test_clouds::cloud(
-            &mut test_clouds::rng(0),
-            Kind::Single,
+        let flat = Aabb::fit_points(&support::cloud(
+            &mut support::rng(0),
+            CloudKind::Single,
             1,
             DVec3::ZERO,
             1.0,

@@ -365,8 +365,8 @@ const MIN_EDGE_AXIS_SQUARED: f64 = 1e-12;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bounding::fit::test_support::*;
     use crate::math::DQuat;
+    use crate::test_support::*;
     use rand::Rng;
 
     /// Eight corners of the box `center + rot · (±half)`.
@@ -491,7 +491,8 @@ mod tests {
         for case in 0..4000 {
             let center = DVec3::splat(CENTERS[case % 4]);
             let scale = SCALES[(case / 4) % 5];
-            let points = cloud(&mut rng, case / 20, 1 + case % 37, center, scale);
+            let kind = CloudKind::ALL[(case / 20) % CloudKind::ALL.len()];
+            let points = cloud(&mut rng, kind, 1 + case % 37, center, scale);
             let obb = Obb::fit_points(&points);
             assert!(
                 obb.half_extents.is_finite() && obb.axes.is_finite(),

@@ -823,7 +823,7 @@ impl BoundingVolume for Rss {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bounding::fit::test_support::*;
+    use crate::test_support::*;
     use rand::Rng;
 
     /// A point of the swept volume: `core_point` plus a random offset within `radius`
@@ -886,7 +886,8 @@ mod tests {
         for case in 0..4000 {
             let center = DVec3::splat(CENTERS[case % 4]);
             let scale = SCALES[(case / 4) % 5];
-            let points = cloud(&mut rng, case / 20, 1 + case % 37, center, scale);
+            let kind = CloudKind::ALL[(case / 20) % CloudKind::ALL.len()];
+            let points = cloud(&mut rng, kind, 1 + case % 37, center, scale);
             let lss = Lss::fit_points(&points);
             let rss = Rss::fit_points(&points);
             for p in &points {

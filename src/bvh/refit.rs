@@ -56,9 +56,9 @@ impl<B: BoundingVolume> Bvh<B> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bounding::fit::test_support::{point_in_cube, rng};
     use crate::bvh::test_support::{PRESETS, for_each_volume, soup};
     use crate::math::DVec3;
+    use crate::test_support::{point_in_cube, rng};
 
     /// Builds with every preset and leaf sizes 1 and 4, then checks refit in both modes.
     fn refit_contracts<B: BoundingVolume + PartialEq>(seed: u64) {

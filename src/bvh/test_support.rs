@@ -2,8 +2,8 @@
 //! macro that runs a check for every volume type.
 
 use super::BuildParams;
-use crate::bounding::fit::test_support::{TestRng, point_in_cube};
 use crate::geometry::Triangle;
+use crate::test_support::{TestRng, point_in_cube};
 
 /// Runs `$check::<B>($args)` for every volume type a BVH is built with in tests.
 macro_rules! for_each_volume {

@@ -143,11 +143,11 @@ impl<B: BoundingVolume> Bvh<B> {
 mod tests {
     use super::*;
     use crate::bounding::Aabb;
-    use crate::bounding::fit::test_support::rng;
     use crate::bvh::test_support::soup;
     use crate::bvh::{BuildParams, BvhNode};
     use crate::geometry::Triangle;
     use crate::math::DVec3;
+    use crate::test_support::rng;
 
     /// An 8-triangle median tree with one triangle per leaf, and one of its leaves.
     fn small_tree() -> (Bvh<Aabb>, usize) {

@@ -2,7 +2,8 @@
 //! point sets that include the degenerate cases every geometric test must survive.
 //! Procedural triangle meshes live in [`meshes`].
 //!
-//! Include with `mod support;` from a test file. Items unused by one test file are allowed.
+//! Include with `mod support;` from a test file; the crate's unit tests reach the same module
+//! as `crate::test_support` (see `src/lib.rs`). Items unused by one test file are allowed.
 #![allow(dead_code)]
 
 use proxima::math::{DQuat, DVec3, Isometry, Pose};
@@ -145,3 +146,22 @@ pub fn cloud(
 pub const CENTERS: [f64; 4] = [0.0, 1.0, 1e3, 1e6];
 /// See [`CENTERS`].
 pub const SCALES: [f64; 5] = [1e-4, 1e-2, 1.0, 1e2, 1e4];
+
+/// One random cloud from the degenerate-input matrix: a random [`CloudKind`], centre at a
+/// random direction times one of [`CENTERS`], size one of [`SCALES`], `1..=max_n` points.
+/// Returns the points and the scale (metres).
+pub fn random_cloud(rng: &mut TestRng, max_n: usize) -> (Vec<DVec3>, f64) {
+    let kind = CloudKind::ALL[rng.random_range(0..CloudKind::ALL.len())];
+    let center = rotation(rng) * DVec3::X * CENTERS[rng.random_range(0..CENTERS.len())];
+    let scale = SCALES[rng.random_range(0..SCALES.len())];
+    let n = rng.random_range(1..=max_n.max(1));
+    (cloud(rng, kind, n, center, scale), scale)
+}
+
+/// The smallest distance between two point sets (brute force over all pairs); infinite if
+/// either is empty.
+pub fn min_distance(a: &[DVec3], b: &[DVec3]) -> f64 {
+    a.iter()
+        .flat_map(|p| b.iter().map(move |q| p.distance(*q)))
+        .fold(f64::INFINITY, f64::min)
+}

@@ -97,12 +97,12 @@ fn convex_hull(mut points: Vec<DVec2>) -> Vec<DVec2> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand::{Rng, SeedableRng};
-    use rand_pcg::Pcg64Mcg;
+    use crate::test_support::rng;
+    use rand::Rng;
 
     #[test]
     fn the_rectangle_of_a_rotated_rectangle_is_its_own_orientation() {
-        let mut rng = Pcg64Mcg::seed_from_u64(7);
+        let mut rng = rng(7);
         for case in 0..1000 {
             let angle: f64 = rng.random_range(0.0..std::f64::consts::TAU);
             let dir = DVec2::from_angle(angle);

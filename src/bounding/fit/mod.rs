@@ -7,8 +7,6 @@
 
 mod calipers;
 mod pca;
-#[cfg(test)]
-pub(crate) mod test_support;
 
 pub use calipers::{frame_about, min_area_direction};
 pub use pca::{

@@ -191,18 +191,8 @@ fn outer(a: DVec3, b: DVec3) -> DMat3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::DQuat;
-    use rand::{Rng, SeedableRng};
-    use rand_pcg::Pcg64Mcg;
-
-    fn random_rotation(rng: &mut Pcg64Mcg) -> DQuat {
-        let v = DVec3::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        );
-        DQuat::from_axis_angle(v.normalize_or(DVec3::Z), rng.random_range(0.0..6.3))
-    }
+    use crate::test_support::{rng, rotation};
+    use rand::Rng;
 
     fn assert_frame(axes: &DMat3) {
         assert!(axes.is_finite(), "{axes}");
@@ -218,9 +208,9 @@ mod tests {
 
     #[test]
     fn axes_of_an_anisotropic_cloud_follow_its_rotation() {
-        let mut rng = Pcg64Mcg::seed_from_u64(1);
+        let mut rng = rng(1);
         for case in 0..1000 {
-            let rot = random_rotation(&mut rng);
+            let rot = rotation(&mut rng);
             let offset = [0.0, 1e3, 1e6][case % 3];
             let scale = [1e-4, 1.0, 1e4][case % 3];
             let half = DVec3::new(3.0, 2.0, 1.0) * scale;
@@ -253,7 +243,7 @@ mod tests {
 
     #[test]
     fn degenerate_covariances_give_orthonormal_frames() {
-        let mut rng = Pcg64Mcg::seed_from_u64(2);
+        let mut rng = rng(2);
         let mut inputs = vec![
             DMat3::ZERO,
             DMat3::IDENTITY,
@@ -263,7 +253,7 @@ mod tests {
             DMat3::from_diagonal(DVec3::new(f64::NAN, 0.0, 0.0)),
         ];
         for _ in 0..1000 {
-            let r = DMat3::from_quat(random_rotation(&mut rng));
+            let r = DMat3::from_quat(rotation(&mut rng));
             let d = DVec3::new(
                 [0.0, 1.0][rng.random_range(0..2)],
                 [0.0, 1.0][rng.random_range(0..2)],
@@ -295,7 +285,7 @@ mod tests {
 
     #[test]
     fn triangle_moments_match_dense_sampling() {
-        let mut rng = Pcg64Mcg::seed_from_u64(3);
+        let mut rng = rng(3);
         for case in 0..50 {
             let tris: Vec<Triangle> = (0..4)
                 .map(|_| {

@@ -225,14 +225,14 @@ pub(super) fn cone_combination(layout: Layout, u: DVec3) -> Combination {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bounding::sphere::test_clouds;
+    use crate::test_support as support;
 
     fn check_combinations<const N: usize>() {
         let dirs = directions::<N>();
         let layout = Layout::of(N);
-        let mut rng = test_clouds::rng(N as u64);
+        let mut rng = support::rng(N as u64);
         for case in 0..5000 {
-            let mut u = test_clouds::point_in_cube(&mut rng, 1.0);
+            let mut u = support::point_in_cube(&mut rng, 1.0);
             // Ties and zeros: snap some components.
             if case % 5 == 0 {
                 u.y = u.x.abs() * u.y.signum();

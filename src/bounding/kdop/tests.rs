@@ -1,7 +1,7 @@
 //! Seeded tests of the k-DOPs, each run for the 14-, 18- and 26-DOP.
 
 use super::*;
-use crate::bounding::sphere::test_clouds::{self, TestRng};
+use crate::test_support::{self as support, CloudKind, TestRng};
 use rand::Rng;
 
 /// Runs a generic check for the three k-DOPs.
@@ -28,9 +28,9 @@ fn point_in<const N: usize>(rng: &mut TestRng, dop: &Kdop<N>) -> DVec3 {
 }
 
 fn fitted_dops_contain_their_points<const N: usize>() {
-    let mut rng = test_clouds::rng(100 + N as u64);
+    let mut rng = support::rng(100 + N as u64);
     for case in 0..3000 {
-        let (points, _) = test_clouds::any_cloud(&mut rng, 50);
+        let (points, _) = support::random_cloud(&mut rng, 50);
         let dop = Kdop::<N>::fit_points(&points);
         for p in &points {
             assert!(dop.contains_point(*p), "N {N} case {case}: {p}");
@@ -60,10 +60,10 @@ fn fitted_dops_contain_every_point_and_their_center() {
 }
 
 fn merged_contains_both<const N: usize>() {
-    let mut rng = test_clouds::rng(200 + N as u64);
+    let mut rng = support::rng(200 + N as u64);
     for case in 0..2000 {
-        let (p, _) = test_clouds::any_cloud(&mut rng, 10);
-        let (q, _) = test_clouds::any_cloud(&mut rng, 10);
+        let (p, _) = support::random_cloud(&mut rng, 10);
+        let (q, _) = support::random_cloud(&mut rng, 10);
         let (a, b) = (Kdop::<N>::fit_points(&p), Kdop::<N>::fit_points(&q));
         let m = a.merged(&b);
         let mut grown = a;
@@ -92,10 +92,10 @@ fn merged_contains_both_inputs() {
 }
 
 fn transformed_contains_rotated_points<const N: usize>() {
-    let mut rng = test_clouds::rng(300 + N as u64);
+    let mut rng = support::rng(300 + N as u64);
     for case in 0..4000 {
-        let (points, scale) = test_clouds::any_cloud(&mut rng, 30);
-        let pose = test_clouds::isometry(&mut rng, 10.0 * scale);
+        let (points, scale) = support::random_cloud(&mut rng, 30);
+        let pose = support::isometry(&mut rng, 10.0 * scale);
         let dop = Kdop::<N>::fit_points(&points);
         let moved = dop.transformed(&pose);
         for p in &points {
@@ -120,14 +120,14 @@ fn transformed_contains_every_rotated_point_and_vertex() {
 /// The refit against the naive approach that fits the DOP to the 8 moved corners of the
 /// AABB part, and against the exact refit (the DOP of the moved polytope vertices).
 fn refit_is_tighter_than_the_moved_aabb_corners<const N: usize>() {
-    let mut rng = test_clouds::rng(400 + N as u64);
+    let mut rng = support::rng(400 + N as u64);
     let (mut ours, mut corners, mut exact) = (0.0, 0.0, 0.0);
     let cases = 500;
     for case in 0..cases {
-        let kind = test_clouds::KINDS[case % 2]; // boxes and spheres: solid DOPs
-        let points = test_clouds::cloud(&mut rng, kind, 40, DVec3::ZERO, 1.0);
+        let kind = [CloudKind::Box, CloudKind::Sphere][case % 2]; // boxes and spheres: solid DOPs
+        let points = support::cloud(&mut rng, kind, 40, DVec3::ZERO, 1.0);
         let dop = Kdop::<N>::fit_points(&points);
-        let pose = test_clouds::isometry(&mut rng, 1.0);
+        let pose = support::isometry(&mut rng, 1.0);
         let moved = dop.transformed(&pose);
         let (lo, hi) = (dop.aabb_min(), dop.aabb_max());
         let box_corners: Vec<DVec3> = (0..8)
@@ -184,12 +184,12 @@ fn refit_is_conservative_and_tighter_than_refitting_the_moved_aabb() {
 }
 
 fn overlap_and_distance_are_conservative<const N: usize>() {
-    let mut rng = test_clouds::rng(500 + N as u64);
+    let mut rng = support::rng(500 + N as u64);
     let (mut overlapping, mut apart) = (0, 0);
     for case in 0..3000 {
-        let (a_points, scale) = test_clouds::any_cloud(&mut rng, 20);
-        let (mut b_points, _) = test_clouds::any_cloud(&mut rng, 20);
-        let pose_ab = test_clouds::isometry(&mut rng, 2.0 * scale);
+        let (a_points, scale) = support::random_cloud(&mut rng, 20);
+        let (mut b_points, _) = support::random_cloud(&mut rng, 20);
+        let pose_ab = support::isometry(&mut rng, 2.0 * scale);
         let shared = case % 3 == 0;
         if shared {
             b_points.push(pose_ab.inverse_transform_point(a_points[0]));
@@ -200,7 +200,7 @@ fn overlap_and_distance_are_conservative<const N: usize>() {
             .iter()
             .map(|p| pose_ab.transform_point(*p))
             .collect();
-        let truth = test_clouds::min_distance(&a_points, &b_in_a);
+        let truth = support::min_distance(&a_points, &b_in_a);
         let bound = a.distance_lower_bound(&b, &pose_ab);
         let overlap = a.overlaps(&b, &pose_ab);
         assert!(
@@ -236,13 +236,13 @@ fn overlap_and_distance_bound_are_conservative_against_brute_force() {
 }
 
 fn volume_matches_monte_carlo<const N: usize>() {
-    let mut rng = test_clouds::rng(600 + N as u64);
+    let mut rng = support::rng(600 + N as u64);
     for case in 0..40 {
-        let kind = test_clouds::KINDS[case % 2];
-        let points = test_clouds::cloud(&mut rng, kind, 12, DVec3::splat(1e3), 2.0);
+        let kind = [CloudKind::Box, CloudKind::Sphere][case % 2];
+        let points = support::cloud(&mut rng, kind, 12, DVec3::splat(1e3), 2.0);
         let fitted = Kdop::<N>::fit_points(&points);
         // A refitted DOP has redundant (non-touching) slabs: its volume must still be right.
-        let refitted = fitted.transformed(&test_clouds::isometry(&mut rng, 5.0));
+        let refitted = fitted.transformed(&support::isometry(&mut rng, 5.0));
         for dop in [fitted, refitted] {
             let (lo, hi) = (dop.aabb_min(), dop.aabb_max());
             let samples = 20_000;
@@ -301,17 +301,17 @@ fn volumes_of_hand_made_polytopes_are_exact() {
 }
 
 fn degenerate_inputs<const N: usize>() {
-    let mut rng = test_clouds::rng(700 + N as u64);
-    for &offset in &test_clouds::CENTERS {
-        for &scale in &test_clouds::SCALES {
+    let mut rng = support::rng(700 + N as u64);
+    for &offset in &support::CENTERS {
+        for &scale in &support::SCALES {
             let center = DVec3::new(offset, -offset, 0.3 * offset);
             for kind in [
-                test_clouds::Kind::Single,
-                test_clouds::Kind::Duplicates,
-                test_clouds::Kind::Collinear,
-                test_clouds::Kind::Coplanar,
+                CloudKind::Single,
+                CloudKind::Duplicates,
+                CloudKind::Collinear,
+                CloudKind::Coplanar,
             ] {
-                let points = test_clouds::cloud(&mut rng, kind, 30, center, scale);
+                let points = support::cloud(&mut rng, kind, 30, center, scale);
                 let dop = Kdop::<N>::fit_points(&points);
                 let volume = dop.volume();
                 assert!(volume.is_finite() && volume >= 0.0);
@@ -321,7 +321,7 @@ fn degenerate_inputs<const N: usize>() {
                     volume <= aabb_volume * (1.0 + 1e-6) + pad.powi(3),
                     "{kind:?}"
                 );
-                if kind == test_clouds::Kind::Single {
+                if kind == CloudKind::Single {
                     assert!(volume <= 8.0 * pad.powi(3), "{volume}");
                 }
                 assert!(dop.stand_off() >= dop.size() * 0.999 && dop.size() <= 4.0 * scale + pad);
@@ -330,7 +330,7 @@ fn degenerate_inputs<const N: usize>() {
                     dop.contains_point(c),
                     "N {N} {kind:?} offset {offset} scale {scale}"
                 );
-                let pose = test_clouds::isometry(&mut rng, 10.0 * scale);
+                let pose = support::isometry(&mut rng, 10.0 * scale);
                 let moved = dop.transformed(&pose);
                 assert!(
                     points
@@ -348,12 +348,12 @@ fn degenerate_inputs_give_finite_tight_dops() {
 }
 
 fn axis_aligned_flat_sets_have_no_volume<const N: usize>() {
-    let mut rng = test_clouds::rng(750 + N as u64);
-    for &offset in &test_clouds::CENTERS {
-        for &scale in &test_clouds::SCALES {
+    let mut rng = support::rng(750 + N as u64);
+    for &offset in &support::CENTERS {
+        for &scale in &support::SCALES {
             let points: Vec<DVec3> = (0..30)
                 .map(|_| {
-                    let p = test_clouds::point_in_cube(&mut rng, scale);
+                    let p = support::point_in_cube(&mut rng, scale);
                     DVec3::new(p.x, p.y, 0.0) + DVec3::splat(offset)
                 })
                 .collect();
@@ -376,13 +376,13 @@ fn axis_aligned_flat_sets_have_no_volume_but_an_inside_center() {
 
 #[test]
 fn transform_then_overlap_agrees_with_overlap_under_the_pose() {
-    let mut rng = test_clouds::rng(800);
+    let mut rng = support::rng(800);
     let mut overlapping = 0;
     for case in 0..2000 {
-        let a_points = test_clouds::cloud(&mut rng, test_clouds::Kind::Box, 8, DVec3::ZERO, 1.0);
-        let b_points = test_clouds::cloud(&mut rng, test_clouds::Kind::Sphere, 8, DVec3::X, 1.0);
+        let a_points = support::cloud(&mut rng, CloudKind::Box, 8, DVec3::ZERO, 1.0);
+        let b_points = support::cloud(&mut rng, CloudKind::Sphere, 8, DVec3::X, 1.0);
         let (a, b) = (Kdop26::fit_points(&a_points), Kdop26::fit_points(&b_points));
-        let pose = test_clouds::isometry(&mut rng, 2.0);
+        let pose = support::isometry(&mut rng, 2.0);
         let moved = b.transformed(&pose);
         let overlap = a.overlaps(&b, &pose);
         assert_eq!(overlap, a.intersects(&moved), "case {case}");
@@ -391,7 +391,7 @@ fn transform_then_overlap_agrees_with_overlap_under_the_pose() {
         // slabs get clipped by its own axes), so the two bounds differ; both stay below
         // the truth.
         let b_in_a: Vec<DVec3> = b_points.iter().map(|p| pose.transform_point(*p)).collect();
-        let truth = test_clouds::min_distance(&a_points, &b_in_a);
+        let truth = support::min_distance(&a_points, &b_in_a);
         assert!(a.distance_lower_bound(&b, &pose) <= truth, "case {case}");
         assert!(
             a.distance_lower_bound(&moved, &Isometry::IDENTITY) <= truth,

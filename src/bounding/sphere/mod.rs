@@ -219,7 +219,4 @@ fn shuffle(points: &mut [DVec3]) {
 }
 
 #[cfg(test)]
-pub(super) mod test_clouds;
-
-#[cfg(test)]
 mod tests;

@@ -1,7 +1,7 @@
 //! Seeded tests of the bounding sphere.
 
-use super::test_clouds::{self, Kind};
 use super::*;
+use crate::test_support::{self as support, CloudKind};
 use rand::Rng;
 
 /// The exact minimum ball of a handful of points, by trying every ball through 2, 3 or 4
@@ -57,9 +57,9 @@ fn welzl_circumcenter4(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<DVec3> 
 
 #[test]
 fn fitted_spheres_contain_every_point_across_the_degenerate_matrix() {
-    let mut rng = test_clouds::rng(1);
+    let mut rng = support::rng(1);
     for case in 0..3000 {
-        let (points, _) = test_clouds::any_cloud(&mut rng, 60);
+        let (points, _) = support::random_cloud(&mut rng, 60);
         for sphere in [
             BoundingSphere::fit_points(&points),
             BoundingSphere::fit_points_ritter(&points),
@@ -77,11 +77,11 @@ fn fitted_spheres_contain_every_point_across_the_degenerate_matrix() {
 
 #[test]
 fn welzl_matches_the_brute_force_minimum_ball() {
-    let mut rng = test_clouds::rng(2);
+    let mut rng = support::rng(2);
     for case in 0..2000 {
         let n = rng.random_range(1..=7);
         let points: Vec<DVec3> = (0..n)
-            .map(|_| test_clouds::point_in_cube(&mut rng, 1.0))
+            .map(|_| support::point_in_cube(&mut rng, 1.0))
             .collect();
         let welzl = BoundingSphere::fit_points(&points);
         let ritter = BoundingSphere::fit_points_ritter(&points);
@@ -97,11 +97,16 @@ fn welzl_matches_the_brute_force_minimum_ball() {
 
 #[test]
 fn welzl_is_minimal_on_large_clouds_far_from_the_origin() {
-    let mut rng = test_clouds::rng(3);
-    for kind in [Kind::Sphere, Kind::Box, Kind::Collinear, Kind::Coplanar] {
-        for &offset in &test_clouds::CENTERS {
+    let mut rng = support::rng(3);
+    for kind in [
+        CloudKind::Sphere,
+        CloudKind::Box,
+        CloudKind::Collinear,
+        CloudKind::Coplanar,
+    ] {
+        for &offset in &support::CENTERS {
             let center = DVec3::new(offset, -offset, 0.5 * offset);
-            let points = test_clouds::cloud(&mut rng, kind, 2000, center, 1.0);
+            let points = support::cloud(&mut rng, kind, 2000, center, 1.0);
             let welzl = BoundingSphere::fit_points(&points);
             let ritter = BoundingSphere::fit_points_ritter(&points);
             assert!(
@@ -113,14 +118,14 @@ fn welzl_is_minimal_on_large_clouds_far_from_the_origin() {
             let farthest = |c: DVec3| points.iter().map(|p| p.distance(c)).fold(0.0, f64::max);
             let at_center = farthest(welzl.center);
             for _ in 0..50 {
-                let step = test_clouds::point_in_cube(&mut rng, 1.0).normalize_or(DVec3::X);
+                let step = support::point_in_cube(&mut rng, 1.0).normalize_or(DVec3::X);
                 let moved = farthest(welzl.center + step * 1e-4);
                 assert!(
                     moved >= at_center - 1e-9 * (1.0 + offset),
                     "{kind:?} {offset}"
                 );
             }
-            if kind == Kind::Sphere {
+            if kind == CloudKind::Sphere {
                 // Points on the unit sphere: the minimum ball is about that sphere.
                 assert!((welzl.radius - 1.0).abs() < 1e-2, "radius {}", welzl.radius);
             }
@@ -130,8 +135,8 @@ fn welzl_is_minimal_on_large_clouds_far_from_the_origin() {
 
 #[test]
 fn fit_handles_a_hundred_thousand_points() {
-    let mut rng = test_clouds::rng(4);
-    let points = test_clouds::cloud(&mut rng, Kind::Sphere, 100_000, DVec3::splat(1e6), 3.0);
+    let mut rng = support::rng(4);
+    let points = support::cloud(&mut rng, CloudKind::Sphere, 100_000, DVec3::splat(1e6), 3.0);
     let sphere = BoundingSphere::fit_points(&points);
     assert!(
         (sphere.radius - 3.0).abs() < 1e-3,
@@ -164,23 +169,23 @@ fn degenerate_inputs_give_finite_tight_spheres() {
 
 #[test]
 fn merged_is_the_smallest_sphere_containing_both() {
-    let mut rng = test_clouds::rng(5);
+    let mut rng = support::rng(5);
     for case in 0..3000 {
-        let scale = test_clouds::SCALES[case % 5];
-        let offset = test_clouds::CENTERS[case % 4];
+        let scale = support::SCALES[case % 5];
+        let offset = support::CENTERS[case % 4];
         let a = BoundingSphere::new(
-            test_clouds::point_in_cube(&mut rng, scale) + DVec3::splat(offset),
+            support::point_in_cube(&mut rng, scale) + DVec3::splat(offset),
             rng.random_range(0.0..scale),
         );
         let b = BoundingSphere::new(
-            test_clouds::point_in_cube(&mut rng, scale) + DVec3::splat(offset),
+            support::point_in_cube(&mut rng, scale) + DVec3::splat(offset),
             rng.random_range(0.0..scale),
         );
         let m = a.merged(&b);
         for s in [a, b] {
             // Far points of each input sphere, in random directions and towards the other.
             for dir in [
-                test_clouds::point_in_cube(&mut rng, 1.0).normalize_or(DVec3::X),
+                support::point_in_cube(&mut rng, 1.0).normalize_or(DVec3::X),
                 (s.center - m.center).normalize_or(DVec3::X),
             ] {
                 assert!(m.contains_point(s.center + dir * s.radius), "case {case}");
@@ -195,10 +200,10 @@ fn merged_is_the_smallest_sphere_containing_both() {
 
 #[test]
 fn transformed_contains_the_moved_points() {
-    let mut rng = test_clouds::rng(6);
+    let mut rng = support::rng(6);
     for case in 0..2000 {
-        let (points, _) = test_clouds::any_cloud(&mut rng, 40);
-        let pose = test_clouds::isometry(&mut rng, 1e3);
+        let (points, _) = support::random_cloud(&mut rng, 40);
+        let pose = support::isometry(&mut rng, 1e3);
         let moved = BoundingSphere::fit_points(&points).transformed(&pose);
         for p in &points {
             assert!(
@@ -211,12 +216,12 @@ fn transformed_contains_the_moved_points() {
 
 #[test]
 fn overlap_and_distance_bound_are_conservative_against_brute_force() {
-    let mut rng = test_clouds::rng(7);
+    let mut rng = support::rng(7);
     let (mut overlapping, mut apart) = (0, 0);
     for case in 0..3000 {
-        let (a_points, scale) = test_clouds::any_cloud(&mut rng, 20);
-        let (mut b_points, _) = test_clouds::any_cloud(&mut rng, 20);
-        let pose_ab = test_clouds::isometry(&mut rng, 2.0 * scale);
+        let (a_points, scale) = support::random_cloud(&mut rng, 20);
+        let (mut b_points, _) = support::random_cloud(&mut rng, 20);
+        let pose_ab = support::isometry(&mut rng, 2.0 * scale);
         if case % 3 == 0 {
             // Force a shared point.
             b_points.push(pose_ab.inverse_transform_point(a_points[0]));
@@ -227,7 +232,7 @@ fn overlap_and_distance_bound_are_conservative_against_brute_force() {
             .iter()
             .map(|p| pose_ab.transform_point(*p))
             .collect();
-        let truth = test_clouds::min_distance(&a_points, &b_in_a);
+        let truth = support::min_distance(&a_points, &b_in_a);
         let bound = a.distance_lower_bound(&b, &pose_ab);
         assert!(bound <= truth, "case {case}: bound {bound} > truth {truth}");
         let overlap = a.overlaps(&b, &pose_ab);
@@ -247,11 +252,11 @@ fn overlap_and_distance_bound_are_conservative_against_brute_force() {
 
 #[test]
 fn transformed_then_identity_overlap_equals_overlap_under_the_pose() {
-    let mut rng = test_clouds::rng(8);
+    let mut rng = support::rng(8);
     for case in 0..3000 {
-        let a = BoundingSphere::new(test_clouds::point_in_cube(&mut rng, 3.0), rng.random());
-        let b = BoundingSphere::new(test_clouds::point_in_cube(&mut rng, 3.0), rng.random());
-        let pose = test_clouds::isometry(&mut rng, 3.0);
+        let a = BoundingSphere::new(support::point_in_cube(&mut rng, 3.0), rng.random());
+        let b = BoundingSphere::new(support::point_in_cube(&mut rng, 3.0), rng.random());
+        let pose = support::isometry(&mut rng, 3.0);
         let moved = b.transformed(&pose);
         let d_direct = a.distance_lower_bound(&b, &pose);
         let d_moved = a.distance_lower_bound(&moved, &Isometry::IDENTITY);

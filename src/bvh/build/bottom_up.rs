@@ -313,9 +313,9 @@ mod tests {
     use super::super::{BuildParams, BuildStrategy, fit_topology};
     use super::*;
     use crate::bounding::Obb;
-    use crate::bounding::fit::test_support::{point_in_cube, rng};
     use crate::bvh::Bvh;
     use crate::bvh::test_support::{for_each_volume, soup};
+    use crate::test_support::{point_in_cube, rng};
     use rand::Rng;
 
     fn primitives(triangles: &[Triangle]) -> Vec<BuildPrimitive> {
