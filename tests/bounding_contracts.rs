@@ -57,11 +57,13 @@ fn check_containment<B: BoundingVolume>(seed: u64) {
         }
         let triangles = triangles_of(&points);
         let bv = B::fit_triangles(&triangles);
+        // A leaf refit keeps an old orientation: here that of the point fit above.
+        let in_frame = B::fit_points(&points).fit_triangles_in_frame(&triangles);
         for t in &triangles {
             for v in t.vertices() {
                 assert!(
-                    bv.contains_point(v),
-                    "{} case {case}: triangle vertex {v} outside {bv:?}",
+                    bv.contains_point(v) && in_frame.contains_point(v),
+                    "{} case {case}: triangle vertex {v} outside {bv:?} or {in_frame:?}",
                     B::NAME
                 );
             }
@@ -88,7 +90,15 @@ fn check_merge_and_transform<B: BoundingVolume>(seed: u64) {
         let merged = bv_a.merged(&bv_b);
         let mut merged_in_place = bv_a;
         merged_in_place.merge(&bv_b);
+        // Refit's merge keeps an old orientation: any other volume's, here a third cloud's.
+        let (c, _) = random_cloud(&mut rng, MAX_POINTS);
+        let in_frame = B::fit_points(&c).merged_in_frame(&bv_a, &bv_b);
         for p in a.iter().chain(&b) {
+            assert!(
+                in_frame.contains_point(*p),
+                "{} case {case}: merged in another frame lost {p}",
+                B::NAME
+            );
             assert!(
                 merged.contains_point(*p),
                 "{} case {case}: merged lost {p}",

@@ -65,6 +65,24 @@ pub trait BoundingVolume: Copy + std::fmt::Debug + Send + Sync + 'static {
     fn merged(&self, other: &Self) -> Self;
 
     /// Grows `self` to contain `other` (same frame).
+    /// A volume containing `triangles` that keeps `self`'s orientation (OBB, LSS, RSS), for
+    /// refitting a leaf after its vertices moved; other types fit afresh.
+    #[must_use]
+    #[inline]
+    fn fit_triangles_in_frame(&self, triangles: &[Triangle]) -> Self {
+        Self::fit_triangles(triangles)
+    }
+
+    /// A volume containing `a` and `b` that keeps `self`'s orientation (for the types that
+    /// have one: OBB, LSS, RSS), for refits after motion: a few projections instead of a
+    /// new fit, and as tight as [`merged`](Self::merged) while the contents have not turned.
+    /// Types without an orientation return `a.merged(b)`.
+    #[must_use]
+    #[inline]
+    fn merged_in_frame(&self, a: &Self, b: &Self) -> Self {
+        a.merged(b)
+    }
+
     #[inline]
     fn merge(&mut self, other: &Self) {
         *self = self.merged(other);

@@ -73,7 +73,12 @@ impl Obb {
         let scale = points
             .iter()
             .fold(0.0f64, |s, p| s.max(p.abs().max_element()));
-        Self::enclosing_padded(points, axes, points[0], conservative_slack(scale))
+        Self::enclosing_padded(
+            points.iter().copied(),
+            axes,
+            points[0],
+            conservative_slack(scale),
+        )
     }
 
     /// The eight corners.
@@ -91,10 +96,15 @@ impl Obb {
 
     /// Tight box in the frame `axes`, extents measured from `reference` (a point near the
     /// set, for precision), padded by `pad`.
-    fn enclosing_padded(points: &[DVec3], axes: DMat3, reference: DVec3, pad: f64) -> Self {
+    fn enclosing_padded(
+        points: impl IntoIterator<Item = DVec3>,
+        axes: DMat3,
+        reference: DVec3,
+        pad: f64,
+    ) -> Self {
         let to_box = axes.transpose();
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for &p in points {
+        for p in points {
             let q = to_box * (p - reference);
             lo = lo.min(q);
             hi = hi.max(q);
@@ -125,10 +135,10 @@ impl Obb {
         let pad = conservative_slack(scale);
         let reference = moments.mean;
         let (axes, values) = principal_frame(&moments.covariance);
-        let mut best = Self::enclosing_padded(points, axes, reference, pad);
+        let mut best = Self::enclosing_padded(points.iter().copied(), axes, reference, pad);
         let mut consider = |normal: DVec3| {
             let frame = frame_about(normal, points, reference);
-            let candidate = Self::enclosing_padded(points, frame, reference, pad);
+            let candidate = Self::enclosing_padded(points.iter().copied(), frame, reference, pad);
             if candidate.cost() < best.cost() {
                 best = candidate;
             }
@@ -230,6 +240,29 @@ impl BoundingVolume for Obb {
 
     /// The least-volume box, over the frames of both inputs and the PCA frame of their 16
     /// corners, that encloses all 16 corners (hence both boxes).
+    fn fit_triangles_in_frame(&self, triangles: &[Triangle]) -> Self {
+        let vertices = triangles.iter().flat_map(Triangle::vertices);
+        let scale = vertices
+            .clone()
+            .fold(0.0f64, |s, p| s.max(p.abs().max_element()));
+        Self::enclosing_padded(
+            vertices,
+            self.axes,
+            triangles[0].a,
+            conservative_slack(scale),
+        )
+    }
+
+    fn merged_in_frame(&self, a: &Self, b: &Self) -> Self {
+        let mut corners = [DVec3::ZERO; 16];
+        corners[..8].copy_from_slice(&a.corners());
+        corners[8..].copy_from_slice(&b.corners());
+        let scale = corners
+            .iter()
+            .fold(0.0f64, |s, p| s.max(p.abs().max_element()));
+        Self::enclosing_padded(corners, self.axes, a.center, conservative_slack(scale))
+    }
+
     fn merged(&self, other: &Self) -> Self {
         let mut corners = [DVec3::ZERO; 16];
         corners[..8].copy_from_slice(&self.corners());
@@ -241,7 +274,7 @@ impl BoundingVolume for Obb {
         let pca = principal_axes(&point_moments(&corners).covariance);
         [self.axes, other.axes, pca]
             .into_iter()
-            .map(|axes| Self::enclosing_padded(&corners, axes, self.center, pad))
+            .map(|axes| Self::enclosing_padded(corners, axes, self.center, pad))
             .min_by(|a, b| a.cost().total_cmp(&b.cost()))
             .unwrap_or(*self)
     }

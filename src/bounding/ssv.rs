@@ -108,6 +108,15 @@ fn polish_frame(candidates: impl Iterator<Item = DMat3>, cost: impl Fn(DMat3) ->
     best.0
 }
 
+/// The triangles' vertices as balls of radius 0.
+fn vertex_balls(triangles: &[Triangle]) -> Vec<Ball> {
+    triangles
+        .iter()
+        .flat_map(Triangle::vertices)
+        .map(|p| (p, 0.0))
+        .collect()
+}
+
 /// The largest coordinate magnitude among the balls (with their radii): the scale of the
 /// fit's slack.
 fn ball_scale(balls: &[Ball]) -> f64 {
@@ -271,6 +280,35 @@ impl BoundingVolume for Lss {
 
     /// Contains the four end balls of both inputs; the axis is the best of both inputs'
     /// axes and the PCA axis of the four end points.
+    fn fit_triangles_in_frame(&self, triangles: &[Triangle]) -> Self {
+        let axis = self.core.direction();
+        let axes = orthonormalise(axis, axis.any_orthogonal_vector());
+        let balls = vertex_balls(triangles);
+        Self::from_balls(
+            &balls,
+            axes,
+            balls[0].0,
+            conservative_slack(ball_scale(&balls)),
+        )
+    }
+
+    fn merged_in_frame(&self, a: &Self, b: &Self) -> Self {
+        let balls = [
+            (a.core.a, a.radius),
+            (a.core.b, a.radius),
+            (b.core.a, b.radius),
+            (b.core.b, b.radius),
+        ];
+        let axis = self.core.direction();
+        let axes = orthonormalise(axis, axis.any_orthogonal_vector());
+        Self::from_balls(
+            &balls,
+            axes,
+            balls[0].0,
+            conservative_slack(ball_scale(&balls)),
+        )
+    }
+
     fn merged(&self, other: &Self) -> Self {
         let balls = [
             (self.core.a, self.radius),
@@ -705,6 +743,32 @@ impl BoundingVolume for Rss {
 
     /// Contains the eight corner balls of both inputs; the frame is the best of both inputs'
     /// frames and the PCA frame of the eight corners.
+    fn fit_triangles_in_frame(&self, triangles: &[Triangle]) -> Self {
+        let balls = vertex_balls(triangles);
+        Self::from_balls(
+            &balls,
+            self.axes,
+            balls[0].0,
+            conservative_slack(ball_scale(&balls)),
+        )
+    }
+
+    fn merged_in_frame(&self, a: &Self, b: &Self) -> Self {
+        let mut balls = [(DVec3::ZERO, 0.0); 8];
+        for (k, corner) in a.corners().into_iter().enumerate() {
+            balls[k] = (corner, a.radius);
+        }
+        for (k, corner) in b.corners().into_iter().enumerate() {
+            balls[4 + k] = (corner, b.radius);
+        }
+        Self::from_balls(
+            &balls,
+            self.axes,
+            balls[0].0,
+            conservative_slack(ball_scale(&balls)),
+        )
+    }
+
     fn merged(&self, other: &Self) -> Self {
         let mut balls = [(DVec3::ZERO, 0.0); 8];
         for (k, corner) in self.corners().into_iter().enumerate() {

@@ -2,8 +2,11 @@
 //!
 //! A deformable mesh keeps its triangle connectivity and moves its vertices; rebuilding
 //! would change the tree. Refit keeps the tree and recomputes the volumes bottom-up: leaves
-//! are fitted to their triangles, internal nodes either merge their children's volumes
-//! ([`RefitMode::Merge`], linear time) or are fitted to all of their subtree's triangles
+//! and internal nodes are either re-enclosed in their own old orientation
+//! ([`RefitMode::Merge`], linear time, a few projections per node: leaves enclose their
+//! triangles, internal nodes their children's volumes; see
+//! [`BoundingVolume::fit_triangles_in_frame`] and [`BoundingVolume::merged_in_frame`]) or
+//! fitted afresh to all of their subtree's triangles
 //! ([`RefitMode::Fit`], as tight as a fresh build of the same tree, `O(n log n)`).
 
 use super::{Bvh, BvhNode};
@@ -13,7 +16,9 @@ use crate::geometry::Triangle;
 /// How internal volumes are recomputed by [`Bvh::refit`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RefitMode {
-    /// Merge the two children's volumes: fast, looser after large motion.
+    /// Re-enclose each node (leaf: its triangles; internal: its children) in its old
+    /// orientation: fast, looser after large rotations of
+    /// the contents.
     Merge,
     /// Fit each node to its subtree's triangles: slower, as tight as a build.
     Fit,
@@ -37,12 +42,16 @@ impl<B: BoundingVolume> Bvh<B> {
         // Children come after their parents: a reverse sweep sees children first.
         for index in (0..self.nodes.len()).rev() {
             let node = self.nodes[index];
-            let bv = if node.is_leaf() || mode == RefitMode::Fit {
-                let [start, end] = self.spans[index];
-                B::fit_triangles(&self.triangles[start as usize..end as usize])
+            let [start, end] = self.spans[index];
+            let triangles = &self.triangles[start as usize..end as usize];
+            let bv = if mode == RefitMode::Fit {
+                B::fit_triangles(triangles)
+            } else if node.is_leaf() {
+                node.bv.fit_triangles_in_frame(triangles)
             } else {
                 let [left, right] = node.children();
-                self.nodes[left].bv.merged(&self.nodes[right].bv)
+                node.bv
+                    .merged_in_frame(&self.nodes[left].bv, &self.nodes[right].bv)
             };
             self.nodes[index] = BvhNode {
                 size: bv.size(),
