@@ -5,6 +5,8 @@
 //! std; records use plain arrays (`[f64; 3]`), never glam, so clients in any language that
 //! iceoryx2 binds can speak it.
 
+pub mod wire;
+
 /// The protocol version. A client and a daemon whose versions differ refuse to talk; bump it
 /// on any change to a wire record's layout or meaning.
 pub const PROTOCOL_VERSION: u32 = 1;
@@ -18,9 +20,122 @@ pub fn control_service_name(root: &str) -> String {
     format!("{root}/control")
 }
 
+/// The name of scene `scene`'s pose service under `root`.
+#[must_use]
+pub fn poses_service_name(root: &str, scene: u32) -> String {
+    format!("{root}/{scene}/poses")
+}
+
+/// The name of scene `scene`'s result service under `root`.
+#[must_use]
+pub fn results_service_name(root: &str, scene: u32) -> String {
+    format!("{root}/{scene}/results")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use iceoryx2::prelude::*;
+    use wire::{
+        ErrorCode, PoseFrameHeader, PoseRecord, RecordKind, ResultFrameHeader, ResultRecord, query,
+    };
+
+    #[test]
+    fn scene_services_live_under_the_root_and_scene() {
+        assert_eq!(poses_service_name("proxima", 3), "proxima/3/poses");
+        assert_eq!(results_service_name("t-1", 0), "t-1/0/results");
+    }
+
+    #[test]
+    fn every_error_code_survives_the_wire_and_unknown_values_are_refused() {
+        let mut known = 0;
+        for value in 0..64u32 {
+            if let Some(code) = ErrorCode::from_u32(value) {
+                assert_eq!(code as u32, value);
+                assert!(!code.to_string().is_empty());
+                known += 1;
+            }
+        }
+        assert_eq!(known, 12);
+        assert_eq!(ErrorCode::from_u32(u32::MAX), None);
+    }
+
+    #[test]
+    fn a_pose_frame_and_a_result_frame_cross_a_real_service_unchanged() {
+        let node = NodeBuilder::new().create::<local::Service>().unwrap();
+        let root = format!("wire-test-{}", std::process::id());
+        let poses = node
+            .service_builder(&poses_service_name(&root, 1).as_str().try_into().unwrap())
+            .publish_subscribe::<[PoseRecord]>()
+            .user_header::<PoseFrameHeader>()
+            .open_or_create()
+            .unwrap();
+        let publisher = poses
+            .publisher_builder()
+            .initial_max_slice_len(3)
+            .create()
+            .unwrap();
+        let subscriber = poses.subscriber_builder().create().unwrap();
+        let record = |i: usize| PoseRecord {
+            body: i as u32,
+            reserved: 0,
+            position: [i as f64, -1.5, 1e6],
+            orientation: [0.0, 0.0, 0.0, 1.0],
+        };
+        let header = PoseFrameHeader {
+            protocol_version: PROTOCOL_VERSION,
+            scene: 1,
+            frame_seq: 42,
+            budget_ns: 1_000_000,
+            query_flags: query::CLOSE | query::CONTACTS,
+            count: 3,
+        };
+        let mut sample = publisher.loan_slice_uninit(3).unwrap();
+        *sample.user_header_mut() = header;
+        sample.write_from_fn(record).send().unwrap();
+        let received = subscriber.receive().unwrap().expect("a pose frame");
+        assert_eq!(*received.user_header(), header);
+        assert_eq!(received.payload(), &[record(0), record(1), record(2)]);
+
+        let results = node
+            .service_builder(&results_service_name(&root, 1).as_str().try_into().unwrap())
+            .publish_subscribe::<[ResultRecord]>()
+            .user_header::<ResultFrameHeader>()
+            .open_or_create()
+            .unwrap();
+        let publisher = results
+            .publisher_builder()
+            .initial_max_slice_len(2)
+            .create()
+            .unwrap();
+        let subscriber = results.subscriber_builder().create().unwrap();
+        let pair = ResultRecord {
+            kind: RecordKind::Pair as u32,
+            body_a: 0,
+            body_b: 2,
+            index: 0,
+            count: 1,
+            distance: -0.01,
+            error_bound: 1e-12,
+            point_a: [0.0, 0.0, 0.5],
+            point_b: [0.0, 0.0, 0.49],
+            normal: [0.0, 0.0, -1.0],
+            ..ResultRecord::default()
+        };
+        let contact = ResultRecord {
+            kind: RecordKind::Contact as u32,
+            count: 0,
+            ..pair
+        };
+        let mut sample = publisher.loan_slice_uninit(2).unwrap();
+        sample.user_header_mut().frame_seq = 42;
+        sample.user_header_mut().pair_count = 1;
+        sample.user_header_mut().contact_count = 1;
+        sample.write_from_slice(&[pair, contact]).send().unwrap();
+        let received = subscriber.receive().unwrap().expect("a result frame");
+        assert_eq!(received.user_header().frame_seq, 42);
+        assert_eq!(received.payload(), &[pair, contact]);
+    }
 
     #[test]
     fn control_service_lives_under_the_root() {
