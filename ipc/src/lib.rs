@@ -41,6 +41,59 @@ mod tests {
     };
 
     #[test]
+    fn reply_reasons_are_cut_at_a_character_boundary_and_read_back() {
+        let reply = wire::ControlReply::error(ErrorCode::UnknownBody, "body 7 is not in scene 2");
+        assert_eq!(reply.status, ErrorCode::UnknownBody as u32);
+        assert_eq!(reply.id, u32::MAX);
+        assert_eq!(reply.reason(), "body 7 is not in scene 2");
+        let long = "é".repeat(100); // 200 bytes, two per character
+        let cut = wire::ControlReply::error(ErrorCode::Internal, &long).reason();
+        assert_eq!(cut, "é".repeat(wire::REASON_BYTES / 2));
+        assert_eq!(wire::ControlReply::ok(5).reason(), "");
+    }
+
+    #[test]
+    fn a_control_request_with_geometry_gets_its_reply_over_a_real_service() {
+        let node = NodeBuilder::new().create::<local::Service>().unwrap();
+        let name = control_service_name(&format!("wire-test-{}", std::process::id()));
+        let control = node
+            .service_builder(&name.as_str().try_into().unwrap())
+            .request_response::<[u8], wire::ControlReply>()
+            .request_user_header::<wire::ControlRequest>()
+            .open_or_create()
+            .unwrap();
+        let (vertices, indices) = (
+            [0.0f64, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            [0u32, 1, 2],
+        );
+        let mut bytes: Vec<u8> = vertices.iter().flat_map(|v| v.to_ne_bytes()).collect();
+        bytes.extend(indices.iter().flat_map(|i| i.to_ne_bytes()));
+        let header = wire::ControlRequest {
+            protocol_version: PROTOCOL_VERSION,
+            command: wire::Command::RegisterShape as u32,
+            shape_kind: wire::ShapeKindCode::Mesh as u32,
+            vertex_count: 3,
+            index_count: 3,
+            ..wire::ControlRequest::default()
+        };
+        let client = control
+            .client_builder()
+            .initial_max_slice_len(bytes.len())
+            .create()
+            .unwrap();
+        let server = control.server_builder().create().unwrap();
+        let mut request = client.loan_slice_uninit(bytes.len()).unwrap();
+        *request.user_header_mut() = header;
+        let pending = request.write_from_slice(&bytes).send().unwrap();
+        let active = server.receive().unwrap().expect("a request");
+        assert_eq!(*active.user_header(), header);
+        assert_eq!(active.payload(), bytes.as_slice());
+        active.send_copy(wire::ControlReply::ok(9)).unwrap();
+        let reply = pending.receive().unwrap().expect("a reply");
+        assert_eq!(*reply.payload(), wire::ControlReply::ok(9));
+    }
+
+    #[test]
     fn scene_services_live_under_the_root_and_scene() {
         assert_eq!(poses_service_name("proxima", 3), "proxima/3/poses");
         assert_eq!(results_service_name("t-1", 0), "t-1/0/results");

@@ -13,6 +13,7 @@
 //! |---|---|---|
 //! | `<root>/<scene>/poses` (publish–subscribe) | `[PoseRecord]` | [`PoseFrameHeader`] |
 //! | `<root>/<scene>/results` (publish–subscribe) | `[ResultRecord]`: pairs, then contacts | [`ResultFrameHeader`] |
+//! | `<root>/control` (request–response) | request `[u8]` (geometry, see [`ControlRequest`]), response [`ControlReply`] | request: [`ControlRequest`] |
 
 use iceoryx2::prelude::ZeroCopySend;
 
@@ -252,6 +253,168 @@ pub struct ResultRecord {
     pub normal: [f64; 3],
 }
 
+/// What a [`ControlRequest`] asks the daemon to do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+#[non_exhaustive]
+pub enum Command {
+    /// Check the protocol version; the reply's `id` is the daemon's version.
+    Hello = 0,
+    /// Create a scene; the reply's `id` is the new scene id.
+    CreateScene = 1,
+    /// Drop scene `scene` with all its bodies.
+    DropScene = 2,
+    /// Register a shape (kind, dimensions, geometry payload) for use in scene `scene`; the
+    /// reply's `id` is the shape id.
+    RegisterShape = 3,
+    /// Add a body of shape `target` to scene `scene` with the request's motion, group,
+    /// mask, margin and pose; the reply's `id` is the body id.
+    AddBody = 4,
+    /// Remove body `target` from scene `scene`.
+    RemoveBody = 5,
+    /// Change body `target`'s motion, group, mask and margin.
+    UpdateBody = 6,
+}
+
+/// Shape kinds of [`ControlRequest::shape_kind`], with the meaning of `dimensions` (metres)
+/// and of the geometry payload.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+#[non_exhaustive]
+pub enum ShapeKindCode {
+    /// `dimensions = [radius, 0, 0, 0]`.
+    Sphere = 0,
+    /// Along local Z: `[radius, half_height, 0, 0]` (half the segment's length).
+    Capsule = 1,
+    /// `[half_x, half_y, half_z, 0]`.
+    Cuboid = 2,
+    /// Along local Z: `[radius, half_height, 0, 0]`.
+    Cylinder = 3,
+    /// Along local Z, apex at `+half_height`: `[radius, half_height, 0, 0]`.
+    Cone = 4,
+    /// The convex hull of `vertex_count` points in the payload.
+    Convex = 5,
+    /// A triangle mesh: `vertex_count` points, then `index_count` vertex indices (three per
+    /// triangle) in the payload.
+    Mesh = 6,
+}
+
+/// Motion kinds of [`ControlRequest::motion`]: static bodies never pair with each other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum MotionCode {
+    /// Never moves after it is added.
+    Static = 0,
+    /// Moved by the client, not by physics.
+    Kinematic = 1,
+    /// Moved by the client's physics.
+    Dynamic = 2,
+}
+
+/// A control request (the user header of a `[u8]` request on `<root>/control`).
+///
+/// The byte payload carries geometry for [`Command::RegisterShape`] of a convex or mesh
+/// shape, in native byte order: `vertex_count × 3` `f64` coordinates (metres, the shape's
+/// local frame), then `index_count` `u32` vertex indices; its length must be exactly
+/// `24·vertex_count + 4·index_count` bytes. Other requests send an empty payload.
+#[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("proxima::ControlRequest")]
+pub struct ControlRequest {
+    /// [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION) of the client.
+    pub protocol_version: u32,
+    /// [`Command`] as `u32`.
+    pub command: u32,
+    /// The scene the command acts on (ignored by `Hello`, `CreateScene`).
+    pub scene: u32,
+    /// The shape (`AddBody`) or body (`RemoveBody`, `UpdateBody`) the command acts on.
+    pub target: u32,
+    /// [`ShapeKindCode`] as `u32` (`RegisterShape`).
+    pub shape_kind: u32,
+    /// [`MotionCode`] as `u32` (`AddBody`, `UpdateBody`).
+    pub motion: u32,
+    /// Collision group bits: a pair is tested when each body's group meets the other's mask.
+    pub group: u32,
+    /// Collision mask bits (see `group`).
+    pub mask: u32,
+    /// Number of points in the geometry payload.
+    pub vertex_count: u32,
+    /// Number of `u32` indices in the geometry payload (a multiple of 3).
+    pub index_count: u32,
+    /// Close-pair margin of the body, metres, `≥ 0`; negative = the scene's default.
+    pub margin: f64,
+    /// Primitive dimensions, metres (see [`ShapeKindCode`]).
+    pub dimensions: [f64; 4],
+    /// Initial position, metres, world frame (`AddBody`).
+    pub position: [f64; 3],
+    /// Initial orientation, unit quaternion `[x, y, z, w]` (`AddBody`).
+    pub orientation: [f64; 4],
+}
+
+/// Bytes of [`ControlReply::reason`].
+pub const REASON_BYTES: usize = 112;
+
+/// The daemon's answer to one [`ControlRequest`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("proxima::ControlReply")]
+pub struct ControlReply {
+    /// [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION) of the daemon.
+    pub protocol_version: u32,
+    /// [`ErrorCode`] as `u32`.
+    pub status: u32,
+    /// The new scene, shape or body id (see [`Command`]); `u32::MAX` on error.
+    pub id: u32,
+    /// Always 0.
+    pub reserved: u32,
+    /// Why the request failed: UTF-8, padded with zero bytes (empty on success).
+    pub reason: [u8; REASON_BYTES],
+}
+
+impl ControlReply {
+    /// A success reply carrying `id`.
+    #[must_use]
+    pub fn ok(id: u32) -> Self {
+        Self {
+            protocol_version: crate::PROTOCOL_VERSION,
+            status: ErrorCode::Ok as u32,
+            id,
+            reserved: 0,
+            reason: [0; REASON_BYTES],
+        }
+    }
+
+    /// A failure reply; `reason` is cut at a character boundary to fit.
+    #[must_use]
+    pub fn error(code: ErrorCode, reason: &str) -> Self {
+        let mut bytes = [0; REASON_BYTES];
+        let mut end = reason.len().min(REASON_BYTES);
+        while !reason.is_char_boundary(end) {
+            end -= 1;
+        }
+        bytes[..end].copy_from_slice(&reason.as_bytes()[..end]);
+        Self {
+            status: code as u32,
+            id: u32::MAX,
+            reason: bytes,
+            ..Self::ok(0)
+        }
+    }
+
+    /// The reason text (up to the first zero byte; invalid UTF-8 is replaced).
+    #[must_use]
+    pub fn reason(&self) -> String {
+        let end = self
+            .reason
+            .iter()
+            .position(|&b| b == 0)
+            .unwrap_or(REASON_BYTES);
+        String::from_utf8_lossy(&self.reason[..end]).into_owned()
+    }
+}
+
+const _: () = assert!(size_of::<ControlRequest>() == 136);
+const _: () = assert!(size_of::<ControlReply>() == 128);
 const _: () = assert!(size_of::<PoseFrameHeader>() == 32);
 const _: () = assert!(size_of::<PoseRecord>() == 64);
 const _: () = assert!(size_of::<ResultFrameHeader>() == 96);
