@@ -39,3 +39,6 @@ pub mod narrow;
 #[cfg(test)]
 #[path = "../tests/support/mod.rs"]
 pub(crate) mod test_support;
+
+/// Scene state: registered shapes and placed bodies.
+pub mod scene;

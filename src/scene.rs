@@ -1,0 +1,545 @@
+//! The scene: registered shapes and the bodies placed with them.
+//!
+//! A [`Scene`] owns every shape registered for it (primitives, convex hulls, triangle meshes
+//! with their BVHs, built once at registration) and every body (a shape at a pose, with a
+//! motion kind, a collision filter and a close-pair margin). It is the state the daemon keeps
+//! per scene and the pipeline reads each frame; it does no collision work itself beyond
+//! keeping each body's world-space bounding box current for the broad phase.
+//!
+//! Ids are scoped to their scene and never reused while the scene lives (DESIGN §9: no
+//! assumption that would block splitting scenes across daemons).
+//!
+//! # Invariants
+//! Checked by [`Scene::validate`]: every live body names a registered shape; its world box
+//! is its shape's local box moved by its pose; the count of live bodies matches.
+
+use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
+use crate::bvh::{BuildParams, Bvh};
+use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
+use crate::math::{DVec3, Pose};
+use std::fmt;
+use std::sync::Arc;
+
+/// A shape's id within its scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ShapeId(pub u32);
+
+/// A body's id within its scene.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct BodyId(pub u32);
+
+/// A triangle mesh ready for queries: the mesh and its two BVHs (OBB trees answer overlap
+/// and contacts fastest, RSS trees distance; measured in `benches/mesh_pair.rs`).
+#[derive(Debug)]
+pub struct MeshShape {
+    /// The mesh, local frame.
+    pub mesh: TriMesh,
+    /// Binned-SAH tree of OBBs.
+    pub overlap_tree: Bvh<Obb>,
+    /// Binned-SAH tree of RSSs.
+    pub distance_tree: Bvh<Rss>,
+}
+
+impl MeshShape {
+    /// Builds both trees over `mesh` (offline work: about 1 s for 70,000 triangles).
+    #[must_use]
+    pub fn new(mesh: TriMesh) -> Self {
+        Self {
+            overlap_tree: Bvh::from_mesh(&mesh, &BuildParams::BINNED_SAH),
+            distance_tree: Bvh::from_mesh(&mesh, &BuildParams::BINNED_SAH),
+            mesh,
+        }
+    }
+}
+
+/// A registered shape, in its local frame. Large shapes are shared (`Arc`) so bodies and
+/// frames never copy geometry.
+#[derive(Debug, Clone)]
+pub enum Shape {
+    /// A sphere about the origin.
+    Sphere(Sphere),
+    /// A capsule along local Z.
+    Capsule(Capsule),
+    /// A box about the origin.
+    Cuboid(Cuboid),
+    /// A cylinder along local Z.
+    Cylinder(Cylinder),
+    /// A cone along local Z, apex at `+half_height`.
+    Cone(Cone),
+    /// A convex polyhedron.
+    Convex(Arc<ConvexPolyhedron>),
+    /// A triangle mesh with its BVHs.
+    Mesh(Arc<MeshShape>),
+}
+
+impl Shape {
+    /// The smallest axis-aligned box of the local frame containing the shape.
+    #[must_use]
+    pub fn local_bounds(&self) -> Aabb {
+        let symmetric = |half: DVec3| Aabb::new(-half, half);
+        match self {
+            Self::Sphere(s) => symmetric(DVec3::splat(s.radius)),
+            Self::Capsule(c) => symmetric(DVec3::new(c.radius, c.radius, c.half_height + c.radius)),
+            Self::Cuboid(c) => symmetric(c.half_extents),
+            Self::Cylinder(c) => symmetric(DVec3::new(c.radius, c.radius, c.half_height)),
+            Self::Cone(c) => symmetric(DVec3::new(c.radius, c.radius, c.half_height)),
+            Self::Convex(c) => Aabb::fit_points(c.vertices()),
+            Self::Mesh(m) => {
+                let (min, max) = m.mesh.bounds();
+                Aabb::new(min, max)
+            }
+        }
+    }
+}
+
+/// How a body moves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Motion {
+    /// Never moves after it is added; two static bodies never pair.
+    Static,
+    /// Moved by the client, not by physics.
+    Kinematic,
+    /// Moved by the client's physics.
+    Dynamic,
+}
+
+/// Which bodies may pair: `a` and `b` do when each one's group meets the other's mask.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CollisionFilter {
+    /// Group bits of this body.
+    pub group: u32,
+    /// Groups this body pairs with.
+    pub mask: u32,
+}
+
+impl CollisionFilter {
+    /// Pairs with everything.
+    pub const ALL: Self = Self {
+        group: u32::MAX,
+        mask: u32::MAX,
+    };
+
+    /// Whether bodies with filters `self` and `other` may pair (symmetric).
+    #[must_use]
+    #[inline]
+    pub fn allows(&self, other: &Self) -> bool {
+        self.group & other.mask != 0 && other.group & self.mask != 0
+    }
+}
+
+/// What a new body is made of.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyDesc {
+    /// The shape, registered in the same scene.
+    pub shape: ShapeId,
+    /// Initial pose, world frame.
+    pub pose: Pose,
+    /// Motion kind.
+    pub motion: Motion,
+    /// Collision filter.
+    pub filter: CollisionFilter,
+    /// Close-pair margin, metres (`None`: the scene's default).
+    pub margin: Option<f64>,
+}
+
+/// A body in a scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Body {
+    /// Its shape.
+    pub shape: ShapeId,
+    /// Its pose, world frame.
+    pub pose: Pose,
+    /// Motion kind.
+    pub motion: Motion,
+    /// Collision filter.
+    pub filter: CollisionFilter,
+    /// Close-pair margin, metres, `≥ 0`.
+    pub margin: f64,
+    /// The shape's local box moved by `pose` (world frame), without the margin.
+    pub world_bounds: Aabb,
+}
+
+/// Limits that keep one client from exhausting the daemon.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SceneLimits {
+    /// Most shapes registered in one scene.
+    pub max_shapes: u32,
+    /// Most live bodies in one scene.
+    pub max_bodies: u32,
+}
+
+impl SceneLimits {
+    /// 4,096 shapes and 100,000 bodies.
+    pub const STANDARD: Self = Self {
+        max_shapes: 4_096,
+        max_bodies: 100_000,
+    };
+}
+
+/// Why a scene operation was refused. The scene is unchanged when one is returned.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// No shape with this id in the scene.
+    UnknownShape(ShapeId),
+    /// No live body with this id in the scene.
+    UnknownBody(BodyId),
+    /// The scene already holds the most shapes its limits allow.
+    TooManyShapes(u32),
+    /// The scene already holds the most bodies its limits allow.
+    TooManyBodies(u32),
+    /// A margin is negative, NaN or infinite.
+    InvalidMargin(f64),
+}
+
+impl fmt::Display for SceneError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::UnknownShape(id) => write!(f, "no shape {} in this scene", id.0),
+            Self::UnknownBody(id) => write!(f, "no body {} in this scene", id.0),
+            Self::TooManyShapes(limit) => {
+                write!(f, "the scene's limit of {limit} shapes is reached")
+            }
+            Self::TooManyBodies(limit) => {
+                write!(f, "the scene's limit of {limit} bodies is reached")
+            }
+            Self::InvalidMargin(m) => write!(f, "margin {m} is not a finite length ≥ 0"),
+        }
+    }
+}
+
+impl std::error::Error for SceneError {}
+
+/// Shapes and bodies of one scene (see the [module docs](self)).
+#[derive(Debug, Clone)]
+pub struct Scene {
+    shapes: Vec<Shape>,
+    /// Slot `i` holds body `i` while it lives; removed bodies leave `None` (ids are not
+    /// reused).
+    bodies: Vec<Option<Body>>,
+    live: u32,
+    default_margin: f64,
+    limits: SceneLimits,
+}
+
+impl Scene {
+    /// An empty scene whose bodies default to `default_margin` metres (finite, `≥ 0`).
+    ///
+    /// # Errors
+    /// [`SceneError::InvalidMargin`] for a negative or non-finite margin.
+    pub fn try_new(default_margin: f64, limits: SceneLimits) -> Result<Self, SceneError> {
+        check_margin(default_margin)?;
+        Ok(Self {
+            shapes: Vec::new(),
+            bodies: Vec::new(),
+            live: 0,
+            default_margin,
+            limits,
+        })
+    }
+
+    /// Registers `shape` for bodies of this scene.
+    ///
+    /// # Errors
+    /// [`SceneError::TooManyShapes`] at the limit.
+    pub fn register_shape(&mut self, shape: Shape) -> Result<ShapeId, SceneError> {
+        if self.shapes.len() >= self.limits.max_shapes as usize {
+            return Err(SceneError::TooManyShapes(self.limits.max_shapes));
+        }
+        self.shapes.push(shape);
+        Ok(ShapeId(self.shapes.len() as u32 - 1))
+    }
+
+    /// The shape with id `id`, if registered.
+    #[must_use]
+    pub fn shape(&self, id: ShapeId) -> Option<&Shape> {
+        self.shapes.get(id.0 as usize)
+    }
+
+    /// Adds a body.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownShape`], [`SceneError::InvalidMargin`] or
+    /// [`SceneError::TooManyBodies`]; the scene is then unchanged.
+    pub fn add_body(&mut self, desc: &BodyDesc) -> Result<BodyId, SceneError> {
+        let shape = self
+            .shape(desc.shape)
+            .ok_or(SceneError::UnknownShape(desc.shape))?;
+        let margin = desc.margin.unwrap_or(self.default_margin);
+        check_margin(margin)?;
+        if self.live >= self.limits.max_bodies || self.bodies.len() >= u32::MAX as usize {
+            return Err(SceneError::TooManyBodies(self.limits.max_bodies));
+        }
+        let world_bounds = world_bounds(shape, &desc.pose);
+        self.bodies.push(Some(Body {
+            shape: desc.shape,
+            pose: desc.pose,
+            motion: desc.motion,
+            filter: desc.filter,
+            margin,
+            world_bounds,
+        }));
+        self.live += 1;
+        Ok(BodyId(self.bodies.len() as u32 - 1))
+    }
+
+    /// Removes a body; its id is not reused.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownBody`] when no such body lives.
+    pub fn remove_body(&mut self, id: BodyId) -> Result<Body, SceneError> {
+        let body = self
+            .bodies
+            .get_mut(id.0 as usize)
+            .and_then(Option::take)
+            .ok_or(SceneError::UnknownBody(id))?;
+        self.live -= 1;
+        Ok(body)
+    }
+
+    /// Changes a body's motion kind, filter and margin (`None`: the scene's default).
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownBody`] or [`SceneError::InvalidMargin`]; the body is then
+    /// unchanged.
+    pub fn update_body(
+        &mut self,
+        id: BodyId,
+        motion: Motion,
+        filter: CollisionFilter,
+        margin: Option<f64>,
+    ) -> Result<(), SceneError> {
+        let margin = margin.unwrap_or(self.default_margin);
+        check_margin(margin)?;
+        let body = self.body_mut(id)?;
+        body.motion = motion;
+        body.filter = filter;
+        body.margin = margin;
+        Ok(())
+    }
+
+    /// Moves a body to `pose` (already validated: see [`Pose::try_new`]) and updates its
+    /// world box.
+    ///
+    /// # Errors
+    /// [`SceneError::UnknownBody`].
+    pub fn set_pose(&mut self, id: BodyId, pose: Pose) -> Result<(), SceneError> {
+        let shape_id = self.body_mut(id)?.shape;
+        let bounds = world_bounds(&self.shapes[shape_id.0 as usize], &pose);
+        let body = self.body_mut(id)?;
+        body.pose = pose;
+        body.world_bounds = bounds;
+        Ok(())
+    }
+
+    /// The live body with id `id`.
+    #[must_use]
+    pub fn body(&self, id: BodyId) -> Option<&Body> {
+        self.bodies.get(id.0 as usize).and_then(Option::as_ref)
+    }
+
+    /// Every live body with its id, in increasing id order.
+    pub fn bodies(&self) -> impl Iterator<Item = (BodyId, &Body)> {
+        self.bodies
+            .iter()
+            .enumerate()
+            .filter_map(|(i, b)| b.as_ref().map(|b| (BodyId(i as u32), b)))
+    }
+
+    /// Number of live bodies.
+    #[must_use]
+    pub fn body_count(&self) -> usize {
+        self.live as usize
+    }
+
+    /// Checks the invariants in the [module docs](self).
+    ///
+    /// # Errors
+    /// A description of the first broken invariant.
+    pub fn validate(&self) -> Result<(), String> {
+        let mut live = 0;
+        for (id, body) in self.bodies() {
+            live += 1;
+            let shape = self
+                .shape(body.shape)
+                .ok_or_else(|| format!("body {} names unknown shape {}", id.0, body.shape.0))?;
+            if body.world_bounds != world_bounds(shape, &body.pose) {
+                return Err(format!("body {} has a stale world box", id.0));
+            }
+        }
+        if live != self.live {
+            return Err(format!("{live} live bodies, {} counted", self.live));
+        }
+        Ok(())
+    }
+
+    fn body_mut(&mut self, id: BodyId) -> Result<&mut Body, SceneError> {
+        self.bodies
+            .get_mut(id.0 as usize)
+            .and_then(Option::as_mut)
+            .ok_or(SceneError::UnknownBody(id))
+    }
+}
+
+/// The world box of `shape` at `pose` (conservative: the local box moved and re-boxed).
+fn world_bounds(shape: &Shape, pose: &Pose) -> Aabb {
+    shape.local_bounds().transformed(&pose.to_isometry())
+}
+
+fn check_margin(margin: f64) -> Result<(), SceneError> {
+    if margin.is_finite() && margin >= 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::InvalidMargin(margin))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::{meshes, pose, rng};
+
+    fn scene() -> Scene {
+        Scene::try_new(
+            0.01,
+            SceneLimits {
+                max_shapes: 4,
+                max_bodies: 3,
+            },
+        )
+        .unwrap()
+    }
+
+    fn desc(shape: ShapeId, pose: Pose) -> BodyDesc {
+        BodyDesc {
+            shape,
+            pose,
+            motion: Motion::Dynamic,
+            filter: CollisionFilter::ALL,
+            margin: None,
+        }
+    }
+
+    #[test]
+    fn world_boxes_contain_the_shape_at_every_pose_and_follow_set_pose() {
+        let mut s = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let torus = meshes::torus(1.0, 0.25, 24, 12);
+        let points: Vec<DVec3> = torus.vertices().to_vec();
+        let shapes = [
+            Shape::Sphere(Sphere::new(0.5)),
+            Shape::Capsule(Capsule::new(1.0, 0.25)),
+            Shape::Cuboid(Cuboid::new(DVec3::new(0.1, 2.0, 0.3))),
+            Shape::Cylinder(Cylinder::new(0.7, 0.2)),
+            Shape::Cone(Cone::new(0.7, 0.2)),
+            Shape::Convex(Arc::new(
+                ConvexPolyhedron::try_from_points(&points).unwrap(),
+            )),
+            Shape::Mesh(Arc::new(MeshShape::new(torus.clone()))),
+        ];
+        let ids: Vec<ShapeId> = shapes
+            .into_iter()
+            .map(|sh| s.register_shape(sh).unwrap())
+            .collect();
+        let mut rng = rng(41);
+        for case in 0..2_000 {
+            let id = ids[case % ids.len()];
+            let body = s.add_body(&desc(id, pose(&mut rng, 1e3))).unwrap();
+            s.set_pose(body, pose(&mut rng, 1e5)).unwrap();
+            let b = *s.body(body).unwrap();
+            // Surface samples of the shape, moved by the pose, must lie in the world box.
+            let local: Vec<DVec3> = match s.shape(id).unwrap() {
+                Shape::Sphere(sp) => vec![DVec3::X * sp.radius, -DVec3::Z * sp.radius],
+                Shape::Capsule(c) => {
+                    vec![DVec3::Z * (c.half_height + c.radius), DVec3::X * c.radius]
+                }
+                Shape::Cuboid(c) => vec![c.half_extents, -c.half_extents],
+                Shape::Cylinder(c) => vec![DVec3::new(c.radius, 0.0, c.half_height)],
+                Shape::Cone(c) => vec![
+                    DVec3::new(0.0, -c.radius, -c.half_height),
+                    DVec3::Z * c.half_height,
+                ],
+                Shape::Convex(_) | Shape::Mesh(_) => points.clone(),
+            };
+            let iso = b.pose.to_isometry();
+            for p in local {
+                assert!(
+                    b.world_bounds.contains_point(iso.transform_point(p)),
+                    "case {case}"
+                );
+            }
+            s.remove_body(body).unwrap();
+        }
+        assert_eq!(s.validate(), Ok(()));
+        assert_eq!(s.body_count(), 0);
+    }
+
+    #[test]
+    fn bad_requests_are_refused_and_leave_the_scene_unchanged() {
+        let mut s = scene();
+        let sphere = s.register_shape(Shape::Sphere(Sphere::new(1.0))).unwrap();
+        let a = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        let before = format!("{s:?}");
+        assert_eq!(
+            s.add_body(&desc(ShapeId(9), Pose::IDENTITY)),
+            Err(SceneError::UnknownShape(ShapeId(9)))
+        );
+        let bad_margin = BodyDesc {
+            margin: Some(f64::NAN),
+            ..desc(sphere, Pose::IDENTITY)
+        };
+        assert!(matches!(
+            s.add_body(&bad_margin),
+            Err(SceneError::InvalidMargin(_))
+        ));
+        assert!(matches!(
+            s.update_body(a, Motion::Static, CollisionFilter::ALL, Some(-1.0)),
+            Err(SceneError::InvalidMargin(_))
+        ));
+        assert_eq!(
+            s.set_pose(BodyId(7), Pose::IDENTITY),
+            Err(SceneError::UnknownBody(BodyId(7)))
+        );
+        assert_eq!(format!("{s:?}"), before);
+        // Limits, and ids never reused after removal.
+        let b = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        let c = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        assert_eq!(
+            s.add_body(&desc(sphere, Pose::IDENTITY)),
+            Err(SceneError::TooManyBodies(3))
+        );
+        s.remove_body(b).unwrap();
+        assert_eq!(s.remove_body(b), Err(SceneError::UnknownBody(b)));
+        let d = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        assert!(d > c && d != b);
+        for _ in 0..3 {
+            s.register_shape(Shape::Sphere(Sphere::new(1.0))).unwrap();
+        }
+        assert!(matches!(
+            s.register_shape(Shape::Sphere(Sphere::new(1.0))),
+            Err(SceneError::TooManyShapes(4))
+        ));
+        assert_eq!(s.validate(), Ok(()));
+        assert!(Scene::try_new(-0.1, SceneLimits::STANDARD).is_err());
+    }
+
+    #[test]
+    fn filters_pair_only_when_both_groups_meet_the_other_mask() {
+        let (a, b) = (
+            CollisionFilter {
+                group: 0b01,
+                mask: 0b10,
+            },
+            CollisionFilter {
+                group: 0b10,
+                mask: 0b01,
+            },
+        );
+        let c = CollisionFilter {
+            group: 0b10,
+            mask: 0b10,
+        };
+        assert!(a.allows(&b) && b.allows(&a));
+        assert!(!a.allows(&c) && !c.allows(&a));
+        assert!(CollisionFilter::ALL.allows(&a));
+    }
+}
