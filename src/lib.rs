@@ -42,3 +42,6 @@ pub(crate) mod test_support;
 
 /// Scene state: registered shapes and placed bodies.
 pub mod scene;
+
+/// The daemon's service loop and wire conversion (the only user of `proxima-ipc`).
+pub mod daemon;

@@ -1,0 +1,486 @@
+//! The control service's logic: one request in, one reply out, against the daemon's scenes.
+//!
+//! Pure state handling, no IPC: the service loop in [`super`] receives a request, calls
+//! [`ControlState::handle`] and sends the reply. A refused request changes nothing and gets
+//! the error code and reason; it is logged once by the caller.
+
+use super::config::DaemonConfig;
+use super::convert::{self, Rejection};
+use crate::scene::{BodyDesc, BodyId, Scene, ShapeId};
+use proxima_ipc::PROTOCOL_VERSION;
+use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
+
+/// The scenes a daemon serves, by id (ids are not reused while the daemon runs).
+#[derive(Debug)]
+pub struct ControlState {
+    config: DaemonConfig,
+    scenes: Vec<Option<Scene>>,
+    live_scenes: u32,
+}
+
+impl ControlState {
+    /// No scenes yet.
+    #[must_use]
+    pub fn new(config: DaemonConfig) -> Self {
+        Self {
+            config,
+            scenes: Vec::new(),
+            live_scenes: 0,
+        }
+    }
+
+    /// Scene `id`, if it lives.
+    #[must_use]
+    pub fn scene(&self, id: u32) -> Option<&Scene> {
+        self.scenes.get(id as usize).and_then(Option::as_ref)
+    }
+
+    /// Answers one request; the state changes only when the reply is a success.
+    pub fn handle(&mut self, request: &ControlRequest, payload: &[u8]) -> ControlReply {
+        match self.try_handle(request, payload) {
+            Ok(id) => ControlReply::ok(id),
+            Err(r) => ControlReply::error(r.code, &r.reason),
+        }
+    }
+
+    fn try_handle(&mut self, request: &ControlRequest, payload: &[u8]) -> Result<u32, Rejection> {
+        if request.protocol_version != PROTOCOL_VERSION {
+            return Err(Rejection::new(
+                ErrorCode::ProtocolMismatch,
+                format!(
+                    "client speaks protocol {}, the daemon {PROTOCOL_VERSION}",
+                    request.protocol_version
+                ),
+            ));
+        }
+        let command = request.command;
+        let is = |c: Command| command == c as u32;
+        if !payload.is_empty() && !is(Command::RegisterShape) {
+            return Err(Rejection::new(
+                ErrorCode::MalformedMessage,
+                "only RegisterShape carries a payload",
+            ));
+        }
+        if is(Command::Hello) {
+            Ok(PROTOCOL_VERSION)
+        } else if is(Command::CreateScene) {
+            self.create_scene()
+        } else if is(Command::DropScene) {
+            self.scene_mut(request.scene)?;
+            self.scenes[request.scene as usize] = None;
+            self.live_scenes -= 1;
+            Ok(request.scene)
+        } else if is(Command::RegisterShape) {
+            let shape = convert::shape(
+                request,
+                payload,
+                &self.config.mesh_limits,
+                self.config.max_convex_points,
+            )?;
+            let id = self
+                .scene_mut(request.scene)?
+                .register_shape(shape)
+                .map_err(scene_rejection)?;
+            Ok(id.0)
+        } else if is(Command::AddBody) {
+            let desc = BodyDesc {
+                shape: ShapeId(request.target),
+                pose: convert::pose(request.position, request.orientation)?,
+                motion: convert::motion(request.motion)?,
+                filter: convert::filter(request),
+                margin: convert::margin(request.margin),
+            };
+            let id = self
+                .scene_mut(request.scene)?
+                .add_body(&desc)
+                .map_err(scene_rejection)?;
+            Ok(id.0)
+        } else if is(Command::RemoveBody) {
+            let scene = self.scene_mut(request.scene)?;
+            scene
+                .remove_body(BodyId(request.target))
+                .map_err(scene_rejection)?;
+            Ok(request.target)
+        } else if is(Command::UpdateBody) {
+            let motion = convert::motion(request.motion)?;
+            let scene = self.scene_mut(request.scene)?;
+            scene
+                .update_body(
+                    BodyId(request.target),
+                    motion,
+                    convert::filter(request),
+                    convert::margin(request.margin),
+                )
+                .map_err(scene_rejection)?;
+            Ok(request.target)
+        } else {
+            Err(Rejection::new(
+                ErrorCode::MalformedMessage,
+                format!("unknown command {command}"),
+            ))
+        }
+    }
+
+    fn create_scene(&mut self) -> Result<u32, Rejection> {
+        if self.live_scenes >= self.config.max_scenes {
+            return Err(Rejection::new(
+                ErrorCode::LimitExceeded,
+                format!(
+                    "the daemon's limit of {} scenes is reached",
+                    self.config.max_scenes
+                ),
+            ));
+        }
+        let scene = Scene::try_new(self.config.default_margin, self.config.scene_limits)
+            .map_err(scene_rejection)?;
+        self.scenes.push(Some(scene));
+        self.live_scenes += 1;
+        Ok(self.scenes.len() as u32 - 1)
+    }
+
+    fn scene_mut(&mut self, id: u32) -> Result<&mut Scene, Rejection> {
+        self.scenes
+            .get_mut(id as usize)
+            .and_then(Option::as_mut)
+            .ok_or_else(|| Rejection::new(ErrorCode::UnknownScene, format!("no scene {id}")))
+    }
+}
+
+fn scene_rejection(e: crate::scene::SceneError) -> Rejection {
+    use crate::scene::SceneError as E;
+    let code = match e {
+        E::UnknownShape(_) => ErrorCode::UnknownShape,
+        E::UnknownBody(_) => ErrorCode::UnknownBody,
+        E::TooManyShapes(_) | E::TooManyBodies(_) => ErrorCode::LimitExceeded,
+        _ => ErrorCode::MalformedMessage,
+    };
+    Rejection::new(code, e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proxima_ipc::wire::{MotionCode, ShapeKindCode};
+
+    fn request(command: Command) -> ControlRequest {
+        ControlRequest {
+            protocol_version: PROTOCOL_VERSION,
+            command: command as u32,
+            orientation: [0.0, 0.0, 0.0, 1.0],
+            motion: MotionCode::Dynamic as u32,
+            group: u32::MAX,
+            mask: u32::MAX,
+            margin: -1.0,
+            ..ControlRequest::default()
+        }
+    }
+
+    fn mesh_payload(vertices: &[[f64; 3]], indices: &[u32]) -> Vec<u8> {
+        let mut bytes: Vec<u8> = vertices
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_ne_bytes())
+            .collect();
+        bytes.extend(indices.iter().flat_map(|i| i.to_ne_bytes()));
+        bytes
+    }
+
+    fn mesh_request(scene: u32, vertices: usize, indices: usize) -> ControlRequest {
+        ControlRequest {
+            scene,
+            shape_kind: ShapeKindCode::Mesh as u32,
+            vertex_count: vertices as u32,
+            index_count: indices as u32,
+            ..request(Command::RegisterShape)
+        }
+    }
+
+    fn code(reply: &ControlReply) -> ErrorCode {
+        ErrorCode::from_u32(reply.status).expect("a defined code")
+    }
+
+    const TETRA: [[f64; 3]; 4] = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    ];
+    const TETRA_INDICES: [u32; 12] = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
+
+    #[test]
+    fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
+        let mut state = ControlState::new(DaemonConfig::default());
+        assert_eq!(
+            state.handle(&request(Command::Hello), &[]).id,
+            PROTOCOL_VERSION
+        );
+        let scene = state.handle(&request(Command::CreateScene), &[]).id;
+        let sphere = ControlRequest {
+            scene,
+            shape_kind: ShapeKindCode::Sphere as u32,
+            dimensions: [0.5, 0.0, 0.0, 0.0],
+            ..request(Command::RegisterShape)
+        };
+        let sphere = state.handle(&sphere, &[]);
+        assert_eq!(code(&sphere), ErrorCode::Ok, "{}", sphere.reason());
+        let mesh = state.handle(
+            &mesh_request(scene, 4, 12),
+            &mesh_payload(&TETRA, &TETRA_INDICES),
+        );
+        assert_eq!(code(&mesh), ErrorCode::Ok, "{}", mesh.reason());
+        let add = |state: &mut ControlState, shape: u32, x: f64| {
+            state.handle(
+                &ControlRequest {
+                    scene,
+                    target: shape,
+                    position: [x, 0.0, 0.0],
+                    ..request(Command::AddBody)
+                },
+                &[],
+            )
+        };
+        let a = add(&mut state, sphere.id, 0.0);
+        let b = add(&mut state, mesh.id, 2.0);
+        assert_eq!((code(&a), code(&b)), (ErrorCode::Ok, ErrorCode::Ok));
+        let s = state.scene(scene).unwrap();
+        assert_eq!(s.body_count(), 2);
+        assert_eq!(s.body(BodyId(b.id)).unwrap().pose.position.x, 2.0);
+        let update = ControlRequest {
+            scene,
+            target: a.id,
+            motion: MotionCode::Static as u32,
+            margin: 0.25,
+            ..request(Command::UpdateBody)
+        };
+        assert_eq!(code(&state.handle(&update, &[])), ErrorCode::Ok);
+        assert_eq!(
+            state
+                .scene(scene)
+                .unwrap()
+                .body(BodyId(a.id))
+                .unwrap()
+                .margin,
+            0.25
+        );
+        let remove = ControlRequest {
+            scene,
+            target: a.id,
+            ..request(Command::RemoveBody)
+        };
+        assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::Ok);
+        assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::UnknownBody);
+        let drop = ControlRequest {
+            scene,
+            ..request(Command::DropScene)
+        };
+        assert_eq!(code(&state.handle(&drop, &[])), ErrorCode::Ok);
+        assert!(state.scene(scene).is_none());
+        assert_eq!(code(&state.handle(&drop, &[])), ErrorCode::UnknownScene);
+    }
+
+    #[test]
+    fn every_bad_request_gets_its_code_and_changes_nothing() {
+        let mut state = ControlState::new(DaemonConfig {
+            max_scenes: 2,
+            mesh_limits: crate::geometry::MeshLimits {
+                max_vertices: 8,
+                max_triangles: 8,
+            },
+            ..DaemonConfig::default()
+        });
+        let scene = state.handle(&request(Command::CreateScene), &[]).id;
+        let sphere = ControlRequest {
+            scene,
+            shape_kind: ShapeKindCode::Sphere as u32,
+            dimensions: [1.0; 4],
+            ..request(Command::RegisterShape)
+        };
+        let shape = state.handle(&sphere, &[]).id;
+        let body = state
+            .handle(
+                &ControlRequest {
+                    scene,
+                    target: shape,
+                    ..request(Command::AddBody)
+                },
+                &[],
+            )
+            .id;
+        let snapshot = format!("{:?}", state.scene(scene));
+        let big: Vec<[f64; 3]> = (0..9).map(|i| [f64::from(i), 0.0, 0.0]).collect();
+        let cases: Vec<(ControlRequest, Vec<u8>, ErrorCode)> = vec![
+            (
+                ControlRequest {
+                    protocol_version: 99,
+                    ..request(Command::Hello)
+                },
+                vec![],
+                ErrorCode::ProtocolMismatch,
+            ),
+            (
+                ControlRequest {
+                    command: 77,
+                    ..request(Command::Hello)
+                },
+                vec![],
+                ErrorCode::MalformedMessage,
+            ),
+            (
+                ControlRequest { scene: 5, ..sphere },
+                vec![],
+                ErrorCode::UnknownScene,
+            ),
+            (
+                ControlRequest {
+                    shape_kind: 42,
+                    ..sphere
+                },
+                vec![],
+                ErrorCode::MalformedMessage,
+            ),
+            (
+                ControlRequest {
+                    dimensions: [f64::NAN; 4],
+                    ..sphere
+                },
+                vec![],
+                ErrorCode::InvalidShape,
+            ),
+            (
+                ControlRequest {
+                    dimensions: [-1.0; 4],
+                    ..sphere
+                },
+                vec![],
+                ErrorCode::InvalidShape,
+            ),
+            (sphere, vec![1, 2, 3], ErrorCode::MalformedMessage),
+            (
+                mesh_request(scene, 4, 12),
+                mesh_payload(&TETRA, &TETRA_INDICES)[..50].to_vec(),
+                ErrorCode::MalformedMessage,
+            ),
+            (
+                mesh_request(scene, 4, 3),
+                mesh_payload(&TETRA, &[0, 1, 9]),
+                ErrorCode::MeshIndexOutOfRange,
+            ),
+            (
+                mesh_request(scene, 4, 4),
+                mesh_payload(&TETRA, &[0, 1, 2, 3]),
+                ErrorCode::MalformedMessage,
+            ),
+            (mesh_request(scene, 0, 0), vec![], ErrorCode::EmptyGeometry),
+            (
+                mesh_request(scene, 3, 3),
+                mesh_payload(
+                    &[[0.0, f64::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                    &[0, 1, 2],
+                ),
+                ErrorCode::InvalidShape,
+            ),
+            (
+                mesh_request(scene, 9, 3),
+                mesh_payload(&big, &[0, 1, 2]),
+                ErrorCode::LimitExceeded,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    target: 9,
+                    ..request(Command::AddBody)
+                },
+                vec![],
+                ErrorCode::UnknownShape,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    target: shape,
+                    position: [f64::NAN, 0.0, 0.0],
+                    ..request(Command::AddBody)
+                },
+                vec![],
+                ErrorCode::InvalidPose,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    target: shape,
+                    orientation: [0.0, 0.0, 0.0, 2.0],
+                    ..request(Command::AddBody)
+                },
+                vec![],
+                ErrorCode::InvalidPose,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    target: shape,
+                    motion: 9,
+                    ..request(Command::AddBody)
+                },
+                vec![],
+                ErrorCode::MalformedMessage,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    target: shape,
+                    margin: f64::INFINITY,
+                    ..request(Command::AddBody)
+                },
+                vec![],
+                ErrorCode::MalformedMessage,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    target: 9,
+                    ..request(Command::RemoveBody)
+                },
+                vec![],
+                ErrorCode::UnknownBody,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    target: body,
+                    margin: f64::NAN,
+                    ..request(Command::UpdateBody)
+                },
+                vec![],
+                ErrorCode::MalformedMessage,
+            ),
+        ];
+        for (i, (req, payload, expected)) in cases.iter().enumerate() {
+            let reply = state.handle(req, payload);
+            assert_eq!(code(&reply), *expected, "case {i}: {}", reply.reason());
+            assert_eq!(reply.id, u32::MAX, "case {i}");
+            assert!(!reply.reason().is_empty(), "case {i}");
+            assert_eq!(
+                format!("{:?}", state.scene(scene)),
+                snapshot,
+                "case {i} changed the scene"
+            );
+        }
+        // The scene limit, and the scene still serves after all of it.
+        assert_eq!(
+            code(&state.handle(&request(Command::CreateScene), &[])),
+            ErrorCode::Ok
+        );
+        assert_eq!(
+            code(&state.handle(&request(Command::CreateScene), &[])),
+            ErrorCode::LimitExceeded
+        );
+        let again = state.handle(
+            &ControlRequest {
+                scene,
+                target: shape,
+                ..request(Command::AddBody)
+            },
+            &[],
+        );
+        assert_eq!(code(&again), ErrorCode::Ok);
+    }
+}

@@ -1,0 +1,190 @@
+//! Wire records to validated domain values, once, at the boundary. Every function here
+//! takes untrusted input and returns either a value the engine may trust or a
+//! [`Rejection`] naming the wire error code and the reason.
+
+use crate::geometry::{
+    Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, MeshError, MeshLimits, Sphere, TriMesh,
+};
+use crate::math::{DQuat, DVec3, Pose};
+use crate::scene::{CollisionFilter, MeshShape, Motion, Shape};
+use proxima_ipc::wire::{ControlRequest, ErrorCode, MotionCode, ShapeKindCode};
+use std::sync::Arc;
+
+/// Why an input was refused: the code for the wire and a reason for people.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Rejection {
+    /// The wire error code.
+    pub code: ErrorCode,
+    /// What exactly was wrong.
+    pub reason: String,
+}
+
+impl Rejection {
+    pub(crate) fn new(code: ErrorCode, reason: impl Into<String>) -> Self {
+        Self {
+            code,
+            reason: reason.into(),
+        }
+    }
+}
+
+/// A pose from wire arrays (world frame, quaternion `[x, y, z, w]`).
+pub fn pose(position: [f64; 3], orientation: [f64; 4]) -> Result<Pose, Rejection> {
+    let [x, y, z, w] = orientation;
+    Pose::try_new(DVec3::from(position), DQuat::from_xyzw(x, y, z, w))
+        .map_err(|e| Rejection::new(ErrorCode::InvalidPose, e.to_string()))
+}
+
+/// A motion kind from its wire code.
+pub fn motion(code: u32) -> Result<Motion, Rejection> {
+    match code {
+        c if c == MotionCode::Static as u32 => Ok(Motion::Static),
+        c if c == MotionCode::Kinematic as u32 => Ok(Motion::Kinematic),
+        c if c == MotionCode::Dynamic as u32 => Ok(Motion::Dynamic),
+        other => Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            format!("unknown motion kind {other}"),
+        )),
+    }
+}
+
+/// A collision filter from a request.
+#[must_use]
+pub fn filter(request: &ControlRequest) -> CollisionFilter {
+    CollisionFilter {
+        group: request.group,
+        mask: request.mask,
+    }
+}
+
+/// A body's margin: negative on the wire means "the scene's default".
+#[must_use]
+pub fn margin(value: f64) -> Option<f64> {
+    (value >= 0.0 || value.is_nan()).then_some(value)
+}
+
+/// The shape a `RegisterShape` request describes, its geometry decoded from `payload`.
+pub fn shape(
+    request: &ControlRequest,
+    payload: &[u8],
+    mesh_limits: &MeshLimits,
+    max_convex_points: u32,
+) -> Result<Shape, Rejection> {
+    let [d0, d1, d2, _] = request.dimensions;
+    let primitive = |result: Result<Shape, crate::geometry::ShapeError>| {
+        result.map_err(|e| Rejection::new(ErrorCode::InvalidShape, e.to_string()))
+    };
+    let kind = request.shape_kind;
+    let is = |code: ShapeKindCode| kind == code as u32;
+    let needs_payload = is(ShapeKindCode::Convex) || is(ShapeKindCode::Mesh);
+    if !needs_payload
+        && (!payload.is_empty() || request.vertex_count != 0 || request.index_count != 0)
+    {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            "a primitive shape carries no geometry payload",
+        ));
+    }
+    if is(ShapeKindCode::Sphere) {
+        primitive(Sphere::try_new(d0).map(Shape::Sphere))
+    } else if is(ShapeKindCode::Capsule) {
+        primitive(Capsule::try_new(d1, d0).map(Shape::Capsule))
+    } else if is(ShapeKindCode::Cuboid) {
+        primitive(Cuboid::try_new(DVec3::new(d0, d1, d2)).map(Shape::Cuboid))
+    } else if is(ShapeKindCode::Cylinder) {
+        primitive(Cylinder::try_new(d1, d0).map(Shape::Cylinder))
+    } else if is(ShapeKindCode::Cone) {
+        primitive(Cone::try_new(d1, d0).map(Shape::Cone))
+    } else if is(ShapeKindCode::Convex) {
+        if request.vertex_count > max_convex_points {
+            return Err(Rejection::new(
+                ErrorCode::LimitExceeded,
+                format!(
+                    "{} points, the limit is {max_convex_points}",
+                    request.vertex_count
+                ),
+            ));
+        }
+        let (points, indices) = geometry(request, payload)?;
+        if !indices.is_empty() {
+            return Err(Rejection::new(
+                ErrorCode::MalformedMessage,
+                "a convex shape carries no indices",
+            ));
+        }
+        ConvexPolyhedron::try_from_points(&points)
+            .map(|hull| Shape::Convex(Arc::new(hull)))
+            .map_err(|e| {
+                let code = match e {
+                    crate::geometry::ConvexHullError::Empty => ErrorCode::EmptyGeometry,
+                    crate::geometry::ConvexHullError::TooLarge { .. } => ErrorCode::LimitExceeded,
+                    _ => ErrorCode::InvalidShape,
+                };
+                Rejection::new(code, e.to_string())
+            })
+    } else if is(ShapeKindCode::Mesh) {
+        let (vertices, indices) = geometry(request, payload)?;
+        if indices.len() % 3 != 0 {
+            return Err(Rejection::new(
+                ErrorCode::MalformedMessage,
+                "mesh indices are not a multiple of 3",
+            ));
+        }
+        let triangles = indices
+            .chunks_exact(3)
+            .map(|t| [t[0], t[1], t[2]])
+            .collect();
+        TriMesh::try_new_with_limits(vertices, triangles, mesh_limits)
+            .map(|mesh| Shape::Mesh(Arc::new(MeshShape::new(mesh))))
+            .map_err(|e| {
+                let code = match e {
+                    MeshError::Empty => ErrorCode::EmptyGeometry,
+                    MeshError::IndexOutOfRange { .. } => ErrorCode::MeshIndexOutOfRange,
+                    MeshError::TooManyVertices { .. } | MeshError::TooManyTriangles { .. } => {
+                        ErrorCode::LimitExceeded
+                    }
+                    _ => ErrorCode::InvalidShape,
+                };
+                Rejection::new(code, e.to_string())
+            })
+    } else {
+        Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            format!("unknown shape kind {kind}"),
+        ))
+    }
+}
+
+/// Decodes the geometry payload: `vertex_count` points, then `index_count` indices.
+fn geometry(request: &ControlRequest, payload: &[u8]) -> Result<(Vec<DVec3>, Vec<u32>), Rejection> {
+    let (points, indices) = (request.vertex_count as usize, request.index_count as usize);
+    let expected = points
+        .checked_mul(24)
+        .and_then(|v| indices.checked_mul(4).and_then(|i| v.checked_add(i)));
+    if expected != Some(payload.len()) {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            format!(
+                "{points} points and {indices} indices need {expected:?} bytes, the payload has {}",
+                payload.len()
+            ),
+        ));
+    }
+    let (vertex_bytes, index_bytes) = payload.split_at(points * 24);
+    let coordinate = |b: &[u8]| f64::from_ne_bytes(b.try_into().expect("8 bytes"));
+    let vertices = vertex_bytes
+        .chunks_exact(24)
+        .map(|v| {
+            DVec3::new(
+                coordinate(&v[..8]),
+                coordinate(&v[8..16]),
+                coordinate(&v[16..]),
+            )
+        })
+        .collect();
+    let indices = index_bytes
+        .chunks_exact(4)
+        .map(|b| u32::from_ne_bytes(b.try_into().expect("4 bytes")))
+        .collect();
+    Ok((vertices, indices))
+}
