@@ -1082,7 +1082,7 @@ mod tests {
     fn a_daemon_under_another_iceoryx_prefix_is_invisible() {
         let root = root("prefix");
         let prefix = format!("proxima_client_test_{}_", std::process::id());
-        let _responder =
+        let responder =
             Responder::start::<iceoryx2::prelude::ipc::Service>(&root, Some(&prefix), conformance);
         let other = ClientBuilder::new()
             .root(&root)
@@ -1096,6 +1096,13 @@ mod tests {
             .connect::<iceoryx2::prelude::ipc::Service>()
             .unwrap();
         assert!(client.create_scene().is_ok());
+        drop((client, responder));
+        // iceoryx2 leaves one small global-management segment per prefix behind.
+        for entry in std::fs::read_dir("/dev/shm").unwrap().flatten() {
+            if entry.file_name().to_string_lossy().starts_with(&prefix) {
+                std::fs::remove_file(entry.path()).unwrap();
+            }
+        }
     }
 
     #[test]
