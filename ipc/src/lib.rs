@@ -5,7 +5,13 @@
 //! std; records use plain arrays (`[f64; 3]`), never glam, so clients in any language that
 //! iceoryx2 binds can speak it.
 
+pub mod client;
+pub mod error;
 pub mod wire;
+
+use iceoryx2::node::Node;
+use iceoryx2::service::builder::request_response::Builder as RequestResponseBuilder;
+use iceoryx2::service::service_name::{ServiceName, ServiceNameError};
 
 /// The protocol version. A client and a daemon whose versions differ refuse to talk; bump it
 /// on any change to a wire record's layout or meaning.
@@ -19,6 +25,49 @@ pub const DEFAULT_ROOT: &str = "proxima";
 pub fn control_service_name(root: &str) -> String {
     format!("{root}/control")
 }
+
+/// The builder of the control service (`<root>/control`), with every setting the daemon and
+/// its clients must agree on. Both sides call this and then `open_or_create()`, so whichever
+/// comes first creates the service with these settings and the other opens it.
+///
+/// Settings: request `[u8]` (geometry) with a [`wire::ControlRequest`] user header, response
+/// [`wire::ControlReply`]; at most [`CONTROL_MAX_CLIENTS`] clients, [`CONTROL_MAX_SERVERS`]
+/// server, [`CONTROL_MAX_ACTIVE_REQUESTS_PER_CLIENT`] requests in flight per client and
+/// [`CONTROL_MAX_RESPONSE_BUFFER_SIZE`] buffered responses. A client port additionally uses
+/// [`CONTROL_INITIAL_MAX_SLICE_LEN`] and `AllocationStrategy::PowerOfTwo`, so meshes of any
+/// size fit.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name (empty, too long, or bad characters).
+pub fn control_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+) -> Result<ControlServiceBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&control_service_name(root))?;
+    Ok(node
+        .service_builder(&name)
+        .request_response::<[u8], wire::ControlReply>()
+        .request_user_header::<wire::ControlRequest>()
+        .max_clients(CONTROL_MAX_CLIENTS)
+        .max_servers(CONTROL_MAX_SERVERS)
+        .max_active_requests_per_client(CONTROL_MAX_ACTIVE_REQUESTS_PER_CLIENT)
+        .max_response_buffer_size(CONTROL_MAX_RESPONSE_BUFFER_SIZE))
+}
+
+/// The iceoryx2 builder type [`control_service_builder`] returns.
+pub type ControlServiceBuilder<S> =
+    RequestResponseBuilder<[u8], wire::ControlRequest, wire::ControlReply, (), S>;
+
+/// Most clients the control service admits at once.
+pub const CONTROL_MAX_CLIENTS: usize = 64;
+/// Servers of the control service: the one daemon.
+pub const CONTROL_MAX_SERVERS: usize = 1;
+/// Control requests one client may have in flight.
+pub const CONTROL_MAX_ACTIVE_REQUESTS_PER_CLIENT: usize = 4;
+/// Responses buffered per control request.
+pub const CONTROL_MAX_RESPONSE_BUFFER_SIZE: usize = 4;
+/// Initial byte capacity of a client's request slice (grows by powers of two).
+pub const CONTROL_INITIAL_MAX_SLICE_LEN: usize = 4096;
 
 /// The name of scene `scene`'s pose service under `root`.
 #[must_use]

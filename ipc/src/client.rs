@@ -1,0 +1,1127 @@
+//! The control half of the client: connect to a `proximad` daemon, create scenes, register
+//! shapes, and add, remove and update bodies. Each call is one request on the control
+//! service (`<root>/control`) and one reply, waited for up to the client's reply timeout.
+//!
+//! ```no_run
+//! use proxima_ipc::client::{BodySpec, ClientBuilder, Motion, Primitive};
+//! use std::time::Duration;
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let client = ClientBuilder::new()
+//!     .root("proxima")
+//!     .reply_timeout(Duration::from_secs(1))
+//!     .connect::<iceoryx2::service::ipc::Service>()?;
+//! let scene = client.create_scene()?;
+//! let ball = client.register_primitive(scene, Primitive::Sphere { radius: 0.1 })?;
+//! let body = client.add_body(
+//!     scene,
+//!     &BodySpec {
+//!         shape: ball,
+//!         position: [0.0, 0.0, 1.0],
+//!         orientation: [0.0, 0.0, 0.0, 1.0],
+//!         motion: Motion::Dynamic,
+//!         group: 1,
+//!         mask: u32::MAX,
+//!         margin: None,
+//!     },
+//! )?;
+//! client.update_body(scene, body, Motion::Kinematic, 1, u32::MAX, Some(0.01))?;
+//! client.remove_body(scene, body)?;
+//! client.drop_scene(scene)?;
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! Request–response ports cannot join a WaitSet, so a reply is awaited by polling with a
+//! short back-off: a spin of [`SPIN`], then sleeps of [`SLEEP`].
+
+use std::time::{Duration, Instant};
+
+use iceoryx2::config::Config;
+use iceoryx2::node::{Node, NodeBuilder};
+use iceoryx2::port::client::Client as ClientPort;
+use iceoryx2::prelude::{AllocationStrategy, FileName, PortFactory as _, SemanticString as _};
+use iceoryx2::service::Service;
+use iceoryx2::service::port_factory::request_response::PortFactory;
+
+use crate::error::{ClientConnectError, ControlError};
+use crate::wire::{Command, ControlReply, ControlRequest, ErrorCode, MotionCode, ShapeKindCode};
+use crate::{CONTROL_INITIAL_MAX_SLICE_LEN, DEFAULT_ROOT, PROTOCOL_VERSION};
+
+/// How long a reply is awaited by spinning before the wait starts sleeping.
+pub const SPIN: Duration = Duration::from_micros(20);
+/// One sleep of the reply wait after the spin.
+pub const SLEEP: Duration = Duration::from_micros(50);
+/// The default reply timeout of [`ClientBuilder`].
+pub const DEFAULT_REPLY_TIMEOUT: Duration = Duration::from_secs(2);
+
+/// A primitive shape, dimensions in metres in the shape's local frame; round shapes' axes
+/// run along local Z.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Primitive {
+    /// A ball about the origin.
+    Sphere {
+        /// Radius, metres.
+        radius: f64,
+    },
+    /// A segment from `−half_height` to `+half_height` on Z, swept by a ball.
+    Capsule {
+        /// Radius, metres.
+        radius: f64,
+        /// Half the segment's length, metres.
+        half_height: f64,
+    },
+    /// A box centred on the origin.
+    Cuboid {
+        /// Half extents along X, Y, Z, metres.
+        half_extents: [f64; 3],
+    },
+    /// A cylinder from `−half_height` to `+half_height` on Z.
+    Cylinder {
+        /// Radius, metres.
+        radius: f64,
+        /// Half the height, metres.
+        half_height: f64,
+    },
+    /// A cone with its base at `−half_height` and apex at `+half_height` on Z.
+    Cone {
+        /// Base radius, metres.
+        radius: f64,
+        /// Half the height, metres.
+        half_height: f64,
+    },
+}
+
+impl Primitive {
+    /// The wire kind and `dimensions` of this primitive (see [`ShapeKindCode`]).
+    #[must_use]
+    pub const fn to_wire(self) -> (ShapeKindCode, [f64; 4]) {
+        match self {
+            Self::Sphere { radius } => (ShapeKindCode::Sphere, [radius, 0.0, 0.0, 0.0]),
+            Self::Capsule {
+                radius,
+                half_height,
+            } => (ShapeKindCode::Capsule, [radius, half_height, 0.0, 0.0]),
+            Self::Cuboid {
+                half_extents: [x, y, z],
+            } => (ShapeKindCode::Cuboid, [x, y, z, 0.0]),
+            Self::Cylinder {
+                radius,
+                half_height,
+            } => (ShapeKindCode::Cylinder, [radius, half_height, 0.0, 0.0]),
+            Self::Cone {
+                radius,
+                half_height,
+            } => (ShapeKindCode::Cone, [radius, half_height, 0.0, 0.0]),
+        }
+    }
+}
+
+/// How a body moves (static bodies never pair with each other).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Motion {
+    /// Never moves after it is added.
+    Static,
+    /// Moved by the client, not by physics.
+    Kinematic,
+    /// Moved by the client's physics.
+    Dynamic,
+}
+
+impl Motion {
+    /// The wire code of this motion kind.
+    #[must_use]
+    pub const fn to_wire(self) -> MotionCode {
+        match self {
+            Self::Static => MotionCode::Static,
+            Self::Kinematic => MotionCode::Kinematic,
+            Self::Dynamic => MotionCode::Dynamic,
+        }
+    }
+}
+
+/// A body to add to a scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodySpec {
+    /// The shape id (from a `register_*` call).
+    pub shape: u32,
+    /// Initial position of the body's local origin, metres, world frame.
+    pub position: [f64; 3],
+    /// Initial orientation, unit quaternion `[x, y, z, w]`, world frame.
+    pub orientation: [f64; 4],
+    /// How the body moves.
+    pub motion: Motion,
+    /// Collision group bits: a pair is tested when each body's group meets the other's mask.
+    pub group: u32,
+    /// Collision mask bits.
+    pub mask: u32,
+    /// Close-pair margin, metres, `≥ 0`; `None` = the scene's default.
+    pub margin: Option<f64>,
+}
+
+/// The wire value of an optional margin: negative means "the scene's default".
+const fn margin_to_wire(margin: Option<f64>) -> f64 {
+    match margin {
+        Some(m) => m,
+        None => -1.0,
+    }
+}
+
+/// Settings of a [`Client`]; [`ClientBuilder::connect`] makes one.
+#[derive(Debug, Clone)]
+pub struct ClientBuilder {
+    root: String,
+    prefix: Option<String>,
+    reply_timeout: Duration,
+}
+
+impl Default for ClientBuilder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ClientBuilder {
+    /// Root [`DEFAULT_ROOT`], iceoryx2's global config, reply timeout
+    /// [`DEFAULT_REPLY_TIMEOUT`].
+    #[must_use]
+    pub fn new() -> Self {
+        Self {
+            root: DEFAULT_ROOT.to_owned(),
+            prefix: None,
+            reply_timeout: DEFAULT_REPLY_TIMEOUT,
+        }
+    }
+
+    /// The root prefix of the daemon's service names (its `--root`).
+    #[must_use]
+    pub fn root(mut self, root: &str) -> Self {
+        self.root = root.to_owned();
+        self
+    }
+
+    /// The iceoryx2 `global.prefix` of every shared-memory file (isolates test instances);
+    /// by default iceoryx2's global config decides.
+    #[must_use]
+    pub fn iceoryx_prefix(mut self, prefix: &str) -> Self {
+        self.prefix = Some(prefix.to_owned());
+        self
+    }
+
+    /// How long each request waits for its reply, and connect for the daemon.
+    #[must_use]
+    pub fn reply_timeout(mut self, timeout: Duration) -> Self {
+        self.reply_timeout = timeout;
+        self
+    }
+
+    /// Creates the node, opens the control service and checks the daemon's protocol version
+    /// with `Hello`. Waits up to the reply timeout for a daemon to serve the service.
+    ///
+    /// # Errors
+    /// [`ClientConnectError::NoDaemon`] when no daemon answers in time,
+    /// [`ClientConnectError::ProtocolMismatch`] when it speaks another version, and the other
+    /// variants for bad settings and iceoryx2 failures.
+    pub fn connect<S: Service>(self) -> Result<Client<S>, ClientConnectError> {
+        let deadline = Instant::now() + self.reply_timeout;
+        let mut config = Config::global_config().clone();
+        if let Some(prefix) = &self.prefix {
+            config.global.prefix = FileName::new(prefix.as_bytes())
+                .map_err(|_| ClientConnectError::InvalidPrefix(prefix.clone()))?;
+        }
+        let node = NodeBuilder::new()
+            .config(&config)
+            .create::<S>()
+            .map_err(|e| ClientConnectError::Transport(format!("creating the node: {e}")))?;
+        let service = crate::control_service_builder(&node, &self.root)
+            .map_err(|_| ClientConnectError::InvalidRoot(self.root.clone()))?
+            .open_or_create()
+            .map_err(|e| {
+                ClientConnectError::Transport(format!("opening the control service: {e}"))
+            })?;
+        let port = service
+            .client_builder()
+            .initial_max_slice_len(CONTROL_INITIAL_MAX_SLICE_LEN)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .map_err(|e| ClientConnectError::Transport(format!("creating the client port: {e}")))?;
+        // A request sent before the daemon's server port exists is lost: wait for it first.
+        poll_until(deadline, || {
+            Ok::<_, ()>((service.dynamic_config().number_of_servers() > 0).then_some(()))
+        })
+        .ok()
+        .flatten()
+        .ok_or(ClientConnectError::NoDaemon)?;
+        let client = Client {
+            root: self.root,
+            reply_timeout: self.reply_timeout,
+            port,
+            service,
+            node,
+        };
+        let hello = ControlRequest {
+            protocol_version: PROTOCOL_VERSION,
+            command: Command::Hello as u32,
+            ..ControlRequest::default()
+        };
+        let reply = match client.request_until(&hello, 0, |_| {}, deadline) {
+            Ok(reply) => reply,
+            Err(ControlError::Timeout) => return Err(ClientConnectError::NoDaemon),
+            Err(e) => return Err(ClientConnectError::Transport(e.to_string())),
+        };
+        check_hello(&reply)?;
+        Ok(client)
+    }
+}
+
+/// The daemon's answer to `Hello`: success with our version, or why not.
+fn check_hello(reply: &ControlReply) -> Result<(), ClientConnectError> {
+    match ErrorCode::from_u32(reply.status) {
+        Some(ErrorCode::Ok) if reply.id == PROTOCOL_VERSION => Ok(()),
+        Some(ErrorCode::Ok) => Err(ClientConnectError::ProtocolMismatch { daemon: reply.id }),
+        Some(ErrorCode::ProtocolMismatch) => Err(ClientConnectError::ProtocolMismatch {
+            daemon: reply.protocol_version,
+        }),
+        code => Err(ClientConnectError::Rejected {
+            code: code.unwrap_or(ErrorCode::Internal),
+            reason: reply.reason(),
+        }),
+    }
+}
+
+/// A connection to a daemon's control service. Not shareable between threads with
+/// `ipc::Service` (iceoryx2's ports are single-threaded there).
+pub struct Client<S: Service> {
+    root: String,
+    reply_timeout: Duration,
+    // Fields drop in order: the port before its service, both before the node.
+    port: ClientPort<S, [u8], ControlRequest, ControlReply, ()>,
+    service: PortFactory<S, [u8], ControlRequest, ControlReply, ()>,
+    node: Node<S>,
+}
+
+impl<S: Service> std::fmt::Debug for Client<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Client")
+            .field("root", &self.root)
+            .field("reply_timeout", &self.reply_timeout)
+            .field("service", &self.service.name())
+            .finish_non_exhaustive()
+    }
+}
+
+impl<S: Service> Client<S> {
+    /// The root prefix of the daemon's service names.
+    #[must_use]
+    pub fn root(&self) -> &str {
+        &self.root
+    }
+
+    /// How long each request waits for its reply.
+    #[must_use]
+    pub fn reply_timeout(&self) -> Duration {
+        self.reply_timeout
+    }
+
+    /// The iceoryx2 node that owns this client's ports (for opening scene services).
+    #[must_use]
+    pub fn node(&self) -> &Node<S> {
+        &self.node
+    }
+
+    /// Creates a scene; returns its id.
+    ///
+    /// # Errors
+    /// See [`ControlError`].
+    pub fn create_scene(&self) -> Result<u32, ControlError> {
+        self.call(&self.header(Command::CreateScene, 0))
+    }
+
+    /// Drops scene `scene` with all its bodies.
+    ///
+    /// # Errors
+    /// See [`ControlError`].
+    pub fn drop_scene(&self, scene: u32) -> Result<(), ControlError> {
+        self.call(&self.header(Command::DropScene, scene)).map(drop)
+    }
+
+    /// Registers a primitive shape for scene `scene`; returns the shape id.
+    ///
+    /// # Errors
+    /// See [`ControlError`].
+    pub fn register_primitive(&self, scene: u32, shape: Primitive) -> Result<u32, ControlError> {
+        let (kind, dimensions) = shape.to_wire();
+        self.call(&ControlRequest {
+            shape_kind: kind as u32,
+            dimensions,
+            ..self.header(Command::RegisterShape, scene)
+        })
+    }
+
+    /// Registers the convex hull of `points` (metres, the shape's local frame) for scene
+    /// `scene`; returns the shape id.
+    ///
+    /// # Errors
+    /// See [`ControlError`]; [`ControlError::TooLarge`] beyond `u32::MAX` points.
+    pub fn register_convex(&self, scene: u32, points: &[[f64; 3]]) -> Result<u32, ControlError> {
+        self.register_geometry(scene, ShapeKindCode::Convex, points, &[])
+    }
+
+    /// Registers a triangle mesh (vertices in metres, the shape's local frame; triangles as
+    /// vertex indices) for scene `scene`; returns the shape id.
+    ///
+    /// # Errors
+    /// See [`ControlError`]; [`ControlError::TooLarge`] beyond `u32::MAX` vertices or
+    /// indices.
+    pub fn register_mesh(
+        &self,
+        scene: u32,
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Result<u32, ControlError> {
+        self.register_geometry(scene, ShapeKindCode::Mesh, vertices, triangles)
+    }
+
+    /// Adds a body to scene `scene`; returns the body id.
+    ///
+    /// # Errors
+    /// See [`ControlError`].
+    pub fn add_body(&self, scene: u32, body: &BodySpec) -> Result<u32, ControlError> {
+        self.call(&ControlRequest {
+            target: body.shape,
+            motion: body.motion.to_wire() as u32,
+            group: body.group,
+            mask: body.mask,
+            margin: margin_to_wire(body.margin),
+            position: body.position,
+            orientation: body.orientation,
+            ..self.header(Command::AddBody, scene)
+        })
+    }
+
+    /// Removes body `body` from scene `scene`.
+    ///
+    /// # Errors
+    /// See [`ControlError`].
+    pub fn remove_body(&self, scene: u32, body: u32) -> Result<(), ControlError> {
+        self.call(&ControlRequest {
+            target: body,
+            ..self.header(Command::RemoveBody, scene)
+        })
+        .map(drop)
+    }
+
+    /// Changes body `body`'s motion kind, collision group and mask, and margin (metres;
+    /// `None` = the scene's default).
+    ///
+    /// # Errors
+    /// See [`ControlError`].
+    pub fn update_body(
+        &self,
+        scene: u32,
+        body: u32,
+        motion: Motion,
+        group: u32,
+        mask: u32,
+        margin: Option<f64>,
+    ) -> Result<(), ControlError> {
+        self.call(&ControlRequest {
+            target: body,
+            motion: motion.to_wire() as u32,
+            group,
+            mask,
+            margin: margin_to_wire(margin),
+            ..self.header(Command::UpdateBody, scene)
+        })
+        .map(drop)
+    }
+
+    /// Sends one raw request and returns the raw reply, its status not interpreted. For
+    /// tests and tools; the typed methods above are built on it.
+    ///
+    /// # Errors
+    /// [`ControlError::Timeout`] and [`ControlError::Transport`] only.
+    pub fn request(
+        &self,
+        header: &ControlRequest,
+        payload: &[u8],
+    ) -> Result<ControlReply, ControlError> {
+        self.request_until(
+            header,
+            payload.len(),
+            |out| out.copy_from_slice(payload),
+            Instant::now() + self.reply_timeout,
+        )
+    }
+
+    /// A request header for `command` on `scene`, every other field zero.
+    fn header(&self, command: Command, scene: u32) -> ControlRequest {
+        ControlRequest {
+            protocol_version: PROTOCOL_VERSION,
+            command: command as u32,
+            scene,
+            ..ControlRequest::default()
+        }
+    }
+
+    /// Registers a convex or mesh shape with its geometry payload.
+    fn register_geometry(
+        &self,
+        scene: u32,
+        kind: ShapeKindCode,
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Result<u32, ControlError> {
+        let count = |n: usize| u32::try_from(n).map_err(|_| ControlError::TooLarge(n));
+        let header = ControlRequest {
+            shape_kind: kind as u32,
+            vertex_count: count(vertices.len())?,
+            index_count: count(triangles.len() * 3)?,
+            ..self.header(Command::RegisterShape, scene)
+        };
+        let len = geometry_len(vertices.len(), triangles.len() * 3);
+        let fill = |out: &mut [u8]| encode_geometry(out, vertices, triangles);
+        let reply = self.request_until(&header, len, fill, Instant::now() + self.reply_timeout)?;
+        reply_id(&reply)
+    }
+
+    /// One request with an empty payload; the reply's id on success.
+    fn call(&self, header: &ControlRequest) -> Result<u32, ControlError> {
+        reply_id(&self.request(header, &[])?)
+    }
+
+    /// Loans a `len`-byte request, lets `fill` write it, sends it and waits for the reply
+    /// until `deadline`.
+    fn request_until(
+        &self,
+        header: &ControlRequest,
+        len: usize,
+        fill: impl FnOnce(&mut [u8]),
+        deadline: Instant,
+    ) -> Result<ControlReply, ControlError> {
+        let mut request = self
+            .port
+            .loan_slice(len)
+            .map_err(|e| ControlError::Transport(format!("loaning a {len}-byte request: {e}")))?;
+        *request.user_header_mut() = *header;
+        fill(request.payload_mut());
+        let pending = request
+            .send()
+            .map_err(|e| ControlError::Transport(format!("sending a request: {e}")))?;
+        poll_until(deadline, || {
+            pending
+                .receive()
+                .map(|reply| reply.map(|r| *r.payload()))
+                .map_err(|e| ControlError::Transport(format!("receiving a reply: {e}")))
+        })?
+        .ok_or(ControlError::Timeout)
+    }
+}
+
+/// The id of a success reply, or the reply's error.
+fn reply_id(reply: &ControlReply) -> Result<u32, ControlError> {
+    match ErrorCode::from_u32(reply.status) {
+        Some(ErrorCode::Ok) => Ok(reply.id),
+        Some(code) => Err(ControlError::Rejected {
+            code,
+            reason: reply.reason(),
+        }),
+        None => Err(ControlError::UnknownStatus(reply.status)),
+    }
+}
+
+/// Bytes of a geometry payload with `vertices` points and `indices` indices.
+const fn geometry_len(vertices: usize, indices: usize) -> usize {
+    vertices * 24 + indices * 4
+}
+
+/// Writes the geometry payload (see [`ControlRequest`]) into `out`, which is exactly
+/// [`geometry_len`] bytes long.
+fn encode_geometry(out: &mut [u8], vertices: &[[f64; 3]], triangles: &[[u32; 3]]) {
+    debug_assert_eq!(out.len(), geometry_len(vertices.len(), triangles.len() * 3));
+    let (points, indices) = out.split_at_mut(vertices.len() * 24);
+    let coordinates = vertices.iter().flatten();
+    for (dst, x) in points.chunks_exact_mut(8).zip(coordinates) {
+        dst.copy_from_slice(&x.to_ne_bytes());
+    }
+    for (dst, i) in indices.chunks_exact_mut(4).zip(triangles.iter().flatten()) {
+        dst.copy_from_slice(&i.to_ne_bytes());
+    }
+}
+
+/// Polls `poll` until it yields a value or `deadline` passes (`Ok(None)`): spins for
+/// [`SPIN`], then sleeps [`SLEEP`] between polls. Polls at least once.
+fn poll_until<T, E>(
+    deadline: Instant,
+    mut poll: impl FnMut() -> Result<Option<T>, E>,
+) -> Result<Option<T>, E> {
+    let start = Instant::now();
+    loop {
+        if let Some(value) = poll()? {
+            return Ok(Some(value));
+        }
+        let now = Instant::now();
+        if now >= deadline {
+            return Ok(None);
+        }
+        if now - start < SPIN {
+            std::hint::spin_loop();
+        } else {
+            std::thread::sleep(SLEEP.min(deadline - now));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wire::REASON_BYTES;
+    use iceoryx2::prelude::local;
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::mpsc;
+    use std::thread::JoinHandle;
+
+    /// How the test responder answers one request; `None` leaves it unanswered.
+    type Answer = fn(&ControlRequest, &[u8]) -> Option<ControlReply>;
+
+    /// A protocol-conformance responder: serves the control service from a thread, reports
+    /// every request it receives through a channel and answers with `answer`.
+    struct Responder {
+        stop: Arc<AtomicBool>,
+        thread: Option<JoinHandle<()>>,
+        received: mpsc::Receiver<(ControlRequest, Vec<u8>)>,
+    }
+
+    impl Responder {
+        fn start<S: Service>(root: &str, prefix: Option<&str>, answer: Answer) -> Self {
+            let stop = Arc::new(AtomicBool::new(false));
+            let (sent, received) = mpsc::channel();
+            let (ready_tx, ready_rx) = mpsc::channel();
+            let (root, prefix, flag) = (root.to_owned(), prefix.map(str::to_owned), stop.clone());
+            let thread = std::thread::spawn(move || {
+                let mut config = Config::global_config().clone();
+                if let Some(prefix) = prefix {
+                    config.global.prefix = FileName::new(prefix.as_bytes()).unwrap();
+                }
+                let node = NodeBuilder::new().config(&config).create::<S>().unwrap();
+                let service = crate::control_service_builder(&node, &root)
+                    .unwrap()
+                    .open_or_create()
+                    .unwrap();
+                let server = service.server_builder().create().unwrap();
+                ready_tx.send(()).unwrap();
+                while !flag.load(Ordering::Relaxed) {
+                    while let Some(active) = server.receive().unwrap() {
+                        let header = *active.user_header();
+                        let payload = active.payload().to_vec();
+                        if let Some(reply) = answer(&header, &payload) {
+                            active.send_copy(reply).unwrap();
+                        }
+                        sent.send((header, payload)).unwrap();
+                    }
+                    std::thread::sleep(Duration::from_micros(20));
+                }
+            });
+            ready_rx.recv().unwrap();
+            Self {
+                stop,
+                thread: Some(thread),
+                received,
+            }
+        }
+
+        /// The next request the responder received.
+        fn next(&self) -> (ControlRequest, Vec<u8>) {
+            self.received
+                .recv_timeout(Duration::from_secs(5))
+                .expect("the responder received a request")
+        }
+    }
+
+    impl Drop for Responder {
+        fn drop(&mut self) {
+            self.stop.store(true, Ordering::Relaxed);
+            if let Some(thread) = self.thread.take() {
+                thread.join().unwrap();
+            }
+        }
+    }
+
+    /// FNV-1a of the header's fields (their exact Debug text) and the payload, below
+    /// `u32::MAX`: the reply id by which the responder proves what it received.
+    fn fingerprint(header: &ControlRequest, payload: &[u8]) -> u32 {
+        let text = format!("{header:?}");
+        let mut hash: u32 = 0x811c_9dc5;
+        for &byte in text.as_bytes().iter().chain(payload) {
+            hash = (hash ^ u32::from(byte)).wrapping_mul(0x0100_0193);
+        }
+        hash.min(u32::MAX - 1)
+    }
+
+    fn conformance(header: &ControlRequest, payload: &[u8]) -> Option<ControlReply> {
+        Some(if header.command == Command::Hello as u32 {
+            ControlReply::ok(PROTOCOL_VERSION)
+        } else {
+            ControlReply::ok(fingerprint(header, payload))
+        })
+    }
+
+    fn root(tag: &str) -> String {
+        format!("client-test-{}-{tag}", std::process::id())
+    }
+
+    fn connect(root: &str) -> Client<local::Service> {
+        ClientBuilder::new()
+            .root(root)
+            .reply_timeout(Duration::from_secs(2))
+            .connect::<local::Service>()
+            .unwrap()
+    }
+
+    /// The header every typed request starts from.
+    fn base(command: Command, scene: u32) -> ControlRequest {
+        ControlRequest {
+            protocol_version: PROTOCOL_VERSION,
+            command: command as u32,
+            scene,
+            ..ControlRequest::default()
+        }
+    }
+
+    /// Checks that the responder received exactly `header` and `payload`, and that `id` is
+    /// the fingerprint it answered with.
+    fn assert_received(
+        responder: &Responder,
+        id: Result<u32, ControlError>,
+        header: ControlRequest,
+        payload: &[u8],
+    ) {
+        let (got_header, got_payload) = responder.next();
+        assert_eq!(got_header, header);
+        assert_eq!(got_payload, payload);
+        assert_eq!(id, Ok(fingerprint(&header, payload)));
+    }
+
+    #[test]
+    fn connect_says_hello_with_the_protocol_version() {
+        let root = root("hello");
+        let responder = Responder::start::<local::Service>(&root, None, conformance);
+        let client = connect(&root);
+        let (header, payload) = responder.next();
+        assert_eq!(header, base(Command::Hello, 0));
+        assert!(payload.is_empty());
+        assert_eq!(client.root(), root);
+        assert_eq!(client.reply_timeout(), Duration::from_secs(2));
+    }
+
+    #[test]
+    fn a_daemon_of_another_version_is_refused_either_way_it_says_so() {
+        let root = root("mismatch-id");
+        let _responder = Responder::start::<local::Service>(&root, None, |_, _| {
+            Some(ControlReply::ok(PROTOCOL_VERSION + 1))
+        });
+        let error = ClientBuilder::new().root(&root).connect::<local::Service>();
+        assert_eq!(
+            error.unwrap_err(),
+            ClientConnectError::ProtocolMismatch {
+                daemon: PROTOCOL_VERSION + 1
+            }
+        );
+
+        let root = self::root("mismatch-status");
+        let _responder = Responder::start::<local::Service>(&root, None, |_, _| {
+            let mut reply = ControlReply::error(ErrorCode::ProtocolMismatch, "version 1 only");
+            reply.protocol_version = 7;
+            Some(reply)
+        });
+        let error = ClientBuilder::new().root(&root).connect::<local::Service>();
+        assert_eq!(
+            error.unwrap_err(),
+            ClientConnectError::ProtocolMismatch { daemon: 7 }
+        );
+    }
+
+    #[test]
+    fn hello_refused_for_another_reason_is_reported_with_its_reason() {
+        let root = root("hello-refused");
+        let _responder = Responder::start::<local::Service>(&root, None, |_, _| {
+            Some(ControlReply::error(ErrorCode::LimitExceeded, "64 clients"))
+        });
+        let error = ClientBuilder::new().root(&root).connect::<local::Service>();
+        assert_eq!(
+            error.unwrap_err(),
+            ClientConnectError::Rejected {
+                code: ErrorCode::LimitExceeded,
+                reason: "64 clients".into()
+            }
+        );
+    }
+
+    #[test]
+    fn scene_and_body_commands_encode_every_field() {
+        let root = root("commands");
+        let responder = Responder::start::<local::Service>(&root, None, conformance);
+        let client = connect(&root);
+        responder.next(); // Hello
+
+        assert_received(
+            &responder,
+            client.create_scene(),
+            base(Command::CreateScene, 0),
+            &[],
+        );
+        let dropped = client.drop_scene(7).map(|()| 0);
+        let (header, payload) = responder.next();
+        assert_eq!((header, payload.len()), (base(Command::DropScene, 7), 0));
+        assert_eq!(dropped, Ok(0));
+
+        for (margin, wire_margin) in [(None, -1.0), (Some(0.025), 0.025), (Some(0.0), 0.0)] {
+            let spec = BodySpec {
+                shape: 11,
+                position: [1.5, -2.25, 1e6],
+                orientation: [0.0, 0.6, 0.0, 0.8],
+                motion: Motion::Kinematic,
+                group: 0b1010,
+                mask: 0xdead_beef,
+                margin,
+            };
+            let expected = ControlRequest {
+                target: 11,
+                motion: MotionCode::Kinematic as u32,
+                group: 0b1010,
+                mask: 0xdead_beef,
+                margin: wire_margin,
+                position: [1.5, -2.25, 1e6],
+                orientation: [0.0, 0.6, 0.0, 0.8],
+                ..base(Command::AddBody, 3)
+            };
+            assert_received(&responder, client.add_body(3, &spec), expected, &[]);
+        }
+
+        client.remove_body(3, 42).unwrap();
+        let (header, _) = responder.next();
+        assert_eq!(
+            header,
+            ControlRequest {
+                target: 42,
+                ..base(Command::RemoveBody, 3)
+            }
+        );
+
+        for (motion, code) in [
+            (Motion::Static, MotionCode::Static),
+            (Motion::Kinematic, MotionCode::Kinematic),
+            (Motion::Dynamic, MotionCode::Dynamic),
+        ] {
+            client.update_body(4, 9, motion, 1, 2, Some(0.5)).unwrap();
+            let (header, payload) = responder.next();
+            let expected = ControlRequest {
+                target: 9,
+                motion: code as u32,
+                group: 1,
+                mask: 2,
+                margin: 0.5,
+                ..base(Command::UpdateBody, 4)
+            };
+            assert_eq!((header, payload.len()), (expected, 0));
+        }
+        client
+            .update_body(4, 9, Motion::Dynamic, 0, 0, None)
+            .unwrap();
+        assert_eq!(responder.next().0.margin, -1.0);
+    }
+
+    #[test]
+    fn every_primitive_encodes_its_kind_and_dimensions() {
+        let root = root("primitives");
+        let responder = Responder::start::<local::Service>(&root, None, conformance);
+        let client = connect(&root);
+        responder.next(); // Hello
+        let cases = [
+            (
+                Primitive::Sphere { radius: 0.5 },
+                ShapeKindCode::Sphere,
+                [0.5, 0.0, 0.0, 0.0],
+            ),
+            (
+                Primitive::Capsule {
+                    radius: 0.1,
+                    half_height: 0.7,
+                },
+                ShapeKindCode::Capsule,
+                [0.1, 0.7, 0.0, 0.0],
+            ),
+            (
+                Primitive::Cuboid {
+                    half_extents: [1.0, 2.0, 3.0],
+                },
+                ShapeKindCode::Cuboid,
+                [1.0, 2.0, 3.0, 0.0],
+            ),
+            (
+                Primitive::Cylinder {
+                    radius: 0.3,
+                    half_height: 0.4,
+                },
+                ShapeKindCode::Cylinder,
+                [0.3, 0.4, 0.0, 0.0],
+            ),
+            (
+                Primitive::Cone {
+                    radius: 0.6,
+                    half_height: 0.9,
+                },
+                ShapeKindCode::Cone,
+                [0.6, 0.9, 0.0, 0.0],
+            ),
+            // Bad dimensions are the daemon's to refuse; the client sends them unchanged.
+            (
+                Primitive::Sphere { radius: f64::NAN },
+                ShapeKindCode::Sphere,
+                [f64::NAN, 0.0, 0.0, 0.0],
+            ),
+        ];
+        for (primitive, kind, dimensions) in cases {
+            let expected = ControlRequest {
+                shape_kind: kind as u32,
+                dimensions,
+                ..base(Command::RegisterShape, 5)
+            };
+            let id = client.register_primitive(5, primitive);
+            let (header, payload) = responder.next();
+            assert!(payload.is_empty());
+            assert_eq!(header.shape_kind, kind as u32);
+            assert_eq!(
+                header.dimensions.map(f64::to_bits),
+                dimensions.map(f64::to_bits)
+            );
+            assert_eq!(id, Ok(fingerprint(&expected, &[])));
+        }
+    }
+
+    /// The geometry payload written independently of the client's encoder.
+    fn expected_geometry(vertices: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        for v in vertices {
+            for x in v {
+                bytes.extend_from_slice(&x.to_ne_bytes());
+            }
+        }
+        for t in triangles {
+            for i in t {
+                bytes.extend_from_slice(&i.to_ne_bytes());
+            }
+        }
+        bytes
+    }
+
+    /// A seeded pseudo-random coordinate in [−10, 10).
+    fn coordinate(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1);
+        (*state >> 11) as f64 / (1u64 << 53) as f64 * 20.0 - 10.0
+    }
+
+    #[test]
+    fn convex_and_mesh_geometry_arrive_byte_exact_at_every_size() {
+        let root = root("geometry");
+        let responder = Responder::start::<local::Service>(&root, None, conformance);
+        let client = connect(&root);
+        responder.next(); // Hello
+        let mut state = 7;
+        // Empty, tiny, around the 4096-byte initial slice, then past it twice (grows).
+        for vertex_count in [0usize, 1, 3, 170, 171, 2_000, 50_000] {
+            let vertices: Vec<[f64; 3]> = (0..vertex_count)
+                .map(|_| [0; 3].map(|_| coordinate(&mut state)))
+                .collect();
+            let triangles: Vec<[u32; 3]> = (0..vertex_count as u32 / 2)
+                .map(|i| [i, (i * 7 + 1) % vertex_count as u32, u32::MAX - i])
+                .collect();
+
+            let payload = expected_geometry(&vertices, &[]);
+            let header = ControlRequest {
+                shape_kind: ShapeKindCode::Convex as u32,
+                vertex_count: vertex_count as u32,
+                ..base(Command::RegisterShape, 2)
+            };
+            assert_received(
+                &responder,
+                client.register_convex(2, &vertices),
+                header,
+                &payload,
+            );
+
+            let payload = expected_geometry(&vertices, &triangles);
+            assert_eq!(payload.len(), 24 * vertex_count + 12 * triangles.len());
+            let header = ControlRequest {
+                shape_kind: ShapeKindCode::Mesh as u32,
+                vertex_count: vertex_count as u32,
+                index_count: 3 * triangles.len() as u32,
+                ..base(Command::RegisterShape, 2)
+            };
+            let id = client.register_mesh(2, &vertices, &triangles);
+            assert_received(&responder, id, header, &payload);
+        }
+    }
+
+    #[test]
+    fn rejected_replies_carry_their_code_and_reason_and_unknown_statuses_are_kept() {
+        let root = root("rejected");
+        let responder = Responder::start::<local::Service>(&root, None, |header, _| {
+            Some(match header.command {
+                c if c == Command::Hello as u32 => ControlReply::ok(PROTOCOL_VERSION),
+                c if c == Command::RemoveBody as u32 => {
+                    ControlReply::error(ErrorCode::UnknownBody, "body 7 is not in scene 2")
+                }
+                c if c == Command::CreateScene as u32 => {
+                    let long = "x".repeat(REASON_BYTES + 10);
+                    ControlReply::error(ErrorCode::LimitExceeded, &long)
+                }
+                _ => ControlReply {
+                    status: 99,
+                    ..ControlReply::ok(3)
+                },
+            })
+        });
+        let client = connect(&root);
+        assert_eq!(
+            client.remove_body(2, 7),
+            Err(ControlError::Rejected {
+                code: ErrorCode::UnknownBody,
+                reason: "body 7 is not in scene 2".into()
+            })
+        );
+        assert_eq!(
+            client.create_scene(),
+            Err(ControlError::Rejected {
+                code: ErrorCode::LimitExceeded,
+                reason: "x".repeat(REASON_BYTES)
+            })
+        );
+        assert_eq!(client.drop_scene(1), Err(ControlError::UnknownStatus(99)));
+        // The raw request hands back the reply without judging its status.
+        let raw = client
+            .request(&base(Command::RemoveBody, 2), &[1, 2, 3])
+            .unwrap();
+        assert_eq!(raw.status, ErrorCode::UnknownBody as u32);
+        assert_eq!(raw.reason(), "body 7 is not in scene 2");
+        let error = client.remove_body(2, 7).unwrap_err().to_string();
+        assert!(
+            error.contains("unknown body") && error.contains("scene 2"),
+            "{error}"
+        );
+        responder.next(); // Hello
+        responder.next(); // RemoveBody
+        responder.next(); // CreateScene
+        responder.next(); // DropScene
+        assert_eq!(responder.next().1, [1, 2, 3]);
+    }
+
+    #[test]
+    fn the_raw_request_sends_any_header_and_payload_unchanged() {
+        let root = root("raw");
+        let responder = Responder::start::<local::Service>(&root, None, conformance);
+        let client = connect(&root);
+        responder.next(); // Hello
+        let header = ControlRequest {
+            protocol_version: 999,
+            command: 12345,
+            vertex_count: 1000,
+            index_count: 1,
+            ..ControlRequest::default()
+        };
+        let payload: Vec<u8> = (0..=255).cycle().take(5000).collect();
+        let reply = client.request(&header, &payload).unwrap();
+        assert_eq!(reply, ControlReply::ok(fingerprint(&header, &payload)));
+        assert_eq!(responder.next(), (header, payload));
+    }
+
+    #[test]
+    fn no_daemon_is_reported_once_the_timeout_has_passed() {
+        let timeout = Duration::from_millis(150);
+        let start = Instant::now();
+        let error = ClientBuilder::new()
+            .root(&root("nobody"))
+            .reply_timeout(timeout)
+            .connect::<local::Service>()
+            .unwrap_err();
+        let elapsed = start.elapsed();
+        assert_eq!(error, ClientConnectError::NoDaemon);
+        assert!(elapsed >= timeout, "{elapsed:?}");
+        assert!(
+            elapsed < timeout + Duration::from_millis(500),
+            "{elapsed:?}"
+        );
+    }
+
+    #[test]
+    fn a_daemon_that_stops_answering_times_out_each_request() {
+        let root = root("silent");
+        let responder = Responder::start::<local::Service>(&root, None, |header, _| {
+            (header.command == Command::Hello as u32).then(|| ControlReply::ok(PROTOCOL_VERSION))
+        });
+        let timeout = Duration::from_millis(100);
+        let client = ClientBuilder::new()
+            .root(&root)
+            .reply_timeout(timeout)
+            .connect::<local::Service>()
+            .unwrap();
+        for _ in 0..6 {
+            // More than max_active_requests_per_client: each timed-out request is released.
+            let start = Instant::now();
+            assert_eq!(client.create_scene(), Err(ControlError::Timeout));
+            assert!(start.elapsed() >= timeout);
+        }
+        assert_eq!(responder.next().0.command, Command::Hello as u32);
+        assert_eq!(responder.next().0.command, Command::CreateScene as u32);
+    }
+
+    #[test]
+    fn a_daemon_under_another_iceoryx_prefix_is_invisible() {
+        let root = root("prefix");
+        let prefix = format!("proxima_client_test_{}_", std::process::id());
+        let responder =
+            Responder::start::<iceoryx2::prelude::ipc::Service>(&root, Some(&prefix), conformance);
+        let other = ClientBuilder::new()
+            .root(&root)
+            .iceoryx_prefix(&format!("{prefix}other_"))
+            .reply_timeout(Duration::from_millis(100))
+            .connect::<iceoryx2::prelude::ipc::Service>();
+        assert_eq!(other.unwrap_err(), ClientConnectError::NoDaemon);
+        let client = ClientBuilder::new()
+            .root(&root)
+            .iceoryx_prefix(&prefix)
+            .connect::<iceoryx2::prelude::ipc::Service>()
+            .unwrap();
+        assert!(client.create_scene().is_ok());
+        drop((client, responder));
+        // iceoryx2 leaves one small global-management segment per prefix behind.
+        for entry in std::fs::read_dir("/dev/shm").unwrap().flatten() {
+            if entry.file_name().to_string_lossy().starts_with(&prefix) {
+                std::fs::remove_file(entry.path()).unwrap();
+            }
+        }
+    }
+
+    #[test]
+    fn bad_roots_and_prefixes_are_refused_before_anything_is_sent() {
+        let too_long = "r".repeat(300); // service names end at 255 characters
+        let error = ClientBuilder::new()
+            .root(&too_long)
+            .reply_timeout(Duration::from_millis(50))
+            .connect::<local::Service>();
+        assert!(
+            matches!(error, Err(ClientConnectError::InvalidRoot(_))),
+            "{error:?}"
+        );
+        let error = ClientBuilder::new()
+            .iceoryx_prefix("a/b")
+            .connect::<local::Service>();
+        assert_eq!(
+            error.unwrap_err(),
+            ClientConnectError::InvalidPrefix("a/b".into())
+        );
+    }
+}

@@ -1,0 +1,99 @@
+//! Errors of the client library, one enum per operation (STYLE §3).
+//!
+//! - [`ClientConnectError`] for `ClientBuilder::connect`;
+//! - [`ControlError`] for every control request of a `Client`.
+//!
+//! iceoryx2 failures keep the iceoryx2 error's text in a `Transport` variant, so the enums
+//! stay `Clone + Eq` and do not expose iceoryx2's error types in this crate's API.
+
+use crate::wire::ErrorCode;
+
+/// Why [`ClientBuilder::connect`](crate::client::ClientBuilder::connect) failed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ClientConnectError {
+    /// The root does not make a valid iceoryx2 service name; carries the root.
+    InvalidRoot(String),
+    /// The iceoryx2 prefix is not a valid file name; carries the prefix.
+    InvalidPrefix(String),
+    /// No daemon serves the control service, or it did not answer `Hello` within the reply
+    /// timeout.
+    NoDaemon,
+    /// The daemon speaks another protocol version.
+    ProtocolMismatch {
+        /// The daemon's [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION).
+        daemon: u32,
+    },
+    /// The daemon refused `Hello` for another reason.
+    Rejected {
+        /// The daemon's error code (`Internal` when the status value is unknown).
+        code: ErrorCode,
+        /// The daemon's reason text.
+        reason: String,
+    },
+    /// iceoryx2 failed to create the node, open the service or send; carries its error text.
+    Transport(String),
+}
+
+impl std::fmt::Display for ClientConnectError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::InvalidRoot(root) => write!(f, "invalid service root {root:?}"),
+            Self::InvalidPrefix(prefix) => write!(f, "invalid iceoryx2 prefix {prefix:?}"),
+            Self::NoDaemon => f.write_str("no proxima daemon answered on the control service"),
+            Self::ProtocolMismatch { daemon } => write!(
+                f,
+                "the daemon speaks protocol version {daemon}, this client {}",
+                crate::PROTOCOL_VERSION
+            ),
+            Self::Rejected { code, reason } => {
+                write!(f, "the daemon refused the connection: {code}: {reason}")
+            }
+            Self::Transport(text) => write!(f, "iceoryx2 failure while connecting: {text}"),
+        }
+    }
+}
+
+impl std::error::Error for ClientConnectError {}
+
+/// Why a control request (create a scene, register a shape, add a body…) failed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ControlError {
+    /// The daemon refused the request.
+    Rejected {
+        /// What was wrong.
+        code: ErrorCode,
+        /// The daemon's reason text.
+        reason: String,
+    },
+    /// The reply's status is a value this protocol version does not define.
+    UnknownStatus(u32),
+    /// No reply arrived within the client's reply timeout (the daemon may be gone).
+    Timeout,
+    /// The geometry has more points or indices than a `u32` count can carry; carries the
+    /// offending count.
+    TooLarge(usize),
+    /// iceoryx2 failed to loan, send or receive; carries its error text.
+    Transport(String),
+}
+
+impl std::fmt::Display for ControlError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Rejected { code, reason } => {
+                write!(f, "rejected by the daemon: {code}: {reason}")
+            }
+            Self::UnknownStatus(status) => {
+                write!(f, "the daemon replied with unknown status {status}")
+            }
+            Self::Timeout => f.write_str("no reply from the daemon within the timeout"),
+            Self::TooLarge(count) => {
+                write!(f, "{count} points or indices exceed the u32 wire count")
+            }
+            Self::Transport(text) => write!(f, "iceoryx2 failure on the control service: {text}"),
+        }
+    }
+}
+
+impl std::error::Error for ControlError {}
