@@ -1,17 +1,45 @@
-//! `proximad`, the Proxima collision daemon.
-//!
-//! The service loop (control service, per-scene pose subscriber, result publisher) is built
-//! by issue #4; until it lands this binary reports its version and the protocol it will
-//! speak, so that the workspace's binary target exists from the start.
+//! `proximad`, the Proxima collision daemon: parse the command line, build the daemon, serve
+//! until SIGINT/SIGTERM.
 
+use clap::Parser;
+use iceoryx2::prelude::ipc;
+use proxima::daemon::{Daemon, DaemonConfig};
 use std::error::Error;
+use std::time::Duration;
+
+/// How often the service loop wakes when idle.
+const CYCLE_TIME: Duration = Duration::from_micros(200);
+
+/// Proxima's collision co-processor: serves scenes over iceoryx2 shared memory.
+#[derive(Debug, Parser)]
+#[command(version, about)]
+struct Cli {
+    /// Root prefix of every service name.
+    #[arg(long, default_value = proxima_ipc::DEFAULT_ROOT)]
+    root: String,
+    /// iceoryx2 file-name prefix, to keep daemons (and test runs) apart.
+    #[arg(long)]
+    iceoryx_prefix: Option<String>,
+    /// Most scenes alive at once.
+    #[arg(long, default_value_t = DaemonConfig::default().max_scenes)]
+    max_scenes: u32,
+}
 
 fn main() -> Result<(), Box<dyn Error>> {
-    // TODO(#4): parse the CLI, build Daemon from the config and run its frame loop.
-    println!(
-        "proximad {} (protocol {}): the service loop arrives with issue #4",
+    let cli = Cli::parse();
+    let config = DaemonConfig {
+        root: cli.root,
+        iceoryx_prefix: cli.iceoryx_prefix,
+        max_scenes: cli.max_scenes,
+        ..DaemonConfig::default()
+    };
+    let mut daemon = Daemon::<ipc::Service>::new(config)?;
+    eprintln!(
+        "proximad {} (protocol {}) serving",
         env!("CARGO_PKG_VERSION"),
         proxima_ipc::PROTOCOL_VERSION
     );
+    daemon.run(CYCLE_TIME)?;
+    eprintln!("proximad: stopped");
     Ok(())
 }

@@ -1,0 +1,43 @@
+//! Errors of starting and running the daemon (never caused by a client: client mistakes are
+//! answered with wire error codes and the daemon keeps serving).
+
+use std::fmt;
+
+/// Why the daemon could not start.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum DaemonStartError {
+    /// The iceoryx2 configuration (prefix, service name) is invalid.
+    Config(String),
+    /// iceoryx2 could not create the node or a service or port.
+    Ipc(String),
+}
+
+impl fmt::Display for DaemonStartError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Config(why) => write!(f, "invalid configuration: {why}"),
+            Self::Ipc(why) => write!(f, "shared-memory setup failed: {why}"),
+        }
+    }
+}
+
+impl std::error::Error for DaemonStartError {}
+
+/// Why the service loop stopped with an error (a termination signal is not one).
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum DaemonRunError {
+    /// Receiving a request or sending a reply failed in iceoryx2.
+    Ipc(String),
+}
+
+impl fmt::Display for DaemonRunError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Ipc(why) => write!(f, "shared-memory transfer failed: {why}"),
+        }
+    }
+}
+
+impl std::error::Error for DaemonRunError {}

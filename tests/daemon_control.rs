@@ -1,0 +1,302 @@
+//! The real `proximad` binary, started per test with its own service root and iceoryx2
+//! prefix, driven over real shared memory by the client library from this process: scene,
+//! shape and body control, every kind of bad request, several clients at once.
+
+use iceoryx2::prelude::ipc;
+use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion, Primitive};
+use proxima_ipc::error::ControlError;
+use proxima_ipc::wire::{ControlRequest, ErrorCode};
+use std::process::{Child, Command};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::Duration;
+
+/// A daemon process with a unique root and prefix, stopped and cleaned up on drop.
+struct Daemon {
+    child: Child,
+    root: String,
+    prefix: String,
+}
+
+impl Daemon {
+    fn start() -> Self {
+        static NEXT: AtomicU32 = AtomicU32::new(0);
+        let tag = format!(
+            "{}_{}",
+            std::process::id(),
+            NEXT.fetch_add(1, Ordering::Relaxed)
+        );
+        let (root, prefix) = (format!("proxima-test-{tag}"), format!("iox2_pxt{tag}_"));
+        let child = Command::new(env!("CARGO_BIN_EXE_proximad"))
+            .args([
+                "--root",
+                &root,
+                "--iceoryx-prefix",
+                &prefix,
+                "--max-scenes",
+                "3",
+            ])
+            .spawn()
+            .expect("proximad starts");
+        Self {
+            child,
+            root,
+            prefix,
+        }
+    }
+
+    fn client(&self) -> Client<ipc::Service> {
+        ClientBuilder::new()
+            .root(&self.root)
+            .iceoryx_prefix(&self.prefix)
+            .reply_timeout(Duration::from_secs(10))
+            .connect::<ipc::Service>()
+            .expect("the daemon answers Hello")
+    }
+}
+
+impl Drop for Daemon {
+    fn drop(&mut self) {
+        // SIGTERM: the daemon's node.wait() sees it and the process exits cleanly.
+        let _ = Command::new("kill")
+            .args(["-TERM", &self.child.id().to_string()])
+            .status();
+        let stopped = (0..200).any(|_| {
+            std::thread::sleep(Duration::from_millis(10));
+            matches!(self.child.try_wait(), Ok(Some(_)))
+        });
+        if !stopped {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+        if let Ok(entries) = std::fs::read_dir("/dev/shm") {
+            for entry in entries.flatten() {
+                if entry
+                    .file_name()
+                    .to_string_lossy()
+                    .starts_with(&self.prefix)
+                {
+                    let _ = std::fs::remove_file(entry.path());
+                }
+            }
+        }
+    }
+}
+
+fn body(shape: u32, x: f64) -> BodySpec {
+    BodySpec {
+        shape,
+        position: [x, 0.0, 0.0],
+        orientation: [0.0, 0.0, 0.0, 1.0],
+        motion: Motion::Dynamic,
+        group: u32::MAX,
+        mask: u32::MAX,
+        margin: None,
+    }
+}
+
+fn rejected(result: Result<impl std::fmt::Debug, ControlError>) -> ErrorCode {
+    match result {
+        Err(ControlError::Rejected { code, reason }) => {
+            assert!(!reason.is_empty());
+            code
+        }
+        other => panic!("expected a rejection, got {other:?}"),
+    }
+}
+
+const TETRA: [[f64; 3]; 4] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+];
+const TETRA_FACES: [[u32; 3]; 4] = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+
+#[test]
+fn a_client_builds_a_scene_of_every_shape_kind_in_a_real_daemon() {
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let scene = client.create_scene().unwrap();
+    let shapes = [
+        client
+            .register_primitive(scene, Primitive::Sphere { radius: 0.5 })
+            .unwrap(),
+        client
+            .register_primitive(
+                scene,
+                Primitive::Capsule {
+                    radius: 0.1,
+                    half_height: 0.4,
+                },
+            )
+            .unwrap(),
+        client
+            .register_primitive(
+                scene,
+                Primitive::Cuboid {
+                    half_extents: [0.1, 0.2, 0.3],
+                },
+            )
+            .unwrap(),
+        client
+            .register_primitive(
+                scene,
+                Primitive::Cylinder {
+                    radius: 0.2,
+                    half_height: 0.5,
+                },
+            )
+            .unwrap(),
+        client
+            .register_primitive(
+                scene,
+                Primitive::Cone {
+                    radius: 0.2,
+                    half_height: 0.5,
+                },
+            )
+            .unwrap(),
+        client.register_convex(scene, &TETRA).unwrap(),
+        client.register_mesh(scene, &TETRA, &TETRA_FACES).unwrap(),
+    ];
+    assert_eq!(
+        shapes,
+        [0, 1, 2, 3, 4, 5, 6],
+        "shape ids count up from 0 in a scene"
+    );
+    let bodies: Vec<u32> = shapes
+        .iter()
+        .map(|&s| client.add_body(scene, &body(s, f64::from(s))).unwrap())
+        .collect();
+    assert_eq!(bodies, [0, 1, 2, 3, 4, 5, 6]);
+    client
+        .update_body(scene, bodies[0], Motion::Static, 1, 2, Some(0.05))
+        .unwrap();
+    client.remove_body(scene, bodies[1]).unwrap();
+    assert_eq!(
+        rejected(client.remove_body(scene, bodies[1])),
+        ErrorCode::UnknownBody
+    );
+    // Ids are not reused.
+    assert_eq!(client.add_body(scene, &body(shapes[0], 9.0)).unwrap(), 7);
+    client.drop_scene(scene).unwrap();
+    assert_eq!(
+        rejected(client.add_body(scene, &body(0, 0.0))),
+        ErrorCode::UnknownScene
+    );
+}
+
+#[test]
+fn bad_requests_get_their_codes_and_another_client_keeps_being_served() {
+    let daemon = Daemon::start();
+    let (bad, good) = (daemon.client(), daemon.client());
+    let scene = good.create_scene().unwrap();
+    let sphere = good
+        .register_primitive(scene, Primitive::Sphere { radius: 1.0 })
+        .unwrap();
+    let mut next_x = 0.0;
+    let mut good_client_still_served = || {
+        next_x += 1.0;
+        good.add_body(scene, &body(sphere, next_x))
+            .expect("the other client is served");
+    };
+    let nan_pose = BodySpec {
+        position: [f64::NAN, 0.0, 0.0],
+        ..body(sphere, 0.0)
+    };
+    let long_quaternion = BodySpec {
+        orientation: [0.0, 0.0, 0.0, 1.1],
+        ..body(sphere, 0.0)
+    };
+    let huge = BodySpec {
+        position: [1e12, 0.0, 0.0],
+        ..body(sphere, 0.0)
+    };
+    let cases: Vec<(&str, ErrorCode)> = vec![
+        ("NaN position", rejected(bad.add_body(scene, &nan_pose))),
+        (
+            "non-unit quaternion",
+            rejected(bad.add_body(scene, &long_quaternion)),
+        ),
+        (
+            "position beyond the coordinate limit",
+            rejected(bad.add_body(scene, &huge)),
+        ),
+        (
+            "unknown shape",
+            rejected(bad.add_body(scene, &body(99, 0.0))),
+        ),
+        ("unknown body", rejected(bad.remove_body(scene, 99))),
+        (
+            "unknown scene",
+            rejected(bad.register_primitive(77, Primitive::Sphere { radius: 1.0 })),
+        ),
+        (
+            "negative radius",
+            rejected(bad.register_primitive(scene, Primitive::Sphere { radius: -1.0 })),
+        ),
+        (
+            "mesh index out of range",
+            rejected(bad.register_mesh(scene, &TETRA, &[[0, 1, 4]])),
+        ),
+        (
+            "empty mesh",
+            rejected(bad.register_mesh(scene, &TETRA, &[])),
+        ),
+        ("empty convex", rejected(bad.register_convex(scene, &[]))),
+    ];
+    let expected = [
+        ErrorCode::InvalidPose,
+        ErrorCode::InvalidPose,
+        ErrorCode::InvalidPose,
+        ErrorCode::UnknownShape,
+        ErrorCode::UnknownBody,
+        ErrorCode::UnknownScene,
+        ErrorCode::InvalidShape,
+        ErrorCode::MeshIndexOutOfRange,
+        ErrorCode::EmptyGeometry,
+        ErrorCode::EmptyGeometry,
+    ];
+    for ((what, got), want) in cases.iter().zip(expected) {
+        assert_eq!(*got, want, "{what}");
+        good_client_still_served();
+    }
+    // Raw requests: wrong protocol version, unknown command, a payload that lies about its size.
+    let hello = ControlRequest {
+        protocol_version: 999,
+        ..ControlRequest::default()
+    };
+    let reply = bad.request(&hello, &[]).unwrap();
+    assert_eq!(
+        ErrorCode::from_u32(reply.status),
+        Some(ErrorCode::ProtocolMismatch)
+    );
+    let unknown = ControlRequest {
+        protocol_version: proxima_ipc::PROTOCOL_VERSION,
+        command: 1234,
+        ..ControlRequest::default()
+    };
+    assert_eq!(
+        ErrorCode::from_u32(bad.request(&unknown, &[]).unwrap().status),
+        Some(ErrorCode::MalformedMessage)
+    );
+    let lying = ControlRequest {
+        protocol_version: proxima_ipc::PROTOCOL_VERSION,
+        command: proxima_ipc::wire::Command::RegisterShape as u32,
+        scene,
+        shape_kind: proxima_ipc::wire::ShapeKindCode::Mesh as u32,
+        vertex_count: 1_000_000,
+        index_count: 3,
+        ..ControlRequest::default()
+    };
+    assert_eq!(
+        ErrorCode::from_u32(bad.request(&lying, &[0; 40]).unwrap().status),
+        Some(ErrorCode::MalformedMessage)
+    );
+    good_client_still_served();
+    // The scene limit (3) holds, and refusing it harms no one.
+    bad.create_scene().unwrap();
+    bad.create_scene().unwrap();
+    assert_eq!(rejected(bad.create_scene()), ErrorCode::LimitExceeded);
+    good_client_still_served();
+}
