@@ -33,6 +33,9 @@ pub mod bounding;
 /// Bounding-volume hierarchies and their tandem traversal.
 pub mod bvh;
 
+/// Broad phase: candidate pairs from margin-grown world boxes.
+pub mod broad;
+
 /// Exact queries: triangle–triangle overlap, intersection and distance; mesh–mesh queries.
 pub mod narrow;
 

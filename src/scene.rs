@@ -14,6 +14,8 @@
 //! is its shape's local box moved by its pose; the count of live bodies matches.
 
 use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
+pub use crate::broad::CollisionFilter;
+use crate::broad::Proxy;
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
 use crate::math::{DVec3, Pose};
@@ -101,30 +103,6 @@ pub enum Motion {
     Kinematic,
     /// Moved by the client's physics.
     Dynamic,
-}
-
-/// Which bodies may pair: `a` and `b` do when each one's group meets the other's mask.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CollisionFilter {
-    /// Group bits of this body.
-    pub group: u32,
-    /// Groups this body pairs with.
-    pub mask: u32,
-}
-
-impl CollisionFilter {
-    /// Pairs with everything.
-    pub const ALL: Self = Self {
-        group: u32::MAX,
-        mask: u32::MAX,
-    };
-
-    /// Whether bodies with filters `self` and `other` may pair (symmetric).
-    #[must_use]
-    #[inline]
-    pub fn allows(&self, other: &Self) -> bool {
-        self.group & other.mask != 0 && other.group & self.mask != 0
-    }
 }
 
 /// What a new body is made of.
@@ -346,6 +324,21 @@ impl Scene {
             .filter_map(|(i, b)| b.as_ref().map(|b| (BodyId(i as u32), b)))
     }
 
+    /// The broad-phase view of every live body, in increasing id order, into `out`
+    /// (cleared first): world boxes grown by each body's margin.
+    ///
+    /// # Allocation
+    /// None once `out` holds as many proxies as there are bodies.
+    pub fn proxies(&self, out: &mut Vec<Proxy>) {
+        out.clear();
+        out.extend(self.bodies().map(|(id, body)| Proxy {
+            body: id.0,
+            bounds: body.world_bounds.grown(body.margin),
+            is_static: body.motion == Motion::Static,
+            filter: body.filter,
+        }));
+    }
+
     /// Number of live bodies.
     #[must_use]
     pub fn body_count(&self) -> usize {
@@ -520,6 +513,31 @@ mod tests {
         ));
         assert_eq!(s.validate(), Ok(()));
         assert!(Scene::try_new(-0.1, SceneLimits::STANDARD).is_err());
+    }
+
+    #[test]
+    fn proxies_grow_world_boxes_by_margins_and_mark_static_bodies() {
+        let mut s = Scene::try_new(0.1, SceneLimits::STANDARD).unwrap();
+        let sphere = s.register_shape(Shape::Sphere(Sphere::new(1.0))).unwrap();
+        let a = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        let wall = BodyDesc {
+            motion: Motion::Static,
+            margin: Some(0.5),
+            ..desc(sphere, Pose::from_translation(DVec3::X * 2.55))
+        };
+        let b = s.add_body(&wall).unwrap();
+        let mut proxies = Vec::new();
+        s.proxies(&mut proxies);
+        assert_eq!(proxies.len(), 2);
+        assert_eq!((proxies[0].body, proxies[1].body), (a.0, b.0));
+        // Radius 1 + margin 0.1, plus the world box's rounding pad (conservative, tiny).
+        let reach = proxies[0].bounds.max.x;
+        assert!((1.1..1.1 + 1e-9).contains(&reach), "{reach}");
+        assert!(!proxies[0].is_static && proxies[1].is_static);
+        // 0.55 m apart, margins 0.1 + 0.5: a candidate pair.
+        let mut pairs = Vec::new();
+        crate::broad::pairs_brute_force(&proxies, &mut pairs);
+        assert_eq!(pairs, [crate::broad::CandidatePair { a: a.0, b: b.0 }]);
     }
 
     #[test]

@@ -43,6 +43,17 @@ impl Aabb {
         }
     }
 
+    /// The box grown by `margin` metres (`≥ 0`) on every side.
+    #[must_use]
+    #[inline]
+    pub fn grown(&self, margin: f64) -> Self {
+        debug_assert!(margin >= 0.0);
+        Self {
+            min: self.min - DVec3::splat(margin),
+            max: self.max + DVec3::splat(margin),
+        }
+    }
+
     /// The box's centre, `(min + max) / 2`.
     #[must_use]
     #[inline]

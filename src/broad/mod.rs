@@ -1,0 +1,73 @@
+//! Broad phase: which pairs of bodies can be close, from their world boxes.
+//!
+//! Each body enters as a [`Proxy`]: its world-space box already grown by its close-pair
+//! margin, whether it is static, and its collision filter. A broad phase reports every pair
+//! of proxies whose boxes overlap and that may pair (filters meet, not both static), each
+//! once with `a < b`, in increasing `(a, b)` order. Overlap of margin-grown boxes is
+//! conservative: two bodies within the sum of their margins always have overlapping grown
+//! boxes, so the narrow phase never misses a close pair.
+//!
+//! [`brute_force`] tests every pair: the reference the faster broad phases are checked
+//! against.
+
+pub mod brute_force;
+
+pub use brute_force::pairs_brute_force;
+
+use crate::bounding::Aabb;
+
+/// Which bodies may pair: `a` and `b` do when each one's group meets the other's mask.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CollisionFilter {
+    /// Group bits of this body.
+    pub group: u32,
+    /// Groups this body pairs with.
+    pub mask: u32,
+}
+
+impl CollisionFilter {
+    /// Pairs with everything.
+    pub const ALL: Self = Self {
+        group: u32::MAX,
+        mask: u32::MAX,
+    };
+
+    /// Whether bodies with filters `self` and `other` may pair (symmetric).
+    #[must_use]
+    #[inline]
+    pub fn allows(&self, other: &Self) -> bool {
+        self.group & other.mask != 0 && other.group & self.mask != 0
+    }
+}
+
+/// One body as the broad phase sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Proxy {
+    /// The body's id.
+    pub body: u32,
+    /// World box of the body's shape grown by the body's margin on every side, metres.
+    pub bounds: Aabb,
+    /// Static bodies never pair with each other.
+    pub is_static: bool,
+    /// Which bodies it may pair with.
+    pub filter: CollisionFilter,
+}
+
+impl Proxy {
+    /// Whether `self` and `other` may pair at all: each group meets the other's mask and
+    /// they are not both static.
+    #[must_use]
+    #[inline]
+    pub fn may_pair(&self, other: &Self) -> bool {
+        !(self.is_static && other.is_static) && self.filter.allows(&other.filter)
+    }
+}
+
+/// A pair of bodies whose grown boxes overlap, `a < b`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct CandidatePair {
+    /// The smaller body id.
+    pub a: u32,
+    /// The larger body id.
+    pub b: u32,
+}
