@@ -3,6 +3,7 @@
 //! - [`config`]: start-up configuration (service root, iceoryx2 prefix, limits);
 //! - `convert`: wire records to validated domain values, once, at the boundary;
 //! - `control`: the control service's logic (scenes, shapes, bodies), one request → one reply;
+//! - `ingest`: stage 1 of a frame, a pose frame checked whole and applied to its scene;
 //! - `service_loop`: the iceoryx2 node and ports, served until a termination signal;
 //! - `error`: start-up and run failures (client mistakes are wire error codes instead).
 
@@ -10,10 +11,12 @@ pub mod config;
 mod control;
 mod convert;
 mod error;
+mod ingest;
 mod service_loop;
 
 pub use config::DaemonConfig;
 pub use control::ControlState;
 pub use convert::Rejection;
 pub use error::{DaemonRunError, DaemonStartError};
+pub use ingest::{FrameRejection, apply_pose_frame};
 pub use service_loop::Daemon;
