@@ -40,7 +40,11 @@ fn build_and_refit<B: BoundingVolume>(
         );
     }
     let built = Bvh::<B>::from_triangles(triangles, &BuildParams::BINNED_SAH);
-    for (name, mode) in [("merge", RefitMode::Merge), ("fit", RefitMode::Fit)] {
+    for (name, mode) in [
+        ("merge", RefitMode::Merge),
+        ("keep_frames", RefitMode::KeepFrames),
+        ("fit", RefitMode::Fit),
+    ] {
         let mut bvh = built.clone();
         let mut flip = false;
         group.bench_function(
