@@ -10,6 +10,8 @@ pub mod error;
 pub mod wire;
 
 use iceoryx2::node::Node;
+use iceoryx2::service::builder::event::Builder as EventBuilder;
+use iceoryx2::service::builder::publish_subscribe::Builder as PublishSubscribeBuilder;
 use iceoryx2::service::builder::request_response::Builder as RequestResponseBuilder;
 use iceoryx2::service::service_name::{ServiceName, ServiceNameError};
 
@@ -68,6 +70,90 @@ pub const CONTROL_MAX_ACTIVE_REQUESTS_PER_CLIENT: usize = 4;
 pub const CONTROL_MAX_RESPONSE_BUFFER_SIZE: usize = 4;
 /// Initial byte capacity of a client's request slice (grows by powers of two).
 pub const CONTROL_INITIAL_MAX_SLICE_LEN: usize = 4096;
+
+/// The builder of scene `scene`'s pose service (`<root>/<scene>/poses`): `[PoseRecord]`
+/// slices with a [`wire::PoseFrameHeader`], up to [`POSES_MAX_PUBLISHERS`] client
+/// publishers, the daemon's one subscriber keeping the newest [`FRAME_BUFFER`] frames
+/// (older ones are overwritten: the newest frame wins under a deadline). Both sides call it,
+/// then `open_or_create()`.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn poses_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+    scene: u32,
+) -> Result<PosesServiceBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&poses_service_name(root, scene))?;
+    Ok(node
+        .service_builder(&name)
+        .publish_subscribe::<[wire::PoseRecord]>()
+        .user_header::<wire::PoseFrameHeader>()
+        .max_publishers(POSES_MAX_PUBLISHERS)
+        .max_subscribers(1)
+        .subscriber_max_buffer_size(FRAME_BUFFER)
+        .history_size(0))
+}
+
+/// The builder of scene `scene`'s result service (`<root>/<scene>/results`): `[ResultRecord]`
+/// slices with a [`wire::ResultFrameHeader`], the daemon's one publisher, up to
+/// [`RESULTS_MAX_SUBSCRIBERS`] subscribers (the simulation, monitors).
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn results_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+    scene: u32,
+) -> Result<ResultsServiceBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&results_service_name(root, scene))?;
+    Ok(node
+        .service_builder(&name)
+        .publish_subscribe::<[wire::ResultRecord]>()
+        .user_header::<wire::ResultFrameHeader>()
+        .max_publishers(1)
+        .max_subscribers(RESULTS_MAX_SUBSCRIBERS)
+        .subscriber_max_buffer_size(FRAME_BUFFER)
+        .history_size(0))
+}
+
+/// The builder of scene `scene`'s event service (`<root>/<scene>/events`): clients notify
+/// [`EVENT_POSES_SENT`] after publishing a pose frame, the daemon notifies
+/// [`EVENT_RESULTS_READY`] after publishing a result frame, so either side can block in a
+/// WaitSet instead of spinning.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn events_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+    scene: u32,
+) -> Result<EventBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&format!("{root}/{scene}/events"))?;
+    Ok(node
+        .service_builder(&name)
+        .event()
+        .max_notifiers(POSES_MAX_PUBLISHERS + 1)
+        .max_listeners(RESULTS_MAX_SUBSCRIBERS + 1))
+}
+
+/// The iceoryx2 builder type [`poses_service_builder`] returns.
+pub type PosesServiceBuilder<S> =
+    PublishSubscribeBuilder<[wire::PoseRecord], wire::PoseFrameHeader, S>;
+/// The iceoryx2 builder type [`results_service_builder`] returns.
+pub type ResultsServiceBuilder<S> =
+    PublishSubscribeBuilder<[wire::ResultRecord], wire::ResultFrameHeader, S>;
+
+/// Client processes that may publish poses to one scene.
+pub const POSES_MAX_PUBLISHERS: usize = 4;
+/// Processes that may subscribe to one scene's results.
+pub const RESULTS_MAX_SUBSCRIBERS: usize = 8;
+/// Frames a subscriber keeps before the oldest is overwritten.
+pub const FRAME_BUFFER: usize = 2;
+/// Event id a client sends after publishing a pose frame.
+pub const EVENT_POSES_SENT: usize = 1;
+/// Event id the daemon sends after publishing a result frame.
+pub const EVENT_RESULTS_READY: usize = 2;
 
 /// The name of scene `scene`'s pose service under `root`.
 #[must_use]
