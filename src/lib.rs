@@ -46,5 +46,8 @@ pub(crate) mod test_support;
 /// Scene state: registered shapes and placed bodies.
 pub mod scene;
 
+/// One frame of collision work over a scene.
+pub mod pipeline;
+
 /// The daemon's service loop and wire conversion (the only user of `proxima-ipc`).
 pub mod daemon;
