@@ -35,6 +35,11 @@ impl ControlState {
         self.scenes.get(id as usize).and_then(Option::as_ref)
     }
 
+    /// Scene `id`, mutable, if it lives.
+    pub fn scene_mut(&mut self, id: u32) -> Option<&mut Scene> {
+        self.scenes.get_mut(id as usize).and_then(Option::as_mut)
+    }
+
     /// Answers one request; the state changes only when the reply is a success.
     pub fn handle(&mut self, request: &ControlRequest, payload: &[u8]) -> ControlReply {
         match self.try_handle(request, payload) {
@@ -66,7 +71,7 @@ impl ControlState {
         } else if is(Command::CreateScene) {
             self.create_scene()
         } else if is(Command::DropScene) {
-            self.scene_mut(request.scene)?;
+            self.live_scene(request.scene)?;
             self.scenes[request.scene as usize] = None;
             self.live_scenes -= 1;
             Ok(request.scene)
@@ -78,7 +83,7 @@ impl ControlState {
                 self.config.max_convex_points,
             )?;
             let id = self
-                .scene_mut(request.scene)?
+                .live_scene(request.scene)?
                 .register_shape(shape)
                 .map_err(scene_rejection)?;
             Ok(id.0)
@@ -91,19 +96,19 @@ impl ControlState {
                 margin: convert::margin(request.margin),
             };
             let id = self
-                .scene_mut(request.scene)?
+                .live_scene(request.scene)?
                 .add_body(&desc)
                 .map_err(scene_rejection)?;
             Ok(id.0)
         } else if is(Command::RemoveBody) {
-            let scene = self.scene_mut(request.scene)?;
+            let scene = self.live_scene(request.scene)?;
             scene
                 .remove_body(BodyId(request.target))
                 .map_err(scene_rejection)?;
             Ok(request.target)
         } else if is(Command::UpdateBody) {
             let motion = convert::motion(request.motion)?;
-            let scene = self.scene_mut(request.scene)?;
+            let scene = self.live_scene(request.scene)?;
             scene
                 .update_body(
                     BodyId(request.target),
@@ -138,7 +143,7 @@ impl ControlState {
         Ok(self.scenes.len() as u32 - 1)
     }
 
-    fn scene_mut(&mut self, id: u32) -> Result<&mut Scene, Rejection> {
+    fn live_scene(&mut self, id: u32) -> Result<&mut Scene, Rejection> {
         self.scenes
             .get_mut(id as usize)
             .and_then(Option::as_mut)

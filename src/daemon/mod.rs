@@ -4,6 +4,8 @@
 //! - `convert`: wire records to validated domain values, once, at the boundary;
 //! - `control`: the control service's logic (scenes, shapes, bodies), one request → one reply;
 //! - `ingest`: stage 1 of a frame, a pose frame checked whole and applied to its scene;
+//! - `frame_loop`: a scene's pose subscriber, result publisher and event notifier, and the
+//!   path of one frame through ingest, the pipeline and publication;
 //! - `service_loop`: the iceoryx2 node and ports, served until a termination signal;
 //! - `error`: start-up and run failures (client mistakes are wire error codes instead).
 
@@ -11,6 +13,7 @@ pub mod config;
 mod control;
 mod convert;
 mod error;
+mod frame_loop;
 mod ingest;
 mod service_loop;
 

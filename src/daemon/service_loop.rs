@@ -1,15 +1,18 @@
 //! The service loop: the daemon's iceoryx2 node, its control server, and the cycle that
 //! serves them until a termination signal.
 //!
-//! TODO(#4): per-scene pose subscribers, result publishers and events, the frame loop and
-//! the worker pool join here.
+//! Each cycle answers the control requests, then every scene's waiting pose frames
+//! ([`SceneFrames`]). A scene's ports are opened when the scene is created and closed when
+//! it is dropped. TODO(#4): blocking on the scenes' events between frames (hybrid wait),
+//! the worker pool, dead-client cleanup.
 
 use super::config::DaemonConfig;
 use super::control::ControlState;
 use super::error::{DaemonRunError, DaemonStartError};
+use super::frame_loop::SceneFrames;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
-use proxima_ipc::wire::{ControlReply, ControlRequest};
+use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
 use std::time::Duration;
 
 /// A running `proximad`: node, control server and the scenes' state.
@@ -17,6 +20,9 @@ pub struct Daemon<S: Service> {
     node: Node<S>,
     control: Server<S, [u8], ControlRequest, ControlReply, ()>,
     state: ControlState,
+    root: String,
+    /// Scene id → its frame ports (`None` for dropped scenes).
+    frames: Vec<Option<SceneFrames<S>>>,
 }
 
 impl<S: Service> Daemon<S> {
@@ -47,7 +53,9 @@ impl<S: Service> Daemon<S> {
         Ok(Self {
             node,
             control,
+            root: config.root.clone(),
             state: ControlState::new(config),
+            frames: Vec::new(),
         })
     }
 
@@ -58,6 +66,7 @@ impl<S: Service> Daemon<S> {
     pub fn run(&mut self, cycle: Duration) -> Result<(), DaemonRunError> {
         while self.node.wait(cycle).is_ok() {
             self.serve_control()?;
+            self.serve_frames()?;
         }
         Ok(())
     }
@@ -73,11 +82,14 @@ impl<S: Service> Daemon<S> {
             .receive()
             .map_err(|e| DaemonRunError::Ipc(format!("control receive: {e:?}")))?
         {
-            let reply = self.state.handle(active.user_header(), active.payload());
-            if reply.status != 0 {
+            let request = *active.user_header();
+            let mut reply = self.state.handle(&request, active.payload());
+            if reply.status == ErrorCode::Ok as u32 {
+                reply = self.follow_scene_changes(&request, reply);
+            } else {
                 eprintln!(
-                    "proximad: refused control request {:?}: {}",
-                    active.user_header().command,
+                    "proximad: refused control request {}: {}",
+                    request.command,
                     reply.reason()
                 );
             }
@@ -86,6 +98,61 @@ impl<S: Service> Daemon<S> {
             served += 1;
         }
         Ok(served)
+    }
+
+    /// Answers every scene's waiting pose frames; returns how many.
+    ///
+    /// # Errors
+    /// [`DaemonRunError`] when iceoryx2 fails to move a frame.
+    pub fn serve_frames(&mut self) -> Result<usize, DaemonRunError> {
+        let mut served = 0;
+        for (id, frames) in self.frames.iter_mut().enumerate() {
+            let (Some(frames), Some(scene)) = (frames.as_mut(), self.state.scene_mut(id as u32))
+            else {
+                continue;
+            };
+            served += frames
+                .serve(id as u32, scene)
+                .map_err(DaemonRunError::Ipc)?;
+        }
+        Ok(served)
+    }
+
+    /// Opens a created scene's frame ports, closes a dropped one's. A scene whose ports
+    /// cannot be opened is dropped again and the reply becomes an error.
+    fn follow_scene_changes(
+        &mut self,
+        request: &ControlRequest,
+        reply: ControlReply,
+    ) -> ControlReply {
+        let id = reply.id as usize;
+        if request.command == Command::CreateScene as u32 {
+            match SceneFrames::open(&self.node, &self.root, reply.id) {
+                Ok(frames) => {
+                    if self.frames.len() <= id {
+                        self.frames.resize_with(id + 1, || None);
+                    }
+                    self.frames[id] = Some(frames);
+                }
+                Err(why) => {
+                    let drop = ControlRequest {
+                        command: Command::DropScene as u32,
+                        scene: reply.id,
+                        ..*request
+                    };
+                    let _ = self.state.handle(&drop, &[]);
+                    return ControlReply::error(
+                        ErrorCode::Internal,
+                        &format!("scene services: {why}"),
+                    );
+                }
+            }
+        } else if request.command == Command::DropScene as u32
+            && let Some(slot) = self.frames.get_mut(id)
+        {
+            *slot = None;
+        }
+        reply
     }
 
     /// The scenes' state (for tests and tools in the same process).

@@ -1,0 +1,184 @@
+//! The frame path of one scene: receive a pose frame, ingest it, run the pipeline, write
+//! the result frame straight into a loaned shared-memory sample, publish, notify.
+//!
+//! # Allocation
+//! After a scene's first frames, none: the pipeline workspace and the result list are
+//! reused, and result records are written into the loaned sample. (A result frame larger
+//! than any before makes iceoryx2 map a bigger segment once.)
+
+use super::convert::Rejection;
+use super::ingest::{FrameRejection, apply_pose_frame};
+use crate::math::Pose;
+use crate::pipeline::{self, Completeness, PairResult, PipelineWorkspace};
+use crate::scene::{BodyId, Scene};
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use proxima_ipc::wire::{
+    self, ErrorCode, PoseFrameHeader, PoseRecord, RecordKind, ResultFrameHeader, ResultRecord,
+};
+use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION};
+use std::time::Instant;
+
+/// Initial number of result records a result sample can hold (grows by powers of two).
+const INITIAL_RESULT_RECORDS: usize = 1024;
+
+/// A scene's ports and per-frame scratch space.
+pub struct SceneFrames<S: Service> {
+    poses: Subscriber<S, [PoseRecord], PoseFrameHeader>,
+    results: Publisher<S, [ResultRecord], ResultFrameHeader>,
+    notifier: Notifier<S>,
+    workspace: PipelineWorkspace,
+    pairs: Vec<PairResult>,
+    validated: Vec<(BodyId, Pose)>,
+}
+
+impl<S: Service> SceneFrames<S> {
+    /// Opens (or creates) scene `scene`'s services under `root`.
+    ///
+    /// # Errors
+    /// The iceoryx2 failure, as text.
+    pub fn open(node: &Node<S>, root: &str, scene: u32) -> Result<Self, String> {
+        let poses = proxima_ipc::poses_service_builder(node, root, scene)
+            .map_err(|e| format!("{e:?}"))?
+            .open_or_create()
+            .map_err(|e| format!("poses service: {e:?}"))?
+            .subscriber_builder()
+            .create()
+            .map_err(|e| format!("poses subscriber: {e:?}"))?;
+        let results = proxima_ipc::results_service_builder(node, root, scene)
+            .map_err(|e| format!("{e:?}"))?
+            .open_or_create()
+            .map_err(|e| format!("results service: {e:?}"))?
+            .publisher_builder()
+            .initial_max_slice_len(INITIAL_RESULT_RECORDS)
+            .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .create()
+            .map_err(|e| format!("results publisher: {e:?}"))?;
+        let notifier = proxima_ipc::events_service_builder(node, root, scene)
+            .map_err(|e| format!("{e:?}"))?
+            .open_or_create()
+            .map_err(|e| format!("events service: {e:?}"))?
+            .notifier_builder()
+            .create()
+            .map_err(|e| format!("events notifier: {e:?}"))?;
+        Ok(Self {
+            poses,
+            results,
+            notifier,
+            workspace: PipelineWorkspace::default(),
+            pairs: Vec::new(),
+            validated: Vec::new(),
+        })
+    }
+
+    /// Answers every waiting pose frame of scene `scene_id`; returns how many.
+    ///
+    /// # Errors
+    /// The iceoryx2 failure, as text (client mistakes are answered in the result header).
+    pub fn serve(&mut self, scene_id: u32, scene: &mut Scene) -> Result<usize, String> {
+        let mut served = 0;
+        while let Some(sample) = self
+            .poses
+            .receive()
+            .map_err(|e| format!("poses receive: {e:?}"))?
+        {
+            let received = Instant::now();
+            let header = *sample.user_header();
+            let outcome = apply_pose_frame(
+                scene_id,
+                scene,
+                &header,
+                sample.payload(),
+                &mut self.validated,
+            );
+            drop(sample);
+            let ingest_ns = elapsed_ns(received);
+            let mut result = ResultFrameHeader {
+                protocol_version: PROTOCOL_VERSION,
+                frame_seq: header.frame_seq,
+                error_body: u32::MAX,
+                ..ResultFrameHeader::default()
+            };
+            result.stage_ns[wire::stage::INGEST] = ingest_ns;
+            self.pairs.clear();
+            match outcome {
+                Err(FrameRejection {
+                    rejection: Rejection { code, reason },
+                    body,
+                }) => {
+                    eprintln!(
+                        "proximad: scene {scene_id} frame {} refused: {reason}",
+                        header.frame_seq
+                    );
+                    result.status = code as u32;
+                    result.error_body = body.unwrap_or(u32::MAX);
+                }
+                Ok(()) => {
+                    let started = Instant::now();
+                    let pairs = &mut self.pairs;
+                    let completeness =
+                        pipeline::step(scene, &mut self.workspace, |r| pairs.push(*r));
+                    result.stage_ns[wire::stage::NARROW] = elapsed_ns(started);
+                    result.status = ErrorCode::Ok as u32;
+                    result.completeness = match completeness {
+                        Completeness::Exact => wire::Completeness::Exact as u32,
+                        Completeness::Truncated { level } => {
+                            result.deepest_level = level;
+                            wire::Completeness::Truncated as u32
+                        }
+                    };
+                    result.pair_count = self.pairs.len() as u32;
+                }
+            }
+            self.publish(result, received, header.budget_ns)?;
+            served += 1;
+        }
+        Ok(served)
+    }
+
+    fn publish(
+        &self,
+        mut header: ResultFrameHeader,
+        received: Instant,
+        budget_ns: u64,
+    ) -> Result<(), String> {
+        let publish_started = Instant::now();
+        let pairs = &self.pairs;
+        let mut sample = self
+            .results
+            .loan_slice_uninit(pairs.len())
+            .map_err(|e| format!("results loan: {e:?}"))?
+            .write_from_fn(|i| record(&pairs[i]));
+        header.stage_ns[wire::stage::PUBLISH] = elapsed_ns(publish_started);
+        header.elapsed_ns = elapsed_ns(received);
+        header.budget_met = u32::from(budget_ns == 0 || header.elapsed_ns <= budget_ns);
+        *sample.user_header_mut() = header;
+        sample.send().map_err(|e| format!("results send: {e:?}"))?;
+        self.notifier
+            .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
+            .map_err(|e| format!("results notify: {e:?}"))?;
+        Ok(())
+    }
+}
+
+fn elapsed_ns(since: Instant) -> u64 {
+    u64::try_from(since.elapsed().as_nanos()).unwrap_or(u64::MAX)
+}
+
+fn record(r: &PairResult) -> ResultRecord {
+    ResultRecord {
+        kind: RecordKind::Pair as u32,
+        body_a: r.a,
+        body_b: r.b,
+        index: 0,
+        count: 0,
+        reserved: 0,
+        distance: r.distance,
+        error_bound: r.error_bound,
+        point_a: r.point_a.to_array(),
+        point_b: r.point_b.to_array(),
+        normal: r.normal.to_array(),
+    }
+}
