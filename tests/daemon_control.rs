@@ -2,85 +2,13 @@
 //! prefix, driven over real shared memory by the client library from this process: scene,
 //! shape and body control, every kind of bad request, several clients at once.
 
-use iceoryx2::prelude::ipc;
-use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion, Primitive};
+#[path = "support/daemon.rs"]
+mod daemon_harness;
+
+use daemon_harness::Daemon;
+use proxima_ipc::client::{BodySpec, Motion, Primitive};
 use proxima_ipc::error::ControlError;
 use proxima_ipc::wire::{ControlRequest, ErrorCode};
-use std::process::{Child, Command};
-use std::sync::atomic::{AtomicU32, Ordering};
-use std::time::Duration;
-
-/// A daemon process with a unique root and prefix, stopped and cleaned up on drop.
-struct Daemon {
-    child: Child,
-    root: String,
-    prefix: String,
-}
-
-impl Daemon {
-    fn start() -> Self {
-        static NEXT: AtomicU32 = AtomicU32::new(0);
-        let tag = format!(
-            "{}_{}",
-            std::process::id(),
-            NEXT.fetch_add(1, Ordering::Relaxed)
-        );
-        let (root, prefix) = (format!("proxima-test-{tag}"), format!("iox2_pxt{tag}_"));
-        let child = Command::new(env!("CARGO_BIN_EXE_proximad"))
-            .args([
-                "--root",
-                &root,
-                "--iceoryx-prefix",
-                &prefix,
-                "--max-scenes",
-                "3",
-            ])
-            .spawn()
-            .expect("proximad starts");
-        Self {
-            child,
-            root,
-            prefix,
-        }
-    }
-
-    fn client(&self) -> Client<ipc::Service> {
-        ClientBuilder::new()
-            .root(&self.root)
-            .iceoryx_prefix(&self.prefix)
-            .reply_timeout(Duration::from_secs(10))
-            .connect::<ipc::Service>()
-            .expect("the daemon answers Hello")
-    }
-}
-
-impl Drop for Daemon {
-    fn drop(&mut self) {
-        // SIGTERM: the daemon's node.wait() sees it and the process exits cleanly.
-        let _ = Command::new("kill")
-            .args(["-TERM", &self.child.id().to_string()])
-            .status();
-        let stopped = (0..200).any(|_| {
-            std::thread::sleep(Duration::from_millis(10));
-            matches!(self.child.try_wait(), Ok(Some(_)))
-        });
-        if !stopped {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-        }
-        if let Ok(entries) = std::fs::read_dir("/dev/shm") {
-            for entry in entries.flatten() {
-                if entry
-                    .file_name()
-                    .to_string_lossy()
-                    .starts_with(&self.prefix)
-                {
-                    let _ = std::fs::remove_file(entry.path());
-                }
-            }
-        }
-    }
-}
 
 fn body(shape: u32, x: f64) -> BodySpec {
     BodySpec {
