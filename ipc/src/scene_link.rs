@@ -817,4 +817,47 @@ mod tests {
         assert_eq!(error, FrameSendError::TooLarge(count));
         assert!(error.to_string().contains("4294967296"));
     }
+
+    #[test]
+    fn a_connected_client_opens_the_scene_under_its_root() {
+        let root = root("client");
+        let stop = Arc::new(AtomicBool::new(false));
+        let (ready_tx, ready_rx) = mpsc::channel();
+        let (control_root, flag) = (root.clone(), stop.clone());
+        // A control server that only answers Hello, so the client connects.
+        let control = std::thread::spawn(move || {
+            let node = node();
+            let service = crate::control_service_builder(&node, &control_root)
+                .unwrap()
+                .open_or_create()
+                .unwrap();
+            let server = service.server_builder().create().unwrap();
+            ready_tx.send(()).unwrap();
+            while !flag.load(Ordering::Relaxed) {
+                while let Some(active) = server.receive().unwrap() {
+                    let reply = crate::wire::ControlReply::ok(PROTOCOL_VERSION);
+                    active.send_copy(reply).unwrap();
+                }
+                std::thread::sleep(Duration::from_micros(50));
+            }
+        });
+        ready_rx.recv().unwrap();
+        let _responder = Responder::start(&root, 8, echo);
+        let client = crate::client::ClientBuilder::new()
+            .root(&root)
+            .connect::<local::Service>()
+            .unwrap();
+        let link = client.open_scene(8).unwrap();
+        drop(client); // the link's ports keep what they need alive
+        assert_eq!(link.scene(), 8);
+        let poses = [pose(8, 0), pose(8, 1), pose(8, 2)];
+        link.publish_poses(80, 0, 0, &poses).unwrap();
+        let frame = link
+            .receive_results_for(80, WAIT)
+            .unwrap()
+            .expect("a result frame");
+        assert_echo(&frame, 80, &poses);
+        stop.store(true, Ordering::Relaxed);
+        control.join().unwrap();
+    }
 }
