@@ -44,7 +44,8 @@ use iceoryx2::prelude::{AllocationStrategy, FileName, PortFactory as _, Semantic
 use iceoryx2::service::Service;
 use iceoryx2::service::port_factory::request_response::PortFactory;
 
-use crate::error::{ClientConnectError, ControlError};
+use crate::error::{ClientConnectError, ControlError, SceneOpenError};
+use crate::scene_link::SceneLink;
 use crate::wire::{Command, ControlReply, ControlRequest, ErrorCode, MotionCode, ShapeKindCode};
 use crate::{CONTROL_INITIAL_MAX_SLICE_LEN, DEFAULT_ROOT, PROTOCOL_VERSION};
 
@@ -327,6 +328,16 @@ impl<S: Service> Client<S> {
     #[must_use]
     pub fn node(&self) -> &Node<S> {
         &self.node
+    }
+
+    /// Opens the frame link to scene `scene` (its pose, result and event services) on this
+    /// client's node and root. Works whether or not the daemon has opened them yet; whether
+    /// the scene exists is not checked here.
+    ///
+    /// # Errors
+    /// See [`SceneOpenError`].
+    pub fn open_scene(&self, scene: u32) -> Result<SceneLink<S>, SceneOpenError> {
+        SceneLink::open(&self.node, &self.root, scene)
     }
 
     /// Creates a scene; returns its id.

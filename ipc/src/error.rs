@@ -1,7 +1,10 @@
 //! Errors of the client library, one enum per operation (STYLE §3).
 //!
 //! - [`ClientConnectError`] for `ClientBuilder::connect`;
-//! - [`ControlError`] for every control request of a `Client`.
+//! - [`ControlError`] for every control request of a `Client`;
+//! - [`SceneOpenError`] for `Client::open_scene` and `SceneLink::open`;
+//! - [`FrameSendError`] for publishing a pose frame on a `SceneLink`;
+//! - [`FrameReceiveError`] for receiving a result frame on a `SceneLink`.
 //!
 //! iceoryx2 failures keep the iceoryx2 error's text in a `Transport` variant, so the enums
 //! stay `Clone + Eq` and do not expose iceoryx2's error types in this crate's API.
@@ -97,3 +100,77 @@ impl std::fmt::Display for ControlError {
 }
 
 impl std::error::Error for ControlError {}
+
+/// Why [`Client::open_scene`](crate::client::Client::open_scene) or
+/// [`SceneLink::open`](crate::scene_link::SceneLink::open) failed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SceneOpenError {
+    /// The root and scene id do not make valid iceoryx2 service names; carries the root.
+    InvalidRoot(String),
+    /// iceoryx2 failed to open or create a scene service or one of its ports (e.g. the
+    /// services exist with incompatible settings, or too many ports); carries its error text.
+    Transport(String),
+}
+
+impl std::fmt::Display for SceneOpenError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::InvalidRoot(root) => {
+                write!(
+                    f,
+                    "service root {root:?} does not make valid scene service names"
+                )
+            }
+            Self::Transport(text) => write!(f, "iceoryx2 failure while opening a scene: {text}"),
+        }
+    }
+}
+
+impl std::error::Error for SceneOpenError {}
+
+/// Why publishing a pose frame failed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum FrameSendError {
+    /// The frame has more poses than the header's `u32` count can carry; carries the count.
+    TooLarge(usize),
+    /// iceoryx2 failed to loan the sample, send it or notify the daemon; carries its error
+    /// text.
+    Transport(String),
+}
+
+impl std::fmt::Display for FrameSendError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::TooLarge(count) => write!(f, "{count} poses exceed the u32 wire count"),
+            Self::Transport(text) => {
+                write!(f, "iceoryx2 failure while publishing a pose frame: {text}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for FrameSendError {}
+
+/// Why receiving a result frame failed. Not receiving one in time is not an error: the
+/// receive calls return `Ok(None)`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum FrameReceiveError {
+    /// iceoryx2 failed to receive a sample (e.g. the caller holds more result frames than
+    /// the subscriber may borrow) or to wait on the event listener; carries its error text.
+    Transport(String),
+}
+
+impl std::fmt::Display for FrameReceiveError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Transport(text) => {
+                write!(f, "iceoryx2 failure while receiving a result frame: {text}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for FrameReceiveError {}

@@ -7,6 +7,7 @@
 
 pub mod client;
 pub mod error;
+pub mod scene_link;
 pub mod wire;
 
 use iceoryx2::node::Node;
