@@ -5,22 +5,10 @@
 #[path = "support/daemon.rs"]
 mod daemon_harness;
 
-use daemon_harness::Daemon;
+use daemon_harness::{Daemon, body};
 use proxima_ipc::client::{BodySpec, Motion, Primitive};
 use proxima_ipc::error::ControlError;
 use proxima_ipc::wire::{ControlRequest, ErrorCode};
-
-fn body(shape: u32, x: f64) -> BodySpec {
-    BodySpec {
-        shape,
-        position: [x, 0.0, 0.0],
-        orientation: [0.0, 0.0, 0.0, 1.0],
-        motion: Motion::Dynamic,
-        group: u32::MAX,
-        mask: u32::MAX,
-        margin: None,
-    }
-}
 
 fn rejected(result: Result<impl std::fmt::Debug, ControlError>) -> ErrorCode {
     match result {

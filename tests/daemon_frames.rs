@@ -6,12 +6,12 @@
 mod daemon_harness;
 mod support;
 
-use daemon_harness::Daemon;
+use daemon_harness::{Daemon, body};
 use proxima::geometry::Sphere;
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::pipeline::{PipelineWorkspace, step};
 use proxima::scene::{BodyDesc, CollisionFilter, Motion as SceneMotion, Scene, SceneLimits, Shape};
-use proxima_ipc::client::{BodySpec, Motion, Primitive};
+use proxima_ipc::client::{BodySpec, Primitive};
 use proxima_ipc::wire::{ErrorCode, PoseRecord, RecordKind, query};
 use rand::Rng;
 use std::time::Duration;
@@ -42,13 +42,8 @@ fn frames_of_moving_spheres_get_the_in_process_pipelines_answer() {
             .register_primitive(scene_id, Primitive::Sphere { radius: r })
             .unwrap();
         let spec = BodySpec {
-            shape,
-            position: [0.0; 3],
-            orientation: [0.0, 0.0, 0.0, 1.0],
-            motion: Motion::Dynamic,
-            group: u32::MAX,
-            mask: u32::MAX,
             margin: Some(0.05),
+            ..body(shape, 0.0)
         };
         client.add_body(scene_id, &spec).unwrap();
         let local = oracle
@@ -127,15 +122,7 @@ fn a_bad_frame_is_answered_with_its_code_and_body_and_another_client_keeps_going
         .register_primitive(scene_id, Primitive::Sphere { radius: 0.5 })
         .unwrap();
     for x in [0.0, 0.9] {
-        let spec = BodySpec {
-            shape: sphere,
-            position: [x, 0.0, 0.0],
-            orientation: [0.0, 0.0, 0.0, 1.0],
-            motion: Motion::Dynamic,
-            group: u32::MAX,
-            mask: u32::MAX,
-            margin: None,
-        };
+        let spec = body(sphere, x);
         good_client.add_body(scene_id, &spec).unwrap();
     }
     let (bad, good) = (

@@ -5,7 +5,7 @@
 #![allow(dead_code)]
 
 use iceoryx2::prelude::ipc;
-use proxima_ipc::client::{Client, ClientBuilder};
+use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion};
 use std::process::{Child, Command};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
@@ -79,5 +79,19 @@ impl Drop for Daemon {
                 }
             }
         }
+    }
+}
+
+/// A dynamic body of `shape` at `(x, 0, 0)`, unrotated, pairing with everything, with the
+/// scene's default margin.
+pub fn body(shape: u32, x: f64) -> BodySpec {
+    BodySpec {
+        shape,
+        position: [x, 0.0, 0.0],
+        orientation: [0.0, 0.0, 0.0, 1.0],
+        motion: Motion::Dynamic,
+        group: u32::MAX,
+        mask: u32::MAX,
+        margin: None,
     }
 }
