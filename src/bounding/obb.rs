@@ -70,15 +70,23 @@ impl Obb {
     /// The smallest box with the given `axes` containing `points` (non-empty), padded.
     #[must_use]
     pub fn enclosing(points: &[DVec3], axes: DMat3) -> Self {
+        Self::enclosing_all(points.iter().copied(), axes)
+    }
+
+    /// [`enclosing`](Self::enclosing) over any re-iterable point sequence (non-empty),
+    /// measured from its first point and padded for its coordinate scale.
+    fn enclosing_all(points: impl Iterator<Item = DVec3> + Clone, axes: DMat3) -> Self {
+        let reference = points.clone().next().expect("at least one point");
         let scale = points
-            .iter()
+            .clone()
             .fold(0.0f64, |s, p| s.max(p.abs().max_element()));
-        Self::enclosing_padded(
-            points.iter().copied(),
-            axes,
-            points[0],
-            conservative_slack(scale),
-        )
+        Self::enclosing_padded(points, axes, reference, conservative_slack(scale))
+    }
+
+    /// The 16 corners of two boxes.
+    fn corners_of(a: &Self, b: &Self) -> [DVec3; 16] {
+        let (ca, cb) = (a.corners(), b.corners());
+        std::array::from_fn(|k| if k < 8 { ca[k] } else { cb[k - 8] })
     }
 
     /// The eight corners.
@@ -238,35 +246,18 @@ impl BoundingVolume for Obb {
         Self::fit_with(&vertices, &moments, triangles)
     }
 
-    /// The least-volume box, over the frames of both inputs and the PCA frame of their 16
-    /// corners, that encloses all 16 corners (hence both boxes).
     fn fit_triangles_in_frame(&self, triangles: &[Triangle]) -> Self {
-        let vertices = triangles.iter().flat_map(Triangle::vertices);
-        let scale = vertices
-            .clone()
-            .fold(0.0f64, |s, p| s.max(p.abs().max_element()));
-        Self::enclosing_padded(
-            vertices,
-            self.axes,
-            triangles[0].a,
-            conservative_slack(scale),
-        )
+        Self::enclosing_all(triangles.iter().flat_map(Triangle::vertices), self.axes)
     }
 
     fn merged_in_frame(&self, a: &Self, b: &Self) -> Self {
-        let mut corners = [DVec3::ZERO; 16];
-        corners[..8].copy_from_slice(&a.corners());
-        corners[8..].copy_from_slice(&b.corners());
-        let scale = corners
-            .iter()
-            .fold(0.0f64, |s, p| s.max(p.abs().max_element()));
-        Self::enclosing_padded(corners, self.axes, a.center, conservative_slack(scale))
+        Self::enclosing_all(Self::corners_of(a, b).into_iter(), self.axes)
     }
 
+    /// The least-volume box, over the frames of both inputs and the PCA frame of their 16
+    /// corners, that encloses all 16 corners (hence both boxes).
     fn merged(&self, other: &Self) -> Self {
-        let mut corners = [DVec3::ZERO; 16];
-        corners[..8].copy_from_slice(&self.corners());
-        corners[8..].copy_from_slice(&other.corners());
+        let corners = Self::corners_of(self, other);
         let scale = corners
             .iter()
             .fold(0.0f64, |s, p| s.max(p.abs().max_element()));

@@ -108,6 +108,11 @@ fn polish_frame(candidates: impl Iterator<Item = DMat3>, cost: impl Fn(DMat3) ->
     best.0
 }
 
+/// A right-handed frame whose first axis is `direction` (any completion; `X` when zero).
+fn frame_along(direction: DVec3) -> DMat3 {
+    orthonormalise(direction, direction.any_orthogonal_vector())
+}
+
 /// The triangles' vertices as balls of radius 0.
 fn vertex_balls(triangles: &[Triangle]) -> Vec<Ball> {
     triangles
@@ -189,14 +194,30 @@ impl Lss {
     /// The least-volume capsule over candidate axes `directions`, polished by
     /// [`polish_frame`].
     fn fit_balls(balls: &[Ball], directions: &[DVec3]) -> Self {
-        let pad = conservative_slack(ball_scale(balls));
         let reference = balls[0].0;
         let cost = |axes: DMat3| Self::from_balls(balls, axes, reference, 0.0).volume();
-        let frames = directions
-            .iter()
-            .map(|d| orthonormalise(*d, d.any_orthogonal_vector()));
-        let axes = polish_frame(frames, cost);
-        Self::from_balls(balls, axes, reference, pad)
+        let axes = polish_frame(directions.iter().map(|&d| frame_along(d)), cost);
+        Self::enclosing_balls(balls, axes)
+    }
+
+    /// The capsule with axis `axes.x_axis` containing every ball, padded for rounding.
+    fn enclosing_balls(balls: &[Ball], axes: DMat3) -> Self {
+        Self::from_balls(
+            balls,
+            axes,
+            balls[0].0,
+            conservative_slack(ball_scale(balls)),
+        )
+    }
+
+    /// The end balls of two capsules.
+    fn end_balls(a: &Self, b: &Self) -> [Ball; 4] {
+        [
+            (a.core.a, a.radius),
+            (a.core.b, a.radius),
+            (b.core.a, b.radius),
+            (b.core.b, b.radius),
+        ]
     }
 
     /// PCA axis, and the axis through the centroids of the two end thirds of the points
@@ -278,44 +299,18 @@ impl BoundingVolume for Lss {
         Self::fit(&vertices, &moments)
     }
 
-    /// Contains the four end balls of both inputs; the axis is the best of both inputs'
-    /// axes and the PCA axis of the four end points.
     fn fit_triangles_in_frame(&self, triangles: &[Triangle]) -> Self {
-        let axis = self.core.direction();
-        let axes = orthonormalise(axis, axis.any_orthogonal_vector());
-        let balls = vertex_balls(triangles);
-        Self::from_balls(
-            &balls,
-            axes,
-            balls[0].0,
-            conservative_slack(ball_scale(&balls)),
-        )
+        Self::enclosing_balls(&vertex_balls(triangles), frame_along(self.core.direction()))
     }
 
     fn merged_in_frame(&self, a: &Self, b: &Self) -> Self {
-        let balls = [
-            (a.core.a, a.radius),
-            (a.core.b, a.radius),
-            (b.core.a, b.radius),
-            (b.core.b, b.radius),
-        ];
-        let axis = self.core.direction();
-        let axes = orthonormalise(axis, axis.any_orthogonal_vector());
-        Self::from_balls(
-            &balls,
-            axes,
-            balls[0].0,
-            conservative_slack(ball_scale(&balls)),
-        )
+        Self::enclosing_balls(&Self::end_balls(a, b), frame_along(self.core.direction()))
     }
 
+    /// Contains the four end balls of both inputs; the axis is the best of both inputs'
+    /// axes and the PCA axis of the four end points.
     fn merged(&self, other: &Self) -> Self {
-        let balls = [
-            (self.core.a, self.radius),
-            (self.core.b, self.radius),
-            (other.core.a, other.radius),
-            (other.core.b, other.radius),
-        ];
+        let balls = Self::end_balls(self, other);
         let ends = balls.map(|(c, _)| c);
         let (pca, _) = principal_frame(&point_moments(&ends).covariance);
         Self::fit_balls(
@@ -461,11 +456,32 @@ impl Rss {
 
     /// The least-volume RSS over candidate frames, polished by [`polish_frame`].
     fn fit_balls(balls: &[Ball], frames: &[DMat3]) -> Self {
-        let pad = conservative_slack(ball_scale(balls));
         let reference = balls[0].0;
         let cost = |axes: DMat3| Self::from_balls(balls, axes, reference, 0.0).volume();
         let axes = polish_frame(frames.iter().copied(), cost);
-        Self::from_balls(balls, axes, reference, pad)
+        Self::enclosing_balls(balls, axes)
+    }
+
+    /// The RSS with rectangle frame `axes` containing every ball, padded for rounding.
+    fn enclosing_balls(balls: &[Ball], axes: DMat3) -> Self {
+        Self::from_balls(
+            balls,
+            axes,
+            balls[0].0,
+            conservative_slack(ball_scale(balls)),
+        )
+    }
+
+    /// The corner balls of two RSSs (four rectangle corners each, with its radius).
+    fn corner_balls(a: &Self, b: &Self) -> [Ball; 8] {
+        let (ca, cb) = (a.corners(), b.corners());
+        std::array::from_fn(|k| {
+            if k < 4 {
+                (ca[k], a.radius)
+            } else {
+                (cb[k - 4], b.radius)
+            }
+        })
     }
 
     /// PCA frame (normal = least axis), plus the minimum-area rectangle frame when the two
@@ -741,42 +757,18 @@ impl BoundingVolume for Rss {
         Self::fit(&vertices, &moments)
     }
 
-    /// Contains the eight corner balls of both inputs; the frame is the best of both inputs'
-    /// frames and the PCA frame of the eight corners.
     fn fit_triangles_in_frame(&self, triangles: &[Triangle]) -> Self {
-        let balls = vertex_balls(triangles);
-        Self::from_balls(
-            &balls,
-            self.axes,
-            balls[0].0,
-            conservative_slack(ball_scale(&balls)),
-        )
+        Self::enclosing_balls(&vertex_balls(triangles), self.axes)
     }
 
     fn merged_in_frame(&self, a: &Self, b: &Self) -> Self {
-        let mut balls = [(DVec3::ZERO, 0.0); 8];
-        for (k, corner) in a.corners().into_iter().enumerate() {
-            balls[k] = (corner, a.radius);
-        }
-        for (k, corner) in b.corners().into_iter().enumerate() {
-            balls[4 + k] = (corner, b.radius);
-        }
-        Self::from_balls(
-            &balls,
-            self.axes,
-            balls[0].0,
-            conservative_slack(ball_scale(&balls)),
-        )
+        Self::enclosing_balls(&Self::corner_balls(a, b), self.axes)
     }
 
+    /// Contains the eight corner balls of both inputs; the frame is the best of both inputs'
+    /// frames and the PCA frame of the eight corners.
     fn merged(&self, other: &Self) -> Self {
-        let mut balls = [(DVec3::ZERO, 0.0); 8];
-        for (k, corner) in self.corners().into_iter().enumerate() {
-            balls[k] = (corner, self.radius);
-        }
-        for (k, corner) in other.corners().into_iter().enumerate() {
-            balls[4 + k] = (corner, other.radius);
-        }
+        let balls = Self::corner_balls(self, other);
         let (pca, _) = principal_frame(&point_moments(&balls.map(|(c, _)| c)).covariance);
         Self::fit_balls(&balls, &[self.axes, other.axes, pca])
     }
