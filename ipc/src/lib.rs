@@ -250,6 +250,25 @@ mod tests {
     }
 
     #[test]
+    fn every_command_shape_kind_and_motion_survives_the_wire_and_unknown_values_are_refused() {
+        let count = |known: &dyn Fn(u32) -> Option<u32>| {
+            (0..64u32)
+                .filter(|&v| known(v).inspect(|&back| assert_eq!(back, v)).is_some())
+                .count()
+        };
+        assert_eq!(count(&|v| wire::Command::from_u32(v).map(|c| c as u32)), 7);
+        assert_eq!(
+            count(&|v| wire::ShapeKindCode::from_u32(v).map(|c| c as u32)),
+            7
+        );
+        assert_eq!(
+            count(&|v| wire::MotionCode::from_u32(v).map(|c| c as u32)),
+            3
+        );
+        assert_eq!(wire::Command::from_u32(u32::MAX), None);
+    }
+
+    #[test]
     fn a_pose_frame_and_a_result_frame_cross_a_real_service_unchanged() {
         let node = NodeBuilder::new().create::<local::Service>().unwrap();
         let root = format!("wire-test-{}", std::process::id());

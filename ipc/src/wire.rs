@@ -254,9 +254,11 @@ pub struct ResultRecord {
 }
 
 /// What a [`ControlRequest`] asks the daemon to do.
+///
+/// Not `#[non_exhaustive]`: the set is versioned with [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION),
+/// so the daemon matches it exhaustively.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u32)]
-#[non_exhaustive]
 pub enum Command {
     /// Check the protocol version; the reply's `id` is the daemon's version.
     Hello = 0,
@@ -278,9 +280,10 @@ pub enum Command {
 
 /// Shape kinds of [`ControlRequest::shape_kind`], with the meaning of `dimensions` (metres)
 /// and of the geometry payload.
+///
+/// Versioned with the protocol like [`Command`], so matched exhaustively.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u32)]
-#[non_exhaustive]
 pub enum ShapeKindCode {
     /// `dimensions = [radius, 0, 0, 0]`.
     Sphere = 0,
@@ -299,6 +302,40 @@ pub enum ShapeKindCode {
     Mesh = 6,
 }
 
+impl Command {
+    /// The command for a wire value, `None` for values this version does not define.
+    #[must_use]
+    pub const fn from_u32(value: u32) -> Option<Self> {
+        Some(match value {
+            0 => Self::Hello,
+            1 => Self::CreateScene,
+            2 => Self::DropScene,
+            3 => Self::RegisterShape,
+            4 => Self::AddBody,
+            5 => Self::RemoveBody,
+            6 => Self::UpdateBody,
+            _ => return None,
+        })
+    }
+}
+
+impl ShapeKindCode {
+    /// The shape kind for a wire value, `None` for values this version does not define.
+    #[must_use]
+    pub const fn from_u32(value: u32) -> Option<Self> {
+        Some(match value {
+            0 => Self::Sphere,
+            1 => Self::Capsule,
+            2 => Self::Cuboid,
+            3 => Self::Cylinder,
+            4 => Self::Cone,
+            5 => Self::Convex,
+            6 => Self::Mesh,
+            _ => return None,
+        })
+    }
+}
+
 /// Motion kinds of [`ControlRequest::motion`]: static bodies never pair with each other.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u32)]
@@ -309,6 +346,19 @@ pub enum MotionCode {
     Kinematic = 1,
     /// Moved by the client's physics.
     Dynamic = 2,
+}
+
+impl MotionCode {
+    /// The motion kind for a wire value, `None` for values this version does not define.
+    #[must_use]
+    pub const fn from_u32(value: u32) -> Option<Self> {
+        Some(match value {
+            0 => Self::Static,
+            1 => Self::Kinematic,
+            2 => Self::Dynamic,
+            _ => return None,
+        })
+    }
 }
 
 /// A control request (the user header of a `[u8]` request on `<root>/control`).

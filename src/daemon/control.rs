@@ -58,72 +58,71 @@ impl ControlState {
                 ),
             ));
         }
-        let command = request.command;
-        let is = |c: Command| command == c as u32;
-        if !payload.is_empty() && !is(Command::RegisterShape) {
+        let Some(command) = Command::from_u32(request.command) else {
+            return Err(Rejection::new(
+                ErrorCode::MalformedMessage,
+                format!("unknown command {}", request.command),
+            ));
+        };
+        if !payload.is_empty() && command != Command::RegisterShape {
             return Err(Rejection::new(
                 ErrorCode::MalformedMessage,
                 "only RegisterShape carries a payload",
             ));
         }
-        if is(Command::Hello) {
-            Ok(PROTOCOL_VERSION)
-        } else if is(Command::CreateScene) {
-            self.create_scene()
-        } else if is(Command::DropScene) {
-            self.live_scene(request.scene)?;
-            self.scenes[request.scene as usize] = None;
-            self.live_scenes -= 1;
-            Ok(request.scene)
-        } else if is(Command::RegisterShape) {
-            let shape = convert::shape(
-                request,
-                payload,
-                &self.config.mesh_limits,
-                self.config.max_convex_points,
-            )?;
-            let id = self
-                .live_scene(request.scene)?
-                .register_shape(shape)
-                .map_err(scene_rejection)?;
-            Ok(id.0)
-        } else if is(Command::AddBody) {
-            let desc = BodyDesc {
-                shape: ShapeId(request.target),
-                pose: convert::pose(request.position, request.orientation)?,
-                motion: convert::motion(request.motion)?,
-                filter: convert::filter(request),
-                margin: convert::margin(request.margin),
-            };
-            let id = self
-                .live_scene(request.scene)?
-                .add_body(&desc)
-                .map_err(scene_rejection)?;
-            Ok(id.0)
-        } else if is(Command::RemoveBody) {
-            let scene = self.live_scene(request.scene)?;
-            scene
-                .remove_body(BodyId(request.target))
-                .map_err(scene_rejection)?;
-            Ok(request.target)
-        } else if is(Command::UpdateBody) {
-            let motion = convert::motion(request.motion)?;
-            let scene = self.live_scene(request.scene)?;
-            scene
-                .update_body(
-                    BodyId(request.target),
-                    motion,
-                    convert::filter(request),
-                    convert::margin(request.margin),
-                )
-                .map_err(scene_rejection)?;
-            Ok(request.target)
-        } else {
-            Err(Rejection::new(
-                ErrorCode::MalformedMessage,
-                format!("unknown command {command}"),
-            ))
+        match command {
+            Command::Hello => Ok(PROTOCOL_VERSION),
+            Command::CreateScene => self.create_scene(),
+            Command::DropScene => self.drop_scene(request.scene).map(|()| request.scene),
+            Command::RegisterShape => {
+                let shape = convert::shape(
+                    request,
+                    payload,
+                    &self.config.mesh_limits,
+                    self.config.max_convex_points,
+                )?;
+                let scene = self.live_scene(request.scene)?;
+                Ok(scene.register_shape(shape).map_err(scene_rejection)?.0)
+            }
+            Command::AddBody => {
+                let desc = BodyDesc {
+                    shape: ShapeId(request.target),
+                    pose: convert::pose(request.position, request.orientation)?,
+                    motion: convert::motion(request.motion)?,
+                    filter: convert::filter(request),
+                    margin: convert::margin(request.margin),
+                };
+                let scene = self.live_scene(request.scene)?;
+                Ok(scene.add_body(&desc).map_err(scene_rejection)?.0)
+            }
+            Command::RemoveBody => {
+                let scene = self.live_scene(request.scene)?;
+                scene
+                    .remove_body(BodyId(request.target))
+                    .map_err(scene_rejection)?;
+                Ok(request.target)
+            }
+            Command::UpdateBody => {
+                let motion = convert::motion(request.motion)?;
+                let (filter, margin) = (convert::filter(request), convert::margin(request.margin));
+                let scene = self.live_scene(request.scene)?;
+                scene
+                    .update_body(BodyId(request.target), motion, filter, margin)
+                    .map_err(scene_rejection)?;
+                Ok(request.target)
+            }
         }
+    }
+
+    /// Drops scene `id` with all its shapes and bodies.
+    ///
+    /// # Errors
+    /// [`ErrorCode::UnknownScene`] when no such scene lives.
+    pub fn drop_scene(&mut self, id: u32) -> Result<(), Rejection> {
+        self.live_scene(id)?;
+        self.scenes[id as usize] = None;
+        self.live_scenes -= 1;
+        Ok(())
     }
 
     fn create_scene(&mut self) -> Result<u32, Rejection> {
@@ -144,9 +143,7 @@ impl ControlState {
     }
 
     fn live_scene(&mut self, id: u32) -> Result<&mut Scene, Rejection> {
-        self.scenes
-            .get_mut(id as usize)
-            .and_then(Option::as_mut)
+        self.scene_mut(id)
             .ok_or_else(|| Rejection::new(ErrorCode::UnknownScene, format!("no scene {id}")))
     }
 }

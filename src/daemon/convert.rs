@@ -3,7 +3,8 @@
 //! [`Rejection`] naming the wire error code and the reason.
 
 use crate::geometry::{
-    Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, MeshError, MeshLimits, Sphere, TriMesh,
+    Capsule, Cone, ConvexHullError, ConvexPolyhedron, Cuboid, Cylinder, MeshError, MeshLimits,
+    Sphere, TriMesh,
 };
 use crate::math::{DQuat, DVec3, Pose};
 use crate::scene::{CollisionFilter, MeshShape, Motion, Shape};
@@ -37,13 +38,13 @@ pub fn pose(position: [f64; 3], orientation: [f64; 4]) -> Result<Pose, Rejection
 
 /// A motion kind from its wire code.
 pub fn motion(code: u32) -> Result<Motion, Rejection> {
-    match code {
-        c if c == MotionCode::Static as u32 => Ok(Motion::Static),
-        c if c == MotionCode::Kinematic as u32 => Ok(Motion::Kinematic),
-        c if c == MotionCode::Dynamic as u32 => Ok(Motion::Dynamic),
-        other => Err(Rejection::new(
+    match MotionCode::from_u32(code) {
+        Some(MotionCode::Static) => Ok(Motion::Static),
+        Some(MotionCode::Kinematic) => Ok(Motion::Kinematic),
+        Some(MotionCode::Dynamic) => Ok(Motion::Dynamic),
+        None => Err(Rejection::new(
             ErrorCode::MalformedMessage,
-            format!("unknown motion kind {other}"),
+            format!("unknown motion kind {code}"),
         )),
     }
 }
@@ -70,89 +71,90 @@ pub fn shape(
     mesh_limits: &MeshLimits,
     max_convex_points: u32,
 ) -> Result<Shape, Rejection> {
-    let [d0, d1, d2, _] = request.dimensions;
-    let primitive = |result: Result<Shape, crate::geometry::ShapeError>| {
-        result.map_err(|e| Rejection::new(ErrorCode::InvalidShape, e.to_string()))
-    };
-    let kind = request.shape_kind;
-    let is = |code: ShapeKindCode| kind == code as u32;
-    let needs_payload = is(ShapeKindCode::Convex) || is(ShapeKindCode::Mesh);
-    if !needs_payload
-        && (!payload.is_empty() || request.vertex_count != 0 || request.index_count != 0)
-    {
+    let Some(kind) = ShapeKindCode::from_u32(request.shape_kind) else {
         return Err(Rejection::new(
             ErrorCode::MalformedMessage,
-            "a primitive shape carries no geometry payload",
+            format!("unknown shape kind {}", request.shape_kind),
+        ));
+    };
+    let [d0, d1, d2, _] = request.dimensions;
+    let primitive = |result: Result<Shape, crate::geometry::ShapeError>| {
+        let has_geometry =
+            !payload.is_empty() || request.vertex_count != 0 || request.index_count != 0;
+        if has_geometry {
+            return Err(Rejection::new(
+                ErrorCode::MalformedMessage,
+                "a primitive shape carries no geometry payload",
+            ));
+        }
+        result.map_err(|e| Rejection::new(ErrorCode::InvalidShape, e.to_string()))
+    };
+    match kind {
+        ShapeKindCode::Sphere => primitive(Sphere::try_new(d0).map(Shape::Sphere)),
+        ShapeKindCode::Capsule => primitive(Capsule::try_new(d1, d0).map(Shape::Capsule)),
+        ShapeKindCode::Cuboid => {
+            primitive(Cuboid::try_new(DVec3::new(d0, d1, d2)).map(Shape::Cuboid))
+        }
+        ShapeKindCode::Cylinder => primitive(Cylinder::try_new(d1, d0).map(Shape::Cylinder)),
+        ShapeKindCode::Cone => primitive(Cone::try_new(d1, d0).map(Shape::Cone)),
+        ShapeKindCode::Convex => convex(request, payload, max_convex_points),
+        ShapeKindCode::Mesh => mesh(request, payload, mesh_limits),
+    }
+}
+
+/// A convex shape: the hull of the payload's points (no indices allowed).
+fn convex(request: &ControlRequest, payload: &[u8], max_points: u32) -> Result<Shape, Rejection> {
+    if request.vertex_count > max_points {
+        return Err(Rejection::new(
+            ErrorCode::LimitExceeded,
+            format!("{} points, the limit is {max_points}", request.vertex_count),
         ));
     }
-    if is(ShapeKindCode::Sphere) {
-        primitive(Sphere::try_new(d0).map(Shape::Sphere))
-    } else if is(ShapeKindCode::Capsule) {
-        primitive(Capsule::try_new(d1, d0).map(Shape::Capsule))
-    } else if is(ShapeKindCode::Cuboid) {
-        primitive(Cuboid::try_new(DVec3::new(d0, d1, d2)).map(Shape::Cuboid))
-    } else if is(ShapeKindCode::Cylinder) {
-        primitive(Cylinder::try_new(d1, d0).map(Shape::Cylinder))
-    } else if is(ShapeKindCode::Cone) {
-        primitive(Cone::try_new(d1, d0).map(Shape::Cone))
-    } else if is(ShapeKindCode::Convex) {
-        if request.vertex_count > max_convex_points {
-            return Err(Rejection::new(
-                ErrorCode::LimitExceeded,
-                format!(
-                    "{} points, the limit is {max_convex_points}",
-                    request.vertex_count
-                ),
-            ));
-        }
-        let (points, indices) = geometry(request, payload)?;
-        if !indices.is_empty() {
-            return Err(Rejection::new(
-                ErrorCode::MalformedMessage,
-                "a convex shape carries no indices",
-            ));
-        }
-        ConvexPolyhedron::try_from_points(&points)
-            .map(|hull| Shape::Convex(Arc::new(hull)))
-            .map_err(|e| {
-                let code = match e {
-                    crate::geometry::ConvexHullError::Empty => ErrorCode::EmptyGeometry,
-                    crate::geometry::ConvexHullError::TooLarge { .. } => ErrorCode::LimitExceeded,
-                    _ => ErrorCode::InvalidShape,
-                };
-                Rejection::new(code, e.to_string())
-            })
-    } else if is(ShapeKindCode::Mesh) {
-        let (vertices, indices) = geometry(request, payload)?;
-        if indices.len() % 3 != 0 {
-            return Err(Rejection::new(
-                ErrorCode::MalformedMessage,
-                "mesh indices are not a multiple of 3",
-            ));
-        }
-        let triangles = indices
-            .chunks_exact(3)
-            .map(|t| [t[0], t[1], t[2]])
-            .collect();
-        TriMesh::try_new_with_limits(vertices, triangles, mesh_limits)
-            .map(|mesh| Shape::Mesh(Arc::new(MeshShape::new(mesh))))
-            .map_err(|e| {
-                let code = match e {
-                    MeshError::Empty => ErrorCode::EmptyGeometry,
-                    MeshError::IndexOutOfRange { .. } => ErrorCode::MeshIndexOutOfRange,
-                    MeshError::TooManyVertices { .. } | MeshError::TooManyTriangles { .. } => {
-                        ErrorCode::LimitExceeded
-                    }
-                    _ => ErrorCode::InvalidShape,
-                };
-                Rejection::new(code, e.to_string())
-            })
-    } else {
-        Err(Rejection::new(
+    let (points, indices) = geometry(request, payload)?;
+    if !indices.is_empty() {
+        return Err(Rejection::new(
             ErrorCode::MalformedMessage,
-            format!("unknown shape kind {kind}"),
-        ))
+            "a convex shape carries no indices",
+        ));
     }
+    ConvexPolyhedron::try_from_points(&points)
+        .map(|hull| Shape::Convex(Arc::new(hull)))
+        .map_err(|e| {
+            let code = match e {
+                ConvexHullError::Empty => ErrorCode::EmptyGeometry,
+                ConvexHullError::TooLarge { .. } => ErrorCode::LimitExceeded,
+                _ => ErrorCode::InvalidShape,
+            };
+            Rejection::new(code, e.to_string())
+        })
+}
+
+/// A triangle mesh from the payload's points and index triples, with its BVHs.
+fn mesh(request: &ControlRequest, payload: &[u8], limits: &MeshLimits) -> Result<Shape, Rejection> {
+    let (vertices, indices) = geometry(request, payload)?;
+    if indices.len() % 3 != 0 {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            "mesh indices are not a multiple of 3",
+        ));
+    }
+    let triangles = indices
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .collect();
+    TriMesh::try_new_with_limits(vertices, triangles, limits)
+        .map(|mesh| Shape::Mesh(Arc::new(MeshShape::new(mesh))))
+        .map_err(|e| {
+            let code = match e {
+                MeshError::Empty => ErrorCode::EmptyGeometry,
+                MeshError::IndexOutOfRange { .. } => ErrorCode::MeshIndexOutOfRange,
+                MeshError::TooManyVertices { .. } | MeshError::TooManyTriangles { .. } => {
+                    ErrorCode::LimitExceeded
+                }
+                _ => ErrorCode::InvalidShape,
+            };
+            Rejection::new(code, e.to_string())
+        })
 }
 
 /// Decodes the geometry payload: `vertex_count` points, then `index_count` indices.

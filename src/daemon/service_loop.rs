@@ -135,12 +135,8 @@ impl<S: Service> Daemon<S> {
                     self.frames[id] = Some(frames);
                 }
                 Err(why) => {
-                    let drop = ControlRequest {
-                        command: Command::DropScene as u32,
-                        scene: reply.id,
-                        ..*request
-                    };
-                    let _ = self.state.handle(&drop, &[]);
+                    // The scene was just created, so dropping it cannot fail.
+                    let _ = self.state.drop_scene(reply.id);
                     return ControlReply::error(
                         ErrorCode::Internal,
                         &format!("scene services: {why}"),
