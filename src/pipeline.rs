@@ -21,6 +21,7 @@ use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh,
 };
 use crate::scene::{Body, BodyId, Scene, Shape};
+use std::collections::HashMap;
 
 /// The answer for one close pair, world frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,12 +56,16 @@ pub enum Completeness {
     },
 }
 
-/// Scratch space of [`step`], reused across frames (no allocation once grown).
+/// State of [`step`] kept across frames: scratch space (no allocation once grown) and the
+/// warm-start cache of every mesh–mesh pair that was a candidate last frame.
 #[derive(Debug, Default)]
 pub struct PipelineWorkspace {
     proxies: Vec<Proxy>,
     candidates: Vec<CandidatePair>,
     mesh: MeshMeshWorkspace,
+    /// Closest triangle pair of each mesh–mesh candidate, for the next frame's first bound.
+    /// Pairs that stop being candidates are forgotten; a pair that appears inserts once.
+    mesh_caches: HashMap<CandidatePair, DistanceCache>,
 }
 
 /// Runs one frame: every pair of bodies within the sum of their margins (filters and
@@ -73,9 +78,20 @@ pub fn step(
     scene.proxies(&mut workspace.proxies);
     pairs_brute_force(&workspace.proxies, &mut workspace.candidates);
     let mut completeness = Completeness::Exact;
-    for pair in &workspace.candidates {
+    let candidates = &workspace.candidates;
+    workspace
+        .mesh_caches
+        .retain(|pair, _| candidates.binary_search(pair).is_ok());
+    for pair in candidates {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        let result = answer(scene, pair, a, b, &mut workspace.mesh);
+        let result = answer(
+            scene,
+            pair,
+            a,
+            b,
+            &mut workspace.mesh,
+            &mut workspace.mesh_caches,
+        );
         if !result.exact {
             completeness = Completeness::Truncated { level: 0 };
         }
@@ -106,6 +122,7 @@ fn answer(
     a: &Body,
     b: &Body,
     mesh: &mut MeshMeshWorkspace,
+    mesh_caches: &mut HashMap<CandidatePair, DistanceCache>,
 ) -> PairResult {
     match (shape(scene, a), shape(scene, b)) {
         (Shape::Sphere(sa), Shape::Sphere(sb)) => {
@@ -131,7 +148,7 @@ fn answer(
                 &mb.distance_tree,
                 &pose_ab,
                 &DistanceParams::EXACT,
-                &mut DistanceCache::new(),
+                mesh_caches.entry(*pair).or_default(),
                 mesh,
             );
             let (point_a, point_b) = (
@@ -177,7 +194,7 @@ fn box_answer(pair: &CandidatePair, a: &Aabb, b: &Aabb) -> PairResult {
 mod tests {
     use super::*;
     use crate::geometry::{Cuboid, Sphere};
-    use crate::scene::{BodyDesc, CollisionFilter, Motion, SceneLimits};
+    use crate::scene::{BodyDesc, CollisionFilter, Motion, SceneLimits, ShapeId};
     use crate::test_support::{point_in_cube, rng};
     use rand::Rng;
 
@@ -251,6 +268,55 @@ mod tests {
         assert!(
             reported > 500 && skipped > 500,
             "reported {reported}, skipped {skipped}"
+        );
+    }
+
+    #[test]
+    fn mesh_pairs_warm_started_across_frames_keep_the_cold_exact_distance() {
+        use crate::scene::MeshShape;
+        use crate::test_support::{meshes, rotation};
+        use std::sync::Arc;
+        let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(1.0, 0.25, 24, 12))));
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let a = add(&mut scene, torus.clone(), DVec3::ZERO, 0.5);
+        let b = add(&mut scene, torus, DVec3::X, 0.5);
+        let (Some(Shape::Mesh(mesh)), mut rng) = (scene.shape(ShapeId(0)).cloned(), rng(73)) else {
+            unreachable!()
+        };
+        let mut workspace = PipelineWorkspace::default();
+        let (mut touching, mut apart) = (0, 0);
+        for frame in 0..60 {
+            let pose_b = Pose::new(point_in_cube(&mut rng, 1.6), rotation(&mut rng));
+            scene.set_pose(b, pose_b).unwrap();
+            let mut results = Vec::new();
+            step(&scene, &mut workspace, |r| results.push(*r));
+            let cold = distance_mesh_mesh(
+                &mesh.distance_tree,
+                &mesh.distance_tree,
+                &Pose::relative(&scene.body(a).unwrap().pose, &pose_b),
+                &DistanceParams::EXACT,
+                &mut DistanceCache::new(),
+                &mut MeshMeshWorkspace::new(),
+            );
+            match results.as_slice() {
+                [r] => {
+                    assert_eq!(r.distance, cold.distance, "frame {frame}");
+                    touching += usize::from(r.distance == 0.0);
+                }
+                [] => {
+                    assert!(
+                        cold.distance > 1.0,
+                        "frame {frame}: missed at {}",
+                        cold.distance
+                    );
+                    apart += 1;
+                }
+                more => panic!("frame {frame}: {} results for one pair", more.len()),
+            }
+        }
+        assert!(
+            touching > 5 && apart + (60 - touching) > 5,
+            "touching {touching}, apart {apart}"
         );
     }
 
