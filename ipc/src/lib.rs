@@ -7,6 +7,7 @@
 
 pub mod client;
 pub mod error;
+pub mod latency;
 pub mod scene_link;
 pub mod wire;
 

@@ -8,11 +8,13 @@
 //! boxes, so the narrow phase never misses a close pair.
 //!
 //! [`brute_force`] tests every pair: the reference the faster broad phases are checked
-//! against.
+//! against. [`sort_sweep`] sorts the boxes on one axis and tests only overlapping intervals.
 
 pub mod brute_force;
+pub mod sort_sweep;
 
 pub use brute_force::pairs_brute_force;
+pub use sort_sweep::SortAndSweep;
 
 use crate::bounding::Aabb;
 
