@@ -16,7 +16,6 @@ use proxima::math::DVec3;
 use rand::Rng;
 use rand::seq::SliceRandom;
 use std::collections::HashMap;
-use std::f64::consts::{PI, TAU};
 use std::path::PathBuf;
 
 /// A mesh from vertices and index triples the generators made (valid by construction).
@@ -39,70 +38,14 @@ pub fn reach(mesh: &TriMesh) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Closed UV sphere of `radius` about the origin: `segments ≥ 3` around the z axis,
-/// `rings ≥ 2` bands from pole to pole; `2 · segments · (rings − 1)` triangles.
+/// Closed UV sphere: see `TriMesh::uv_sphere`.
 pub fn uv_sphere(radius: f64, segments: u32, rings: u32) -> TriMesh {
-    assert!(segments >= 3 && rings >= 2);
-    let mut vertices = vec![DVec3::new(0.0, 0.0, radius)];
-    for k in 1..rings {
-        let theta = PI * f64::from(k) / f64::from(rings);
-        for j in 0..segments {
-            let phi = TAU * f64::from(j) / f64::from(segments);
-            vertices.push(
-                radius
-                    * DVec3::new(
-                        theta.sin() * phi.cos(),
-                        theta.sin() * phi.sin(),
-                        theta.cos(),
-                    ),
-            );
-        }
-    }
-    let south = vertices.len() as u32;
-    vertices.push(DVec3::new(0.0, 0.0, -radius));
-    let ring = |k: u32, j: u32| 1 + (k - 1) * segments + j % segments;
-    let mut tris = Vec::new();
-    for j in 0..segments {
-        tris.push([0, ring(1, j), ring(1, j + 1)]);
-    }
-    for k in 1..rings - 1 {
-        for j in 0..segments {
-            let (a, b) = (ring(k, j), ring(k + 1, j));
-            let (c, d) = (ring(k + 1, j + 1), ring(k, j + 1));
-            tris.push([a, b, c]);
-            tris.push([a, c, d]);
-        }
-    }
-    for j in 0..segments {
-        tris.push([ring(rings - 1, j), south, ring(rings - 1, j + 1)]);
-    }
-    mesh(vertices, tris)
+    TriMesh::uv_sphere(radius, segments, rings)
 }
 
-/// Closed torus about the z axis: tube centre line of radius `major`, tube radius
-/// `minor < major`; `around` steps along the centre line, `across` around the tube;
-/// `2 · around · across` triangles.
+/// Closed torus about the z axis: see `TriMesh::torus`.
 pub fn torus(major: f64, minor: f64, around: u32, across: u32) -> TriMesh {
-    assert!(minor < major && around >= 3 && across >= 3);
-    let mut vertices = Vec::new();
-    for i in 0..around {
-        let u = TAU * f64::from(i) / f64::from(around);
-        for j in 0..across {
-            let v = TAU * f64::from(j) / f64::from(across);
-            let r = major + minor * v.cos();
-            vertices.push(DVec3::new(r * u.cos(), r * u.sin(), minor * v.sin()));
-        }
-    }
-    let at = |i: u32, j: u32| (i % around) * across + j % across;
-    let mut tris = Vec::new();
-    for i in 0..around {
-        for j in 0..across {
-            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            tris.push([a, b, c]);
-            tris.push([a, c, d]);
-        }
-    }
-    mesh(vertices, tris)
+    TriMesh::torus(major, minor, around, across)
 }
 
 /// The box `[-half, half]` with 12 triangles (8 vertices).

@@ -6,6 +6,7 @@
 
 mod error;
 mod obj;
+mod procedural;
 mod stl;
 
 pub use error::{MeshError, ParseReason};
