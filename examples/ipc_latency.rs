@@ -31,13 +31,13 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use proxima::daemon::{Daemon, DaemonConfig};
 use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion, Primitive};
+use proxima_ipc::daemon_process::{ChildProcess, Isolation};
 use proxima_ipc::latency::LatencyRecorder;
 use proxima_ipc::scene_link::SceneLink;
 use proxima_ipc::wire::{
     ErrorCode, PoseFrameHeader, PoseRecord, ResultFrameHeader, ResultRecord, query, stage,
 };
 use std::error::Error;
-use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
 /// How long either side polls before it blocks on its event listener (as the client does).
@@ -98,9 +98,15 @@ fn main() -> Result<(), Box<dyn Error>> {
 // The measuring client.
 
 fn measure(args: &Args) -> Result<(), Box<dyn Error>> {
-    let tag = std::process::id();
-    let (root, prefix) = (format!("proxima-lat-{tag}"), format!("iox2_pxlat{tag}_"));
-    let _children = Children::spawn(&root, &prefix)?;
+    let Isolation { root, prefix } = Isolation::unique("lat");
+    let exe = std::env::current_exe()?;
+    let _children = ["daemon", "echo"]
+        .map(|role| {
+            let args = ["--role", role, "--root", &root, "--prefix", &prefix];
+            ChildProcess::spawn(&exe, args, &prefix)
+        })
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()?;
     let client = ClientBuilder::new()
         .root(&root)
         .iceoryx_prefix(&prefix)
@@ -337,62 +343,6 @@ fn wait_until(due: Instant) {
     }
     while Instant::now() < due {
         std::hint::spin_loop();
-    }
-}
-
-/// The helper processes, stopped (SIGTERM, then SIGKILL) and their shared memory removed
-/// on drop.
-struct Children {
-    processes: Vec<Child>,
-    prefix: String,
-}
-
-impl Children {
-    fn spawn(root: &str, prefix: &str) -> Result<Self, Box<dyn Error>> {
-        let exe = std::env::current_exe()?;
-        let mut children = Self {
-            processes: Vec::new(),
-            prefix: prefix.to_owned(),
-        };
-        for role in ["daemon", "echo"] {
-            children.processes.push(
-                Command::new(&exe)
-                    .args(["--role", role, "--root", root, "--prefix", prefix])
-                    .spawn()?,
-            );
-        }
-        Ok(children)
-    }
-}
-
-impl Drop for Children {
-    fn drop(&mut self) {
-        for child in &mut self.processes {
-            let _ = Command::new("kill")
-                .args(["-TERM", &child.id().to_string()])
-                .status();
-        }
-        for child in &mut self.processes {
-            let stopped = (0..100).any(|_| {
-                std::thread::sleep(Duration::from_millis(10));
-                matches!(child.try_wait(), Ok(Some(_)))
-            });
-            if !stopped {
-                let _ = child.kill();
-                let _ = child.wait();
-            }
-        }
-        remove_shared_memory(&self.prefix);
-    }
-}
-
-fn remove_shared_memory(prefix: &str) {
-    if let Ok(entries) = std::fs::read_dir("/dev/shm") {
-        for entry in entries.flatten() {
-            if entry.file_name().to_string_lossy().starts_with(prefix) {
-                let _ = std::fs::remove_file(entry.path());
-            }
-        }
     }
 }
 

@@ -1,7 +1,10 @@
 //! `proximad`, the Proxima collision daemon: parse the command line, build the daemon, serve
-//! until SIGINT/SIGTERM.
+//! until SIGINT/SIGTERM. `proximad demo` runs the daemon with a built-in simulation client
+//! instead ([`demo`], part of this binary only).
 
-use clap::Parser;
+mod demo;
+
+use clap::{Parser, Subcommand};
 use iceoryx2::prelude::ipc;
 use proxima::daemon::{Daemon, DaemonConfig};
 use std::error::Error;
@@ -14,6 +17,8 @@ const CYCLE_TIME: Duration = Duration::from_micros(200);
 #[derive(Debug, Parser)]
 #[command(version, about)]
 struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
     /// Root prefix of every service name.
     #[arg(long, default_value = proxima_ipc::DEFAULT_ROOT)]
     root: String,
@@ -25,8 +30,19 @@ struct Cli {
     max_scenes: u32,
 }
 
+/// What to run instead of serving.
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Start the daemon and a demo simulation client in a second process: bouncing spheres
+    /// and tumbling tori, per-frame pairs, contacts, latency and deadline hits, a summary.
+    Demo(demo::DemoArgs),
+}
+
 fn main() -> Result<(), Box<dyn Error>> {
     let cli = Cli::parse();
+    if let Some(Command::Demo(args)) = &cli.command {
+        return demo::run(args);
+    }
     let config = DaemonConfig {
         root: cli.root,
         iceoryx_prefix: cli.iceoryx_prefix,

@@ -6,6 +6,7 @@
 //! iceoryx2 binds can speak it.
 
 pub mod client;
+pub mod daemon_process;
 pub mod error;
 pub mod latency;
 pub mod scene_link;
