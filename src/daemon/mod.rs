@@ -1,6 +1,7 @@
 //! The daemon: `proximad`'s service loop and the only code that touches the wire.
 //!
 //! - [`config`]: start-up configuration (service root, iceoryx2 prefix, limits);
+//! - [`config_file`]: the same as a TOML file (`proximad --config FILE`);
 //! - `convert`: wire records to validated domain values, once, at the boundary;
 //! - `control`: the control service's logic (scenes, shapes, bodies), one request → one reply;
 //! - `ingest`: stage 1 of a frame, a pose frame checked whole and applied to its scene;
@@ -10,6 +11,7 @@
 //! - `error`: start-up and run failures (client mistakes are wire error codes instead).
 
 pub mod config;
+pub mod config_file;
 mod control;
 mod convert;
 mod error;

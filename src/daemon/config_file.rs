@@ -1,0 +1,285 @@
+//! `proximad --config FILE`: the daemon's configuration as TOML.
+//!
+//! Every key is optional; a key that is absent keeps the default, and command-line flags
+//! override the file. Unknown keys and out-of-range values are errors naming the key, so a
+//! misspelt limit never silently falls back to the default.
+//!
+//! ```toml
+//! root = "proxima"                # service root prefix
+//! iceoryx_prefix = "iox2_"        # iceoryx2 file-name prefix (omit: iceoryx2's default)
+//!
+//! [limits]
+//! max_scenes = 64
+//! max_shapes_per_scene = 4096
+//! max_bodies_per_scene = 100000
+//! max_mesh_vertices = 4194304
+//! max_mesh_triangles = 4194304
+//! max_convex_points = 65536
+//!
+//! [scene]
+//! default_margin_m = 0.0          # close-pair margin of bodies that set none, metres
+//! ```
+
+use super::config::DaemonConfig;
+use serde::Deserialize;
+use std::fmt;
+use std::path::Path;
+
+/// The parsed file: every key optional.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConfigFile {
+    /// Root prefix of every service name.
+    pub root: Option<String>,
+    /// iceoryx2 file-name prefix.
+    pub iceoryx_prefix: Option<String>,
+    /// `[limits]`.
+    #[serde(default)]
+    pub limits: LimitsSection,
+    /// `[scene]`.
+    #[serde(default)]
+    pub scene: SceneSection,
+}
+
+/// `[limits]`: what one client may ask of the daemon.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitsSection {
+    /// Most scenes alive at once.
+    pub max_scenes: Option<u32>,
+    /// Most shapes registered in one scene.
+    pub max_shapes_per_scene: Option<u32>,
+    /// Most live bodies in one scene.
+    pub max_bodies_per_scene: Option<u32>,
+    /// Largest vertex count of a registered mesh.
+    pub max_mesh_vertices: Option<usize>,
+    /// Largest triangle count of a registered mesh.
+    pub max_mesh_triangles: Option<usize>,
+    /// Most points of a registered convex shape.
+    pub max_convex_points: Option<u32>,
+}
+
+/// `[scene]`: defaults of every scene.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSection {
+    /// Close-pair margin of bodies that set none, metres, finite and `≥ 0`.
+    pub default_margin_m: Option<f64>,
+}
+
+/// Why a configuration file was refused.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ConfigFileError {
+    /// The file could not be read.
+    Read(String),
+    /// Not valid TOML, an unknown key or a value of the wrong type (toml's message, with
+    /// the line).
+    Parse(String),
+    /// A value outside its range: the key and why.
+    Invalid {
+        /// The key, dotted (`limits.max_scenes`).
+        key: &'static str,
+        /// What is wrong with its value.
+        reason: String,
+    },
+}
+
+impl fmt::Display for ConfigFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Read(why) => write!(f, "cannot read the configuration file: {why}"),
+            Self::Parse(why) => write!(f, "invalid configuration file: {why}"),
+            Self::Invalid { key, reason } => write!(f, "configuration key {key}: {reason}"),
+        }
+    }
+}
+
+impl std::error::Error for ConfigFileError {}
+
+impl ConfigFile {
+    /// Parses TOML text.
+    ///
+    /// # Errors
+    /// [`ConfigFileError::Parse`] for bad TOML, unknown keys or wrong types.
+    pub fn parse(text: &str) -> Result<Self, ConfigFileError> {
+        toml::from_str(text).map_err(|e| ConfigFileError::Parse(e.to_string()))
+    }
+
+    /// Reads and parses the file at `path`.
+    ///
+    /// # Errors
+    /// [`ConfigFileError::Read`] or those of [`parse`](Self::parse).
+    pub fn load(path: &Path) -> Result<Self, ConfigFileError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ConfigFileError::Read(format!("{}: {e}", path.display())))?;
+        Self::parse(&text)
+    }
+
+    /// `config` with every key this file sets replaced; `config` is unchanged on error.
+    ///
+    /// # Errors
+    /// [`ConfigFileError::Invalid`] for a value out of range (zero limits, a negative or
+    /// non-finite margin, an empty root).
+    pub fn apply(&self, config: &DaemonConfig) -> Result<DaemonConfig, ConfigFileError> {
+        let mut out = config.clone();
+        if let Some(root) = &self.root {
+            out.root = non_empty("root", root)?;
+        }
+        if let Some(prefix) = &self.iceoryx_prefix {
+            out.iceoryx_prefix = Some(non_empty("iceoryx_prefix", prefix)?);
+        }
+        let l = &self.limits;
+        set_positive(&mut out.max_scenes, l.max_scenes, "limits.max_scenes")?;
+        set_positive(
+            &mut out.scene_limits.max_shapes,
+            l.max_shapes_per_scene,
+            "limits.max_shapes_per_scene",
+        )?;
+        set_positive(
+            &mut out.scene_limits.max_bodies,
+            l.max_bodies_per_scene,
+            "limits.max_bodies_per_scene",
+        )?;
+        set_positive(
+            &mut out.mesh_limits.max_vertices,
+            l.max_mesh_vertices,
+            "limits.max_mesh_vertices",
+        )?;
+        set_positive(
+            &mut out.mesh_limits.max_triangles,
+            l.max_mesh_triangles,
+            "limits.max_mesh_triangles",
+        )?;
+        set_positive(
+            &mut out.max_convex_points,
+            l.max_convex_points,
+            "limits.max_convex_points",
+        )?;
+        if let Some(margin) = self.scene.default_margin_m {
+            if !(margin.is_finite() && margin >= 0.0) {
+                return Err(ConfigFileError::Invalid {
+                    key: "scene.default_margin_m",
+                    reason: format!("{margin} is not a finite distance ≥ 0"),
+                });
+            }
+            out.default_margin = margin;
+        }
+        Ok(out)
+    }
+}
+
+fn non_empty(key: &'static str, value: &str) -> Result<String, ConfigFileError> {
+    if value.is_empty() {
+        return Err(ConfigFileError::Invalid {
+            key,
+            reason: "must not be empty".to_owned(),
+        });
+    }
+    Ok(value.to_owned())
+}
+
+/// Sets `target` to `value` when given; zero is refused (a limit of zero serves nothing).
+fn set_positive<T: Copy + PartialEq + Default + fmt::Display>(
+    target: &mut T,
+    value: Option<T>,
+    key: &'static str,
+) -> Result<(), ConfigFileError> {
+    match value {
+        Some(v) if v == T::default() => Err(ConfigFileError::Invalid {
+            key,
+            reason: "must be at least 1".to_owned(),
+        }),
+        Some(v) => {
+            *target = v;
+            Ok(())
+        }
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_empty_file_keeps_every_default() {
+        let file = ConfigFile::parse("").unwrap();
+        assert_eq!(
+            file.apply(&DaemonConfig::default()).unwrap(),
+            DaemonConfig::default()
+        );
+    }
+
+    #[test]
+    fn every_key_reaches_its_field() {
+        let file = ConfigFile::parse(
+            r#"
+            root = "lab"
+            iceoryx_prefix = "iox2_lab_"
+            [limits]
+            max_scenes = 3
+            max_shapes_per_scene = 10
+            max_bodies_per_scene = 20
+            max_mesh_vertices = 30
+            max_mesh_triangles = 40
+            max_convex_points = 50
+            [scene]
+            default_margin_m = 0.25
+            "#,
+        )
+        .unwrap();
+        let c = file.apply(&DaemonConfig::default()).unwrap();
+        assert_eq!(c.root, "lab");
+        assert_eq!(c.iceoryx_prefix.as_deref(), Some("iox2_lab_"));
+        assert_eq!(c.max_scenes, 3);
+        assert_eq!(
+            (c.scene_limits.max_shapes, c.scene_limits.max_bodies),
+            (10, 20)
+        );
+        assert_eq!(
+            (c.mesh_limits.max_vertices, c.mesh_limits.max_triangles),
+            (30, 40)
+        );
+        assert_eq!((c.max_convex_points, c.default_margin), (50, 0.25));
+    }
+
+    #[test]
+    fn unknown_keys_wrong_types_and_bad_values_are_refused_by_name() {
+        let parse_error = |text: &str| match ConfigFile::parse(text) {
+            Err(ConfigFileError::Parse(why)) => why,
+            other => panic!("{text:?}: expected a parse error, got {other:?}"),
+        };
+        assert!(parse_error("max_scene = 3").contains("max_scene"));
+        assert!(parse_error("[limits]\nmax_scenes = -1").contains("max_scenes"));
+        assert!(parse_error("[limits]\nmax_scenes = \"many\"").contains("max_scenes"));
+        assert!(parse_error("root = ").contains("line 1"));
+        let invalid = |text: &str| {
+            ConfigFile::parse(text)
+                .unwrap()
+                .apply(&DaemonConfig::default())
+                .unwrap_err()
+        };
+        for (text, key) in [
+            ("[limits]\nmax_scenes = 0", "limits.max_scenes"),
+            (
+                "[limits]\nmax_mesh_triangles = 0",
+                "limits.max_mesh_triangles",
+            ),
+            ("[scene]\ndefault_margin_m = -0.1", "scene.default_margin_m"),
+            ("[scene]\ndefault_margin_m = nan", "scene.default_margin_m"),
+            ("[scene]\ndefault_margin_m = inf", "scene.default_margin_m"),
+            ("root = \"\"", "root"),
+        ] {
+            assert!(
+                matches!(invalid(text), ConfigFileError::Invalid { key: k, .. } if k == key),
+                "{text:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_missing_file_is_a_read_error_naming_it() {
+        let err = ConfigFile::load(Path::new("/nonexistent/proximad.toml")).unwrap_err();
+        assert!(matches!(&err, ConfigFileError::Read(why) if why.contains("/nonexistent")));
+    }
+}
