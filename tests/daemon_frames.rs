@@ -9,13 +9,15 @@ mod daemon_harness;
 mod support;
 
 use daemon_harness::{Daemon, body};
+use iceoryx2::prelude::ipc;
 use proxima::geometry::{Cuboid, Sphere};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, StepReport, step};
 use proxima::scene::{
     BodyDesc, BodyId, CollisionFilter, MeshShape, Motion as SceneMotion, Scene, SceneLimits, Shape,
 };
-use proxima_ipc::client::{BodySpec, Primitive};
+use proxima_ipc::client::{BodySpec, Client, Primitive};
+use proxima_ipc::scene_link::ResultFrame;
 use proxima_ipc::wire::{self, ErrorCode, PoseRecord, RecordKind, ResultRecord, query};
 use rand::Rng;
 use std::sync::Arc;
@@ -53,9 +55,7 @@ struct TwinScenes {
     oracle: Scene,
 }
 
-fn twin_scenes(
-    client: &proxima_ipc::client::Client<iceoryx2::prelude::ipc::Service>,
-) -> TwinScenes {
+fn twin_scenes(client: &Client<ipc::Service>) -> TwinScenes {
     let scene_id = client.create_scene().unwrap();
     let mut oracle = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
     let torus = support::meshes::torus(0.5, 0.15, 16, 8);
@@ -149,19 +149,23 @@ fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame:
     }
 }
 
-/// Every pair's `index`/`count` runs over contact records that name it back, and together
-/// they cover the contacts exactly once, in pair order.
-fn assert_linked(pairs: &[ResultRecord], contacts: &[ResultRecord]) {
+/// Every pair's `index`/`count` runs over contact records that name it back (what
+/// `contacts_of` returns), and together they cover the contacts exactly once, in pair order.
+fn assert_linked(frame: &ResultFrame<ipc::Service>) {
+    let (pairs, contacts) = (frame.pairs(), frame.contacts());
     let mut next = 0;
     for (i, pair) in pairs.iter().enumerate() {
         assert_eq!(pair.kind, RecordKind::Pair as u32);
         assert!(pair.count <= wire::MAX_CONTACTS_PER_PAIR);
+        let linked = frame.contacts_of(pair);
+        assert_eq!(linked.len(), pair.count as usize);
         if pair.count == 0 {
             continue;
         }
         assert_eq!(pair.index as usize, next);
-        next += pair.count as usize;
-        for c in &contacts[pair.index as usize..next] {
+        next += linked.len();
+        assert_eq!(linked, &contacts[pair.index as usize..next]);
+        for c in linked {
             assert_eq!(c.kind, RecordKind::Contact as u32);
             assert_eq!(
                 (c.index as usize, c.body_a, c.body_b),
@@ -242,7 +246,7 @@ fn every_query_combination_gets_the_in_process_pipelines_answer_over_shared_memo
             expected.pairs.len() + expected.contacts.len()
         );
         assert_same_records(result.records(), &expected, frame);
-        assert_linked(result.pairs(), result.contacts());
+        assert_linked(&result);
         assert!(header.stage_ns[wire::stage::NARROW] > 0 || report.candidates == 0);
         pairs_seen += expected.pairs.len();
         contacts_seen += expected.contacts.len();
@@ -265,7 +269,10 @@ fn empty_undefined_and_unimplemented_query_flags_are_refused_and_the_scene_is_un
     for x in [0.0, 0.9] {
         client.add_body(scene_id, &body(sphere, x)).unwrap();
     }
-    let link = client.open_scene(scene_id).unwrap();
+    let (link, other) = (
+        client.open_scene(scene_id).unwrap(),
+        daemon.client().open_scene(scene_id).unwrap(),
+    );
     let mut seq = 0;
     for bad in [
         0,
@@ -294,9 +301,10 @@ fn empty_undefined_and_unimplemented_query_flags_are_refused_and_the_scene_is_un
         );
         assert!(answer.records().is_empty());
         seq += 1;
-        link.publish_poses(seq, 0, query::OVERLAP | query::CONTACTS, &[])
+        other
+            .publish_poses(seq, 0, query::OVERLAP | query::CONTACTS, &[])
             .unwrap();
-        let answer = link
+        let answer = other
             .receive_results_for(seq, TIMEOUT)
             .unwrap()
             .expect("an answer");

@@ -189,22 +189,26 @@ impl std::fmt::Display for ErrorCode {
 pub enum Completeness {
     /// Every pair answered exactly.
     Exact = 0,
-    /// The deadline cut traversal short; answers are conservative (see DESIGN §4) and
-    /// [`ResultFrameHeader::deepest_level`] bounds their error.
+    /// The deadline cut traversal short, or some candidate pair has no exact narrow phase
+    /// yet and got the conservative box answer (level 0); answers are conservative (see
+    /// DESIGN §4) and [`ResultFrameHeader::deepest_level`] bounds their error.
     Truncated = 1,
 }
 
-/// Stage indices of [`ResultFrameHeader::stage_ns`], in pipeline order.
+/// Stage indices of [`ResultFrameHeader::stage_ns`], in pipeline order. A stage the
+/// daemon does not run separately yet reports 0.
 pub mod stage {
-    /// Ingest and validation of the pose frame.
+    /// Ingest and validation of the pose frame (header, query flags, every pose).
     pub const INGEST: usize = 0;
-    /// Planning: what moved, which stages run.
+    /// Planning: what moved, which stages run (not separate yet: 0).
     pub const PLAN: usize = 1;
-    /// Broad phase.
+    /// Broad phase: margin-grown world boxes to candidate pairs.
     pub const BROAD: usize = 2;
-    /// Mid phase: BVH traversal.
+    /// Mid phase: BVH traversal (not separate yet: 0; counted in `NARROW`, since the mesh
+    /// queries traverse and test triangles in one pass).
     pub const MID: usize = 3;
-    /// Narrow phase: exact primitive tests and manifolds.
+    /// Narrow phase: every candidate pair's answer for the frame's query, BVH traversal
+    /// and manifold reduction included.
     pub const NARROW: usize = 4;
     /// Writing and publishing the result frame.
     pub const PUBLISH: usize = 5;
