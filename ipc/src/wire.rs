@@ -29,7 +29,7 @@ use iceoryx2::prelude::ZeroCopySend;
 ///
 /// A frame with no flag set (`0`) asks for nothing and is refused with
 /// [`ErrorCode::MalformedMessage`] (its poses are not applied), so a forgotten flag is an
-/// error rather than an empty answer. A frame asking [`TOI`] is refused the same way until
+/// error rather than an empty answer. A frame asking [`TOI`](query::TOI) is refused the same way until
 /// time of impact is implemented (the daemon logs the reason). Undefined bits are refused.
 ///
 /// Pairs answered by the conservative box answer (shape-kind pairs without an exact narrow

@@ -26,9 +26,11 @@ pub const MAX_CONTACTS_PER_PAIR: usize = 4;
 /// linear double sweep.
 pub const EXACT_DIAMETER_POINTS: usize = 256;
 
-/// The indices into `points` of at most [`MAX_CONTACTS_PER_PAIR`] points spanning the set
-/// (see the [module docs](self)), written to `out` (cleared first) in the order chosen:
-/// farthest pair first. Empty input gives empty output.
+/// The indices into `points` of at most [`MAX_CONTACTS_PER_PAIR`] distinct points spanning
+/// the set, written to `out` (cleared first) in the order chosen: the farthest pair (exact
+/// up to [`EXACT_DIAMETER_POINTS`] points, else a double sweep, at least half the diameter),
+/// the point making the largest triangle with it, the point adding the most area beyond
+/// that triangle. Equal points give one index, collinear ones two; empty input, none.
 ///
 /// # Allocation
 /// None once `out` holds [`MAX_CONTACTS_PER_PAIR`] indices.

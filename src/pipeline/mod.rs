@@ -11,7 +11,7 @@
 //! | [`Query::close`] | distance ≤ the sum of the two margins; signed distance, witnesses, normal A→B | exact distance |
 //! | [`Query::overlap`] | the shapes touch or intersect (distance ≤ 0) | [`intersects_mesh_mesh`](crate::narrow::mesh_mesh::intersects_mesh_mesh), stops at the first proof |
 //! | [`Query::distance`] | every candidate pair, also beyond the margins, with its exact signed distance | exact distance |
-//! | [`Query::contacts`] | touching pairs, each with its manifold ([`ContactPoint`]s, at most [`MAX_CONTACTS_PER_PAIR`]) | every intersecting triangle pair, then [`reduce_manifold`] |
+//! | [`Query::contacts`] | touching pairs, each with its manifold ([`ContactPoint`]s, at most [`MAX_CONTACTS_PER_PAIR`]) | every intersecting triangle pair ([`contacts_mesh_mesh`](crate::narrow::mesh_mesh::contacts_mesh_mesh)), then [`reduce_manifold`] |
 //!
 //! Flags combine: `CLOSE | CONTACTS` reports the close pairs, and the touching ones among
 //! them carry contacts. `OVERLAP` adds nothing to `CLOSE` or `DISTANCE` (their records
@@ -21,11 +21,19 @@
 //! contact, or, with `OVERLAP` alone, has none: points and normal all zero (a zero normal
 //! means "not computed"). Sphere–sphere records are always complete (closed form).
 //!
-//! Contacts per pair kind: sphere–sphere one point (the witnesses, `distance = −depth`);
-//! mesh–mesh the reduced intersection set (see [`answer`]'s `mesh_mesh`; depth 0 since
-//! meshes are surfaces); box-answer pairs one conservative point (depth unknown: distance 0
-//! with the box error bound, which covers it). [`PairResult::first_contact`] and
-//! [`PairResult::contact_count`] locate a pair's contacts in [`FrameResults::contacts`].
+//! Contacts per pair kind:
+//! - sphere–sphere: one point, the witnesses, `distance = −depth`;
+//! - mesh–mesh: the ends of every intersection segment of the two surfaces, reduced by
+//!   [`reduce_manifold`] to the extremes, each with `point_a == point_b` and depth 0 (meshes
+//!   are surfaces: intersecting meshes touch along curves and have no inside to measure a
+//!   depth in). One normal for the manifold: the sum of the intersecting triangles' normals
+//!   on A (A→B), one per segment end, normalised (when they cancel exactly, the normal at
+//!   the first kept point);
+//! - box-answer pairs: one conservative point, the box witnesses and normal, distance 0
+//!   (depth unknown) with the box error bound, which covers the true depth.
+//!
+//! [`PairResult::first_contact`] and [`PairResult::contact_count`] locate a pair's contacts
+//! in [`FrameResults::contacts`]; each [`ContactPoint::pair`] names its pair back.
 //!
 //! # Design note: determinism and ordering
 //! The same scene and query give the same results: the broad phase yields pairs sorted by
@@ -43,7 +51,8 @@
 //! replaces that.
 //!
 //! # Allocation
-//! None once the workspace and the output have grown to the largest frame.
+//! None once the workspace and the output have grown to the largest frame, except one
+//! warm-start cache entry when a mesh–mesh pair becomes a candidate.
 
 mod answer;
 mod contacts;
@@ -59,7 +68,6 @@ use std::time::Instant;
 /// What a frame asks for (see the [module docs](self)); at least one flag should be set, or
 /// the frame reports nothing.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-#[allow(clippy::struct_excessive_bools)]
 pub struct Query {
     /// Pairs whose shapes touch or intersect.
     pub overlap: bool,
