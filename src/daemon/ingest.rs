@@ -1,9 +1,9 @@
 //! Stage 1 of a frame: check a pose frame and apply its poses to the scene.
 //!
 //! A frame is applied whole or not at all: the header is checked (protocol, scene, count,
-//! query flags, see [`convert::query`]), then every record (known body,
-//! finite position within range, unit quaternion — renormalised within 1e-6), and only then
-//! are the poses written. A rejected frame leaves the scene as it was and names the first
+//! query flags, see [`convert::query`]), then every record (known body, finite position
+//! within range, unit quaternion — renormalised within 1e-6), and only then are the poses
+//! written. A rejected frame leaves the scene as it was and names the first
 //! offending body, so a client's bad frame never corrupts the state other frames rely on.
 
 use super::convert::{self, Rejection};
