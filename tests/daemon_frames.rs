@@ -1,22 +1,30 @@
 //! Pose frames in, result frames out, through the real `proximad` over shared memory:
-//! results equal the in-process pipeline's on the same scene, bad frames are answered with
-//! their code and the offending body while other clients keep being served.
+//! for every combination of query flags the result frame holds exactly what the in-process
+//! pipeline returns on the same scene and poses (pairs, then contacts linked by
+//! index/count); bad frames are answered with their code and the offending body while other
+//! clients keep being served; undefined, empty and not-yet-implemented flags are refused.
 
 #[path = "support/daemon.rs"]
 mod daemon_harness;
 mod support;
 
 use daemon_harness::{Daemon, body};
-use proxima::geometry::Sphere;
+use iceoryx2::prelude::ipc;
+use proxima::geometry::{Cuboid, Sphere};
 use proxima::math::{DQuat, DVec3, Pose};
-use proxima::pipeline::{PipelineWorkspace, step};
-use proxima::scene::{BodyDesc, CollisionFilter, Motion as SceneMotion, Scene, SceneLimits, Shape};
-use proxima_ipc::client::{BodySpec, Primitive};
-use proxima_ipc::wire::{ErrorCode, PoseRecord, RecordKind, query};
+use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, StepReport, step};
+use proxima::scene::{
+    BodyDesc, BodyId, CollisionFilter, MeshShape, Motion as SceneMotion, Scene, SceneLimits, Shape,
+};
+use proxima_ipc::client::{BodySpec, Client, Primitive};
+use proxima_ipc::scene_link::ResultFrame;
+use proxima_ipc::wire::{self, ErrorCode, PoseRecord, RecordKind, ResultRecord, query};
 use rand::Rng;
+use std::sync::Arc;
 use std::time::Duration;
 
 const TIMEOUT: Duration = Duration::from_secs(10);
+const MARGIN: f64 = 0.1;
 
 fn pose_record(body: u32, p: DVec3) -> PoseRecord {
     PoseRecord {
@@ -27,61 +35,187 @@ fn pose_record(body: u32, p: DVec3) -> PoseRecord {
     }
 }
 
-#[test]
-fn frames_of_moving_spheres_get_the_in_process_pipelines_answer() {
-    let daemon = Daemon::start();
-    let client = daemon.client();
+/// The wire flags of a typed query.
+fn flags(q: Query) -> u32 {
+    [
+        (q.overlap, query::OVERLAP),
+        (q.close, query::CLOSE),
+        (q.distance, query::DISTANCE),
+        (q.contacts, query::CONTACTS),
+    ]
+    .iter()
+    .filter(|(on, _)| *on)
+    .fold(0, |bits, (_, bit)| bits | bit)
+}
+
+/// A scene of spheres, tori (meshes) and boxes (box answers) registered both in the daemon
+/// and in process, body for body, with the same ids.
+struct TwinScenes {
+    scene_id: u32,
+    oracle: Scene,
+}
+
+fn twin_scenes(client: &Client<ipc::Service>) -> TwinScenes {
     let scene_id = client.create_scene().unwrap();
-    let link = client.open_scene(scene_id).unwrap();
-    let mut rng = support::rng(81);
-    let radii: Vec<f64> = (0..40).map(|_| rng.random_range(0.05..0.4)).collect();
-    // The same scene in process, as the oracle.
     let mut oracle = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
-    for &r in &radii {
-        let shape = client
-            .register_primitive(scene_id, Primitive::Sphere { radius: r })
-            .unwrap();
-        let spec = BodySpec {
-            margin: Some(0.05),
-            ..body(shape, 0.0)
+    let torus = support::meshes::torus(0.5, 0.15, 16, 8);
+    let vertices: Vec<[f64; 3]> = torus.vertices().iter().map(|v| v.to_array()).collect();
+    let torus_id = client
+        .register_mesh(scene_id, &vertices, torus.triangles())
+        .unwrap();
+    let torus_local = oracle
+        .register_shape(Shape::Mesh(Arc::new(MeshShape::new(torus))))
+        .unwrap();
+    let box_id = client
+        .register_primitive(
+            scene_id,
+            Primitive::Cuboid {
+                half_extents: [0.2, 0.3, 0.25],
+            },
+        )
+        .unwrap();
+    let box_local = oracle
+        .register_shape(Shape::Cuboid(Cuboid::new(DVec3::new(0.2, 0.3, 0.25))))
+        .unwrap();
+    let mut rng = support::rng(83);
+    for i in 0..24 {
+        let (remote, local) = match i % 6 {
+            0 | 1 => (torus_id, torus_local),
+            2 => (box_id, box_local),
+            _ => {
+                let r = rng.random_range(0.1..0.35);
+                let remote = client
+                    .register_primitive(scene_id, Primitive::Sphere { radius: r })
+                    .unwrap();
+                let local = oracle
+                    .register_shape(Shape::Sphere(Sphere::new(r)))
+                    .unwrap();
+                (remote, local)
+            }
         };
-        client.add_body(scene_id, &spec).unwrap();
-        let local = oracle
-            .register_shape(Shape::Sphere(Sphere::new(r)))
-            .unwrap();
+        let spec = BodySpec {
+            margin: Some(MARGIN),
+            ..body(remote, 0.0)
+        };
+        let id = client.add_body(scene_id, &spec).unwrap();
         let desc = BodyDesc {
             shape: local,
             pose: Pose::IDENTITY,
             motion: SceneMotion::Dynamic,
             filter: CollisionFilter::ALL,
-            margin: Some(0.05),
+            margin: Some(MARGIN),
         };
-        oracle.add_body(&desc).unwrap();
+        assert_eq!(oracle.add_body(&desc).unwrap(), BodyId(id));
     }
-    let mut workspace = PipelineWorkspace::default();
-    let (mut total_pairs, mut empty_frames) = (0, 0);
-    for frame in 1..=50u64 {
-        let positions: Vec<DVec3> = radii
-            .iter()
-            .map(|_| support::point_in_cube(&mut rng, 1.5))
-            .collect();
-        let records: Vec<PoseRecord> = positions
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| pose_record(i as u32, p))
-            .collect();
-        link.publish_poses(frame, 0, query::CLOSE, &records)
-            .unwrap();
-        for (i, &p) in positions.iter().enumerate() {
-            oracle
-                .set_pose(
-                    proxima::scene::BodyId(i as u32),
-                    Pose::new(p, DQuat::IDENTITY),
-                )
-                .unwrap();
+    TwinScenes { scene_id, oracle }
+}
+
+/// Field-by-field equality of a result frame's records with the in-process results.
+fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame: u64) {
+    let (pairs, contacts) = records.split_at(expected.pairs.len());
+    assert_eq!(contacts.len(), expected.contacts.len(), "frame {frame}");
+    for (got, want) in pairs.iter().zip(&expected.pairs) {
+        let want = ResultRecord {
+            kind: RecordKind::Pair as u32,
+            body_a: want.a,
+            body_b: want.b,
+            index: want.first_contact,
+            count: want.contact_count,
+            reserved: 0,
+            distance: want.distance,
+            error_bound: want.error_bound,
+            point_a: want.point_a.to_array(),
+            point_b: want.point_b.to_array(),
+            normal: want.normal.to_array(),
+        };
+        assert_eq!(*got, want, "frame {frame}");
+    }
+    for (got, want) in contacts.iter().zip(&expected.contacts) {
+        let pair = &expected.pairs[want.pair as usize];
+        let want = ResultRecord {
+            kind: RecordKind::Contact as u32,
+            body_a: pair.a,
+            body_b: pair.b,
+            index: want.pair,
+            count: 0,
+            reserved: 0,
+            distance: want.distance,
+            error_bound: want.error_bound,
+            point_a: want.point_a.to_array(),
+            point_b: want.point_b.to_array(),
+            normal: want.normal.to_array(),
+        };
+        assert_eq!(*got, want, "frame {frame}");
+    }
+}
+
+/// Every pair's `index`/`count` runs over contact records that name it back (what
+/// `contacts_of` returns), and together they cover the contacts exactly once, in pair order.
+fn assert_linked(frame: &ResultFrame<ipc::Service>) {
+    let (pairs, contacts) = (frame.pairs(), frame.contacts());
+    let mut next = 0;
+    for (i, pair) in pairs.iter().enumerate() {
+        assert_eq!(pair.kind, RecordKind::Pair as u32);
+        assert!(pair.count <= wire::MAX_CONTACTS_PER_PAIR);
+        let linked = frame.contacts_of(pair);
+        assert_eq!(linked.len(), pair.count as usize);
+        if pair.count == 0 {
+            continue;
         }
-        let mut expected = Vec::new();
-        step(&oracle, &mut workspace, |r| expected.push(*r));
+        assert_eq!(pair.index as usize, next);
+        next += linked.len();
+        assert_eq!(linked, &contacts[pair.index as usize..next]);
+        for c in linked {
+            assert_eq!(c.kind, RecordKind::Contact as u32);
+            assert_eq!(
+                (c.index as usize, c.body_a, c.body_b),
+                (i, pair.body_a, pair.body_b)
+            );
+        }
+    }
+    assert_eq!(next, contacts.len());
+}
+
+#[test]
+fn every_query_combination_gets_the_in_process_pipelines_answer_over_shared_memory() {
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let TwinScenes {
+        scene_id,
+        mut oracle,
+    } = twin_scenes(&client);
+    let link = client.open_scene(scene_id).unwrap();
+    let mut rng = support::rng(81);
+    let mut workspace = PipelineWorkspace::default();
+    let mut expected = FrameResults::default();
+    let (mut pairs_seen, mut contacts_seen, mut truncated) = (0, 0, 0);
+    let queries: Vec<Query> = (1u32..16)
+        .map(|bits| Query {
+            overlap: bits & 1 != 0,
+            close: bits & 2 != 0,
+            distance: bits & 4 != 0,
+            contacts: bits & 8 != 0,
+        })
+        .collect();
+    for frame in 1..=45u64 {
+        let q = queries[(frame as usize - 1) % queries.len()];
+        let records: Vec<PoseRecord> = (0..oracle.body_count() as u32)
+            .map(|i| {
+                let r = support::rotation(&mut rng);
+                PoseRecord {
+                    orientation: [r.x, r.y, r.z, r.w],
+                    ..pose_record(i, support::point_in_cube(&mut rng, 1.3))
+                }
+            })
+            .collect();
+        link.publish_poses(frame, 0, flags(q), &records).unwrap();
+        for r in &records {
+            let [x, y, z, w] = r.orientation;
+            let pose =
+                Pose::try_new(DVec3::from(r.position), DQuat::from_xyzw(x, y, z, w)).unwrap();
+            oracle.set_pose(BodyId(r.body), pose).unwrap();
+        }
+        let report: StepReport = step(&oracle, q, &mut workspace, &mut expected);
         let result = link
             .receive_results_for(frame, TIMEOUT)
             .unwrap()
@@ -93,24 +227,97 @@ fn frames_of_moving_spheres_get_the_in_process_pipelines_answer() {
             "frame {frame}"
         );
         assert_eq!(header.budget_met, 1);
-        assert_eq!(header.pair_count as usize, expected.len(), "frame {frame}");
-        for (got, want) in result.pairs().iter().zip(&expected) {
-            assert_eq!(got.kind, RecordKind::Pair as u32);
-            assert_eq!((got.body_a, got.body_b), (want.a, want.b));
-            assert_eq!(got.distance, want.distance);
-            assert_eq!(got.normal, want.normal.to_array());
-            assert_eq!(
-                (got.point_a, got.point_b),
-                (want.point_a.to_array(), want.point_b.to_array())
-            );
-        }
-        total_pairs += expected.len();
-        empty_frames += usize::from(expected.is_empty());
+        assert_eq!(
+            (
+                header.candidate_count,
+                header.pair_count,
+                header.contact_count
+            ),
+            (report.candidates, report.pairs, report.contacts),
+            "frame {frame} {q:?}"
+        );
+        let completeness = match report.completeness {
+            proxima::pipeline::Completeness::Exact => wire::Completeness::Exact,
+            proxima::pipeline::Completeness::Truncated { .. } => wire::Completeness::Truncated,
+        };
+        assert_eq!(header.completeness, completeness as u32);
+        assert_eq!(
+            result.records().len(),
+            expected.pairs.len() + expected.contacts.len()
+        );
+        assert_same_records(result.records(), &expected, frame);
+        assert_linked(&result);
+        assert!(header.stage_ns[wire::stage::NARROW] > 0 || report.candidates == 0);
+        pairs_seen += expected.pairs.len();
+        contacts_seen += expected.contacts.len();
+        truncated += usize::from(completeness == wire::Completeness::Truncated);
     }
     assert!(
-        total_pairs > 100 && empty_frames < 50,
-        "pairs {total_pairs}"
+        pairs_seen > 100 && contacts_seen > 30 && truncated > 10,
+        "pairs {pairs_seen}, contacts {contacts_seen}, truncated {truncated}"
     );
+}
+
+#[test]
+fn empty_undefined_and_unimplemented_query_flags_are_refused_and_the_scene_is_untouched() {
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let scene_id = client.create_scene().unwrap();
+    let sphere = client
+        .register_primitive(scene_id, Primitive::Sphere { radius: 0.5 })
+        .unwrap();
+    for x in [0.0, 0.9] {
+        client.add_body(scene_id, &body(sphere, x)).unwrap();
+    }
+    let (link, other) = (
+        client.open_scene(scene_id).unwrap(),
+        daemon.client().open_scene(scene_id).unwrap(),
+    );
+    let mut seq = 0;
+    for bad in [
+        0,
+        query::TOI,
+        query::CLOSE | query::TOI,
+        1 << 5,
+        query::CLOSE | 1 << 31,
+    ] {
+        seq += 1;
+        // A refused frame must not move body 1 away.
+        link.publish_poses(seq, 0, bad, &[pose_record(1, DVec3::new(5.0, 0.0, 0.0))])
+            .unwrap();
+        let answer = link
+            .receive_results_for(seq, TIMEOUT)
+            .unwrap()
+            .expect("an answer");
+        let header = answer.header();
+        assert_eq!(
+            ErrorCode::from_u32(header.status),
+            Some(ErrorCode::MalformedMessage),
+            "flags {bad:#x}"
+        );
+        assert_eq!(
+            (header.error_body, header.pair_count, header.contact_count),
+            (u32::MAX, 0, 0)
+        );
+        assert!(answer.records().is_empty());
+        seq += 1;
+        other
+            .publish_poses(seq, 0, query::OVERLAP | query::CONTACTS, &[])
+            .unwrap();
+        let answer = other
+            .receive_results_for(seq, TIMEOUT)
+            .unwrap()
+            .expect("an answer");
+        assert_eq!(
+            ErrorCode::from_u32(answer.header().status),
+            Some(ErrorCode::Ok)
+        );
+        let (pairs, contacts) = (answer.pairs(), answer.contacts());
+        assert_eq!((pairs.len(), contacts.len()), (1, 1), "flags {bad:#x}");
+        assert!((pairs[0].distance - (0.9 - 1.0)).abs() < 1e-12);
+        assert_eq!((pairs[0].index, pairs[0].count), (0, 1));
+        assert_eq!(contacts[0].distance, pairs[0].distance);
+    }
 }
 
 #[test]

@@ -361,6 +361,22 @@ impl<S: Service> ResultFrame<S> {
         let header = self.header();
         split(self.records(), header.pair_count, header.contact_count).1
     }
+
+    /// The contact records of `pair` (one of [`pairs`](Self::pairs)): the `count` contacts
+    /// from `index` on, counted from the first contact record; clamped to
+    /// [`contacts`](Self::contacts), so a lying record cannot cause a panic.
+    #[must_use]
+    pub fn contacts_of(&self, pair: &ResultRecord) -> &[ResultRecord] {
+        contacts_of(self.contacts(), pair)
+    }
+}
+
+/// `pair.count` records of `contacts` from `pair.index` on, clamped to the slice.
+fn contacts_of<'r>(contacts: &'r [ResultRecord], pair: &ResultRecord) -> &'r [ResultRecord] {
+    let start = usize::try_from(pair.index).map_or(contacts.len(), |i| i.min(contacts.len()));
+    let rest = &contacts[start..];
+    let count = usize::try_from(pair.count).map_or(rest.len(), |c| c.min(rest.len()));
+    &rest[..count]
 }
 
 /// Splits `records` into `pair_count` pairs and the `contact_count` contacts after them,
@@ -797,6 +813,27 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_pairs_contacts_are_its_index_and_count_clamped_to_the_contact_records() {
+        let contacts: Vec<_> = (0..5)
+            .map(|i| ResultRecord {
+                index: i,
+                ..ResultRecord::default()
+            })
+            .collect();
+        let pair = |index, count| ResultRecord {
+            index,
+            count,
+            ..ResultRecord::default()
+        };
+        assert_eq!(contacts_of(&contacts, &pair(1, 3)), &contacts[1..4]);
+        assert_eq!(contacts_of(&contacts, &pair(0, 0)), &[]);
+        assert_eq!(contacts_of(&contacts, &pair(3, 9)), &contacts[3..]);
+        assert_eq!(contacts_of(&contacts, &pair(5, 1)), &[]);
+        assert_eq!(contacts_of(&contacts, &pair(u32::MAX, u32::MAX)), &[]);
+        assert_eq!(contacts_of(&[], &pair(0, 4)), &[]);
     }
 
     #[test]

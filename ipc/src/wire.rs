@@ -18,21 +18,59 @@
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Bits of [`PoseFrameHeader::query_flags`]: what the frame asks for. A frame pays only for
-/// what it asks.
+/// what it asks (DESIGN §4).
+///
+/// *Candidate pairs* are the broad phase's: bodies whose world boxes, grown by their margins,
+/// overlap (never static–static, filtered by group/mask). Each flag selects pairs among them;
+/// the frame reports the union, once per pair, in `(body_a, body_b)` order, then the contacts
+/// of those pairs. Flags combine (`CLOSE | CONTACTS`: the close pairs, the touching ones with
+/// contacts); `OVERLAP` adds nothing to `CLOSE` or `DISTANCE`, whose records already say it
+/// (`distance ≤ 0`).
+///
+/// A frame with no flag set (`0`) asks for nothing and is refused with
+/// [`ErrorCode::MalformedMessage`] (its poses are not applied), so a forgotten flag is an
+/// error rather than an empty answer. A frame asking [`TOI`](query::TOI) is refused the same way until
+/// time of impact is implemented (the daemon logs the reason). Undefined bits are refused.
+///
+/// Pairs answered by the conservative box answer (shape-kind pairs without an exact narrow
+/// phase yet; the frame says `Truncated`, level 0) are reported whenever the truth *may*
+/// qualify: their distance is a lower bound and "touching" means "the world boxes touch".
 pub mod query {
-    /// Yes/no overlap per close pair.
+    /// Pairs whose shapes touch or intersect (distance ≤ 0), found by the cheapest proof
+    /// (meshes: the first intersecting triangle pair; spheres: closed form). When neither
+    /// `CLOSE` nor `DISTANCE` is asked, a mesh pair's record says distance 0 (intersecting
+    /// surfaces), error bound 0, and its points and normal are all zero ("not computed")
+    /// unless `CONTACTS` supplies them (its first contact). Sphere pair records are always
+    /// complete.
     pub const OVERLAP: u32 = 1 << 0;
-    /// Pairs within the sum of their margins, with a distance.
+    /// Pairs whose distance is at most the sum of the two bodies' margins, with signed
+    /// distance, witnesses and normal A→B.
     pub const CLOSE: u32 = 1 << 1;
-    /// The exact signed distance of every candidate pair, with witnesses and normal.
+    /// The exact signed distance of every candidate pair (also those beyond the margins),
+    /// with witnesses and normal A→B.
     pub const DISTANCE: u32 = 1 << 2;
-    /// Contact manifolds of touching pairs.
+    /// A contact manifold for each touching or penetrating pair, at most
+    /// [`MAX_CONTACTS_PER_PAIR`](super::MAX_CONTACTS_PER_PAIR) points, linked from the pair
+    /// record by `index`/`count`:
+    /// - sphere–sphere: one point (the witnesses), `distance = −depth`;
+    /// - mesh–mesh: points of the intersection curve (segment ends of the intersecting
+    ///   triangle pairs) reduced to the extremes: the farthest pair, the point making the
+    ///   largest triangle with them, the point adding the most area beyond it. One normal:
+    ///   the normalised sum of A's triangle normals at the intersection (A→B). Depth 0 and
+    ///   `point_a == point_b`: meshes are surfaces, so intersecting meshes touch along a
+    ///   curve and have no penetration depth;
+    /// - box-answer pairs: one conservative point (the box witnesses and normal), distance 0
+    ///   with the box answer's error bound, which covers the unknown depth.
     pub const CONTACTS: u32 = 1 << 3;
-    /// Time of impact over the motion since the previous frame.
+    /// Time of impact over the motion since the previous frame. **Not implemented yet:**
+    /// frames asking it are refused with [`MalformedMessage`](super::ErrorCode::MalformedMessage).
     pub const TOI: u32 = 1 << 4;
     /// Every flag defined by this protocol version; other bits are rejected.
     pub const ALL: u32 = OVERLAP | CLOSE | DISTANCE | CONTACTS | TOI;
 }
+
+/// Most contact records per pair (one manifold).
+pub const MAX_CONTACTS_PER_PAIR: u32 = 4;
 
 /// The header of one pose frame (the user header of a `[PoseRecord]` sample).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, ZeroCopySend)]
@@ -151,22 +189,26 @@ impl std::fmt::Display for ErrorCode {
 pub enum Completeness {
     /// Every pair answered exactly.
     Exact = 0,
-    /// The deadline cut traversal short; answers are conservative (see DESIGN §4) and
-    /// [`ResultFrameHeader::deepest_level`] bounds their error.
+    /// The deadline cut traversal short, or some candidate pair has no exact narrow phase
+    /// yet and got the conservative box answer (level 0); answers are conservative (see
+    /// DESIGN §4) and [`ResultFrameHeader::deepest_level`] bounds their error.
     Truncated = 1,
 }
 
-/// Stage indices of [`ResultFrameHeader::stage_ns`], in pipeline order.
+/// Stage indices of [`ResultFrameHeader::stage_ns`], in pipeline order. A stage the
+/// daemon does not run separately yet reports 0.
 pub mod stage {
-    /// Ingest and validation of the pose frame.
+    /// Ingest and validation of the pose frame (header, query flags, every pose).
     pub const INGEST: usize = 0;
-    /// Planning: what moved, which stages run.
+    /// Planning: what moved, which stages run (not separate yet: 0).
     pub const PLAN: usize = 1;
-    /// Broad phase.
+    /// Broad phase: margin-grown world boxes to candidate pairs.
     pub const BROAD: usize = 2;
-    /// Mid phase: BVH traversal.
+    /// Mid phase: BVH traversal (not separate yet: 0; counted in `NARROW`, since the mesh
+    /// queries traverse and test triangles in one pass).
     pub const MID: usize = 3;
-    /// Narrow phase: exact primitive tests and manifolds.
+    /// Narrow phase: every candidate pair's answer for the frame's query, BVH traversal
+    /// and manifold reduction included.
     pub const NARROW: usize = 4;
     /// Writing and publishing the result frame.
     pub const PUBLISH: usize = 5;
@@ -199,6 +241,11 @@ pub struct ResultFrameHeader {
     pub pair_count: u32,
     /// Number of contact records after the pairs.
     pub contact_count: u32,
+    /// Number of candidate pairs the broad phase handed to the narrow phase (pairs whose
+    /// margin-grown world boxes overlap), reported or not.
+    pub candidate_count: u32,
+    /// Always 0.
+    pub reserved: u32,
     /// Time from the receipt of the pose frame to the publication of this one, nanoseconds.
     pub elapsed_ns: u64,
     /// Time per pipeline stage, nanoseconds, indexed by [`stage`].
@@ -220,11 +267,14 @@ pub enum RecordKind {
 ///
 /// - `Pair`: `body_a < body_b`; `distance` is the signed distance (positive = separation,
 ///   negative = penetration depth), `point_a`/`point_b` its witnesses, `normal` the unit
-///   normal from A to B; `index`/`count` locate the pair's contacts among the contact
-///   records (`count` 0 when none were asked or found).
-/// - `Contact`: `distance = −depth` (≤ 0 when touching or penetrating), `point_a`/`point_b`
-///   the contact points on each surface, `normal` from A to B, `index` the pair's position
-///   among the pair records.
+///   normal from A to B (all zero when not computed, see [`query::OVERLAP`]);
+///   `index`/`count` locate the pair's contacts among the contact records: `index` counts
+///   from the first contact record (0 = the record right after the last pair), `count` is
+///   at most [`MAX_CONTACTS_PER_PAIR`] (both 0 when none were asked or found).
+/// - `Contact`: `body_a`/`body_b` its pair's bodies, `distance = −depth` (≤ 0),
+///   `point_a`/`point_b` the contact points on each surface, `normal` from A to B (the same
+///   for every contact of a pair), `index` the pair's position among the pair records,
+///   `count` 0. See [`query::CONTACTS`] for what each pair kind gives.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("proxima::ResultRecord")]
@@ -467,5 +517,5 @@ const _: () = assert!(size_of::<ControlRequest>() == 136);
 const _: () = assert!(size_of::<ControlReply>() == 128);
 const _: () = assert!(size_of::<PoseFrameHeader>() == 32);
 const _: () = assert!(size_of::<PoseRecord>() == 64);
-const _: () = assert!(size_of::<ResultFrameHeader>() == 96);
+const _: () = assert!(size_of::<ResultFrameHeader>() == 104);
 const _: () = assert!(size_of::<ResultRecord>() == 112);

@@ -7,8 +7,9 @@ use crate::geometry::{
     Sphere, TriMesh,
 };
 use crate::math::{DQuat, DVec3, Pose};
+use crate::pipeline::{self, Query};
 use crate::scene::{CollisionFilter, MeshShape, Motion, Shape};
-use proxima_ipc::wire::{ControlRequest, ErrorCode, MotionCode, ShapeKindCode};
+use proxima_ipc::wire::{self, ControlRequest, ErrorCode, MotionCode, ShapeKindCode, query};
 use std::sync::Arc;
 
 /// Why an input was refused: the code for the wire and a reason for people.
@@ -34,6 +35,33 @@ pub fn pose(position: [f64; 3], orientation: [f64; 4]) -> Result<Pose, Rejection
     let [x, y, z, w] = orientation;
     Pose::try_new(DVec3::from(position), DQuat::from_xyzw(x, y, z, w))
         .map_err(|e| Rejection::new(ErrorCode::InvalidPose, e.to_string()))
+}
+
+// The wire promises clients the engine's manifold size.
+const _: () = assert!(pipeline::MAX_CONTACTS_PER_PAIR as u32 == wire::MAX_CONTACTS_PER_PAIR);
+
+/// The [`Query`] a pose frame's `query_flags` ask for.
+///
+/// Refused with [`ErrorCode::MalformedMessage`]: undefined bits; no flag at all (a frame
+/// that asks nothing is a client mistake, not an empty answer); `TOI` (not implemented yet,
+/// and answering without it would pretend).
+pub fn query(flags: u32) -> Result<Query, Rejection> {
+    let refuse = |reason: String| Err(Rejection::new(ErrorCode::MalformedMessage, reason));
+    if flags & !query::ALL != 0 {
+        return refuse(format!("undefined query flags {:#x}", flags & !query::ALL));
+    }
+    if flags == 0 {
+        return refuse("no query flags: the frame asks for nothing".to_owned());
+    }
+    if flags & query::TOI != 0 {
+        return refuse("query flag TOI is not implemented yet".to_owned());
+    }
+    Ok(Query {
+        overlap: flags & query::OVERLAP != 0,
+        close: flags & query::CLOSE != 0,
+        distance: flags & query::DISTANCE != 0,
+        contacts: flags & query::CONTACTS != 0,
+    })
 }
 
 /// A motion kind from its wire code.
@@ -189,4 +217,38 @@ fn geometry(request: &ControlRequest, payload: &[u8]) -> Result<(Vec<DVec3>, Vec
         .map(|b| u32::from_ne_bytes(b.try_into().expect("4 bytes")))
         .collect();
     Ok((vertices, indices))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_defined_flag_combination_but_toi_becomes_the_matching_query() {
+        for flags in 1..=query::ALL {
+            match query(flags) {
+                Ok(q) => {
+                    assert_eq!(flags & query::TOI, 0);
+                    assert_eq!(q.overlap, flags & query::OVERLAP != 0);
+                    assert_eq!(q.close, flags & query::CLOSE != 0);
+                    assert_eq!(q.distance, flags & query::DISTANCE != 0);
+                    assert_eq!(q.contacts, flags & query::CONTACTS != 0);
+                }
+                Err(r) => {
+                    assert_ne!(flags & query::TOI, 0, "flags {flags:#x} refused");
+                    assert_eq!(r.code, ErrorCode::MalformedMessage);
+                    assert!(r.reason.contains("TOI"));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn no_flags_and_undefined_bits_are_refused_with_a_reason() {
+        for flags in [0, 1 << 5, query::CLOSE | 1 << 31] {
+            let r = query(flags).expect_err("refused");
+            assert_eq!(r.code, ErrorCode::MalformedMessage);
+            assert!(!r.reason.is_empty());
+        }
+    }
 }

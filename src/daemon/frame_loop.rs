@@ -1,15 +1,22 @@
-//! The frame path of one scene: receive a pose frame, ingest it, run the pipeline, write
-//! the result frame straight into a loaned shared-memory sample, publish, notify.
+//! The frame path of one scene: receive a pose frame, ingest it (poses and query), run the
+//! pipeline for that query, write the result frame — pair records, then contact records —
+//! straight into a loaned shared-memory sample, publish, notify.
+//!
+//! The header carries the pipeline's own [`StepReport`]: broad and narrow timings
+//! (`stage_ns[BROAD]`, `stage_ns[NARROW]`), candidate, pair and contact counts; ingest and
+//! publish are timed here. Stages the pipeline does not have yet (plan, mid) stay 0.
 //!
 //! # Allocation
-//! After a scene's first frames, none: the pipeline workspace and the result list are
+//! After a scene's first frames, none: the pipeline workspace and the result lists are
 //! reused, and result records are written into the loaned sample. (A result frame larger
 //! than any before makes iceoryx2 map a bigger segment once.)
 
 use super::convert::Rejection;
 use super::ingest::{FrameRejection, apply_pose_frame};
 use crate::math::Pose;
-use crate::pipeline::{self, Completeness, PairResult, PipelineWorkspace};
+use crate::pipeline::{
+    self, Completeness, ContactPoint, FrameResults, PairResult, PipelineWorkspace, StepReport,
+};
 use crate::scene::{BodyId, Scene};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
@@ -30,7 +37,7 @@ pub struct SceneFrames<S: Service> {
     results: Publisher<S, [ResultRecord], ResultFrameHeader>,
     notifier: Notifier<S>,
     workspace: PipelineWorkspace,
-    pairs: Vec<PairResult>,
+    output: FrameResults,
     validated: Vec<(BodyId, Pose)>,
 }
 
@@ -68,7 +75,7 @@ impl<S: Service> SceneFrames<S> {
             results,
             notifier,
             workspace: PipelineWorkspace::default(),
-            pairs: Vec::new(),
+            output: FrameResults::default(),
             validated: Vec::new(),
         })
     }
@@ -102,7 +109,8 @@ impl<S: Service> SceneFrames<S> {
                 ..ResultFrameHeader::default()
             };
             result.stage_ns[wire::stage::INGEST] = ingest_ns;
-            self.pairs.clear();
+            self.output.pairs.clear();
+            self.output.contacts.clear();
             match outcome {
                 Err(FrameRejection {
                     rejection: Rejection { code, reason },
@@ -115,21 +123,10 @@ impl<S: Service> SceneFrames<S> {
                     result.status = code as u32;
                     result.error_body = body.unwrap_or(u32::MAX);
                 }
-                Ok(()) => {
-                    let started = Instant::now();
-                    let pairs = &mut self.pairs;
-                    let completeness =
-                        pipeline::step(scene, &mut self.workspace, |r| pairs.push(*r));
-                    result.stage_ns[wire::stage::NARROW] = elapsed_ns(started);
-                    result.status = ErrorCode::Ok as u32;
-                    result.completeness = match completeness {
-                        Completeness::Exact => wire::Completeness::Exact as u32,
-                        Completeness::Truncated { level } => {
-                            result.deepest_level = level;
-                            wire::Completeness::Truncated as u32
-                        }
-                    };
-                    result.pair_count = self.pairs.len() as u32;
+                Ok(query) => {
+                    let report =
+                        pipeline::step(scene, query, &mut self.workspace, &mut self.output);
+                    fill_header(&mut result, &report);
                 }
             }
             self.publish(result, received, header.budget_ns)?;
@@ -145,12 +142,15 @@ impl<S: Service> SceneFrames<S> {
         budget_ns: u64,
     ) -> Result<(), String> {
         let publish_started = Instant::now();
-        let pairs = &self.pairs;
+        let FrameResults { pairs, contacts } = &self.output;
         let mut sample = self
             .results
-            .loan_slice_uninit(pairs.len())
+            .loan_slice_uninit(pairs.len() + contacts.len())
             .map_err(|e| format!("results loan: {e:?}"))?
-            .write_from_fn(|i| record(&pairs[i]));
+            .write_from_fn(|i| match pairs.get(i) {
+                Some(pair) => pair_record(pair),
+                None => contact_record(pairs, &contacts[i - pairs.len()]),
+            });
         header.stage_ns[wire::stage::PUBLISH] = elapsed_ns(publish_started);
         header.elapsed_ns = elapsed_ns(received);
         header.budget_met = u32::from(budget_ns == 0 || header.elapsed_ns <= budget_ns);
@@ -167,18 +167,53 @@ fn elapsed_ns(since: Instant) -> u64 {
     u64::try_from(since.elapsed().as_nanos()).unwrap_or(u64::MAX)
 }
 
-fn record(r: &PairResult) -> ResultRecord {
+/// Copies the pipeline's report into a successful frame's header.
+fn fill_header(header: &mut ResultFrameHeader, report: &StepReport) {
+    header.status = ErrorCode::Ok as u32;
+    header.completeness = match report.completeness {
+        Completeness::Exact => wire::Completeness::Exact as u32,
+        Completeness::Truncated { level } => {
+            header.deepest_level = level;
+            wire::Completeness::Truncated as u32
+        }
+    };
+    header.stage_ns[wire::stage::BROAD] = report.broad_ns;
+    header.stage_ns[wire::stage::NARROW] = report.narrow_ns;
+    header.candidate_count = report.candidates;
+    header.pair_count = report.pairs;
+    header.contact_count = report.contacts;
+}
+
+fn pair_record(r: &PairResult) -> ResultRecord {
     ResultRecord {
         kind: RecordKind::Pair as u32,
         body_a: r.a,
         body_b: r.b,
-        index: 0,
-        count: 0,
+        index: r.first_contact,
+        count: r.contact_count,
         reserved: 0,
         distance: r.distance,
         error_bound: r.error_bound,
         point_a: r.point_a.to_array(),
         point_b: r.point_b.to_array(),
         normal: r.normal.to_array(),
+    }
+}
+
+/// The record of contact `c`, naming its pair's bodies (from `pairs`).
+fn contact_record(pairs: &[PairResult], c: &ContactPoint) -> ResultRecord {
+    let pair = &pairs[c.pair as usize];
+    ResultRecord {
+        kind: RecordKind::Contact as u32,
+        body_a: pair.a,
+        body_b: pair.b,
+        index: c.pair,
+        count: 0,
+        reserved: 0,
+        distance: c.distance,
+        error_bound: c.error_bound,
+        point_a: c.point_a.to_array(),
+        point_b: c.point_b.to_array(),
+        normal: c.normal.to_array(),
     }
 }

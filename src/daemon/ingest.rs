@@ -1,15 +1,17 @@
 //! Stage 1 of a frame: check a pose frame and apply its poses to the scene.
 //!
-//! A frame is applied whole or not at all: every record is validated first (known body,
-//! finite position within range, unit quaternion — renormalised within 1e-6), and only then
-//! are the poses written. A rejected frame leaves the scene as it was and names the first
+//! A frame is applied whole or not at all: the header is checked (protocol, scene, count,
+//! query flags, see [`convert::query`]), then every record (known body, finite position
+//! within range, unit quaternion — renormalised within 1e-6), and only then are the poses
+//! written. A rejected frame leaves the scene as it was and names the first
 //! offending body, so a client's bad frame never corrupts the state other frames rely on.
 
 use super::convert::{self, Rejection};
 use crate::math::Pose;
+use crate::pipeline::Query;
 use crate::scene::{BodyId, Scene};
 use proxima_ipc::PROTOCOL_VERSION;
-use proxima_ipc::wire::{ErrorCode, PoseFrameHeader, PoseRecord, query};
+use proxima_ipc::wire::{ErrorCode, PoseFrameHeader, PoseRecord};
 
 /// A frame the scene refused: why, and which body (`None` for a header problem).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -20,8 +22,9 @@ pub struct FrameRejection {
     pub body: Option<u32>,
 }
 
-/// Checks `header` and `records` against `scene` (id `scene_id`) and applies the poses.
-/// `validated` is scratch space for the checked poses (cleared, reused across frames).
+/// Checks `header` and `records` against `scene` (id `scene_id`) and applies the poses;
+/// returns the frame's query. `validated` is scratch space for the checked poses (cleared,
+/// reused across frames).
 ///
 /// # Errors
 /// The first problem found; the scene is then unchanged.
@@ -31,7 +34,7 @@ pub fn apply_pose_frame(
     header: &PoseFrameHeader,
     records: &[PoseRecord],
     validated: &mut Vec<(BodyId, Pose)>,
-) -> Result<(), FrameRejection> {
+) -> Result<Query, FrameRejection> {
     let refuse = |code, reason: String, body| {
         Err(FrameRejection {
             rejection: Rejection::new(code, reason),
@@ -69,13 +72,10 @@ pub fn apply_pose_frame(
             None,
         );
     }
-    if header.query_flags & !query::ALL != 0 {
-        return refuse(
-            ErrorCode::MalformedMessage,
-            format!("undefined query flags {:#x}", header.query_flags),
-            None,
-        );
-    }
+    let query = convert::query(header.query_flags).map_err(|rejection| FrameRejection {
+        rejection,
+        body: None,
+    })?;
     validated.clear();
     for record in records {
         let id = BodyId(record.body);
@@ -101,7 +101,7 @@ pub fn apply_pose_frame(
             .set_pose(id, pose)
             .expect("checked above: the body lives");
     }
-    Ok(())
+    Ok(query)
 }
 
 #[cfg(test)]
@@ -109,6 +109,7 @@ mod tests {
     use super::*;
     use crate::geometry::Sphere;
     use crate::scene::{BodyDesc, CollisionFilter, Motion, SceneLimits, Shape};
+    use proxima_ipc::wire::query;
 
     fn scene_with_bodies(n: usize) -> Scene {
         let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
@@ -223,6 +224,19 @@ mod tests {
             ),
             (ErrorCode::MalformedMessage, None)
         );
+        for flags in [0, query::TOI, query::CLOSE | query::TOI] {
+            assert_eq!(
+                bad(
+                    vec![record(0, 1.0)],
+                    PoseFrameHeader {
+                        query_flags: flags,
+                        ..header(1)
+                    }
+                ),
+                (ErrorCode::MalformedMessage, None),
+                "flags {flags:#x}"
+            );
+        }
         assert_eq!(
             bad(
                 vec![record(0, 1.0)],

@@ -1,0 +1,268 @@
+//! The answer for one candidate pair, per pair of shape kinds, doing only what the frame's
+//! [`Query`] asks: sphere–sphere in closed form, mesh–mesh by exact BVH queries, every other
+//! pair the conservative box answer (TODO(#5): the exact narrow phase replaces it).
+//!
+//! Each function returns the pair's [`Answer`] and, when the query asks for contacts and the
+//! pair touches, appends its manifold (at most [`MAX_CONTACTS_PER_PAIR`] points) to
+//! `contacts`. Whether the pair is *reported* is decided by the caller from the answer.
+
+use super::contacts::{MAX_CONTACTS_PER_PAIR, reduce_manifold};
+use super::{ContactPoint, PairResult, Query};
+use crate::bounding::Aabb;
+use crate::broad::CandidatePair;
+use crate::geometry::Sphere;
+use crate::math::{DVec3, Pose, conservative_slack};
+use crate::narrow::mesh_mesh::{
+    DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
+    intersects_mesh_mesh,
+};
+use crate::scene::{Body, MeshShape};
+use std::collections::HashMap;
+use std::ops::ControlFlow;
+
+/// One pair's answer before the report decision.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Answer {
+    /// The pair record (contacts not yet linked).
+    pub result: PairResult,
+    /// Whether the shapes touch or intersect (for a box answer: may touch).
+    pub touching: bool,
+}
+
+/// Mesh–mesh scratch kept across frames.
+#[derive(Debug, Default)]
+pub(super) struct MeshScratch {
+    pub traversal: MeshMeshWorkspace,
+    /// Closest triangle pair of each mesh–mesh candidate, for the next frame's first bound.
+    pub caches: HashMap<CandidatePair, DistanceCache>,
+    /// Every intersection segment end of the pair being answered, A's frame.
+    points: Vec<DVec3>,
+    /// The contact normal (A's triangle normal) of each entry of `points`.
+    normals: Vec<DVec3>,
+    /// Indices into `points` kept by the manifold reduction.
+    kept: Vec<usize>,
+}
+
+impl MeshScratch {
+    /// Capacities of the manifold scratch vectors (tests check they stop growing).
+    #[cfg(test)]
+    pub fn capacities(&self) -> [usize; 3] {
+        [
+            self.points.capacity(),
+            self.normals.capacity(),
+            self.kept.capacity(),
+        ]
+    }
+}
+
+/// Sphere–sphere in closed form: everything is cheap, so every field is always filled.
+/// Contacts: one point, the two witnesses, `distance = −depth`.
+pub(super) fn sphere_sphere(
+    pair: &CandidatePair,
+    (a, sa): (&Body, &Sphere),
+    (b, sb): (&Body, &Sphere),
+    query: Query,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    let (ca, cb) = (a.pose.position, b.pose.position);
+    let normal = (cb - ca).try_normalize().unwrap_or(DVec3::X);
+    let result = PairResult {
+        a: pair.a,
+        b: pair.b,
+        distance: ca.distance(cb) - sa.radius - sb.radius,
+        error_bound: conservative_slack(
+            ca.abs().max_element() + cb.abs().max_element() + sa.radius + sb.radius,
+        ),
+        point_a: ca + normal * sa.radius,
+        point_b: cb - normal * sb.radius,
+        normal,
+        exact: true,
+        first_contact: 0,
+        contact_count: 0,
+    };
+    let touching = result.distance <= 0.0;
+    if query.contacts && touching {
+        contacts.push(ContactPoint {
+            pair: 0,
+            point_a: result.point_a,
+            point_b: result.point_b,
+            normal,
+            distance: result.distance,
+            error_bound: result.error_bound,
+        });
+    }
+    Answer { result, touching }
+}
+
+/// Mesh–mesh (meshes are surfaces): the exact distance when the query needs one (`CLOSE`,
+/// `DISTANCE`; warm-started per pair), the reduced intersection set when it asks `CONTACTS`,
+/// else (`OVERLAP` alone) [`intersects_mesh_mesh`], which stops at the first proof.
+///
+/// Without a distance, a touching pair's record says distance 0 (intersecting surfaces),
+/// error bound 0, and takes its witnesses and normal from the first contact when contacts
+/// were asked; with `OVERLAP` alone it has none (points and normal all zero).
+pub(super) fn mesh_mesh(
+    pair: &CandidatePair,
+    (a, ma): (&Body, &MeshShape),
+    (b, mb): (&Body, &MeshShape),
+    query: Query,
+    scratch: &mut MeshScratch,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    let pose_ab = Pose::relative(&a.pose, &b.pose);
+    let mut result = PairResult {
+        a: pair.a,
+        b: pair.b,
+        distance: 0.0,
+        error_bound: 0.0,
+        point_a: DVec3::ZERO,
+        point_b: DVec3::ZERO,
+        normal: DVec3::ZERO,
+        exact: true,
+        first_contact: 0,
+        contact_count: 0,
+    };
+    let mut touching = None;
+    if query.close || query.distance {
+        let d = distance_mesh_mesh(
+            &ma.distance_tree,
+            &mb.distance_tree,
+            &pose_ab,
+            &DistanceParams::EXACT,
+            scratch.caches.entry(*pair).or_default(),
+            &mut scratch.traversal,
+        );
+        result.distance = d.distance;
+        result.error_bound = d.error_bound;
+        result.point_a = a.pose.transform_point(d.point_a);
+        result.point_b = a.pose.transform_point(d.point_b);
+        result.normal = (result.point_b - result.point_a)
+            .try_normalize()
+            .unwrap_or(DVec3::X);
+        touching = Some(d.distance <= 0.0);
+    }
+    if query.contacts && touching != Some(false) {
+        let first = contacts.len();
+        mesh_manifold(a, ma, mb, &pose_ab, scratch, contacts);
+        if let Some(c) = contacts.get(first) {
+            touching = Some(true);
+            if !(query.close || query.distance) {
+                (result.point_a, result.point_b, result.normal) = (c.point_a, c.point_b, c.normal);
+            }
+        } else if touching.is_none() {
+            touching = Some(false);
+        }
+    }
+    let touching = touching.unwrap_or_else(|| {
+        intersects_mesh_mesh(
+            &ma.overlap_tree,
+            &mb.overlap_tree,
+            &pose_ab,
+            &mut scratch.traversal,
+        )
+    });
+    Answer { result, touching }
+}
+
+/// Appends the manifold of two meshes (nothing when they do not intersect): the segment ends
+/// of every intersecting triangle pair ([`contacts_mesh_mesh`]), reduced by
+/// [`reduce_manifold`]. Depth is 0 (surfaces have no inside): `distance` 0 with the rounding
+/// of the coordinates as error bound. One normal for the manifold: the sum of the contacts'
+/// normals (A's triangle normals, A→B), each counted once per segment end, normalised; when
+/// they cancel, the normal of the first kept point's contact.
+fn mesh_manifold(
+    a: &Body,
+    ma: &MeshShape,
+    mb: &MeshShape,
+    pose_ab: &Pose,
+    scratch: &mut MeshScratch,
+    contacts: &mut Vec<ContactPoint>,
+) {
+    let MeshScratch {
+        traversal,
+        points,
+        normals,
+        kept,
+        ..
+    } = scratch;
+    points.clear();
+    normals.clear();
+    contacts_mesh_mesh(
+        &ma.overlap_tree,
+        &mb.overlap_tree,
+        pose_ab,
+        traversal,
+        |c| {
+            for end in c.segment {
+                points.push(end);
+                normals.push(c.normal);
+            }
+            ControlFlow::Continue(())
+        },
+    );
+    reduce_manifold(points, kept);
+    let Some(&first) = kept.first() else {
+        return;
+    };
+    debug_assert!(kept.len() <= MAX_CONTACTS_PER_PAIR);
+    let normal_a = normals
+        .iter()
+        .sum::<DVec3>()
+        .try_normalize()
+        .unwrap_or(normals[first]);
+    let normal = a.pose.transform_vector(normal_a);
+    for &i in kept.iter() {
+        let point = a.pose.transform_point(points[i]);
+        contacts.push(ContactPoint {
+            pair: 0,
+            point_a: point,
+            point_b: point,
+            normal,
+            distance: 0.0,
+            error_bound: conservative_slack(point.abs().max_element()),
+        });
+    }
+}
+
+/// The conservative answer from two world boxes: their distance (a lower bound of the
+/// shapes' distance) with the sum of their diagonals as error bound; the pair *may* touch
+/// when the boxes do. Its contact (when asked and the boxes touch) is one point: the box
+/// witnesses, the box normal, distance 0 (the depth is unknown) with the box answer's error
+/// bound, which covers the true depth.
+pub(super) fn boxes(
+    pair: &CandidatePair,
+    a: &Aabb,
+    b: &Aabb,
+    query: Query,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    let point_a = b.center().clamp(a.min, a.max);
+    let point_b = point_a.clamp(b.min, b.max);
+    let gap = (a.min - b.max).max(b.min - a.max).max(DVec3::ZERO);
+    let result = PairResult {
+        a: pair.a,
+        b: pair.b,
+        distance: gap.length(),
+        error_bound: (a.max - a.min).length() + (b.max - b.min).length(),
+        point_a,
+        point_b,
+        normal: (b.center() - a.center())
+            .try_normalize()
+            .unwrap_or(DVec3::X),
+        exact: false,
+        first_contact: 0,
+        contact_count: 0,
+    };
+    let touching = result.distance <= 0.0;
+    if query.contacts && touching {
+        contacts.push(ContactPoint {
+            pair: 0,
+            point_a,
+            point_b,
+            normal: result.normal,
+            distance: 0.0,
+            error_bound: result.error_bound,
+        });
+    }
+    Answer { result, touching }
+}

@@ -1,0 +1,651 @@
+//! One frame of collision work over a scene: broad phase, then per candidate pair only the
+//! work the frame's [`Query`] asks for.
+//!
+//! # What a query asks (DESIGN §4)
+//! The broad phase yields *candidate pairs*: bodies whose world boxes, grown by their
+//! margins, overlap (never static–static, filtered by group/mask). Each flag selects pairs
+//! among them; the frame reports the union, once per pair, in `(a, b)` order:
+//!
+//! | flag | pairs reported | what it costs for meshes |
+//! |---|---|---|
+//! | [`Query::close`] | distance ≤ the sum of the two margins; signed distance, witnesses, normal A→B | exact distance |
+//! | [`Query::overlap`] | the shapes touch or intersect (distance ≤ 0) | [`intersects_mesh_mesh`](crate::narrow::mesh_mesh::intersects_mesh_mesh), stops at the first proof |
+//! | [`Query::distance`] | every candidate pair, also beyond the margins, with its exact signed distance | exact distance |
+//! | [`Query::contacts`] | touching pairs, each with its manifold ([`ContactPoint`]s, at most [`MAX_CONTACTS_PER_PAIR`]) | every intersecting triangle pair ([`contacts_mesh_mesh`](crate::narrow::mesh_mesh::contacts_mesh_mesh)), then [`reduce_manifold`] |
+//!
+//! Flags combine: `CLOSE | CONTACTS` reports the close pairs, and the touching ones among
+//! them carry contacts. `OVERLAP` adds nothing to `CLOSE` or `DISTANCE` (their records
+//! already say it: distance ≤ 0). A pair record always has `a`, `b`, `distance`,
+//! `error_bound`; when neither `CLOSE` nor `DISTANCE` is asked, a mesh pair's record says
+//! distance 0 (intersecting surfaces) and takes its witnesses and normal from its first
+//! contact, or, with `OVERLAP` alone, has none: points and normal all zero (a zero normal
+//! means "not computed"). Sphere–sphere records are always complete (closed form).
+//!
+//! Contacts per pair kind:
+//! - sphere–sphere: one point, the witnesses, `distance = −depth`;
+//! - mesh–mesh: the ends of every intersection segment of the two surfaces, reduced by
+//!   [`reduce_manifold`] to the extremes, each with `point_a == point_b` and depth 0 (meshes
+//!   are surfaces: intersecting meshes touch along curves and have no inside to measure a
+//!   depth in). One normal for the manifold: the sum of the intersecting triangles' normals
+//!   on A (A→B), one per segment end, normalised (when they cancel exactly, the normal at
+//!   the first kept point);
+//! - box-answer pairs: one conservative point, the box witnesses and normal, distance 0
+//!   (depth unknown) with the box error bound, which covers the true depth.
+//!
+//! [`PairResult::first_contact`] and [`PairResult::contact_count`] locate a pair's contacts
+//! in [`FrameResults::contacts`]; each [`ContactPoint::pair`] names its pair back.
+//!
+//! # Design note: determinism and ordering
+//! The same scene and query give the same results: the broad phase yields pairs sorted by
+//! `(a, b)`, each pair is answered independently in that order, and nothing depends on
+//! timing (only [`StepReport`]'s timings do). Budgeted (time-critical) traversal joins with
+//! issue #7 behind this same seam.
+//!
+//! # What is exact today
+//! Sphere–sphere (closed form) and mesh–mesh (exact BVH queries, meshes as surfaces:
+//! intersecting meshes report 0) pairs are exact. Every other pair of shape kinds gets the
+//! conservative answer DESIGN §5 prescribes for a truncated traversal at level 0: the
+//! distance between the two world boxes (a lower bound), with the boxes' diagonals as error
+//! bound, "may touch" when the boxes touch, and the report says
+//! [`Completeness::Truncated`]. TODO(#5): the narrow phase for every pair of shape kinds
+//! replaces that.
+//!
+//! # Allocation
+//! None once the workspace and the output have grown to the largest frame, except one
+//! warm-start cache entry when a mesh–mesh pair becomes a candidate.
+
+mod answer;
+mod contacts;
+
+pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
+
+use crate::broad::{CandidatePair, Proxy, pairs_brute_force};
+use crate::math::DVec3;
+use crate::scene::{Body, BodyId, Scene, Shape};
+use answer::{Answer, MeshScratch};
+use std::time::Instant;
+
+/// What a frame asks for (see the [module docs](self)); at least one flag should be set, or
+/// the frame reports nothing.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Query {
+    /// Pairs whose shapes touch or intersect.
+    pub overlap: bool,
+    /// Pairs within the sum of their margins, with signed distance and witnesses.
+    pub close: bool,
+    /// Every candidate pair's exact signed distance.
+    pub distance: bool,
+    /// Contact manifolds of touching pairs.
+    pub contacts: bool,
+}
+
+impl Query {
+    /// Nothing asked.
+    pub const NONE: Self = Self {
+        overlap: false,
+        close: false,
+        distance: false,
+        contacts: false,
+    };
+    /// Only `overlap`.
+    pub const OVERLAP: Self = Self {
+        overlap: true,
+        ..Self::NONE
+    };
+    /// Only `close`.
+    pub const CLOSE: Self = Self {
+        close: true,
+        ..Self::NONE
+    };
+    /// Only `distance`.
+    pub const DISTANCE: Self = Self {
+        distance: true,
+        ..Self::NONE
+    };
+    /// Only `contacts`.
+    pub const CONTACTS: Self = Self {
+        contacts: true,
+        ..Self::NONE
+    };
+
+    /// Both queries' flags.
+    #[must_use]
+    pub const fn union(self, other: Self) -> Self {
+        Self {
+            overlap: self.overlap || other.overlap,
+            close: self.close || other.close,
+            distance: self.distance || other.distance,
+            contacts: self.contacts || other.contacts,
+        }
+    }
+
+    /// Whether a pair with this answer and these margins is reported.
+    fn reports(self, answer: &Answer, margins: f64) -> bool {
+        // A box answer's distance is a lower bound and its `touching` a "may touch": the
+        // pair is reported whenever the truth may qualify (conservative).
+        self.distance
+            || (self.close && answer.result.distance <= margins)
+            || ((self.overlap || self.contacts) && answer.touching)
+    }
+}
+
+/// The answer for one reported pair, world frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairResult {
+    /// The smaller body id.
+    pub a: u32,
+    /// The larger body id.
+    pub b: u32,
+    /// Signed distance, metres (negative = penetration).
+    pub distance: f64,
+    /// `|distance − true distance| ≤ error_bound`, metres.
+    pub error_bound: f64,
+    /// Witness on A, world frame (zero when not computed, see the module docs).
+    pub point_a: DVec3,
+    /// Witness on B, world frame (zero when not computed).
+    pub point_b: DVec3,
+    /// Unit normal from A to B, world frame (zero when not computed).
+    pub normal: DVec3,
+    /// Whether the answer is exact (to `error_bound` rounding) or the conservative box answer.
+    pub exact: bool,
+    /// Index of the pair's first contact in [`FrameResults::contacts`] (0 when none).
+    pub first_contact: u32,
+    /// Number of the pair's contacts, at most [`MAX_CONTACTS_PER_PAIR`].
+    pub contact_count: u32,
+}
+
+/// One point of a pair's contact manifold, world frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactPoint {
+    /// Index of its pair in [`FrameResults::pairs`].
+    pub pair: u32,
+    /// Contact point on A's surface, metres.
+    pub point_a: DVec3,
+    /// Contact point on B's surface, metres.
+    pub point_b: DVec3,
+    /// Unit normal from A to B (one per manifold).
+    pub normal: DVec3,
+    /// `−depth`, metres (≤ 0).
+    pub distance: f64,
+    /// `|distance − true distance| ≤ error_bound`, metres.
+    pub error_bound: f64,
+}
+
+/// The reported pairs and their contacts, reused across frames (cleared by [`step`]).
+#[derive(Debug, Default)]
+pub struct FrameResults {
+    /// Reported pairs in `(a, b)` order.
+    pub pairs: Vec<PairResult>,
+    /// Every reported pair's contacts, in pair order.
+    pub contacts: Vec<ContactPoint>,
+}
+
+/// Whether a frame's answers are all exact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Completeness {
+    /// Every pair exact.
+    Exact,
+    /// Some pairs carry a conservative answer from level `level` of their hierarchies.
+    Truncated {
+        /// The shallowest level any pair stopped at (0 = world boxes).
+        level: u32,
+    },
+}
+
+/// What [`step`] did: completeness, stage timings, counts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepReport {
+    /// Whether every answer is exact.
+    pub completeness: Completeness,
+    /// Broad phase (proxies and candidate pairs), nanoseconds.
+    pub broad_ns: u64,
+    /// Narrow phase (every candidate's answer and manifold), nanoseconds.
+    pub narrow_ns: u64,
+    /// Candidate pairs from the broad phase.
+    pub candidates: u32,
+    /// Reported pairs (`results.pairs.len()`).
+    pub pairs: u32,
+    /// Contact points (`results.contacts.len()`).
+    pub contacts: u32,
+}
+
+/// State of [`step`] kept across frames: scratch space (no allocation once grown) and the
+/// warm-start cache of every mesh–mesh pair that was a candidate last frame.
+#[derive(Debug, Default)]
+pub struct PipelineWorkspace {
+    proxies: Vec<Proxy>,
+    candidates: Vec<CandidatePair>,
+    mesh: MeshScratch,
+}
+
+/// Runs one frame over `scene`: the pairs `query` asks for (see the [module docs](self)),
+/// with their contacts, written to `results` (cleared first).
+pub fn step(
+    scene: &Scene,
+    query: Query,
+    workspace: &mut PipelineWorkspace,
+    results: &mut FrameResults,
+) -> StepReport {
+    let started = Instant::now();
+    results.pairs.clear();
+    results.contacts.clear();
+    scene.proxies(&mut workspace.proxies);
+    pairs_brute_force(&workspace.proxies, &mut workspace.candidates);
+    let broad_ns = elapsed_ns(started);
+    let started = Instant::now();
+    let mut completeness = Completeness::Exact;
+    let candidates = &workspace.candidates;
+    // Pairs that stop being candidates are forgotten; a pair that appears inserts once.
+    workspace
+        .mesh
+        .caches
+        .retain(|pair, _| candidates.binary_search(pair).is_ok());
+    for pair in candidates {
+        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+        let first_contact = results.contacts.len();
+        let contacts = &mut results.contacts;
+        let mut answer = match (shape(scene, a), shape(scene, b)) {
+            (Shape::Sphere(sa), Shape::Sphere(sb)) => {
+                answer::sphere_sphere(pair, (a, sa), (b, sb), query, contacts)
+            }
+            (Shape::Mesh(ma), Shape::Mesh(mb)) => {
+                answer::mesh_mesh(pair, (a, ma), (b, mb), query, &mut workspace.mesh, contacts)
+            }
+            _ => answer::boxes(pair, &a.world_bounds, &b.world_bounds, query, contacts),
+        };
+        if !answer.result.exact {
+            completeness = Completeness::Truncated { level: 0 };
+        }
+        if query.reports(&answer, a.margin + b.margin) {
+            let count = results.contacts.len() - first_contact;
+            if count > 0 {
+                answer.result.first_contact = index(first_contact);
+                answer.result.contact_count = index(count);
+                let pair = index(results.pairs.len());
+                for c in &mut results.contacts[first_contact..] {
+                    c.pair = pair;
+                }
+            }
+            results.pairs.push(answer.result);
+        } else {
+            results.contacts.truncate(first_contact);
+        }
+    }
+    StepReport {
+        completeness,
+        broad_ns,
+        narrow_ns: elapsed_ns(started),
+        candidates: index(workspace.candidates.len()),
+        pairs: index(results.pairs.len()),
+        contacts: index(results.contacts.len()),
+    }
+}
+
+fn index(n: usize) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
+
+fn elapsed_ns(since: Instant) -> u64 {
+    u64::try_from(since.elapsed().as_nanos()).unwrap_or(u64::MAX)
+}
+
+fn body(scene: &Scene, id: u32) -> &Body {
+    scene
+        .body(BodyId(id))
+        .expect("the broad phase reports live bodies")
+}
+
+fn shape<'s>(scene: &'s Scene, body: &Body) -> &'s Shape {
+    scene
+        .shape(body.shape)
+        .expect("bodies name registered shapes")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Cuboid, Sphere};
+    use crate::math::Pose;
+    use crate::narrow::mesh_mesh::{
+        DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
+        intersects_mesh_mesh,
+    };
+    use crate::scene::{BodyDesc, CollisionFilter, MeshShape, Motion, SceneLimits};
+    use crate::test_support::{meshes, point_in_cube, rng, rotation};
+    use rand::Rng;
+    use std::ops::ControlFlow;
+    use std::sync::Arc;
+
+    fn add(scene: &mut Scene, shape: Shape, at: DVec3, margin: f64) -> BodyId {
+        let shape = scene.register_shape(shape).unwrap();
+        let desc = BodyDesc {
+            shape,
+            pose: Pose::from_translation(at),
+            motion: Motion::Dynamic,
+            filter: CollisionFilter::ALL,
+            margin: Some(margin),
+        };
+        scene.add_body(&desc).unwrap()
+    }
+
+    /// Every non-empty combination of the four flags.
+    fn every_query() -> impl Iterator<Item = Query> {
+        (1u32..16).map(|bits| Query {
+            overlap: bits & 1 != 0,
+            close: bits & 2 != 0,
+            distance: bits & 4 != 0,
+            contacts: bits & 8 != 0,
+        })
+    }
+
+    fn run(scene: &Scene, query: Query, workspace: &mut PipelineWorkspace) -> FrameResults {
+        let mut results = FrameResults::default();
+        let report = step(scene, query, workspace, &mut results);
+        assert_eq!(report.pairs as usize, results.pairs.len());
+        assert_eq!(report.contacts as usize, results.contacts.len());
+        assert!(report.candidates >= report.pairs);
+        assert_links(&results);
+        results
+    }
+
+    /// Pairs in `(a, b)` order; each pair's contacts are exactly the ones that name it, in
+    /// one run, in pair order, at most `MAX_CONTACTS_PER_PAIR`.
+    fn assert_links(results: &FrameResults) {
+        assert!(
+            results
+                .pairs
+                .windows(2)
+                .all(|w| (w[0].a, w[0].b) < (w[1].a, w[1].b))
+        );
+        let mut next = 0;
+        for (i, p) in results.pairs.iter().enumerate() {
+            assert!(p.contact_count as usize <= MAX_CONTACTS_PER_PAIR);
+            if p.contact_count == 0 {
+                assert_eq!(p.first_contact, 0);
+                continue;
+            }
+            assert_eq!(p.first_contact as usize, next);
+            next += p.contact_count as usize;
+            for c in &results.contacts[p.first_contact as usize..next] {
+                assert_eq!(c.pair as usize, i);
+            }
+        }
+        assert_eq!(next, results.contacts.len());
+    }
+
+    #[test]
+    fn sphere_scenes_report_exactly_what_each_query_asks_against_the_closed_form() {
+        let mut rng = rng(71);
+        let mut seen = [0usize; 4]; // close, far-but-candidate, touching, contacts
+        for case in 0..60 {
+            let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+            let spheres: Vec<(DVec3, f64, f64)> = (0..rng.random_range(2..40))
+                .map(|_| {
+                    (
+                        point_in_cube(&mut rng, 1.2),
+                        rng.random_range(0.05..0.6),
+                        rng.random_range(0.0..0.3),
+                    )
+                })
+                .collect();
+            for &(c, r, m) in &spheres {
+                add(&mut scene, Shape::Sphere(Sphere::new(r)), c, m);
+            }
+            let mut workspace = PipelineWorkspace::default();
+            for query in every_query() {
+                let results = run(&scene, query, &mut workspace);
+                for i in 0..spheres.len() {
+                    for j in i + 1..spheres.len() {
+                        let ((ci, ri, mi), (cj, rj, mj)) = (spheres[i], spheres[j]);
+                        let truth = ci.distance(cj) - ri - rj;
+                        // The broad phase's candidates: margin-grown boxes overlap.
+                        let reach = DVec3::splat(1.0);
+                        let candidate =
+                            ((ci - cj).abs() - (ri + mi + rj + mj) * reach).max_element() <= 0.0;
+                        let wanted = (query.distance && candidate)
+                            || (query.close && truth <= mi + mj)
+                            || ((query.overlap || query.contacts) && truth <= 0.0);
+                        let found = results
+                            .pairs
+                            .iter()
+                            .find(|r| (r.a, r.b) == (i as u32, j as u32));
+                        let Some(r) = found else {
+                            assert!(!wanted, "case {case} {query:?}: pair {i},{j} missed");
+                            continue;
+                        };
+                        assert!(wanted, "case {case} {query:?}: pair {i},{j} not asked");
+                        assert!((r.distance - truth).abs() <= r.error_bound.max(1e-12));
+                        assert!(
+                            (r.normal.length() - 1.0).abs() < 1e-12 && r.normal.dot(cj - ci) >= 0.0
+                        );
+                        assert!(
+                            (r.point_a.distance(ci) - ri).abs() < 1e-9
+                                && (r.point_b.distance(cj) - rj).abs() < 1e-9
+                        );
+                        if query.contacts && truth <= 0.0 {
+                            assert_eq!(r.contact_count, 1);
+                            let c = results.contacts[r.first_contact as usize];
+                            assert_eq!(
+                                (c.point_a, c.point_b, c.normal),
+                                (r.point_a, r.point_b, r.normal)
+                            );
+                            assert_eq!(c.distance, r.distance);
+                            assert!(c.distance <= 0.0);
+                            seen[3] += 1;
+                        } else {
+                            assert_eq!(r.contact_count, 0);
+                        }
+                        seen[0] += usize::from(truth <= mi + mj);
+                        seen[1] += usize::from(truth > mi + mj);
+                        seen[2] += usize::from(truth <= 0.0);
+                    }
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n > 500), "seen {seen:?}");
+    }
+
+    fn torus_scene() -> (Scene, BodyId, BodyId, Arc<MeshShape>) {
+        let torus = Arc::new(MeshShape::new(meshes::torus(1.0, 0.25, 24, 12)));
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let a = add(&mut scene, Shape::Mesh(torus.clone()), DVec3::ZERO, 0.5);
+        let b = add(&mut scene, Shape::Mesh(torus.clone()), DVec3::X, 0.5);
+        (scene, a, b, torus)
+    }
+
+    #[test]
+    fn mesh_pairs_answer_each_query_as_the_mesh_queries_do_directly() {
+        let (mut scene, a, b, mesh) = torus_scene();
+        let mut rng = rng(73);
+        let mut workspace = PipelineWorkspace::default();
+        let (mut touching, mut close, mut far) = (0, 0, 0);
+        for frame in 0..80 {
+            let pose_b = Pose::new(point_in_cube(&mut rng, 2.2), rotation(&mut rng));
+            scene.set_pose(b, pose_b).unwrap();
+            let (mut proxies, mut candidates) = (Vec::new(), Vec::new());
+            scene.proxies(&mut proxies);
+            pairs_brute_force(&proxies, &mut candidates);
+            let candidate = !candidates.is_empty();
+            let pose_a = scene.body(a).unwrap().pose;
+            let pose_ab = Pose::relative(&pose_a, &pose_b);
+            let cold = distance_mesh_mesh(
+                &mesh.distance_tree,
+                &mesh.distance_tree,
+                &pose_ab,
+                &DistanceParams::EXACT,
+                &mut DistanceCache::new(),
+                &mut MeshMeshWorkspace::new(),
+            );
+            let intersects = intersects_mesh_mesh(
+                &mesh.overlap_tree,
+                &mesh.overlap_tree,
+                &pose_ab,
+                &mut MeshMeshWorkspace::new(),
+            );
+            let mut segment_ends = Vec::new();
+            contacts_mesh_mesh(
+                &mesh.overlap_tree,
+                &mesh.overlap_tree,
+                &pose_ab,
+                &mut MeshMeshWorkspace::new(),
+                |c| {
+                    segment_ends.extend(c.segment.map(|p| pose_a.transform_point(p)));
+                    ControlFlow::Continue(())
+                },
+            );
+            assert_eq!(intersects, cold.distance == 0.0, "frame {frame}");
+            assert_eq!(intersects, !segment_ends.is_empty(), "frame {frame}");
+            touching += usize::from(intersects);
+            close += usize::from(cold.distance <= 1.0);
+            far += usize::from(candidate && cold.distance > 1.0);
+            for query in every_query() {
+                let results = run(&scene, query, &mut workspace);
+                let wanted = (query.distance && candidate)
+                    || (query.close && cold.distance <= 1.0)
+                    || ((query.overlap || query.contacts) && intersects);
+                let r = match (results.pairs.as_slice(), wanted) {
+                    ([r], true) => r,
+                    ([], false) => continue,
+                    (pairs, _) => panic!("frame {frame} {query:?}: {} pairs", pairs.len()),
+                };
+                assert!(r.exact);
+                if query.close || query.distance {
+                    // Warm-started across frames and queries, the exact distance is the cold one.
+                    assert_eq!(r.distance, cold.distance, "frame {frame}");
+                    assert_eq!(
+                        (r.point_a, r.point_b),
+                        (
+                            pose_a.transform_point(cold.point_a),
+                            pose_a.transform_point(cold.point_b)
+                        )
+                    );
+                } else {
+                    assert_eq!(r.distance, 0.0);
+                }
+                if !(query.contacts && intersects) {
+                    assert_eq!(r.contact_count, 0);
+                    continue;
+                }
+                let range = r.first_contact as usize..(r.first_contact + r.contact_count) as usize;
+                let manifold = &results.contacts[range];
+                let mut kept = Vec::new();
+                reduce_manifold(&segment_ends, &mut kept);
+                assert_eq!(manifold.len(), kept.len(), "frame {frame}");
+                assert!(!manifold.is_empty());
+                for (c, &i) in manifold.iter().zip(&kept) {
+                    assert_eq!((c.point_a, c.point_b), (segment_ends[i], segment_ends[i]));
+                    assert_eq!((c.distance, c.normal), (0.0, manifold[0].normal));
+                    assert!((c.normal.length() - 1.0).abs() < 1e-12);
+                }
+                if !(query.close || query.distance) {
+                    assert_eq!(
+                        (r.point_a, r.normal),
+                        (manifold[0].point_a, manifold[0].normal)
+                    );
+                }
+            }
+        }
+        assert!(
+            touching > 5 && close - touching > 3 && far > 3,
+            "{touching} {close} {far}"
+        );
+    }
+
+    #[test]
+    fn overlap_alone_proves_mesh_contact_without_witnesses() {
+        let (mut scene, _, b, _) = torus_scene();
+        scene
+            .set_pose(b, Pose::from_translation(DVec3::new(0.3, 0.0, 0.0)))
+            .unwrap();
+        let results = run(&scene, Query::OVERLAP, &mut PipelineWorkspace::default());
+        let [r] = results.pairs.as_slice() else {
+            panic!("{} pairs", results.pairs.len())
+        };
+        assert_eq!((r.distance, r.error_bound), (0.0, 0.0));
+        assert_eq!(
+            (r.point_a, r.point_b, r.normal),
+            (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO)
+        );
+        assert!(results.contacts.is_empty());
+    }
+
+    #[test]
+    fn pairs_without_an_exact_narrow_phase_get_a_conservative_box_answer() {
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let a = add(
+            &mut scene,
+            Shape::Sphere(Sphere::new(0.5)),
+            DVec3::ZERO,
+            0.1,
+        );
+        let b = add(
+            &mut scene,
+            Shape::Cuboid(Cuboid::new(DVec3::splat(0.5))),
+            DVec3::new(1.05, 0.3, 0.0),
+            0.1,
+        );
+        let mut workspace = PipelineWorkspace::default();
+        let mut results = FrameResults::default();
+        let report = step(&scene, Query::CLOSE, &mut workspace, &mut results);
+        assert_eq!(report.completeness, Completeness::Truncated { level: 0 });
+        assert_eq!(results.pairs.len(), 1);
+        let r = results.pairs[0];
+        assert_eq!((r.a, r.b, r.exact), (a.0, b.0, false));
+        // True distance: sphere centre to the box face x = 0.55, minus the radius.
+        let truth = 0.55 - 0.5;
+        assert!(r.distance <= truth && (r.distance - truth).abs() <= r.error_bound);
+        // The boxes do not touch: no overlap, no contacts.
+        let report = step(
+            &scene,
+            Query::OVERLAP.union(Query::CONTACTS),
+            &mut workspace,
+            &mut results,
+        );
+        assert_eq!(
+            (report.candidates, report.pairs, report.contacts),
+            (1, 0, 0)
+        );
+        // Boxes overlapping (the shapes too): one conservative contact covering the depth.
+        scene
+            .set_pose(b, Pose::from_translation(DVec3::new(0.8, 0.0, 0.0)))
+            .unwrap();
+        step(&scene, Query::CONTACTS, &mut workspace, &mut results);
+        let (r, c) = (results.pairs[0], results.contacts[0]);
+        assert_eq!(
+            (results.pairs.len(), results.contacts.len(), r.contact_count),
+            (1, 1, 1)
+        );
+        let depth = 0.5 - (0.8 - 0.5);
+        assert!(c.distance == 0.0 && depth <= c.error_bound);
+        assert_eq!(c.normal, r.normal);
+    }
+
+    #[test]
+    fn a_warm_workspace_answers_frame_after_frame_without_growing() {
+        let (mut scene, _, b, _) = torus_scene();
+        let mut rng = rng(75);
+        let poses: Vec<Pose> = (0..20)
+            .map(|_| Pose::new(point_in_cube(&mut rng, 1.0), rotation(&mut rng)))
+            .collect();
+        let all = Query::CLOSE.union(Query::CONTACTS).union(Query::DISTANCE);
+        let (mut workspace, mut results) = (PipelineWorkspace::default(), FrameResults::default());
+        let capacities = |w: &PipelineWorkspace, r: &FrameResults| {
+            (
+                w.mesh.capacities(),
+                w.candidates.capacity(),
+                r.pairs.capacity(),
+                r.contacts.capacity(),
+            )
+        };
+        for &pose in &poses {
+            scene.set_pose(b, pose).unwrap();
+            step(&scene, all, &mut workspace, &mut results);
+        }
+        let warm = capacities(&workspace, &results);
+        for &pose in &poses {
+            scene.set_pose(b, pose).unwrap();
+            step(&scene, all, &mut workspace, &mut results);
+            assert_eq!(capacities(&workspace, &results), warm);
+        }
+    }
+}
