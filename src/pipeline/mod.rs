@@ -59,7 +59,7 @@ mod contacts;
 
 pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
 
-use crate::broad::{CandidatePair, Proxy, pairs_brute_force};
+use crate::broad::{CandidatePair, Proxy, SortAndSweep};
 use crate::math::DVec3;
 use crate::scene::{Body, BodyId, Scene, Shape};
 use answer::{Answer, MeshScratch};
@@ -214,6 +214,8 @@ pub struct StepReport {
 #[derive(Debug, Default)]
 pub struct PipelineWorkspace {
     proxies: Vec<Proxy>,
+    /// The broad phase's order, kept between frames (coherent motion re-sorts in linear time).
+    sweep: SortAndSweep,
     candidates: Vec<CandidatePair>,
     mesh: MeshScratch,
 }
@@ -230,7 +232,9 @@ pub fn step(
     results.pairs.clear();
     results.contacts.clear();
     scene.proxies(&mut workspace.proxies);
-    pairs_brute_force(&workspace.proxies, &mut workspace.candidates);
+    workspace
+        .sweep
+        .pairs(&workspace.proxies, &mut workspace.candidates);
     let broad_ns = elapsed_ns(started);
     let started = Instant::now();
     let mut completeness = Completeness::Exact;
@@ -464,7 +468,7 @@ mod tests {
             scene.set_pose(b, pose_b).unwrap();
             let (mut proxies, mut candidates) = (Vec::new(), Vec::new());
             scene.proxies(&mut proxies);
-            pairs_brute_force(&proxies, &mut candidates);
+            crate::broad::pairs_brute_force(&proxies, &mut candidates);
             let candidate = !candidates.is_empty();
             let pose_a = scene.body(a).unwrap().pose;
             let pose_ab = Pose::relative(&pose_a, &pose_b);
