@@ -225,8 +225,8 @@ fn mesh_manifold(
 }
 
 /// The conservative answer from two world boxes: their distance (a lower bound of the
-/// shapes' distance) with the sum of their diagonals as error bound; the pair *may* touch
-/// when the boxes do. Its contact (when asked and the boxes touch) is one point: the box
+/// shapes' distance) with the sum of their diagonals as error bound, and [`box_normal`];
+/// the pair *may* touch when the boxes do. Its contact (when asked and the boxes touch) is one point: the box
 /// witnesses, the box normal, distance 0 (the depth is unknown) with the box answer's error
 /// bound, which covers the true depth.
 pub(super) fn boxes(
@@ -246,9 +246,7 @@ pub(super) fn boxes(
         error_bound: (a.max - a.min).length() + (b.max - b.min).length(),
         point_a,
         point_b,
-        normal: (b.center() - a.center())
-            .try_normalize()
-            .unwrap_or(DVec3::X),
+        normal: box_normal(a, b, gap),
         exact: false,
         first_contact: 0,
         contact_count: 0,
@@ -265,4 +263,27 @@ pub(super) fn boxes(
         });
     }
     Answer { result, touching }
+}
+
+/// The normal A→B of two world boxes: along their gap when they are apart, else along the
+/// axis on which they overlap least (the direction that separates them soonest), pointing
+/// from A's centre towards B's. `gap` is the per-axis separation (zero where they overlap).
+fn box_normal(a: &Aabb, b: &Aabb, gap: DVec3) -> DVec3 {
+    let towards_b = b.center() - a.center();
+    let sign = |axis: usize| if towards_b[axis] < 0.0 { -1.0 } else { 1.0 };
+    if gap != DVec3::ZERO {
+        let signed = DVec3::new(gap.x * sign(0), gap.y * sign(1), gap.z * sign(2));
+        return signed.normalize();
+    }
+    let overlap = a.max.min(b.max) - a.min.max(b.min);
+    let axis = if overlap.x <= overlap.y && overlap.x <= overlap.z {
+        0
+    } else if overlap.y <= overlap.z {
+        1
+    } else {
+        2
+    };
+    let mut normal = DVec3::ZERO;
+    normal[axis] = sign(axis);
+    normal
 }

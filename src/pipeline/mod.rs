@@ -624,6 +624,39 @@ mod tests {
         assert_eq!(c.normal, r.normal);
     }
 
+    /// A small body near the edge of a wide floor: the box normal is the floor's normal (the
+    /// axis of least overlap, or of the gap), not the direction between the box centres.
+    #[test]
+    fn box_answers_take_their_normal_from_the_axis_that_separates_soonest() {
+        for (height, a_below) in [(0.45, true), (0.55, true), (0.45, false), (0.55, false)] {
+            let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+            let floor = Shape::Cuboid(Cuboid::new(DVec3::new(5.0, 5.0, 0.25)));
+            let ball = Shape::Sphere(Sphere::new(0.2));
+            let (floor_at, ball_at) = (DVec3::new(0.0, 0.0, 0.0), DVec3::new(4.5, -4.0, height));
+            // Body ids follow insertion: the first added is A.
+            if a_below {
+                add(&mut scene, floor, floor_at, 0.1);
+                add(&mut scene, ball, ball_at, 0.1);
+            } else {
+                add(&mut scene, ball, ball_at, 0.1);
+                add(&mut scene, floor, floor_at, 0.1);
+            }
+            let mut results = FrameResults::default();
+            step(
+                &scene,
+                Query::CLOSE,
+                &mut PipelineWorkspace::default(),
+                &mut results,
+            );
+            let expected = if a_below { DVec3::Z } else { -DVec3::Z };
+            assert_eq!(results.pairs.len(), 1, "height {height}");
+            assert_eq!(
+                results.pairs[0].normal, expected,
+                "height {height}, A below {a_below}"
+            );
+        }
+    }
+
     #[test]
     fn a_warm_workspace_answers_frame_after_frame_without_growing() {
         let (mut scene, _, b, _) = torus_scene();
