@@ -17,7 +17,6 @@ use crate::narrow::mesh_mesh::{
     intersects_mesh_mesh,
 };
 use crate::scene::{Body, MeshShape};
-use std::collections::HashMap;
 use std::ops::ControlFlow;
 
 /// One pair's answer before the report decision.
@@ -29,12 +28,10 @@ pub(super) struct Answer {
     pub touching: bool,
 }
 
-/// Mesh–mesh scratch kept across frames.
+/// Mesh–mesh scratch of one thread, reused across pairs and frames.
 #[derive(Debug, Default)]
 pub(super) struct MeshScratch {
     pub traversal: MeshMeshWorkspace,
-    /// Closest triangle pair of each mesh–mesh candidate, for the next frame's first bound.
-    pub caches: HashMap<CandidatePair, DistanceCache>,
     /// Every intersection segment end of the pair being answered, A's frame.
     points: Vec<DVec3>,
     /// The contact normal (A's triangle normal) of each entry of `points`.
@@ -95,7 +92,7 @@ pub(super) fn sphere_sphere(
 }
 
 /// Mesh–mesh (meshes are surfaces): the exact distance when the query needs one (`CLOSE`,
-/// `DISTANCE`; warm-started per pair), the reduced intersection set when it asks `CONTACTS`,
+/// `DISTANCE`; warm-started from the pair's `cache`), the reduced intersection set when it asks `CONTACTS`,
 /// else (`OVERLAP` alone) [`intersects_mesh_mesh`], which stops at the first proof.
 ///
 /// Without a distance, a touching pair's record says distance 0 (intersecting surfaces),
@@ -106,6 +103,7 @@ pub(super) fn mesh_mesh(
     (a, ma): (&Body, &MeshShape),
     (b, mb): (&Body, &MeshShape),
     query: Query,
+    cache: &mut DistanceCache,
     scratch: &mut MeshScratch,
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
@@ -129,7 +127,7 @@ pub(super) fn mesh_mesh(
             &mb.distance_tree,
             &pose_ab,
             &DistanceParams::EXACT,
-            scratch.caches.entry(*pair).or_default(),
+            cache,
             &mut scratch.traversal,
         );
         result.distance = d.distance;

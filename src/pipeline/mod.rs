@@ -56,14 +56,21 @@
 
 mod answer;
 mod contacts;
+pub mod workers;
 
 pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
 
 use crate::broad::{CandidatePair, Proxy, SortAndSweep};
 use crate::math::DVec3;
+use crate::narrow::mesh_mesh::DistanceCache;
+use crate::scene::MeshShape;
 use crate::scene::{Body, BodyId, Scene, Shape};
 use answer::{Answer, MeshScratch};
+use std::collections::HashMap;
+use std::sync::Arc;
 use std::time::Instant;
+pub use workers::{MIN_PARALLEL_MESH_PAIRS, WorkerPool};
+use workers::{MeshJob, MeshOutcome};
 
 /// What a frame asks for (see the [module docs](self)); at least one flag should be set, or
 /// the frame reports nothing.
@@ -209,15 +216,38 @@ pub struct StepReport {
     pub contacts: u32,
 }
 
-/// State of [`step`] kept across frames: scratch space (no allocation once grown) and the
-/// warm-start cache of every mesh–mesh pair that was a candidate last frame.
+/// State of [`step`] kept across frames: scratch space (no allocation once grown), the
+/// broad phase's order, the warm-start cache of every mesh–mesh pair that was a candidate
+/// last frame, and the worker pool when there is one.
 #[derive(Debug, Default)]
 pub struct PipelineWorkspace {
     proxies: Vec<Proxy>,
     /// The broad phase's order, kept between frames (coherent motion re-sorts in linear time).
     sweep: SortAndSweep,
     candidates: Vec<CandidatePair>,
+    /// This thread's mesh–mesh scratch.
     mesh: MeshScratch,
+    /// Closest triangle pair of each mesh–mesh candidate, for the next frame's first bound.
+    /// Pairs that stop being candidates are forgotten; a pair that appears inserts once.
+    mesh_caches: HashMap<CandidatePair, DistanceCache>,
+    /// Answers a frame's mesh–mesh pairs in parallel (see [`workers`]).
+    workers: Option<Arc<WorkerPool>>,
+    /// The pool's answers of this frame, by candidate slot.
+    outcomes: Vec<MeshOutcome>,
+    /// Contact scratch of one pair answered on this thread for the pool.
+    job_contacts: Vec<ContactPoint>,
+}
+
+impl PipelineWorkspace {
+    /// A workspace that answers mesh–mesh pairs on `workers` too (when a frame has at least
+    /// [`MIN_PARALLEL_MESH_PAIRS`] of them). Results are identical with or without.
+    #[must_use]
+    pub fn with_workers(workers: Arc<WorkerPool>) -> Self {
+        Self {
+            workers: Some(workers),
+            ..Self::default()
+        }
+    }
 }
 
 /// Runs one frame over `scene`: the pairs `query` asks for (see the [module docs](self)),
@@ -238,13 +268,43 @@ pub fn step(
     let broad_ns = elapsed_ns(started);
     let started = Instant::now();
     let mut completeness = Completeness::Exact;
-    let candidates = &workspace.candidates;
-    // Pairs that stop being candidates are forgotten; a pair that appears inserts once.
-    workspace
-        .mesh
-        .caches
-        .retain(|pair, _| candidates.binary_search(pair).is_ok());
-    for pair in candidates {
+    let PipelineWorkspace {
+        candidates,
+        mesh,
+        mesh_caches,
+        workers,
+        outcomes,
+        job_contacts,
+        ..
+    } = workspace;
+    mesh_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
+    outcomes.clear();
+    let parallel = workers.as_ref().filter(|_| {
+        candidates
+            .iter()
+            .filter(|pair| mesh_pair(scene, pair).is_some())
+            .take(MIN_PARALLEL_MESH_PAIRS)
+            .count()
+            == MIN_PARALLEL_MESH_PAIRS
+    });
+    if let Some(pool) = parallel {
+        let jobs = candidates.iter().enumerate().filter_map(|(slot, pair)| {
+            let (mesh_a, mesh_b) = mesh_pair(scene, pair)?;
+            Some(MeshJob {
+                slot: index(slot),
+                pair: *pair,
+                a: *body(scene, pair.a),
+                b: *body(scene, pair.b),
+                mesh_a: Arc::clone(mesh_a),
+                mesh_b: Arc::clone(mesh_b),
+                query,
+                cache: mesh_caches.get(pair).copied().unwrap_or_default(),
+            })
+        });
+        pool.answer_all(jobs, outcomes, mesh, job_contacts);
+    }
+    let mut pooled = outcomes.iter();
+    for (slot, pair) in candidates.iter().enumerate() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let first_contact = results.contacts.len();
         let contacts = &mut results.contacts;
@@ -252,9 +312,24 @@ pub fn step(
             (Shape::Sphere(sa), Shape::Sphere(sb)) => {
                 answer::sphere_sphere(pair, (a, sa), (b, sb), query, contacts)
             }
-            (Shape::Mesh(ma), Shape::Mesh(mb)) => {
-                answer::mesh_mesh(pair, (a, ma), (b, mb), query, &mut workspace.mesh, contacts)
-            }
+            (Shape::Mesh(ma), Shape::Mesh(mb)) => match parallel {
+                Some(_) => {
+                    let outcome = pooled.next().expect("one pool outcome per mesh pair");
+                    debug_assert_eq!(outcome.slot as usize, slot);
+                    contacts.extend_from_slice(outcome.contacts());
+                    mesh_caches.insert(*pair, outcome.cache);
+                    outcome.answer
+                }
+                None => answer::mesh_mesh(
+                    pair,
+                    (a, ma),
+                    (b, mb),
+                    query,
+                    mesh_caches.entry(*pair).or_default(),
+                    mesh,
+                    contacts,
+                ),
+            },
             _ => answer::boxes(pair, &a.world_bounds, &b.world_bounds, query, contacts),
         };
         if !answer.result.exact {
@@ -279,7 +354,7 @@ pub fn step(
         completeness,
         broad_ns,
         narrow_ns: elapsed_ns(started),
-        candidates: index(workspace.candidates.len()),
+        candidates: index(candidates.len()),
         pairs: index(results.pairs.len()),
         contacts: index(results.contacts.len()),
     }
@@ -291,6 +366,20 @@ fn index(n: usize) -> u32 {
 
 fn elapsed_ns(since: Instant) -> u64 {
     u64::try_from(since.elapsed().as_nanos()).unwrap_or(u64::MAX)
+}
+
+/// The two meshes of a mesh–mesh candidate, else `None`.
+fn mesh_pair<'s>(
+    scene: &'s Scene,
+    pair: &CandidatePair,
+) -> Option<(&'s Arc<MeshShape>, &'s Arc<MeshShape>)> {
+    match (
+        shape(scene, body(scene, pair.a)),
+        shape(scene, body(scene, pair.b)),
+    ) {
+        (Shape::Mesh(a), Shape::Mesh(b)) => Some((a, b)),
+        _ => None,
+    }
 }
 
 fn body(scene: &Scene, id: u32) -> &Body {
@@ -455,6 +544,61 @@ mod tests {
         let a = add(&mut scene, Shape::Mesh(torus.clone()), DVec3::ZERO, 0.5);
         let b = add(&mut scene, Shape::Mesh(torus.clone()), DVec3::X, 0.5);
         (scene, a, b, torus)
+    }
+
+    /// Tori and spheres moving coherently: a workspace with a worker pool gives exactly the
+    /// results of one without, frame after frame (warm starts included), for every query.
+    #[test]
+    fn the_worker_pool_changes_nothing_but_who_answers() {
+        let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.6, 0.15, 20, 8))));
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let mut rng = rng(79);
+        let mut bodies = Vec::new();
+        for i in 0..10 {
+            let shape = if i % 3 == 2 {
+                Shape::Sphere(Sphere::new(0.3))
+            } else {
+                torus.clone()
+            };
+            bodies.push(add(&mut scene, shape, point_in_cube(&mut rng, 1.5), 0.2));
+        }
+        let pool = Arc::new(WorkerPool::new(2));
+        let queries = [
+            Query::CLOSE.union(Query::CONTACTS),
+            Query::DISTANCE,
+            Query::OVERLAP,
+        ];
+        let (mut serial, mut parallel) = (
+            PipelineWorkspace::default(),
+            PipelineWorkspace::with_workers(pool),
+        );
+        let (mut expected, mut found) = (FrameResults::default(), FrameResults::default());
+        let (mut mesh_pairs, mut contact_frames) = (0, 0);
+        for frame in 0..120 {
+            for &body in &bodies {
+                let pose = scene.body(body).unwrap().pose;
+                let moved = Pose::new(
+                    (pose.position + point_in_cube(&mut rng, 0.08)).clamp_length_max(1.8),
+                    rotation(&mut rng).slerp(pose.rotation, 0.9),
+                );
+                scene.set_pose(body, moved).unwrap();
+            }
+            let query = queries[frame % queries.len()];
+            let a = step(&scene, query, &mut serial, &mut expected);
+            let b = step(&scene, query, &mut parallel, &mut found);
+            assert_eq!(found.pairs, expected.pairs, "frame {frame}");
+            assert_eq!(found.contacts, expected.contacts, "frame {frame}");
+            assert_eq!(
+                (a.completeness, a.candidates, a.pairs, a.contacts),
+                (b.completeness, b.candidates, b.pairs, b.contacts)
+            );
+            mesh_pairs += parallel.outcomes.len();
+            contact_frames += usize::from(!found.contacts.is_empty());
+        }
+        assert!(
+            mesh_pairs > 200 && contact_frames > 10,
+            "mesh pairs through the pool {mesh_pairs}, frames with contacts {contact_frames}"
+        );
     }
 
     #[test]

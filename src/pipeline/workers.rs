@@ -1,0 +1,242 @@
+//! The pipeline's worker pool: persistent threads that answer a frame's expensive pairs
+//! (mesh–mesh) alongside the calling thread.
+//!
+//! # Design note
+//! A job owns everything it needs (the two bodies, `Arc`s of their meshes, the query and
+//! the pair's warm-start cache), so workers hold no borrow of the scene and need no
+//! `unsafe`. Jobs travel over a bounded crossbeam channel (a fixed ring: no allocation per
+//! message); the calling thread takes queued jobs itself once it has handed them out, then
+//! collects the workers' outcomes and sorts them by candidate slot, so the frame's results
+//! are the same, in the same order, whichever thread answered which pair.
+//!
+//! Waking a parked worker costs 60–120 µs on a VM, so [`step`](super::step) hands out work
+//! only when a frame has at least [`MIN_PARALLEL_MESH_PAIRS`] mesh pairs. A pool serves one
+//! frame at a time (a lock held for the frame), so scenes may share one.
+//!
+//! A worker that panics on a job (a bug, never client input, which is validated at ingest)
+//! answers that pair with the conservative box answer instead of leaving the frame waiting.
+
+use super::answer::{self, Answer, MeshScratch};
+use super::contacts::MAX_CONTACTS_PER_PAIR;
+use super::{ContactPoint, Query};
+use crate::broad::CandidatePair;
+use crate::math::DVec3;
+use crate::narrow::mesh_mesh::DistanceCache;
+use crate::scene::{Body, MeshShape};
+use crossbeam::channel::{self, Receiver, Sender, TrySendError};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
+
+/// Fewest mesh–mesh pairs in a frame for the pool to be used (below it, waking a worker
+/// costs more than it saves).
+pub const MIN_PARALLEL_MESH_PAIRS: usize = 2;
+/// Jobs the channel holds; a frame with more answers the overflow on the calling thread.
+const QUEUE_CAPACITY: usize = 4096;
+
+/// One mesh–mesh pair to answer.
+#[derive(Debug, Clone)]
+pub(super) struct MeshJob {
+    /// Index of the pair among the frame's candidates.
+    pub slot: u32,
+    pub pair: CandidatePair,
+    pub a: Body,
+    pub b: Body,
+    pub mesh_a: Arc<MeshShape>,
+    pub mesh_b: Arc<MeshShape>,
+    pub query: Query,
+    pub cache: DistanceCache,
+}
+
+/// A pair's answer, its contacts and its updated warm-start cache.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct MeshOutcome {
+    pub slot: u32,
+    pub answer: Answer,
+    contacts: [ContactPoint; MAX_CONTACTS_PER_PAIR],
+    contact_count: usize,
+    pub cache: DistanceCache,
+}
+
+impl MeshOutcome {
+    /// The pair's contacts (their `pair` index not yet set).
+    pub fn contacts(&self) -> &[ContactPoint] {
+        &self.contacts[..self.contact_count]
+    }
+}
+
+/// A placeholder for unused contact slots.
+const NO_CONTACT: ContactPoint = ContactPoint {
+    pair: 0,
+    point_a: DVec3::ZERO,
+    point_b: DVec3::ZERO,
+    normal: DVec3::ZERO,
+    distance: 0.0,
+    error_bound: 0.0,
+};
+
+/// Answers `job` with `scratch`; `contacts` is scratch for the pair's contacts.
+pub(super) fn run(
+    job: &MeshJob,
+    scratch: &mut MeshScratch,
+    contacts: &mut Vec<ContactPoint>,
+) -> MeshOutcome {
+    contacts.clear();
+    let mut cache = job.cache;
+    let answer = answer::mesh_mesh(
+        &job.pair,
+        (&job.a, &job.mesh_a),
+        (&job.b, &job.mesh_b),
+        job.query,
+        &mut cache,
+        scratch,
+        contacts,
+    );
+    let mut outcome = MeshOutcome {
+        slot: job.slot,
+        answer,
+        contacts: [NO_CONTACT; MAX_CONTACTS_PER_PAIR],
+        contact_count: contacts.len().min(MAX_CONTACTS_PER_PAIR),
+        cache,
+    };
+    outcome.contacts[..outcome.contact_count].copy_from_slice(&contacts[..outcome.contact_count]);
+    outcome
+}
+
+/// [`run`], with a panic turned into the pair's conservative box answer.
+fn run_guarded(
+    job: &MeshJob,
+    scratch: &mut MeshScratch,
+    contacts: &mut Vec<ContactPoint>,
+) -> MeshOutcome {
+    catch_unwind(AssertUnwindSafe(|| run(job, scratch, contacts))).unwrap_or_else(|_| {
+        // The scratch may be half-updated: start afresh.
+        *scratch = MeshScratch::default();
+        contacts.clear();
+        let answer = answer::boxes(
+            &job.pair,
+            &job.a.world_bounds,
+            &job.b.world_bounds,
+            job.query,
+            contacts,
+        );
+        let mut outcome = MeshOutcome {
+            slot: job.slot,
+            answer,
+            contacts: [NO_CONTACT; MAX_CONTACTS_PER_PAIR],
+            contact_count: contacts.len().min(MAX_CONTACTS_PER_PAIR),
+            cache: DistanceCache::new(),
+        };
+        outcome.contacts[..outcome.contact_count]
+            .copy_from_slice(&contacts[..outcome.contact_count]);
+        outcome
+    })
+}
+
+/// Persistent worker threads; dropping the pool stops and joins them.
+#[derive(Debug)]
+pub struct WorkerPool {
+    /// `None` only while dropping (closing it stops the workers).
+    jobs: Option<Sender<MeshJob>>,
+    /// The same queue, for the calling thread to take jobs from.
+    queue: Receiver<MeshJob>,
+    outcomes: Receiver<MeshOutcome>,
+    /// Held for the length of a frame: one frame at a time.
+    frame: Mutex<()>,
+    threads: Vec<JoinHandle<()>>,
+}
+
+impl WorkerPool {
+    /// A pool of `workers` threads (besides the calling thread, which works too).
+    ///
+    /// # Panics
+    /// When the operating system cannot start a thread.
+    #[must_use]
+    pub fn new(workers: usize) -> Self {
+        let (jobs, queue) = channel::bounded::<MeshJob>(QUEUE_CAPACITY);
+        let (outcome_tx, outcomes) = channel::bounded(QUEUE_CAPACITY);
+        let threads = (0..workers)
+            .map(|i| {
+                let (queue, outcome_tx) = (queue.clone(), outcome_tx.clone());
+                std::thread::Builder::new()
+                    .name(format!("proxima-worker-{i}"))
+                    .spawn(move || {
+                        let (mut scratch, mut contacts) = (MeshScratch::default(), Vec::new());
+                        for job in queue {
+                            let outcome = run_guarded(&job, &mut scratch, &mut contacts);
+                            if outcome_tx.send(outcome).is_err() {
+                                break;
+                            }
+                        }
+                    })
+                    .expect("the operating system starts a worker thread")
+            })
+            .collect();
+        Self {
+            jobs: Some(jobs),
+            queue,
+            outcomes,
+            frame: Mutex::new(()),
+            threads,
+        }
+    }
+
+    /// A pool using every core: one worker fewer than the available parallelism (the
+    /// calling thread is the other), at least one.
+    #[must_use]
+    pub fn sized_to_cores() -> Self {
+        let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
+        Self::new(cores.saturating_sub(1).max(1))
+    }
+
+    /// Number of worker threads.
+    #[must_use]
+    pub fn workers(&self) -> usize {
+        self.threads.len()
+    }
+
+    /// Answers every job, on the workers and the calling thread (with `scratch` and
+    /// `contacts` as its scratch); `outcomes` receives one outcome per job, sorted by slot.
+    pub(super) fn answer_all(
+        &self,
+        jobs: impl Iterator<Item = MeshJob>,
+        outcomes: &mut Vec<MeshOutcome>,
+        scratch: &mut MeshScratch,
+        contacts: &mut Vec<ContactPoint>,
+    ) {
+        let _frame = self.frame.lock().unwrap_or_else(PoisonError::into_inner);
+        let sender = self.jobs.as_ref().expect("open until the pool drops");
+        let mut pending = 0usize;
+        for job in jobs {
+            match sender.try_send(job) {
+                Ok(()) => pending += 1,
+                Err(TrySendError::Full(job) | TrySendError::Disconnected(job)) => {
+                    outcomes.push(run_guarded(&job, scratch, contacts));
+                }
+            }
+        }
+        while let Ok(job) = self.queue.try_recv() {
+            outcomes.push(run_guarded(&job, scratch, contacts));
+            pending -= 1;
+        }
+        for _ in 0..pending {
+            // Every worker answers every job it takes (`run_guarded` catches panics) and lives
+            // until the pool drops, so the channel stays open and `pending` outcomes arrive.
+            let outcome = self
+                .outcomes
+                .recv()
+                .expect("workers live as long as the pool");
+            outcomes.push(outcome);
+        }
+        outcomes.sort_unstable_by_key(|o| o.slot);
+    }
+}
+
+impl Drop for WorkerPool {
+    fn drop(&mut self) {
+        self.jobs = None;
+        for thread in self.threads.drain(..) {
+            let _ = thread.join();
+        }
+    }
+}
