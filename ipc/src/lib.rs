@@ -118,10 +118,47 @@ pub fn results_service_builder<S: iceoryx2::service::Service>(
         .history_size(0))
 }
 
-/// The builder of scene `scene`'s event service (`<root>/<scene>/events`): clients notify
-/// [`EVENT_POSES_SENT`] after publishing a pose frame, the daemon notifies
-/// [`EVENT_RESULTS_READY`] after publishing a result frame, so either side can block in a
-/// WaitSet instead of spinning.
+/// The builder of scene `scene`'s poses-ready event service (`<root>/<scene>/poses-ready`):
+/// clients notify [`EVENT_POSES_SENT`] after publishing a pose frame; the daemon's one
+/// listener blocks on it (in its WaitSet) between frames. One service per direction, so
+/// neither side is woken by its own notifications.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn poses_ready_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+    scene: u32,
+) -> Result<EventBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&format!("{root}/{scene}/poses-ready"))?;
+    Ok(node
+        .service_builder(&name)
+        .event()
+        .max_notifiers(POSES_MAX_PUBLISHERS)
+        .max_listeners(DAEMON_LISTENERS))
+}
+
+/// The builder of scene `scene`'s results-ready event service (`<root>/<scene>/results-ready`):
+/// the daemon notifies [`EVENT_RESULTS_READY`] after publishing a result frame; clients
+/// block on it instead of spinning.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn results_ready_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+    scene: u32,
+) -> Result<EventBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&format!("{root}/{scene}/results-ready"))?;
+    Ok(node
+        .service_builder(&name)
+        .event()
+        .max_notifiers(DAEMON_LISTENERS)
+        .max_listeners(RESULTS_MAX_SUBSCRIBERS))
+}
+
+/// The daemon's side of the result events: the same service as
+/// [`results_ready_service_builder`], under the name the daemon's frame path uses.
 ///
 /// # Errors
 /// `root` does not make a valid iceoryx2 service name.
@@ -130,12 +167,27 @@ pub fn events_service_builder<S: iceoryx2::service::Service>(
     root: &str,
     scene: u32,
 ) -> Result<EventBuilder<S>, ServiceNameError> {
-    let name = ServiceName::new(&format!("{root}/{scene}/events"))?;
+    results_ready_service_builder(node, root, scene)
+}
+
+/// The builder of the control event service (`<root>/control-events`): a client notifies
+/// [`EVENT_CONTROL_SENT`] after each control request, so the daemon, blocked in its WaitSet,
+/// wakes for it (request–response ports cannot join a WaitSet). Up to
+/// [`CONTROL_MAX_CLIENTS`] notifiers; the daemon's one listener.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn control_events_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+) -> Result<EventBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&format!("{root}/control-events"))?;
     Ok(node
         .service_builder(&name)
         .event()
-        .max_notifiers(POSES_MAX_PUBLISHERS + 1)
-        .max_listeners(RESULTS_MAX_SUBSCRIBERS + 1))
+        .max_notifiers(CONTROL_MAX_CLIENTS)
+        .max_listeners(DAEMON_LISTENERS)
+        .max_nodes(CONTROL_MAX_CLIENTS + DAEMON_LISTENERS))
 }
 
 /// The iceoryx2 builder type [`poses_service_builder`] returns.
@@ -155,6 +207,11 @@ pub const FRAME_BUFFER: usize = 2;
 pub const EVENT_POSES_SENT: usize = 1;
 /// Event id the daemon sends after publishing a result frame.
 pub const EVENT_RESULTS_READY: usize = 2;
+/// Event id a client sends after sending a control request.
+pub const EVENT_CONTROL_SENT: usize = 3;
+/// Daemon ports on a daemon-side event service: the running daemon, plus one slot for a
+/// crashed predecessor whose node has not been cleaned up yet when a new daemon starts.
+pub const DAEMON_LISTENERS: usize = 2;
 
 /// The name of scene `scene`'s pose service under `root`.
 #[must_use]
