@@ -137,9 +137,10 @@ where
             return Ok(());
         }
         self.log.info(format_args!(
-            "serving root {:?} (protocol {}), dead-client grace {:?}",
+            "root {:?}, spin {:?}, sweep every {:?}, dead-client grace {:?}",
             self.root,
-            proxima_ipc::PROTOCOL_VERSION,
+            self.spin,
+            self.sweep_interval,
             self.liveness.grace()
         ));
         let mut next_sweep = Instant::now() + self.sweep_interval;
@@ -193,11 +194,11 @@ where
                 };
                 self.log
                     .once(Level::Warn, Subject::Client(origin), cause, || {
-                        format!(
-                            "refused control request {}: {}",
-                            request.command,
-                            reply.reason()
-                        )
+                        let name = Command::from_u32(request.command).map_or_else(
+                            || format!("command {}", request.command),
+                            |c| format!("{c:?}"),
+                        );
+                        format!("refused {name}: {}", reply.reason())
                     });
             }
             // A client that went away no longer wants the reply: not an error of the daemon.
