@@ -1171,6 +1171,68 @@ mod tests {
     }
 
     #[test]
+    fn every_request_notifies_the_control_event_service_so_a_blocked_daemon_wakes() {
+        let root = root("events");
+        let _responder = Responder::start::<local::Service>(&root, None, conformance);
+        let node = NodeBuilder::new().create::<local::Service>().unwrap();
+        let listener = crate::control_events_service_builder(&node, &root)
+            .unwrap()
+            .open_or_create()
+            .unwrap()
+            .listener_builder()
+            .create()
+            .unwrap();
+        let client = ClientBuilder::new()
+            .root(&root)
+            .connect::<local::Service>()
+            .unwrap();
+        let drain = || {
+            let mut ids = Vec::new();
+            listener.try_wait(|e| ids.push(e.id.as_value())).unwrap();
+            ids
+        };
+        assert_eq!(drain(), [EVENT_CONTROL_SENT]); // Hello
+        assert_eq!(drain(), Vec::<usize>::new());
+        client.create_scene().unwrap();
+        client.drop_scene(0).unwrap();
+        assert_eq!(drain(), [EVENT_CONTROL_SENT]);
+    }
+
+    #[test]
+    fn a_daemon_that_went_away_or_was_replaced_is_reported_as_lost_without_waiting() {
+        let root = root("replaced");
+        let first = Responder::start::<local::Service>(&root, None, conformance);
+        let timeout = Duration::from_secs(5);
+        let client = ClientBuilder::new()
+            .root(&root)
+            .reply_timeout(timeout)
+            .connect::<local::Service>()
+            .unwrap();
+        assert!(client.create_scene().is_ok());
+        assert!(client.daemon_is_alive());
+        drop(first); // its server port is gone
+        let start = Instant::now();
+        assert_eq!(client.create_scene(), Err(ControlError::DaemonLost));
+        assert!(start.elapsed() < timeout, "{:?}", start.elapsed());
+        assert!(!client.daemon_is_alive());
+        // Another daemon serves the root now: still not the one this client said Hello to.
+        let second = Responder::start::<local::Service>(&root, None, conformance);
+        let start = Instant::now();
+        assert_eq!(client.drop_scene(0), Err(ControlError::DaemonLost));
+        assert!(start.elapsed() < timeout, "{:?}", start.elapsed());
+        assert!(!client.daemon_is_alive());
+        // A client that connects again is served by it.
+        let rejoined = ClientBuilder::new()
+            .root(&root)
+            .connect::<local::Service>()
+            .unwrap();
+        assert!(rejoined.create_scene().is_ok());
+        assert_eq!(second.next().0.command, Command::Hello as u32);
+        assert_eq!(second.next().0.command, Command::CreateScene as u32);
+        assert!(ControlError::DaemonLost.to_string().contains("reconnect"));
+    }
+
+    #[test]
     fn a_daemon_under_another_iceoryx_prefix_is_invisible() {
         let root = root("prefix");
         let prefix = format!("proxima_client_test_{}_", std::process::id());

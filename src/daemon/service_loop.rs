@@ -15,9 +15,11 @@
 //! scenes and a scene dropped between two waits simply is not attached at the next one.
 //!
 //! # Sweeps
-//! Every [`DaemonConfig::sweep_interval`]: termination signals are checked (a loop that
-//! never runs out of work never blocks), the nodes of crashed processes are cleaned up, and
-//! scenes whose creating control client is gone are orphaned and, after
+//! Every [`DaemonConfig::sweep_interval`] termination signals are checked (a loop that
+//! never runs out of work never blocks). About as often, at the next idle moment (the
+//! cleanup takes hundreds of µs, too long to slip in between a frame's arrival and its
+//! answer; at most [`MAX_SWEEP_DELAY`] late), the nodes of crashed processes are cleaned
+//! up, and scenes whose creating control client is gone are orphaned and, after
 //! [`DaemonConfig::dead_client_grace`], dropped ([`Liveness`]).
 
 use super::config::DaemonConfig;
@@ -33,6 +35,9 @@ use iceoryx2::service::port_factory::request_response::PortFactory as RequestRes
 use iceoryx2::waitset::WaitSetRunResult;
 use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
 use std::time::{Duration, Instant};
+
+/// How late a due sweep may be postponed while frames keep the loop busy.
+const MAX_SWEEP_DELAY: Duration = Duration::from_secs(1);
 
 /// A scene's ports: its frame path and the listener that wakes the loop for its frames.
 struct ScenePorts<S: Service> {
@@ -143,28 +148,41 @@ where
             self.sweep_interval,
             self.liveness.grace()
         ));
-        let mut next_sweep = Instant::now() + self.sweep_interval;
-        let mut last_work = Instant::now();
+        let start = Instant::now();
+        let (mut next_sweep, mut next_signal_check) =
+            (start + self.sweep_interval, start + self.sweep_interval);
+        let mut last_work = start;
         loop {
             let served = self.serve_control()? + self.serve_frames()?;
             let now = Instant::now();
-            if now >= next_sweep {
+            if served > 0 {
+                last_work = now;
+            }
+            let idle = now.duration_since(last_work) >= self.spin;
+            // A loop that never runs out of work never blocks, so it checks for signals
+            // itself (about 2 µs).
+            if now >= next_signal_check {
                 if self.termination_requested() {
                     break;
                 }
+                next_signal_check = now + self.sweep_interval;
+            }
+            // The dead-node cleanup costs hundreds of µs: it waits for an idle moment
+            // between frames, unless it is overdue by more than `MAX_SWEEP_DELAY`.
+            if now >= next_sweep && (idle || now >= next_sweep + MAX_SWEEP_DELAY) {
                 self.sweep(now);
-                next_sweep = now + self.sweep_interval;
+                next_sweep = Instant::now() + self.sweep_interval;
+                continue;
             }
-            if served > 0 {
-                last_work = now;
-            } else if now.duration_since(last_work) < self.spin {
+            if !idle {
                 std::hint::spin_loop();
-            } else {
-                if self.block(next_sweep.saturating_duration_since(now))? == Wake::Stop {
-                    break;
-                }
-                last_work = Instant::now();
+                continue;
             }
+            let wake_at = next_sweep.min(next_signal_check);
+            if self.block(wake_at.saturating_duration_since(now))? == Wake::Stop {
+                break;
+            }
+            last_work = Instant::now();
         }
         self.log.info(format_args!("stopping"));
         Ok(())
@@ -239,12 +257,13 @@ where
             return Ok(Wake::Serve);
         }
         let attach_error = |e| DaemonRunError::Ipc(format!("wait set attach: {e:?}"));
-        let listeners: Vec<&Listener<S>> = std::iter::once(&self.control_events)
-            .chain(self.scenes.iter().flatten().map(|p| &p.poses_ready))
-            .collect();
-        let guards = listeners
-            .iter()
-            .map(|listener| self.waitset.attach_notification(*listener))
+        let listeners = || {
+            std::iter::once(&self.control_events)
+                .chain(self.scenes.iter().flatten().map(|p| &p.poses_ready))
+        };
+        // One small allocation per blocking wait, never on the polled path.
+        let guards = listeners()
+            .map(|listener| self.waitset.attach_notification(listener))
             .collect::<Result<Vec<_>, _>>()
             .map_err(attach_error)?;
         let mut drain_error = None;
@@ -252,7 +271,7 @@ where
             .waitset
             .wait_and_process_once_with_timeout(
                 |id| {
-                    for (listener, guard) in listeners.iter().zip(&guards) {
+                    for (listener, guard) in listeners().zip(&guards) {
                         if id.has_event_from(guard)
                             && let Err(e) = listener.try_wait(|_| {})
                         {
