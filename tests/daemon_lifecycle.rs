@@ -285,6 +285,28 @@ fn sigterm_while_frames_flow_stops_the_daemon_with_status_zero() {
     assert!(signalled.elapsed() < TIMEOUT);
 }
 
+#[test]
+fn sigint_stops_an_idle_daemon_with_status_zero_and_sigusr1_does_not() {
+    let mut daemon = Daemon::start();
+    let client = daemon.client();
+    let (_, link) = two_spheres(&client);
+    // iceoryx2 catches SIGUSR1 too (the daemon answered Hello, so its handler is in place):
+    // it interrupts the blocking wait, but must not stop the daemon.
+    std::thread::sleep(Duration::from_millis(50));
+    daemon_harness::signal(daemon.pid(), "-USR1");
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(!daemon.has_exited(), "SIGUSR1 stopped the daemon");
+    assert_frame_answered(&link, 1, 0.5);
+    daemon_harness::signal(daemon.pid(), "-INT");
+    let signalled = Instant::now();
+    while !daemon.has_exited() && signalled.elapsed() < TIMEOUT {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(daemon.has_exited(), "SIGINT did not stop the daemon");
+    let status = daemon.terminate(Duration::ZERO).expect("exited");
+    assert!(status.success(), "{status:?}");
+}
+
 /// User plus system CPU time of process `pid`, in clock ticks (`/proc/<pid>/stat`).
 fn cpu_ticks(pid: u32) -> u64 {
     let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();

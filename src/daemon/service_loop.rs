@@ -287,7 +287,9 @@ where
             return Err(DaemonRunError::Ipc(format!("event listener: {e:?}")));
         }
         Ok(match result {
-            WaitSetRunResult::Interrupt | WaitSetRunResult::TerminationRequest => Wake::Stop,
+            WaitSetRunResult::TerminationRequest => Wake::Stop,
+            // Any signal interrupts the wait; only SIGINT and SIGTERM stop the daemon.
+            WaitSetRunResult::Interrupt if self.termination_requested() => Wake::Stop,
             _ => Wake::Serve,
         })
     }
@@ -318,8 +320,8 @@ where
         });
         for &id in &outcome.orphaned {
             self.log.warn(format_args!(
-                "scene {id}: the client that created it is gone; dropping it in {:?} unless it \
-                 returns",
+                "scene {id}: the client that created it is gone; the scene is dropped after a \
+                 grace period of {:?}",
                 self.liveness.grace()
             ));
         }
