@@ -135,7 +135,7 @@ pub fn poses_ready_service_builder<S: iceoryx2::service::Service>(
         .service_builder(&name)
         .event()
         .max_notifiers(POSES_MAX_PUBLISHERS)
-        .max_listeners(DAEMON_LISTENERS))
+        .max_listeners(DAEMON_EVENT_PORTS))
 }
 
 /// The builder of scene `scene`'s results-ready event service (`<root>/<scene>/results-ready`):
@@ -153,7 +153,7 @@ pub fn results_ready_service_builder<S: iceoryx2::service::Service>(
     Ok(node
         .service_builder(&name)
         .event()
-        .max_notifiers(DAEMON_LISTENERS)
+        .max_notifiers(DAEMON_EVENT_PORTS)
         .max_listeners(RESULTS_MAX_SUBSCRIBERS))
 }
 
@@ -186,8 +186,8 @@ pub fn control_events_service_builder<S: iceoryx2::service::Service>(
         .service_builder(&name)
         .event()
         .max_notifiers(CONTROL_MAX_CLIENTS)
-        .max_listeners(DAEMON_LISTENERS)
-        .max_nodes(CONTROL_MAX_CLIENTS + DAEMON_LISTENERS))
+        .max_listeners(DAEMON_EVENT_PORTS)
+        .max_nodes(CONTROL_MAX_CLIENTS + DAEMON_EVENT_PORTS))
 }
 
 /// The iceoryx2 builder type [`poses_service_builder`] returns.
@@ -211,7 +211,7 @@ pub const EVENT_RESULTS_READY: usize = 2;
 pub const EVENT_CONTROL_SENT: usize = 3;
 /// Daemon ports on a daemon-side event service: the running daemon, plus one slot for a
 /// crashed predecessor whose node has not been cleaned up yet when a new daemon starts.
-pub const DAEMON_LISTENERS: usize = 2;
+pub const DAEMON_EVENT_PORTS: usize = 2;
 
 /// The name of scene `scene`'s pose service under `root`.
 #[must_use]
@@ -400,6 +400,47 @@ mod tests {
         let received = subscriber.receive().unwrap().expect("a result frame");
         assert_eq!(received.user_header().frame_seq, 42);
         assert_eq!(received.payload(), &[pair, contact]);
+    }
+
+    #[test]
+    fn each_direction_of_scene_events_has_its_own_service_so_no_side_hears_itself() {
+        let node = NodeBuilder::new().create::<local::Service>().unwrap();
+        let root = format!("events-test-{}", std::process::id());
+        let poses_ready = poses_ready_service_builder(&node, &root, 4)
+            .unwrap()
+            .open_or_create()
+            .unwrap();
+        let results_ready = results_ready_service_builder(&node, &root, 4)
+            .unwrap()
+            .open_or_create()
+            .unwrap();
+        let daemon_listener = poses_ready.listener_builder().create().unwrap();
+        let client_listener = results_ready.listener_builder().create().unwrap();
+        let ids = |listener: &iceoryx2::port::listener::Listener<local::Service>| {
+            let mut ids = Vec::new();
+            listener.try_wait(|e| ids.push(e.id.as_value())).unwrap();
+            ids
+        };
+        poses_ready
+            .notifier_builder()
+            .create()
+            .unwrap()
+            .notify_with_custom_event_id(EventId::new(EVENT_POSES_SENT))
+            .unwrap();
+        assert_eq!(ids(&client_listener), Vec::<usize>::new());
+        assert_eq!(ids(&daemon_listener), [EVENT_POSES_SENT]);
+        // The daemon's frame path opens the result events under their older name.
+        events_service_builder(&node, &root, 4)
+            .unwrap()
+            .open_or_create()
+            .unwrap()
+            .notifier_builder()
+            .create()
+            .unwrap()
+            .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
+            .unwrap();
+        assert_eq!(ids(&daemon_listener), Vec::<usize>::new());
+        assert_eq!(ids(&client_listener), [EVENT_RESULTS_READY]);
     }
 
     #[test]
