@@ -6,12 +6,10 @@ mod demo;
 
 use clap::{Parser, Subcommand};
 use iceoryx2::prelude::ipc;
+use proxima::daemon::log::Level;
 use proxima::daemon::{Daemon, DaemonConfig};
 use std::error::Error;
 use std::time::Duration;
-
-/// How often the service loop wakes when idle.
-const CYCLE_TIME: Duration = Duration::from_micros(200);
 
 /// Proxima's collision co-processor: serves scenes over iceoryx2 shared memory.
 #[derive(Debug, Parser)]
@@ -28,6 +26,15 @@ struct Cli {
     /// Most scenes alive at once.
     #[arg(long, default_value_t = DaemonConfig::default().max_scenes)]
     max_scenes: u32,
+    /// Milliseconds a scene outlives the client that created it before it is dropped.
+    #[arg(long, default_value_t = DaemonConfig::default().dead_client_grace.as_millis() as u64)]
+    grace_ms: u64,
+    /// Microseconds the service loop keeps polling after its last work before it blocks.
+    #[arg(long, default_value_t = DaemonConfig::default().spin.as_micros() as u64)]
+    spin_us: u64,
+    /// The least important messages written to stderr: error, warn, info or debug.
+    #[arg(long, default_value_t = DaemonConfig::default().log_level)]
+    log_level: Level,
 }
 
 /// What to run instead of serving.
@@ -47,6 +54,9 @@ fn main() -> Result<(), Box<dyn Error>> {
         root: cli.root,
         iceoryx_prefix: cli.iceoryx_prefix,
         max_scenes: cli.max_scenes,
+        dead_client_grace: Duration::from_millis(cli.grace_ms),
+        spin: Duration::from_micros(cli.spin_us),
+        log_level: cli.log_level,
         ..DaemonConfig::default()
     };
     let mut daemon = Daemon::<ipc::Service>::new(config)?;
@@ -55,7 +65,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         env!("CARGO_PKG_VERSION"),
         proxima_ipc::PROTOCOL_VERSION
     );
-    daemon.run(CYCLE_TIME)?;
+    daemon.run()?;
     eprintln!("proximad: stopped");
     Ok(())
 }

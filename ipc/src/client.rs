@@ -33,21 +33,35 @@
 //! ```
 //!
 //! Request–response ports cannot join a WaitSet, so a reply is awaited by polling with a
-//! short back-off: a spin of [`SPIN`], then sleeps of [`SLEEP`].
+//! short back-off: a spin of [`SPIN`], then sleeps of [`SLEEP`]. After each request the
+//! client notifies the control event service, which wakes a daemon blocked in its WaitSet.
+//!
+//! # When the daemon goes away
+//! A client is bound to the daemon that answered its `Hello` (its server port). When that
+//! daemon has crashed or was replaced by a restart, every request fails with
+//! [`ControlError::DaemonLost`], at once if the daemon's port is already gone and otherwise
+//! once the reply timeout has passed: the daemon's scenes, shapes and bodies are gone with
+//! it, so connect again ([`ClientBuilder::connect`]) and register everything anew.
 
 use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
+use iceoryx2::identifiers::UniqueServerId;
 use iceoryx2::node::{Node, NodeBuilder};
 use iceoryx2::port::client::Client as ClientPort;
-use iceoryx2::prelude::{AllocationStrategy, FileName, PortFactory as _, SemanticString as _};
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::prelude::{
+    AllocationStrategy, CallbackProgression, EventId, FileName, PortFactory as _,
+    SemanticString as _,
+};
 use iceoryx2::service::Service;
+use iceoryx2::service::port_factory::event::PortFactory as EventPortFactory;
 use iceoryx2::service::port_factory::request_response::PortFactory;
 
 use crate::error::{ClientConnectError, ControlError, SceneOpenError};
 use crate::scene_link::SceneLink;
 use crate::wire::{Command, ControlReply, ControlRequest, ErrorCode, MotionCode, ShapeKindCode};
-use crate::{CONTROL_INITIAL_MAX_SLICE_LEN, DEFAULT_ROOT, PROTOCOL_VERSION};
+use crate::{CONTROL_INITIAL_MAX_SLICE_LEN, DEFAULT_ROOT, EVENT_CONTROL_SENT, PROTOCOL_VERSION};
 
 /// How long a reply is awaited by spinning before the wait starts sleeping.
 pub const SPIN: Duration = Duration::from_micros(20);
@@ -246,6 +260,15 @@ impl ClientBuilder {
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
             .create()
             .map_err(|e| ClientConnectError::Transport(format!("creating the client port: {e}")))?;
+        let events = crate::control_events_service_builder(&node, &self.root)
+            .map_err(|_| ClientConnectError::InvalidRoot(self.root.clone()))?
+            .open_or_create()
+            .map_err(|e| {
+                ClientConnectError::Transport(format!("opening the control event service: {e}"))
+            })?;
+        let notifier = events.notifier_builder().create().map_err(|e| {
+            ClientConnectError::Transport(format!("creating the control notifier: {e}"))
+        })?;
         // A request sent before the daemon's server port exists is lost: wait for it first.
         poll_until(deadline, || {
             Ok::<_, ()>((service.dynamic_config().number_of_servers() > 0).then_some(()))
@@ -253,11 +276,14 @@ impl ClientBuilder {
         .ok()
         .flatten()
         .ok_or(ClientConnectError::NoDaemon)?;
-        let client = Client {
+        let mut client = Client {
             root: self.root,
             reply_timeout: self.reply_timeout,
+            daemon: None,
             port,
+            notifier,
             service,
+            _events: events,
             node,
         };
         let hello = ControlRequest {
@@ -266,7 +292,10 @@ impl ClientBuilder {
             ..ControlRequest::default()
         };
         let reply = match client.request_until(&hello, 0, |_| {}, deadline) {
-            Ok(reply) => reply,
+            Ok((reply, daemon)) => {
+                client.daemon = Some(daemon);
+                reply
+            }
             Err(ControlError::Timeout) => return Err(ClientConnectError::NoDaemon),
             Err(e) => return Err(ClientConnectError::Transport(e.to_string())),
         };
@@ -295,9 +324,13 @@ fn check_hello(reply: &ControlReply) -> Result<(), ClientConnectError> {
 pub struct Client<S: Service> {
     root: String,
     reply_timeout: Duration,
-    // Fields drop in order: the port before its service, both before the node.
+    /// The server port of the daemon that answered `Hello` (`None` only during connect).
+    daemon: Option<UniqueServerId>,
+    // Fields drop in order: the ports before their services, all before the node.
     port: ClientPort<S, [u8], ControlRequest, ControlReply, ()>,
+    notifier: Notifier<S>,
     service: PortFactory<S, [u8], ControlRequest, ControlReply, ()>,
+    _events: EventPortFactory<S>,
     node: Node<S>,
 }
 
@@ -451,7 +484,8 @@ impl<S: Service> Client<S> {
     /// tests and tools; the typed methods above are built on it.
     ///
     /// # Errors
-    /// [`ControlError::Timeout`] and [`ControlError::Transport`] only.
+    /// [`ControlError::Timeout`], [`ControlError::DaemonLost`] and
+    /// [`ControlError::Transport`] only.
     pub fn request(
         &self,
         header: &ControlRequest,
@@ -463,6 +497,34 @@ impl<S: Service> Client<S> {
             |out| out.copy_from_slice(payload),
             Instant::now() + self.reply_timeout,
         )
+        .map(|(reply, _)| reply)
+    }
+
+    /// Whether the daemon this client said `Hello` to still serves the control service.
+    /// Removes the ports of crashed processes first, so a daemon killed without a chance to
+    /// clean up counts as gone.
+    #[must_use]
+    pub fn daemon_is_alive(&self) -> bool {
+        let _ = self.node.try_cleanup_dead_nodes();
+        self.daemon_is_listed()
+    }
+
+    /// Whether the daemon's server port is listed on the control service (a crashed
+    /// daemon's port stays listed until some process cleans up its node).
+    fn daemon_is_listed(&self) -> bool {
+        let Some(daemon) = self.daemon else {
+            return true;
+        };
+        let mut listed = false;
+        self.service.dynamic_config().list_servers(|server| {
+            listed = server.server_id == daemon;
+            if listed {
+                CallbackProgression::Stop
+            } else {
+                CallbackProgression::Continue
+            }
+        });
+        listed
     }
 
     /// A request header for `command` on `scene`, every other field zero.
@@ -492,7 +554,8 @@ impl<S: Service> Client<S> {
         };
         let len = geometry_len(vertices.len(), triangles.len() * 3);
         let fill = |out: &mut [u8]| encode_geometry(out, vertices, triangles);
-        let reply = self.request_until(&header, len, fill, Instant::now() + self.reply_timeout)?;
+        let (reply, _) =
+            self.request_until(&header, len, fill, Instant::now() + self.reply_timeout)?;
         reply_id(&reply)
     }
 
@@ -501,15 +564,21 @@ impl<S: Service> Client<S> {
         reply_id(&self.request(header, &[])?)
     }
 
-    /// Loans a `len`-byte request, lets `fill` write it, sends it and waits for the reply
-    /// until `deadline`.
+    /// Loans a `len`-byte request, lets `fill` write it, sends it, wakes the daemon and waits
+    /// for the reply until `deadline`; returns the reply and the server port that sent it.
+    ///
+    /// [`ControlError::DaemonLost`] before sending when the daemon's port is gone, when a
+    /// reply comes from another daemon, and at the deadline when the daemon has died.
     fn request_until(
         &self,
         header: &ControlRequest,
         len: usize,
         fill: impl FnOnce(&mut [u8]),
         deadline: Instant,
-    ) -> Result<ControlReply, ControlError> {
+    ) -> Result<(ControlReply, UniqueServerId), ControlError> {
+        if !self.daemon_is_listed() {
+            return Err(ControlError::DaemonLost);
+        }
         let mut request = self
             .port
             .loan_slice(len)
@@ -519,13 +588,25 @@ impl<S: Service> Client<S> {
         let pending = request
             .send()
             .map_err(|e| ControlError::Transport(format!("sending a request: {e}")))?;
-        poll_until(deadline, || {
+        // No listener (a daemon that never blocks, or none at all) is not an error here: the
+        // reply wait below decides.
+        let _ = self
+            .notifier
+            .notify_with_custom_event_id(EventId::new(EVENT_CONTROL_SENT));
+        let answer = poll_until(deadline, || {
             pending
                 .receive()
-                .map(|reply| reply.map(|r| *r.payload()))
+                .map(|reply| reply.map(|r| (*r.payload(), r.origin())))
                 .map_err(|e| ControlError::Transport(format!("receiving a reply: {e}")))
-        })?
-        .ok_or(ControlError::Timeout)
+        })?;
+        match answer {
+            Some((_, origin)) if self.daemon.is_some_and(|daemon| daemon != origin) => {
+                Err(ControlError::DaemonLost)
+            }
+            Some(answer) => Ok(answer),
+            None if !self.daemon_is_alive() => Err(ControlError::DaemonLost),
+            None => Err(ControlError::Timeout),
+        }
     }
 }
 
@@ -1087,6 +1168,68 @@ mod tests {
         }
         assert_eq!(responder.next().0.command, Command::Hello as u32);
         assert_eq!(responder.next().0.command, Command::CreateScene as u32);
+    }
+
+    #[test]
+    fn every_request_notifies_the_control_event_service_so_a_blocked_daemon_wakes() {
+        let root = root("events");
+        let _responder = Responder::start::<local::Service>(&root, None, conformance);
+        let node = NodeBuilder::new().create::<local::Service>().unwrap();
+        let listener = crate::control_events_service_builder(&node, &root)
+            .unwrap()
+            .open_or_create()
+            .unwrap()
+            .listener_builder()
+            .create()
+            .unwrap();
+        let client = ClientBuilder::new()
+            .root(&root)
+            .connect::<local::Service>()
+            .unwrap();
+        let drain = || {
+            let mut ids = Vec::new();
+            listener.try_wait(|e| ids.push(e.id.as_value())).unwrap();
+            ids
+        };
+        assert_eq!(drain(), [EVENT_CONTROL_SENT]); // Hello
+        assert_eq!(drain(), Vec::<usize>::new());
+        client.create_scene().unwrap();
+        client.drop_scene(0).unwrap();
+        assert_eq!(drain(), [EVENT_CONTROL_SENT]);
+    }
+
+    #[test]
+    fn a_daemon_that_went_away_or_was_replaced_is_reported_as_lost_without_waiting() {
+        let root = root("replaced");
+        let first = Responder::start::<local::Service>(&root, None, conformance);
+        let timeout = Duration::from_secs(5);
+        let client = ClientBuilder::new()
+            .root(&root)
+            .reply_timeout(timeout)
+            .connect::<local::Service>()
+            .unwrap();
+        assert!(client.create_scene().is_ok());
+        assert!(client.daemon_is_alive());
+        drop(first); // its server port is gone
+        let start = Instant::now();
+        assert_eq!(client.create_scene(), Err(ControlError::DaemonLost));
+        assert!(start.elapsed() < timeout, "{:?}", start.elapsed());
+        assert!(!client.daemon_is_alive());
+        // Another daemon serves the root now: still not the one this client said Hello to.
+        let second = Responder::start::<local::Service>(&root, None, conformance);
+        let start = Instant::now();
+        assert_eq!(client.drop_scene(0), Err(ControlError::DaemonLost));
+        assert!(start.elapsed() < timeout, "{:?}", start.elapsed());
+        assert!(!client.daemon_is_alive());
+        // A client that connects again is served by it.
+        let rejoined = ClientBuilder::new()
+            .root(&root)
+            .connect::<local::Service>()
+            .unwrap();
+        assert!(rejoined.create_scene().is_ok());
+        assert_eq!(second.next().0.command, Command::Hello as u32);
+        assert_eq!(second.next().0.command, Command::CreateScene as u32);
+        assert!(ControlError::DaemonLost.to_string().contains("reconnect"));
     }
 
     #[test]

@@ -72,8 +72,12 @@ pub enum ControlError {
     },
     /// The reply's status is a value this protocol version does not define.
     UnknownStatus(u32),
-    /// No reply arrived within the client's reply timeout (the daemon may be gone).
+    /// No reply arrived within the client's reply timeout, though the daemon still serves.
     Timeout,
+    /// The daemon this client connected to is gone (it crashed, or a restarted daemon now
+    /// serves the root): its scenes, shapes and bodies went with it. Connect again and
+    /// register everything anew.
+    DaemonLost,
     /// The geometry has more points or indices than a `u32` count can carry; carries the
     /// offending count.
     TooLarge(usize),
@@ -91,6 +95,9 @@ impl std::fmt::Display for ControlError {
                 write!(f, "the daemon replied with unknown status {status}")
             }
             Self::Timeout => f.write_str("no reply from the daemon within the timeout"),
+            Self::DaemonLost => f.write_str(
+                "the daemon this client connected to is gone (crashed or restarted): reconnect",
+            ),
             Self::TooLarge(count) => {
                 write!(f, "{count} points or indices exceed the u32 wire count")
             }

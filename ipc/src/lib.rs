@@ -120,10 +120,47 @@ pub fn results_service_builder<S: iceoryx2::service::Service>(
         .history_size(0))
 }
 
-/// The builder of scene `scene`'s event service (`<root>/<scene>/events`): clients notify
-/// [`EVENT_POSES_SENT`] after publishing a pose frame, the daemon notifies
-/// [`EVENT_RESULTS_READY`] after publishing a result frame, so either side can block in a
-/// WaitSet instead of spinning.
+/// The builder of scene `scene`'s poses-ready event service (`<root>/<scene>/poses-ready`):
+/// clients notify [`EVENT_POSES_SENT`] after publishing a pose frame; the daemon's one
+/// listener blocks on it (in its WaitSet) between frames. One service per direction, so
+/// neither side is woken by its own notifications.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn poses_ready_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+    scene: u32,
+) -> Result<EventBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&format!("{root}/{scene}/poses-ready"))?;
+    Ok(node
+        .service_builder(&name)
+        .event()
+        .max_notifiers(POSES_MAX_PUBLISHERS)
+        .max_listeners(DAEMON_EVENT_PORTS))
+}
+
+/// The builder of scene `scene`'s results-ready event service (`<root>/<scene>/results-ready`):
+/// the daemon notifies [`EVENT_RESULTS_READY`] after publishing a result frame; clients
+/// block on it instead of spinning.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn results_ready_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+    scene: u32,
+) -> Result<EventBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&format!("{root}/{scene}/results-ready"))?;
+    Ok(node
+        .service_builder(&name)
+        .event()
+        .max_notifiers(DAEMON_EVENT_PORTS)
+        .max_listeners(RESULTS_MAX_SUBSCRIBERS))
+}
+
+/// The daemon's side of the result events: the same service as
+/// [`results_ready_service_builder`], under the name the daemon's frame path uses.
 ///
 /// # Errors
 /// `root` does not make a valid iceoryx2 service name.
@@ -132,12 +169,27 @@ pub fn events_service_builder<S: iceoryx2::service::Service>(
     root: &str,
     scene: u32,
 ) -> Result<EventBuilder<S>, ServiceNameError> {
-    let name = ServiceName::new(&format!("{root}/{scene}/events"))?;
+    results_ready_service_builder(node, root, scene)
+}
+
+/// The builder of the control event service (`<root>/control-events`): a client notifies
+/// [`EVENT_CONTROL_SENT`] after each control request, so the daemon, blocked in its WaitSet,
+/// wakes for it (request–response ports cannot join a WaitSet). Up to
+/// [`CONTROL_MAX_CLIENTS`] notifiers; the daemon's one listener.
+///
+/// # Errors
+/// `root` does not make a valid iceoryx2 service name.
+pub fn control_events_service_builder<S: iceoryx2::service::Service>(
+    node: &Node<S>,
+    root: &str,
+) -> Result<EventBuilder<S>, ServiceNameError> {
+    let name = ServiceName::new(&format!("{root}/control-events"))?;
     Ok(node
         .service_builder(&name)
         .event()
-        .max_notifiers(POSES_MAX_PUBLISHERS + 1)
-        .max_listeners(RESULTS_MAX_SUBSCRIBERS + 1))
+        .max_notifiers(CONTROL_MAX_CLIENTS)
+        .max_listeners(DAEMON_EVENT_PORTS)
+        .max_nodes(CONTROL_MAX_CLIENTS + DAEMON_EVENT_PORTS))
 }
 
 /// The iceoryx2 builder type [`poses_service_builder`] returns.
@@ -157,6 +209,11 @@ pub const FRAME_BUFFER: usize = 2;
 pub const EVENT_POSES_SENT: usize = 1;
 /// Event id the daemon sends after publishing a result frame.
 pub const EVENT_RESULTS_READY: usize = 2;
+/// Event id a client sends after sending a control request.
+pub const EVENT_CONTROL_SENT: usize = 3;
+/// Daemon ports on a daemon-side event service: the running daemon, plus one slot for a
+/// crashed predecessor whose node has not been cleaned up yet when a new daemon starts.
+pub const DAEMON_EVENT_PORTS: usize = 2;
 
 /// The name of scene `scene`'s pose service under `root`.
 #[must_use]
@@ -345,6 +402,47 @@ mod tests {
         let received = subscriber.receive().unwrap().expect("a result frame");
         assert_eq!(received.user_header().frame_seq, 42);
         assert_eq!(received.payload(), &[pair, contact]);
+    }
+
+    #[test]
+    fn each_direction_of_scene_events_has_its_own_service_so_no_side_hears_itself() {
+        let node = NodeBuilder::new().create::<local::Service>().unwrap();
+        let root = format!("events-test-{}", std::process::id());
+        let poses_ready = poses_ready_service_builder(&node, &root, 4)
+            .unwrap()
+            .open_or_create()
+            .unwrap();
+        let results_ready = results_ready_service_builder(&node, &root, 4)
+            .unwrap()
+            .open_or_create()
+            .unwrap();
+        let daemon_listener = poses_ready.listener_builder().create().unwrap();
+        let client_listener = results_ready.listener_builder().create().unwrap();
+        let ids = |listener: &iceoryx2::port::listener::Listener<local::Service>| {
+            let mut ids = Vec::new();
+            listener.try_wait(|e| ids.push(e.id.as_value())).unwrap();
+            ids
+        };
+        poses_ready
+            .notifier_builder()
+            .create()
+            .unwrap()
+            .notify_with_custom_event_id(EventId::new(EVENT_POSES_SENT))
+            .unwrap();
+        assert_eq!(ids(&client_listener), Vec::<usize>::new());
+        assert_eq!(ids(&daemon_listener), [EVENT_POSES_SENT]);
+        // The daemon's frame path opens the result events under their older name.
+        events_service_builder(&node, &root, 4)
+            .unwrap()
+            .open_or_create()
+            .unwrap()
+            .notifier_builder()
+            .create()
+            .unwrap()
+            .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
+            .unwrap();
+        assert_eq!(ids(&daemon_listener), Vec::<usize>::new());
+        assert_eq!(ids(&client_listener), [EVENT_RESULTS_READY]);
     }
 
     #[test]

@@ -30,9 +30,11 @@
 //! ```
 //!
 //! Waiting is hybrid (see `shared/notes/iceoryx2-0.10.md`): the subscriber is polled for
-//! [`SPIN`], then the wait blocks on the scene's event listener until the daemon notifies
-//! [`EVENT_RESULTS_READY`](crate::EVENT_RESULTS_READY) or the deadline passes. Waking a
-//! halted vCPU costs 60–120 µs on a VM; the spin catches answers that come sooner.
+//! [`SPIN`], then the wait blocks on the scene's results-ready listener until the daemon
+//! notifies [`EVENT_RESULTS_READY`](crate::EVENT_RESULTS_READY) or the deadline passes.
+//! Waking a halted vCPU costs 60–120 µs on a VM; the spin catches answers that come sooner.
+//! Pose frames are announced on a separate poses-ready service, so the client's own
+//! notifications never wake its wait.
 //!
 //! A pose frame published before the daemon's subscriber exists is lost (the service keeps
 //! no history); the daemon opens a scene's services when the scene is created.
@@ -71,11 +73,14 @@ pub struct SceneLink<S: Service> {
     // Fields drop in order: the ports before their services.
     poses: Publisher<S, [PoseRecord], PoseFrameHeader>,
     results: Subscriber<S, [ResultRecord], ResultFrameHeader>,
+    /// Notifies the poses-ready service (the daemon listens).
     notifier: Notifier<S>,
+    /// Listens on the results-ready service (the daemon notifies).
     listener: Listener<S>,
     _poses_service: PubSubPortFactory<S, [PoseRecord], PoseFrameHeader>,
     _results_service: PubSubPortFactory<S, [ResultRecord], ResultFrameHeader>,
-    _events_service: EventPortFactory<S>,
+    _poses_ready_service: EventPortFactory<S>,
+    _results_ready_service: EventPortFactory<S>,
 }
 
 impl<S: Service> std::fmt::Debug for SceneLink<S> {
@@ -106,10 +111,14 @@ impl<S: Service> SceneLink<S> {
             .map_err(invalid)?
             .open_or_create()
             .map_err(|e| transport("opening the result service", e))?;
-        let events_service = crate::events_service_builder(node, root, scene)
+        let poses_ready_service = crate::poses_ready_service_builder(node, root, scene)
             .map_err(invalid)?
             .open_or_create()
-            .map_err(|e| transport("opening the event service", e))?;
+            .map_err(|e| transport("opening the poses-ready event service", e))?;
+        let results_ready_service = crate::results_ready_service_builder(node, root, scene)
+            .map_err(invalid)?
+            .open_or_create()
+            .map_err(|e| transport("opening the results-ready event service", e))?;
         let poses = poses_service
             .publisher_builder()
             .initial_max_slice_len(POSES_INITIAL_MAX_SLICE_LEN)
@@ -121,11 +130,11 @@ impl<S: Service> SceneLink<S> {
             .subscriber_builder()
             .create()
             .map_err(|e| transport("creating the result subscriber", e))?;
-        let notifier = events_service
+        let notifier = poses_ready_service
             .notifier_builder()
             .create()
             .map_err(|e| transport("creating the event notifier", e))?;
-        let listener = events_service
+        let listener = results_ready_service
             .listener_builder()
             .create()
             .map_err(|e| transport("creating the event listener", e))?;
@@ -137,7 +146,8 @@ impl<S: Service> SceneLink<S> {
             listener,
             _poses_service: poses_service,
             _results_service: results_service,
-            _events_service: events_service,
+            _poses_ready_service: poses_ready_service,
+            _results_ready_service: results_ready_service,
         })
     }
 
@@ -433,7 +443,11 @@ mod tests {
                     .unwrap()
                     .open_or_create()
                     .unwrap();
-                let events = crate::events_service_builder(&node, &root, scene)
+                let poses_ready = crate::poses_ready_service_builder(&node, &root, scene)
+                    .unwrap()
+                    .open_or_create()
+                    .unwrap();
+                let results_ready = crate::results_ready_service_builder(&node, &root, scene)
                     .unwrap()
                     .open_or_create()
                     .unwrap();
@@ -445,8 +459,8 @@ mod tests {
                     .max_loaned_samples(1)
                     .create()
                     .unwrap();
-                let notifier = events.notifier_builder().create().unwrap();
-                let listener = events.listener_builder().create().unwrap();
+                let notifier = results_ready.notifier_builder().create().unwrap();
+                let listener = poses_ready.listener_builder().create().unwrap();
                 ready_tx.send(()).unwrap();
                 while !flag.load(Ordering::Relaxed) {
                     while let Some(frame) = subscriber.receive().unwrap() {
@@ -673,7 +687,7 @@ mod tests {
     fn receive_times_out_with_none_when_nobody_answers() {
         let root = root("silent");
         let link = SceneLink::open(&node(), &root, 1).unwrap();
-        // Our own poses-sent event wakes the listener: the wait must not end on it.
+        // Nobody answers: the wait must last its whole timeout and then give up.
         link.publish_poses(1, 0, 0, &[pose(1, 0)]).unwrap();
         for timeout in [
             Duration::ZERO,

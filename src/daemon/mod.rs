@@ -7,7 +7,10 @@
 //! - `ingest`: stage 1 of a frame, a pose frame checked whole and applied to its scene;
 //! - `frame_loop`: a scene's pose subscriber, result publisher and event notifier, and the
 //!   path of one frame through ingest, the pipeline and publication;
-//! - `service_loop`: the iceoryx2 node and ports, served until a termination signal;
+//! - `service_loop`: the iceoryx2 node and ports, served until a termination signal, with a
+//!   hybrid wait (spin, then block in a WaitSet) and a periodic dead-client sweep;
+//! - [`liveness`]: which client owns each scene, and which scenes outlived their owner;
+//! - [`log`]: leveled stderr lines, once per (scene or client, cause);
 //! - `error`: start-up and run failures (client mistakes are wire error codes instead).
 
 pub mod config;
@@ -17,6 +20,8 @@ mod convert;
 mod error;
 mod frame_loop;
 mod ingest;
+pub mod liveness;
+pub mod log;
 mod service_loop;
 
 pub use config::DaemonConfig;

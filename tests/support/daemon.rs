@@ -6,19 +6,27 @@
 
 use iceoryx2::prelude::ipc;
 use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion};
-use std::process::{Child, Command};
+use std::process::{Child, Command, ExitStatus};
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// A daemon process with a unique root and prefix, stopped and cleaned up on drop.
 pub struct Daemon {
     child: Child,
     root: String,
     prefix: String,
+    /// Extra command-line arguments, kept for [`restart`](Self::restart).
+    args: Vec<String>,
 }
 
 impl Daemon {
+    /// A daemon with `--max-scenes 3` and otherwise default settings.
     pub fn start() -> Self {
+        Self::start_with(&[])
+    }
+
+    /// A daemon with `--max-scenes 3` and the extra arguments `args` (e.g. `--grace-ms`).
+    pub fn start_with(args: &[&str]) -> Self {
         static NEXT: AtomicU32 = AtomicU32::new(0);
         let tag = format!(
             "{}_{}",
@@ -26,57 +34,130 @@ impl Daemon {
             NEXT.fetch_add(1, Ordering::Relaxed)
         );
         let (root, prefix) = (format!("proxima-test-{tag}"), format!("iox2_pxt{tag}_"));
-        let child = Command::new(env!("CARGO_BIN_EXE_proximad"))
-            .args([
-                "--root",
-                &root,
-                "--iceoryx-prefix",
-                &prefix,
-                "--max-scenes",
-                "3",
-            ])
-            .spawn()
-            .expect("proximad starts");
+        let args: Vec<String> = args.iter().map(|&a| a.to_owned()).collect();
+        let child = spawn(&root, &prefix, &args);
         Self {
             child,
             root,
             prefix,
+            args,
         }
     }
 
+    /// The daemon's service root (`--root`).
+    pub fn root(&self) -> &str {
+        &self.root
+    }
+
+    /// The daemon's iceoryx2 prefix (`--iceoryx-prefix`).
+    pub fn prefix(&self) -> &str {
+        &self.prefix
+    }
+
+    /// The daemon's process id.
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// A connected client with a 10 s reply timeout.
     pub fn client(&self) -> Client<ipc::Service> {
+        self.client_with_timeout(Duration::from_secs(10))
+    }
+
+    /// A connected client with reply timeout `timeout`.
+    pub fn client_with_timeout(&self, timeout: Duration) -> Client<ipc::Service> {
+        self.client_builder()
+            .reply_timeout(timeout)
+            .connect::<ipc::Service>()
+            .expect("the daemon answers Hello")
+    }
+
+    /// A client builder for this daemon's root and prefix.
+    pub fn client_builder(&self) -> ClientBuilder {
         ClientBuilder::new()
             .root(&self.root)
             .iceoryx_prefix(&self.prefix)
-            .reply_timeout(Duration::from_secs(10))
-            .connect::<ipc::Service>()
-            .expect("the daemon answers Hello")
+    }
+
+    /// Kills the daemon with SIGKILL (no chance to clean up) and reaps it.
+    pub fn kill(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+
+    /// Starts a new daemon process with the same root, prefix and arguments (after
+    /// [`kill`](Self::kill) or [`terminate`](Self::terminate)).
+    pub fn restart(&mut self) {
+        assert!(
+            matches!(self.child.try_wait(), Ok(Some(_))),
+            "the old daemon has stopped"
+        );
+        self.child = spawn(&self.root, &self.prefix, &self.args);
+    }
+
+    /// Sends SIGTERM and waits up to `timeout` for the daemon to exit; its exit status, or
+    /// `None` if it was still running (it is then killed).
+    pub fn terminate(&mut self, timeout: Duration) -> Option<ExitStatus> {
+        if let Ok(Some(status)) = self.child.try_wait() {
+            return Some(status);
+        }
+        signal(self.child.id(), "-TERM");
+        let deadline = Instant::now() + timeout;
+        while Instant::now() < deadline {
+            if let Ok(Some(status)) = self.child.try_wait() {
+                return Some(status);
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        self.kill();
+        None
+    }
+
+    /// Whether the daemon process has exited (it is reaped if so).
+    pub fn has_exited(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(Some(_)))
     }
 }
 
 impl Drop for Daemon {
     fn drop(&mut self) {
-        // SIGTERM: the daemon's node.wait() sees it and the process exits cleanly.
-        let _ = Command::new("kill")
-            .args(["-TERM", &self.child.id().to_string()])
-            .status();
-        let stopped = (0..200).any(|_| {
-            std::thread::sleep(Duration::from_millis(10));
-            matches!(self.child.try_wait(), Ok(Some(_)))
-        });
-        if !stopped {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
+        // SIGTERM: the daemon's service loop sees it and the process exits cleanly.
+        if self.terminate(Duration::from_secs(2)).is_none() {
+            self.kill();
         }
-        if let Ok(entries) = std::fs::read_dir("/dev/shm") {
-            for entry in entries.flatten() {
-                if entry
-                    .file_name()
-                    .to_string_lossy()
-                    .starts_with(&self.prefix)
-                {
-                    let _ = std::fs::remove_file(entry.path());
-                }
+        remove_shared_memory(&self.prefix);
+    }
+}
+
+/// Starts `proximad` with `root`, `prefix`, `--max-scenes 3` and `args`.
+fn spawn(root: &str, prefix: &str, args: &[String]) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_proximad"))
+        .args([
+            "--root",
+            root,
+            "--iceoryx-prefix",
+            prefix,
+            "--max-scenes",
+            "3",
+        ])
+        .args(args)
+        .spawn()
+        .expect("proximad starts")
+}
+
+/// Sends `signal` (e.g. `-TERM`) to process `pid`.
+pub fn signal(pid: u32, signal: &str) {
+    let _ = Command::new("kill")
+        .args([signal, &pid.to_string()])
+        .status();
+}
+
+/// Removes the `/dev/shm` files of iceoryx2 prefix `prefix`.
+pub fn remove_shared_memory(prefix: &str) {
+    if let Ok(entries) = std::fs::read_dir("/dev/shm") {
+        for entry in entries.flatten() {
+            if entry.file_name().to_string_lossy().starts_with(prefix) {
+                let _ = std::fs::remove_file(entry.path());
             }
         }
     }
