@@ -22,7 +22,7 @@
 
 use clap::Parser;
 use glam::{DQuat, DVec3};
-use iceoryx2::prelude::ipc;
+use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
 use proxima::geometry::TriMesh;
 use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion, Primitive};
 use proxima_ipc::daemon_process::{ChildProcess, Isolation};
@@ -75,6 +75,7 @@ struct Args {
 
 fn main() -> Result<(), Box<dyn Error>> {
     let args = Args::parse();
+    set_log_level_from_env_or(LogLevel::Error);
     let (_daemon, root, prefix) = if args.spawn_daemon {
         let Isolation { root, prefix } = Isolation::unique("fall");
         let exe = match &args.daemon {

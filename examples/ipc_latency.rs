@@ -86,6 +86,7 @@ enum Role {
 
 fn main() -> Result<(), Box<dyn Error>> {
     let args = Args::parse();
+    set_log_level_from_env_or(LogLevel::Error);
     match (args.role, &args.root, &args.prefix) {
         (Some(Role::Daemon), Some(root), Some(prefix)) => run_daemon(root, prefix),
         (Some(Role::Echo), Some(root), Some(prefix)) => run_echo(root, prefix),
@@ -361,7 +362,7 @@ fn run_daemon(root: &str, prefix: &str) -> Result<(), Box<dyn Error>> {
         iceoryx_prefix: Some(prefix.to_owned()),
         ..DaemonConfig::default()
     };
-    Daemon::<ipc::Service>::new(config)?.run(Duration::from_micros(200))?;
+    Daemon::<ipc::Service>::new(config)?.run()?;
     Ok(())
 }
 

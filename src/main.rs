@@ -5,36 +5,48 @@
 mod demo;
 
 use clap::{Parser, Subcommand};
-use iceoryx2::prelude::ipc;
+use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
+use proxima::daemon::config_file::ConfigFile;
 use proxima::daemon::log::Level;
 use proxima::daemon::{Daemon, DaemonConfig};
 use std::error::Error;
+use std::path::PathBuf;
 use std::time::Duration;
 
 /// Proxima's collision co-processor: serves scenes over iceoryx2 shared memory.
+///
+/// Settings come from the defaults, then `--config FILE` (TOML), then the flags given.
 #[derive(Debug, Parser)]
 #[command(version, about)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Root prefix of every service name.
-    #[arg(long, default_value = proxima_ipc::DEFAULT_ROOT)]
-    root: String,
+    /// TOML configuration file (see the `proxima::daemon::config_file` docs for its keys).
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Root prefix of every service name [default: proxima].
+    #[arg(long)]
+    root: Option<String>,
     /// iceoryx2 file-name prefix, to keep daemons (and test runs) apart.
     #[arg(long)]
     iceoryx_prefix: Option<String>,
-    /// Most scenes alive at once.
-    #[arg(long, default_value_t = DaemonConfig::default().max_scenes)]
-    max_scenes: u32,
-    /// Milliseconds a scene outlives the client that created it before it is dropped.
-    #[arg(long, default_value_t = DaemonConfig::default().dead_client_grace.as_millis() as u64)]
-    grace_ms: u64,
-    /// Microseconds the service loop keeps polling after its last work before it blocks.
-    #[arg(long, default_value_t = DaemonConfig::default().spin.as_micros() as u64)]
-    spin_us: u64,
-    /// The least important messages written to stderr: error, warn, info or debug.
-    #[arg(long, default_value_t = DaemonConfig::default().log_level)]
-    log_level: Level,
+    /// Most scenes alive at once [default: 64].
+    #[arg(long)]
+    max_scenes: Option<u32>,
+    /// Milliseconds a scene outlives the client that created it [default: 2000].
+    #[arg(long)]
+    grace_ms: Option<u64>,
+    /// Microseconds the service loop keeps polling after its last work before it blocks
+    /// [default: 50].
+    #[arg(long)]
+    spin_us: Option<u64>,
+    /// The least important messages written to stderr: error, warn, info or debug
+    /// [default: info].
+    #[arg(long)]
+    log_level: Option<Level>,
+    /// Worker threads answering mesh pairs beside the service loop [default: cores − 1].
+    #[arg(long)]
+    workers: Option<usize>,
 }
 
 /// What to run instead of serving.
@@ -45,27 +57,46 @@ enum Command {
     Demo(demo::DemoArgs),
 }
 
+impl Cli {
+    /// The defaults, overridden by the configuration file, overridden by the flags given.
+    fn config(&self) -> Result<DaemonConfig, Box<dyn Error>> {
+        let mut config = DaemonConfig::default();
+        if let Some(path) = &self.config {
+            config = ConfigFile::load(path)?.apply(&config)?;
+        }
+        if let Some(root) = &self.root {
+            config.root.clone_from(root);
+        }
+        if let Some(prefix) = &self.iceoryx_prefix {
+            config.iceoryx_prefix = Some(prefix.clone());
+        }
+        if let Some(max_scenes) = self.max_scenes {
+            config.max_scenes = max_scenes;
+        }
+        if let Some(ms) = self.grace_ms {
+            config.dead_client_grace = Duration::from_millis(ms);
+        }
+        if let Some(us) = self.spin_us {
+            config.spin = Duration::from_micros(us);
+        }
+        if let Some(level) = self.log_level {
+            config.log_level = level;
+        }
+        if let Some(workers) = self.workers {
+            config.workers = workers;
+        }
+        Ok(config)
+    }
+}
+
 fn main() -> Result<(), Box<dyn Error>> {
     let cli = Cli::parse();
+    // iceoryx2's own warnings (e.g. "no config file loaded": we configure it in code) stay
+    // quiet unless IOX2_LOG_LEVEL asks for them.
+    set_log_level_from_env_or(LogLevel::Error);
     if let Some(Command::Demo(args)) = &cli.command {
         return demo::run(args);
     }
-    let config = DaemonConfig {
-        root: cli.root,
-        iceoryx_prefix: cli.iceoryx_prefix,
-        max_scenes: cli.max_scenes,
-        dead_client_grace: Duration::from_millis(cli.grace_ms),
-        spin: Duration::from_micros(cli.spin_us),
-        log_level: cli.log_level,
-        ..DaemonConfig::default()
-    };
-    let mut daemon = Daemon::<ipc::Service>::new(config)?;
-    eprintln!(
-        "proximad {} (protocol {}) serving",
-        env!("CARGO_PKG_VERSION"),
-        proxima_ipc::PROTOCOL_VERSION
-    );
-    daemon.run()?;
-    eprintln!("proximad: stopped");
+    Daemon::<ipc::Service>::new(cli.config()?)?.run()?;
     Ok(())
 }

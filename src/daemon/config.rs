@@ -36,6 +36,9 @@ pub struct DaemonConfig {
     pub dead_client_grace: Duration,
     /// The least important messages written to stderr.
     pub log_level: Level,
+    /// Worker threads answering mesh–mesh pairs beside the service loop's thread (0: the
+    /// loop answers everything itself). Default: one fewer than the cores, at least one.
+    pub workers: usize,
 }
 
 impl Default for DaemonConfig {
@@ -55,6 +58,8 @@ impl Default for DaemonConfig {
             sweep_interval: Duration::from_millis(100),
             dead_client_grace: Duration::from_millis(2000),
             log_level: Level::Info,
+            workers: std::thread::available_parallelism()
+                .map_or(1, |n| n.get().saturating_sub(1).max(1)),
         }
     }
 }

@@ -7,6 +7,7 @@
 //! ```toml
 //! root = "proxima"                # service root prefix
 //! iceoryx_prefix = "iox2_"        # iceoryx2 file-name prefix (omit: iceoryx2's default)
+//! log_level = "info"              # error, warn, info or debug
 //!
 //! [limits]
 //! max_scenes = 64
@@ -18,12 +19,19 @@
 //!
 //! [scene]
 //! default_margin_m = 0.0          # close-pair margin of bodies that set none, metres
+//!
+//! [service_loop]
+//! spin_us = 50                    # polling after the last work before blocking
+//! sweep_interval_ms = 100         # dead-client and signal checks
+//! dead_client_grace_ms = 2000     # a dead client's scenes live this long
+//! workers = 1                     # threads answering mesh pairs (default: cores − 1)
 //! ```
 
 use super::config::DaemonConfig;
 use serde::Deserialize;
 use std::fmt;
 use std::path::Path;
+use std::time::Duration;
 
 /// The parsed file: every key optional.
 #[derive(Debug, Clone, Default, PartialEq, Deserialize)]
@@ -33,12 +41,31 @@ pub struct ConfigFile {
     pub root: Option<String>,
     /// iceoryx2 file-name prefix.
     pub iceoryx_prefix: Option<String>,
+    /// `error`, `warn`, `info` or `debug`.
+    pub log_level: Option<String>,
     /// `[limits]`.
     #[serde(default)]
     pub limits: LimitsSection,
     /// `[scene]`.
     #[serde(default)]
     pub scene: SceneSection,
+    /// `[service_loop]`.
+    #[serde(default)]
+    pub service_loop: ServiceLoopSection,
+}
+
+/// `[service_loop]`: waiting and dead-client handling.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ServiceLoopSection {
+    /// Polling after the last piece of work before blocking, microseconds.
+    pub spin_us: Option<u64>,
+    /// Period of the dead-client and signal checks, milliseconds, `≥ 1`.
+    pub sweep_interval_ms: Option<u64>,
+    /// How long a dead client's scenes live on, milliseconds.
+    pub dead_client_grace_ms: Option<u64>,
+    /// Worker threads answering mesh–mesh pairs beside the loop (0: none).
+    pub workers: Option<usize>,
 }
 
 /// `[limits]`: what one client may ask of the daemon.
@@ -128,6 +155,29 @@ impl ConfigFile {
         if let Some(prefix) = &self.iceoryx_prefix {
             out.iceoryx_prefix = Some(non_empty("iceoryx_prefix", prefix)?);
         }
+        if let Some(level) = &self.log_level {
+            out.log_level = level.parse().map_err(|reason| ConfigFileError::Invalid {
+                key: "log_level",
+                reason,
+            })?;
+        }
+        let l = &self.service_loop;
+        if let Some(us) = l.spin_us {
+            out.spin = Duration::from_micros(us);
+        }
+        let mut sweep_ms = out.sweep_interval.as_millis() as u64;
+        set_positive(
+            &mut sweep_ms,
+            l.sweep_interval_ms,
+            "service_loop.sweep_interval_ms",
+        )?;
+        out.sweep_interval = Duration::from_millis(sweep_ms);
+        if let Some(ms) = l.dead_client_grace_ms {
+            out.dead_client_grace = Duration::from_millis(ms);
+        }
+        if let Some(workers) = l.workers {
+            out.workers = workers;
+        }
         let l = &self.limits;
         set_positive(&mut out.max_scenes, l.max_scenes, "limits.max_scenes")?;
         set_positive(
@@ -216,6 +266,7 @@ mod tests {
             r#"
             root = "lab"
             iceoryx_prefix = "iox2_lab_"
+            log_level = "debug"
             [limits]
             max_scenes = 3
             max_shapes_per_scene = 10
@@ -225,6 +276,11 @@ mod tests {
             max_convex_points = 50
             [scene]
             default_margin_m = 0.25
+            [service_loop]
+            spin_us = 7
+            sweep_interval_ms = 9
+            dead_client_grace_ms = 11
+            workers = 13
             "#,
         )
         .unwrap();
@@ -241,6 +297,18 @@ mod tests {
             (30, 40)
         );
         assert_eq!((c.max_convex_points, c.default_margin), (50, 0.25));
+        assert_eq!(
+            (c.log_level, c.workers),
+            (super::super::log::Level::Debug, 13)
+        );
+        assert_eq!(
+            (c.spin, c.sweep_interval, c.dead_client_grace),
+            (
+                Duration::from_micros(7),
+                Duration::from_millis(9),
+                Duration::from_millis(11)
+            )
+        );
     }
 
     #[test]
@@ -269,6 +337,11 @@ mod tests {
             ("[scene]\ndefault_margin_m = nan", "scene.default_margin_m"),
             ("[scene]\ndefault_margin_m = inf", "scene.default_margin_m"),
             ("root = \"\"", "root"),
+            ("log_level = \"loud\"", "log_level"),
+            (
+                "[service_loop]\nsweep_interval_ms = 0",
+                "service_loop.sweep_interval_ms",
+            ),
         ] {
             assert!(
                 matches!(invalid(text), ConfigFileError::Invalid { key: k, .. } if k == key),

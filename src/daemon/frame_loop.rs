@@ -13,9 +13,11 @@
 
 use super::convert::Rejection;
 use super::ingest::{FrameRejection, apply_pose_frame};
+use super::log::{Cause, Level, Logger, Subject};
 use crate::math::Pose;
 use crate::pipeline::{
     self, Completeness, ContactPoint, FrameResults, PairResult, PipelineWorkspace, StepReport,
+    WorkerPool,
 };
 use crate::scene::{BodyId, Scene};
 use iceoryx2::port::notifier::Notifier;
@@ -26,6 +28,7 @@ use proxima_ipc::wire::{
     self, ErrorCode, PoseFrameHeader, PoseRecord, RecordKind, ResultFrameHeader, ResultRecord,
 };
 use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Initial number of result records a result sample can hold (grows by powers of two).
@@ -46,7 +49,12 @@ impl<S: Service> SceneFrames<S> {
     ///
     /// # Errors
     /// The iceoryx2 failure, as text.
-    pub fn open(node: &Node<S>, root: &str, scene: u32) -> Result<Self, String> {
+    pub fn open(
+        node: &Node<S>,
+        root: &str,
+        scene: u32,
+        workers: &Arc<WorkerPool>,
+    ) -> Result<Self, String> {
         let poses = proxima_ipc::poses_service_builder(node, root, scene)
             .map_err(|e| format!("{e:?}"))?
             .open_or_create()
@@ -74,7 +82,7 @@ impl<S: Service> SceneFrames<S> {
             poses,
             results,
             notifier,
-            workspace: PipelineWorkspace::default(),
+            workspace: PipelineWorkspace::with_workers(Arc::clone(workers)),
             output: FrameResults::default(),
             validated: Vec::new(),
         })
@@ -84,7 +92,12 @@ impl<S: Service> SceneFrames<S> {
     ///
     /// # Errors
     /// The iceoryx2 failure, as text (client mistakes are answered in the result header).
-    pub fn serve(&mut self, scene_id: u32, scene: &mut Scene) -> Result<usize, String> {
+    pub fn serve(
+        &mut self,
+        scene_id: u32,
+        scene: &mut Scene,
+        log: &mut Logger,
+    ) -> Result<usize, String> {
         let mut served = 0;
         while let Some(sample) = self
             .poses
@@ -116,9 +129,15 @@ impl<S: Service> SceneFrames<S> {
                     rejection: Rejection { code, reason },
                     body,
                 }) => {
-                    eprintln!(
-                        "proximad: scene {scene_id} frame {} refused: {reason}",
-                        header.frame_seq
+                    let seq = header.frame_seq;
+                    log.once(
+                        Level::Warn,
+                        Subject::Scene(scene_id),
+                        Cause {
+                            what: "refused pose frame",
+                            code: code as u32,
+                        },
+                        || format!("frame {seq} refused: {reason}"),
                     );
                     result.status = code as u32;
                     result.error_body = body.unwrap_or(u32::MAX);

@@ -28,12 +28,14 @@ use super::error::{DaemonRunError, DaemonStartError};
 use super::frame_loop::SceneFrames;
 use super::liveness::{Liveness, OwnerId};
 use super::log::{Cause, Level, Logger, Subject};
+use crate::pipeline::WorkerPool;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::request_response::PortFactory as RequestResponseFactory;
 use iceoryx2::waitset::WaitSetRunResult;
 use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// How late a due sweep may be postponed while frames keep the loop busy.
@@ -65,6 +67,8 @@ pub struct Daemon<S: Service> {
     state: ControlState,
     liveness: Liveness,
     log: Logger,
+    /// Answers the mesh–mesh pairs of every scene's frames alongside the service loop.
+    workers: Arc<WorkerPool>,
     root: String,
     spin: Duration,
     sweep_interval: Duration,
@@ -123,6 +127,7 @@ where
             node,
             liveness: Liveness::new(config.dead_client_grace),
             log: Logger::new(config.log_level),
+            workers: Arc::new(WorkerPool::new(config.workers)),
             root: config.root.clone(),
             spin: config.spin,
             sweep_interval: config.sweep_interval,
@@ -239,7 +244,7 @@ where
             };
             served += ports
                 .frames
-                .serve(id as u32, scene)
+                .serve(id as u32, scene, &mut self.log)
                 .map_err(DaemonRunError::Ipc)?;
         }
         Ok(served)
@@ -392,7 +397,7 @@ where
 
     /// Opens scene `id`'s frame ports and poses-ready listener.
     fn open_scene(&self, id: u32) -> Result<ScenePorts<S>, String> {
-        let frames = SceneFrames::open(&self.node, &self.root, id)?;
+        let frames = SceneFrames::open(&self.node, &self.root, id, &self.workers)?;
         let poses_ready = proxima_ipc::poses_ready_service_builder(&self.node, &self.root, id)
             .map_err(|e| format!("{e:?}"))?
             .open_or_create()

@@ -52,7 +52,14 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn Error>> {
     let exe = std::env::current_exe()?;
     let mut daemon = ChildProcess::spawn(
         &exe,
-        ["--root", &root, "--iceoryx-prefix", &prefix],
+        [
+            "--root",
+            &root,
+            "--iceoryx-prefix",
+            &prefix,
+            "--log-level",
+            "warn",
+        ],
         &prefix,
     )?;
     let client = ClientBuilder::new()

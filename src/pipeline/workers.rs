@@ -181,14 +181,6 @@ impl WorkerPool {
         }
     }
 
-    /// A pool using every core: one worker fewer than the available parallelism (the
-    /// calling thread is the other), at least one.
-    #[must_use]
-    pub fn sized_to_cores() -> Self {
-        let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
-        Self::new(cores.saturating_sub(1).max(1))
-    }
-
     /// Number of worker threads.
     #[must_use]
     pub fn workers(&self) -> usize {
