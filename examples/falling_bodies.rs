@@ -41,8 +41,9 @@ const BIN_HALF: f64 = 4.0;
 const WALL_HEIGHT: f64 = 3.0;
 /// Close-pair margin of every body, metres.
 const MARGIN: f64 = 0.02;
-/// A body whose speed stays under this, m/s, counts as resting.
-const REST_SPEED: f64 = 0.05;
+/// A body whose speed stays under this for 30 frames counts as resting, m/s (a body at
+/// rest on the floor still gains g·dt ≈ 0.08 m/s each frame before its contact stops it).
+const REST_SPEED: f64 = 0.15;
 
 #[derive(Debug, Parser)]
 #[command(about = "Bodies falling into a bin, bounced with proximad's contacts")]

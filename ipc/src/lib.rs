@@ -9,6 +9,7 @@ pub mod client;
 pub mod daemon_process;
 pub mod error;
 pub mod latency;
+pub mod result_feed;
 pub mod scene_link;
 pub mod wire;
 

@@ -39,22 +39,21 @@
 //! A pose frame published before the daemon's subscriber exists is lost (the service keeps
 //! no history); the daemon opens a scene's services when the scene is created.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use iceoryx2::node::Node;
-use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::{AllocationStrategy, EventId};
-use iceoryx2::sample::Sample;
 use iceoryx2::service::Service;
 use iceoryx2::service::port_factory::event::PortFactory as EventPortFactory;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPortFactory;
 
 use crate::error::{FrameReceiveError, FrameSendError, SceneOpenError};
-use crate::wire::{PoseFrameHeader, PoseRecord, ResultFrameHeader, ResultRecord};
+use crate::wire::{PoseFrameHeader, PoseRecord};
 use crate::{EVENT_POSES_SENT, PROTOCOL_VERSION};
+
+pub use crate::result_feed::{ResultFeed, ResultFrame};
 
 /// How long a receive polls the result subscriber before it blocks on the event listener.
 pub const SPIN: Duration = Duration::from_micros(50);
@@ -72,15 +71,12 @@ pub struct SceneLink<S: Service> {
     scene: u32,
     // Fields drop in order: the ports before their services.
     poses: Publisher<S, [PoseRecord], PoseFrameHeader>,
-    results: Subscriber<S, [ResultRecord], ResultFrameHeader>,
     /// Notifies the poses-ready service (the daemon listens).
     notifier: Notifier<S>,
-    /// Listens on the results-ready service (the daemon notifies).
-    listener: Listener<S>,
+    /// The receiving half: result subscriber and results-ready listener.
+    feed: ResultFeed<S>,
     _poses_service: PubSubPortFactory<S, [PoseRecord], PoseFrameHeader>,
-    _results_service: PubSubPortFactory<S, [ResultRecord], ResultFrameHeader>,
     _poses_ready_service: EventPortFactory<S>,
-    _results_ready_service: EventPortFactory<S>,
 }
 
 impl<S: Service> std::fmt::Debug for SceneLink<S> {
@@ -107,18 +103,10 @@ impl<S: Service> SceneLink<S> {
             .map_err(invalid)?
             .open_or_create()
             .map_err(|e| transport("opening the pose service", e))?;
-        let results_service = crate::results_service_builder(node, root, scene)
-            .map_err(invalid)?
-            .open_or_create()
-            .map_err(|e| transport("opening the result service", e))?;
         let poses_ready_service = crate::poses_ready_service_builder(node, root, scene)
             .map_err(invalid)?
             .open_or_create()
             .map_err(|e| transport("opening the poses-ready event service", e))?;
-        let results_ready_service = crate::results_ready_service_builder(node, root, scene)
-            .map_err(invalid)?
-            .open_or_create()
-            .map_err(|e| transport("opening the results-ready event service", e))?;
         let poses = poses_service
             .publisher_builder()
             .initial_max_slice_len(POSES_INITIAL_MAX_SLICE_LEN)
@@ -126,28 +114,18 @@ impl<S: Service> SceneLink<S> {
             .max_loaned_samples(1)
             .create()
             .map_err(|e| transport("creating the pose publisher", e))?;
-        let results = results_service
-            .subscriber_builder()
-            .create()
-            .map_err(|e| transport("creating the result subscriber", e))?;
         let notifier = poses_ready_service
             .notifier_builder()
             .create()
             .map_err(|e| transport("creating the event notifier", e))?;
-        let listener = results_ready_service
-            .listener_builder()
-            .create()
-            .map_err(|e| transport("creating the event listener", e))?;
+        let feed = ResultFeed::open(node, root, scene)?;
         Ok(Self {
             scene,
             poses,
-            results,
             notifier,
-            listener,
+            feed,
             _poses_service: poses_service,
-            _results_service: results_service,
             _poses_ready_service: poses_ready_service,
-            _results_ready_service: results_ready_service,
         })
     }
 
@@ -210,14 +188,11 @@ impl<S: Service> SceneLink<S> {
     /// # Errors
     /// [`FrameReceiveError::Transport`] when iceoryx2 fails (e.g. two frames are still held).
     pub fn try_receive_results(&self) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
-        self.results
-            .receive()
-            .map(|sample| sample.map(|sample| ResultFrame { sample }))
-            .map_err(|e| FrameReceiveError::Transport(format!("receiving a result frame: {e}")))
+        self.feed.try_receive()
     }
 
-    /// The next result frame, waiting up to `timeout` (hybrid: a spin of [`SPIN`], then a
-    /// blocking wait on the event listener); `Ok(None)` when none arrived in time.
+    /// The next result frame, waiting up to `timeout` (see [`ResultFeed::receive`]);
+    /// `Ok(None)` when none arrived in time.
     ///
     /// # Errors
     /// [`FrameReceiveError::Transport`] when iceoryx2 fails.
@@ -225,12 +200,11 @@ impl<S: Service> SceneLink<S> {
         &self,
         timeout: Duration,
     ) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
-        self.receive_until(Instant::now() + timeout, |_| true)
+        self.feed.receive(timeout)
     }
 
-    /// The result frame answering pose frame `frame_seq`, waiting up to `timeout`; every
-    /// other frame received meanwhile (older answers, or newer ones if `frame_seq`'s was
-    /// overwritten) is dropped. `Ok(None)` when it did not arrive in time.
+    /// The result frame answering pose frame `frame_seq`, waiting up to `timeout` (see
+    /// [`ResultFeed::receive_for`]); `Ok(None)` when it did not arrive in time.
     ///
     /// # Errors
     /// [`FrameReceiveError::Transport`] when iceoryx2 fails.
@@ -239,45 +213,7 @@ impl<S: Service> SceneLink<S> {
         frame_seq: u64,
         timeout: Duration,
     ) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
-        self.receive_until(Instant::now() + timeout, |header| {
-            header.frame_seq == frame_seq
-        })
-    }
-
-    /// The first received frame whose header `accept`s, waiting until `deadline`.
-    ///
-    /// A notification that arrives between a poll and the blocking wait stays pending in the
-    /// listener, so the wait returns at once and the loop polls again: no wake-up is lost.
-    /// The listener may also wake with nothing new (a stale or foreign event, or zero
-    /// activations), so the deadline is always judged by the clock.
-    fn receive_until(
-        &self,
-        deadline: Instant,
-        mut accept: impl FnMut(&ResultFrameHeader) -> bool,
-    ) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
-        let spin_end = Instant::now() + SPIN;
-        loop {
-            while let Some(frame) = self.try_receive_results()? {
-                if accept(frame.header()) {
-                    return Ok(Some(frame));
-                }
-            }
-            let now = Instant::now();
-            if now >= deadline {
-                return Ok(None);
-            }
-            if now < spin_end {
-                std::hint::spin_loop();
-                continue;
-            }
-            self.listener
-                .timed_wait(|_| {}, deadline - now)
-                .map_err(|e| {
-                    FrameReceiveError::Transport(format!(
-                        "waiting on the scene's event listener: {e}"
-                    ))
-                })?;
-        }
+        self.feed.receive_for(frame_seq, timeout)
     }
 
     /// The header of a frame of `count` poses.
@@ -325,93 +261,23 @@ impl<S: Service> SceneLink<S> {
 }
 
 /// A transport error: `what` failed with iceoryx2's error `e`.
-fn transport(what: &str, e: impl std::fmt::Display) -> SceneOpenError {
+pub(crate) fn transport(what: &str, e: impl std::fmt::Display) -> SceneOpenError {
     SceneOpenError::Transport(format!("{what}: {e}"))
-}
-
-/// A received result frame, read in place in shared memory. Dropping it hands the memory
-/// back to the daemon's publisher.
-pub struct ResultFrame<S: Service> {
-    sample: Sample<S, [ResultRecord], ResultFrameHeader>,
-}
-
-impl<S: Service> std::fmt::Debug for ResultFrame<S> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ResultFrame")
-            .field("header", self.header())
-            .field("records", &self.records().len())
-            .finish()
-    }
-}
-
-impl<S: Service> ResultFrame<S> {
-    /// The frame's header: status, `frame_seq`, counts, timings.
-    #[must_use]
-    pub fn header(&self) -> &ResultFrameHeader {
-        self.sample.user_header()
-    }
-
-    /// Every record of the payload: the pairs, then the contacts.
-    #[must_use]
-    pub fn records(&self) -> &[ResultRecord] {
-        self.sample.payload()
-    }
-
-    /// The pair records: the first `pair_count`, fewer if the payload is shorter.
-    #[must_use]
-    pub fn pairs(&self) -> &[ResultRecord] {
-        let header = self.header();
-        split(self.records(), header.pair_count, header.contact_count).0
-    }
-
-    /// The contact records: the `contact_count` after the pairs, fewer if the payload is
-    /// shorter.
-    #[must_use]
-    pub fn contacts(&self) -> &[ResultRecord] {
-        let header = self.header();
-        split(self.records(), header.pair_count, header.contact_count).1
-    }
-
-    /// The contact records of `pair` (one of [`pairs`](Self::pairs)): the `count` contacts
-    /// from `index` on, counted from the first contact record; clamped to
-    /// [`contacts`](Self::contacts), so a lying record cannot cause a panic.
-    #[must_use]
-    pub fn contacts_of(&self, pair: &ResultRecord) -> &[ResultRecord] {
-        contacts_of(self.contacts(), pair)
-    }
-}
-
-/// `pair.count` records of `contacts` from `pair.index` on, clamped to the slice.
-fn contacts_of<'r>(contacts: &'r [ResultRecord], pair: &ResultRecord) -> &'r [ResultRecord] {
-    let start = usize::try_from(pair.index).map_or(contacts.len(), |i| i.min(contacts.len()));
-    let rest = &contacts[start..];
-    let count = usize::try_from(pair.count).map_or(rest.len(), |c| c.min(rest.len()));
-    &rest[..count]
-}
-
-/// Splits `records` into `pair_count` pairs and the `contact_count` contacts after them,
-/// each clamped to what the slice holds, so a header that lies cannot cause a panic.
-fn split(
-    records: &[ResultRecord],
-    pair_count: u32,
-    contact_count: u32,
-) -> (&[ResultRecord], &[ResultRecord]) {
-    let clamp = |count: u32, len: usize| usize::try_from(count).map_or(len, |c| c.min(len));
-    let (pairs, rest) = records.split_at(clamp(pair_count, records.len()));
-    (pairs, &rest[..clamp(contact_count, rest.len())])
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::EVENT_RESULTS_READY;
-    use crate::wire::{RecordKind, query};
+    use crate::result_feed::{contacts_of, split};
+    use crate::wire::{RecordKind, ResultFrameHeader, ResultRecord, query};
     use iceoryx2::node::NodeBuilder;
     use iceoryx2::prelude::local;
     use std::sync::Arc;
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::mpsc;
     use std::thread::JoinHandle;
+    use std::time::Instant;
 
     /// How the test responder answers one pose frame; `None` leaves it unanswered.
     type Answer =

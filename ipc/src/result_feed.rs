@@ -1,0 +1,223 @@
+//! The receiving half of a scene's frame path: a [`ResultFeed`] subscribes to a scene's
+//! result frames and waits for them (hybrid: a spin, then a blocking wait on the scene's
+//! results-ready listener); each arrives as a [`ResultFrame`], read in place in shared memory.
+//!
+//! A [`SceneLink`](crate::scene_link::SceneLink) holds one to receive the answers to its
+//! own pose frames; a monitor opens one alone to watch a scene it does not drive (a scene's
+//! result service admits [`RESULTS_MAX_SUBSCRIBERS`](crate::RESULTS_MAX_SUBSCRIBERS)).
+
+use std::time::{Duration, Instant};
+
+use iceoryx2::node::Node;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::sample::Sample;
+use iceoryx2::service::Service;
+use iceoryx2::service::port_factory::event::PortFactory as EventPortFactory;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPortFactory;
+
+use crate::error::{FrameReceiveError, SceneOpenError};
+use crate::scene_link::{SPIN, transport};
+use crate::wire::{ResultFrameHeader, ResultRecord};
+
+/// A subscription to one scene's result frames.
+///
+/// A subscriber lends at most two frames at once: drop a [`ResultFrame`] before receiving
+/// the third. Not shareable between threads with `ipc::Service`.
+pub struct ResultFeed<S: Service> {
+    // Fields drop in order: the ports before their services.
+    results: Subscriber<S, [ResultRecord], ResultFrameHeader>,
+    /// Listens on the results-ready service (the daemon notifies).
+    listener: Listener<S>,
+    _results_service: PubSubPortFactory<S, [ResultRecord], ResultFrameHeader>,
+    _results_ready_service: EventPortFactory<S>,
+}
+
+impl<S: Service> std::fmt::Debug for ResultFeed<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ResultFeed").finish_non_exhaustive()
+    }
+}
+
+impl<S: Service> ResultFeed<S> {
+    /// Opens (or creates, if the daemon has not yet) scene `scene`'s result and
+    /// results-ready services under `root` on `node`, and subscribes. Frames published
+    /// before this call are not seen (the service keeps no history).
+    ///
+    /// # Errors
+    /// [`SceneOpenError::InvalidRoot`] when `root` and `scene` make no valid service name,
+    /// [`SceneOpenError::Transport`] when iceoryx2 fails (incompatible existing services,
+    /// too many subscribers).
+    pub fn open(node: &Node<S>, root: &str, scene: u32) -> Result<Self, SceneOpenError> {
+        let invalid = |_| SceneOpenError::InvalidRoot(root.to_owned());
+        let results_service = crate::results_service_builder(node, root, scene)
+            .map_err(invalid)?
+            .open_or_create()
+            .map_err(|e| transport("opening the result service", e))?;
+        let results_ready_service = crate::results_ready_service_builder(node, root, scene)
+            .map_err(invalid)?
+            .open_or_create()
+            .map_err(|e| transport("opening the results-ready event service", e))?;
+        let results = results_service
+            .subscriber_builder()
+            .create()
+            .map_err(|e| transport("creating the result subscriber", e))?;
+        let listener = results_ready_service
+            .listener_builder()
+            .create()
+            .map_err(|e| transport("creating the event listener", e))?;
+        Ok(Self {
+            results,
+            listener,
+            _results_service: results_service,
+            _results_ready_service: results_ready_service,
+        })
+    }
+
+    /// The next result frame if one has arrived, without waiting.
+    ///
+    /// # Errors
+    /// [`FrameReceiveError::Transport`] when iceoryx2 fails (e.g. two frames are still held).
+    pub fn try_receive(&self) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
+        self.results
+            .receive()
+            .map(|sample| sample.map(|sample| ResultFrame { sample }))
+            .map_err(|e| FrameReceiveError::Transport(format!("receiving a result frame: {e}")))
+    }
+
+    /// The next result frame, waiting up to `timeout` (hybrid: a spin of [`SPIN`], then a
+    /// blocking wait on the event listener); `Ok(None)` when none arrived in time.
+    ///
+    /// # Errors
+    /// [`FrameReceiveError::Transport`] when iceoryx2 fails.
+    pub fn receive(&self, timeout: Duration) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
+        self.receive_until(Instant::now() + timeout, |_| true)
+    }
+
+    /// The result frame answering pose frame `frame_seq`, waiting up to `timeout`; every
+    /// other frame received meanwhile (older answers, or newer ones if `frame_seq`'s was
+    /// overwritten) is dropped. `Ok(None)` when it did not arrive in time.
+    ///
+    /// # Errors
+    /// [`FrameReceiveError::Transport`] when iceoryx2 fails.
+    pub fn receive_for(
+        &self,
+        frame_seq: u64,
+        timeout: Duration,
+    ) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
+        self.receive_until(Instant::now() + timeout, |header| {
+            header.frame_seq == frame_seq
+        })
+    }
+
+    /// The first received frame whose header `accept`s, waiting until `deadline`.
+    ///
+    /// A notification that arrives between a poll and the blocking wait stays pending in the
+    /// listener, so the wait returns at once and the loop polls again: no wake-up is lost.
+    /// The listener may also wake with nothing new (a stale or foreign event, or zero
+    /// activations), so the deadline is always judged by the clock.
+    fn receive_until(
+        &self,
+        deadline: Instant,
+        mut accept: impl FnMut(&ResultFrameHeader) -> bool,
+    ) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
+        let spin_end = Instant::now() + SPIN;
+        loop {
+            while let Some(frame) = self.try_receive()? {
+                if accept(frame.header()) {
+                    return Ok(Some(frame));
+                }
+            }
+            let now = Instant::now();
+            if now >= deadline {
+                return Ok(None);
+            }
+            if now < spin_end {
+                std::hint::spin_loop();
+                continue;
+            }
+            self.listener
+                .timed_wait(|_| {}, deadline - now)
+                .map_err(|e| {
+                    FrameReceiveError::Transport(format!(
+                        "waiting on the scene's event listener: {e}"
+                    ))
+                })?;
+        }
+    }
+}
+
+/// A received result frame, read in place in shared memory. Dropping it hands the memory
+/// back to the daemon's publisher.
+pub struct ResultFrame<S: Service> {
+    sample: Sample<S, [ResultRecord], ResultFrameHeader>,
+}
+
+impl<S: Service> std::fmt::Debug for ResultFrame<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ResultFrame")
+            .field("header", self.header())
+            .field("records", &self.records().len())
+            .finish()
+    }
+}
+
+impl<S: Service> ResultFrame<S> {
+    /// The frame's header: status, `frame_seq`, counts, timings.
+    #[must_use]
+    pub fn header(&self) -> &ResultFrameHeader {
+        self.sample.user_header()
+    }
+
+    /// Every record of the payload: the pairs, then the contacts.
+    #[must_use]
+    pub fn records(&self) -> &[ResultRecord] {
+        self.sample.payload()
+    }
+
+    /// The pair records: the first `pair_count`, fewer if the payload is shorter.
+    #[must_use]
+    pub fn pairs(&self) -> &[ResultRecord] {
+        let header = self.header();
+        split(self.records(), header.pair_count, header.contact_count).0
+    }
+
+    /// The contact records: the `contact_count` after the pairs, fewer if the payload is
+    /// shorter.
+    #[must_use]
+    pub fn contacts(&self) -> &[ResultRecord] {
+        let header = self.header();
+        split(self.records(), header.pair_count, header.contact_count).1
+    }
+
+    /// The contact records of `pair` (one of [`pairs`](Self::pairs)): the `count` contacts
+    /// from `index` on, counted from the first contact record; clamped to
+    /// [`contacts`](Self::contacts), so a lying record cannot cause a panic.
+    #[must_use]
+    pub fn contacts_of(&self, pair: &ResultRecord) -> &[ResultRecord] {
+        contacts_of(self.contacts(), pair)
+    }
+}
+
+/// `pair.count` records of `contacts` from `pair.index` on, clamped to the slice.
+pub(crate) fn contacts_of<'r>(
+    contacts: &'r [ResultRecord],
+    pair: &ResultRecord,
+) -> &'r [ResultRecord] {
+    let start = usize::try_from(pair.index).map_or(contacts.len(), |i| i.min(contacts.len()));
+    let rest = &contacts[start..];
+    let count = usize::try_from(pair.count).map_or(rest.len(), |c| c.min(rest.len()));
+    &rest[..count]
+}
+
+/// Splits `records` into `pair_count` pairs and the `contact_count` contacts after them,
+/// each clamped to what the slice holds, so a header that lies cannot cause a panic.
+pub(crate) fn split(
+    records: &[ResultRecord],
+    pair_count: u32,
+    contact_count: u32,
+) -> (&[ResultRecord], &[ResultRecord]) {
+    let clamp = |count: u32, len: usize| usize::try_from(count).map_or(len, |c| c.min(len));
+    let (pairs, rest) = records.split_at(clamp(pair_count, records.len()));
+    (pairs, &rest[..clamp(contact_count, rest.len())])
+}
