@@ -79,16 +79,22 @@ pub(super) fn sphere_sphere(
     };
     let touching = result.distance <= 0.0;
     if query.contacts && touching {
-        contacts.push(ContactPoint {
-            pair: 0,
-            point_a: result.point_a,
-            point_b: result.point_b,
-            normal,
-            distance: result.distance,
-            error_bound: result.error_bound,
-        });
+        contacts.push(witness_contact(&result, result.distance));
     }
     Answer { result, touching }
+}
+
+/// A one-point manifold from a pair record: its witnesses and normal, `distance` (−depth)
+/// and the record's error bound.
+fn witness_contact(result: &PairResult, distance: f64) -> ContactPoint {
+    ContactPoint {
+        pair: 0,
+        point_a: result.point_a,
+        point_b: result.point_b,
+        normal: result.normal,
+        distance,
+        error_bound: result.error_bound,
+    }
 }
 
 /// Mesh–mesh (meshes are surfaces): the exact distance when the query needs one (`CLOSE`,
@@ -251,14 +257,7 @@ pub(super) fn boxes(
     };
     let touching = result.distance <= 0.0;
     if query.contacts && touching {
-        contacts.push(ContactPoint {
-            pair: 0,
-            point_a,
-            point_b,
-            normal: result.normal,
-            distance: 0.0,
-            error_bound: result.error_bound,
-        });
+        contacts.push(witness_contact(&result, 0.0));
     }
     Answer { result, touching }
 }

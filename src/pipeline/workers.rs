@@ -59,6 +59,21 @@ pub(super) struct MeshOutcome {
 }
 
 impl MeshOutcome {
+    /// The outcome of pair `slot`: its answer, the first [`MAX_CONTACTS_PER_PAIR`] of
+    /// `contacts` and its cache.
+    fn new(slot: u32, answer: Answer, contacts: &[ContactPoint], cache: DistanceCache) -> Self {
+        let mut outcome = Self {
+            slot,
+            answer,
+            contacts: [NO_CONTACT; MAX_CONTACTS_PER_PAIR],
+            contact_count: contacts.len().min(MAX_CONTACTS_PER_PAIR),
+            cache,
+        };
+        outcome.contacts[..outcome.contact_count]
+            .copy_from_slice(&contacts[..outcome.contact_count]);
+        outcome
+    }
+
     /// The pair's contacts (their `pair` index not yet set).
     pub fn contacts(&self) -> &[ContactPoint] {
         &self.contacts[..self.contact_count]
@@ -92,15 +107,7 @@ pub(super) fn run(
         scratch,
         contacts,
     );
-    let mut outcome = MeshOutcome {
-        slot: job.slot,
-        answer,
-        contacts: [NO_CONTACT; MAX_CONTACTS_PER_PAIR],
-        contact_count: contacts.len().min(MAX_CONTACTS_PER_PAIR),
-        cache,
-    };
-    outcome.contacts[..outcome.contact_count].copy_from_slice(&contacts[..outcome.contact_count]);
-    outcome
+    MeshOutcome::new(job.slot, answer, contacts, cache)
 }
 
 /// [`run`], with a panic turned into the pair's conservative box answer.
@@ -120,16 +127,7 @@ fn run_guarded(
             job.query,
             contacts,
         );
-        let mut outcome = MeshOutcome {
-            slot: job.slot,
-            answer,
-            contacts: [NO_CONTACT; MAX_CONTACTS_PER_PAIR],
-            contact_count: contacts.len().min(MAX_CONTACTS_PER_PAIR),
-            cache: DistanceCache::new(),
-        };
-        outcome.contacts[..outcome.contact_count]
-            .copy_from_slice(&contacts[..outcome.contact_count]);
-        outcome
+        MeshOutcome::new(job.slot, answer, contacts, DistanceCache::new())
     })
 }
 
