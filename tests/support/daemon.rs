@@ -17,6 +17,8 @@ pub struct Daemon {
     prefix: String,
     /// Extra command-line arguments, kept for [`restart`](Self::restart).
     args: Vec<String>,
+    /// Whether `--max-scenes 3` precedes `args` (not for [`start_plain`](Self::start_plain)).
+    default_max_scenes: bool,
 }
 
 impl Daemon {
@@ -27,6 +29,16 @@ impl Daemon {
 
     /// A daemon with `--max-scenes 3` and the extra arguments `args` (e.g. `--grace-ms`).
     pub fn start_with(args: &[&str]) -> Self {
+        Self::spawn_unique(args, true)
+    }
+
+    /// A daemon with only a unique root and prefix and the arguments `args`: no
+    /// `--max-scenes 3`, so `args` (or a `--config` file) may set the scene limit.
+    pub fn start_plain(args: &[&str]) -> Self {
+        Self::spawn_unique(args, false)
+    }
+
+    fn spawn_unique(args: &[&str], default_max_scenes: bool) -> Self {
         static NEXT: AtomicU32 = AtomicU32::new(0);
         let tag = format!(
             "{}_{}",
@@ -35,12 +47,13 @@ impl Daemon {
         );
         let (root, prefix) = (format!("proxima-test-{tag}"), format!("iox2_pxt{tag}_"));
         let args: Vec<String> = args.iter().map(|&a| a.to_owned()).collect();
-        let child = spawn(&root, &prefix, &args);
+        let child = spawn(&root, &prefix, &args, default_max_scenes);
         Self {
             child,
             root,
             prefix,
             args,
+            default_max_scenes,
         }
     }
 
@@ -92,7 +105,12 @@ impl Daemon {
             matches!(self.child.try_wait(), Ok(Some(_))),
             "the old daemon has stopped"
         );
-        self.child = spawn(&self.root, &self.prefix, &self.args);
+        self.child = spawn(
+            &self.root,
+            &self.prefix,
+            &self.args,
+            self.default_max_scenes,
+        );
     }
 
     /// Sends SIGTERM and waits up to `timeout` for the daemon to exit; its exit status, or
@@ -129,17 +147,17 @@ impl Drop for Daemon {
     }
 }
 
-/// Starts `proximad` with `root`, `prefix`, `--max-scenes 3` and `args`.
-fn spawn(root: &str, prefix: &str, args: &[String]) -> Child {
+/// Starts `proximad` with `root`, `prefix`, `--max-scenes 3` if `default_max_scenes`, and
+/// `args`.
+fn spawn(root: &str, prefix: &str, args: &[String], default_max_scenes: bool) -> Child {
+    let max_scenes: &[&str] = if default_max_scenes {
+        &["--max-scenes", "3"]
+    } else {
+        &[]
+    };
     Command::new(env!("CARGO_BIN_EXE_proximad"))
-        .args([
-            "--root",
-            root,
-            "--iceoryx-prefix",
-            prefix,
-            "--max-scenes",
-            "3",
-        ])
+        .args(["--root", root, "--iceoryx-prefix", prefix])
+        .args(max_scenes)
         .args(args)
         .spawn()
         .expect("proximad starts")
