@@ -40,7 +40,7 @@ use proxima_ipc::wire::{
 use std::error::Error;
 use std::time::{Duration, Instant};
 
-/// How long either side polls before it blocks on its event listener (as the client does).
+/// How long the echo server polls before it blocks on its event listener (as the daemon).
 const SPIN: Duration = Duration::from_micros(50);
 /// Round trips per block before switching between raw and daemon.
 const BLOCK: usize = 500;
@@ -70,6 +70,14 @@ struct Args {
     /// Length of a paced run, seconds.
     #[arg(long, default_value_t = 10.0)]
     seconds: f64,
+    /// Pin this client to CPU 0 and the daemon and echo processes to CPU 1 (with `taskset`),
+    /// so the client's spinning never shares a core with the daemon.
+    #[arg(long)]
+    pin: bool,
+    /// How long the client polls for an answer before it blocks, microseconds, for both
+    /// the daemon and the raw ping-pong (a long spin needs `--pin`).
+    #[arg(long, default_value_t = 50)]
+    client_spin_us: u64,
     #[arg(long, hide = true)]
     role: Option<Role>,
     #[arg(long, hide = true)]
@@ -100,44 +108,65 @@ fn main() -> Result<(), Box<dyn Error>> {
 
 fn measure(args: &Args) -> Result<(), Box<dyn Error>> {
     let Isolation { root, prefix } = Isolation::unique("lat");
+    let pin = args.pin;
     let exe = std::env::current_exe()?;
+    let exe = exe.to_string_lossy().into_owned();
     let _children = ["daemon", "echo"]
         .map(|role| {
             let args = ["--role", role, "--root", &root, "--prefix", &prefix];
-            ChildProcess::spawn(&exe, args, &prefix)
+            if pin {
+                let pinned = ["-c", "1", exe.as_str()].into_iter().chain(args);
+                ChildProcess::spawn("taskset", pinned, &prefix)
+            } else {
+                ChildProcess::spawn(&exe, args, &prefix)
+            }
         })
         .into_iter()
         .collect::<Result<Vec<_>, _>>()?;
+    if pin {
+        let me = std::process::id().to_string();
+        let status = std::process::Command::new("taskset")
+            .args(["-pc", "0", &me])
+            .stdout(std::process::Stdio::null())
+            .status()?;
+        if !status.success() {
+            return Err("taskset could not pin the client to CPU 0".into());
+        }
+    }
     let client = ClientBuilder::new()
         .root(&root)
         .iceoryx_prefix(&prefix)
         .reply_timeout(Duration::from_secs(10))
         .connect::<ipc::Service>()?;
     let scene = client.create_scene()?;
-    let link = setup_scene(&client, scene, args.bodies)?;
+    let mut link = setup_scene(&client, scene, args.bodies)?;
+    let client_spin = Duration::from_micros(args.client_spin_us);
+    link.set_result_spin(client_spin);
     if args.rate_hz > 0 {
         return paced(args, &link);
     }
-    let raw = RawLink::open(client.node(), &raw_root(&root))?;
+    let raw = RawLink::open(client.node(), &raw_root(&root), client_spin)?;
     let mut daemon_trips = DaemonTrips::with_capacity(args.iterations);
     let mut raw_trips = LatencyRecorder::with_capacity(args.iterations);
     let mut seq = 0u64;
     let (mut done, total) = (0, args.warmup + args.iterations);
     while done < total {
         let block = BLOCK.min(total - done);
-        for _ in 0..block {
-            seq += 1;
-            let measured = done >= args.warmup;
-            let rtt = raw.round_trip(seq, args.bodies)?;
+        let measured = done >= args.warmup;
+        for i in 0..block {
+            let rtt = raw.round_trip(seq + i as u64, args.bodies)?;
             if measured {
                 raw_trips.record(rtt);
             }
-            let (rtt, header) = daemon_round_trip(&link, seq, args, 0.0)?;
+        }
+        for i in 0..block {
+            let (rtt, header) = daemon_round_trip(&link, seq + i as u64, args, 0.0)?;
             if measured {
                 daemon_trips.record(rtt, &header);
             }
-            done += 1;
         }
+        seq += block as u64;
+        done += block;
     }
     report(args, &raw_trips, &daemon_trips);
     Ok(())
@@ -225,6 +254,8 @@ struct DaemonTrips {
     engine: LatencyRecorder,
     overhead: LatencyRecorder,
     in_daemon: LatencyRecorder,
+    ingest: LatencyRecorder,
+    publish: LatencyRecorder,
 }
 
 impl DaemonTrips {
@@ -234,6 +265,8 @@ impl DaemonTrips {
             engine: LatencyRecorder::with_capacity(n),
             overhead: LatencyRecorder::with_capacity(n),
             in_daemon: LatencyRecorder::with_capacity(n),
+            ingest: LatencyRecorder::with_capacity(n),
+            publish: LatencyRecorder::with_capacity(n),
         }
     }
 
@@ -244,24 +277,34 @@ impl DaemonTrips {
         self.engine.record_ns(engine);
         self.overhead.record_ns(rtt_ns.saturating_sub(engine));
         self.in_daemon.record_ns(header.elapsed_ns);
+        self.ingest.record_ns(header.stage_ns[stage::INGEST]);
+        self.publish.record_ns(header.stage_ns[stage::PUBLISH]);
     }
 }
 
 fn report(args: &Args, raw: &LatencyRecorder, daemon: &DaemonTrips) {
     println!(
         "ipc_latency: {} bodies ({} KiB of poses per frame), budget {} µs, {} round trips per mode \
-         after {} warm-up, alternating blocks of {BLOCK}",
+         after {} warm-up, alternating blocks of {BLOCK}; client spin {} µs{}",
         args.bodies,
         args.bodies * size_of::<PoseRecord>() / 1024,
         args.budget_ns / 1000,
         args.iterations,
-        args.warmup
+        args.warmup,
+        args.client_spin_us,
+        if args.pin {
+            ", pinned (client CPU 0, daemon and echo CPU 1)"
+        } else {
+            ", unpinned"
+        }
     );
     let rows = [
         ("raw iceoryx2 round trip", raw),
         ("daemon round trip", &daemon.round_trip),
         ("daemon engine time", &daemon.engine),
         ("daemon receipt → publish", &daemon.in_daemon),
+        ("  of which ingest (check, apply)", &daemon.ingest),
+        ("  of which publish", &daemon.publish),
         ("daemon overhead (rtt − engine)", &daemon.overhead),
     ];
     for (name, recorder) in rows {
@@ -310,11 +353,13 @@ fn paced(args: &Args, link: &SceneLink<ipc::Service>) -> Result<(), Box<dyn Erro
     }
     let wall = start.elapsed();
     println!(
-        "ipc_latency paced: {} bodies moving, {frames} frames at {} Hz ({:.1} s wall), budget {} µs",
+        "ipc_latency paced: {} bodies moving, {frames} frames at {} Hz ({:.1} s wall), budget {} µs, client spin {} µs, {}",
         args.bodies,
         args.rate_hz,
         wall.as_secs_f64(),
-        args.budget_ns / 1000
+        args.budget_ns / 1000,
+        args.client_spin_us,
+        if args.pin { "pinned" } else { "unpinned" }
     );
     for (name, recorder) in [
         ("round trip", &trips.round_trip),
@@ -384,10 +429,12 @@ struct RawLink {
     results: Subscriber<ipc::Service, [ResultRecord], ResultFrameHeader>,
     poses_sent: Notifier<ipc::Service>,
     results_ready: Listener<ipc::Service>,
+    /// How long a round trip polls before it blocks.
+    spin: Duration,
 }
 
 impl RawLink {
-    fn open(node: &Node<ipc::Service>, root: &str) -> Result<Self, Box<dyn Error>> {
+    fn open(node: &Node<ipc::Service>, root: &str, spin: Duration) -> Result<Self, Box<dyn Error>> {
         let fail = |what: &str, e: &dyn std::fmt::Debug| format!("raw {what}: {e:?}");
         let poses_service = proxima_ipc::poses_service_builder(node, root, 0)
             .map_err(|e| fail("name", &e))?
@@ -435,6 +482,7 @@ impl RawLink {
             results,
             poses_sent,
             results_ready,
+            spin,
         })
     }
 
@@ -464,7 +512,7 @@ impl RawLink {
             .send()
             .map_err(|e| format!("{e:?}"))?;
         self.poses_sent.notify().map_err(|e| format!("{e:?}"))?;
-        let spin_end = started + SPIN;
+        let spin_end = started + self.spin;
         let deadline = started + Duration::from_secs(1);
         loop {
             while let Some(answer) = self.results.receive().map_err(|e| format!("{e:?}"))? {

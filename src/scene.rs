@@ -18,7 +18,7 @@ pub use crate::broad::CollisionFilter;
 use crate::broad::Proxy;
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
-use crate::math::{DVec3, Pose};
+use crate::math::{DVec3, Pose, conservative_slack};
 use std::fmt;
 use std::sync::Arc;
 
@@ -192,6 +192,8 @@ impl std::error::Error for SceneError {}
 #[derive(Debug, Clone)]
 pub struct Scene {
     shapes: Vec<Shape>,
+    /// `shape_boxes[i]` is shape `i`'s local box, computed once at registration.
+    shape_boxes: Vec<LocalBox>,
     /// Slot `i` holds body `i` while it lives; removed bodies leave `None` (ids are not
     /// reused).
     bodies: Vec<Option<Body>>,
@@ -209,6 +211,7 @@ impl Scene {
         check_margin(default_margin)?;
         Ok(Self {
             shapes: Vec::new(),
+            shape_boxes: Vec::new(),
             bodies: Vec::new(),
             live: 0,
             default_margin,
@@ -224,6 +227,7 @@ impl Scene {
         if self.shapes.len() >= self.limits.max_shapes as usize {
             return Err(SceneError::TooManyShapes(self.limits.max_shapes));
         }
+        self.shape_boxes.push(LocalBox::of(&shape));
         self.shapes.push(shape);
         Ok(ShapeId(self.shapes.len() as u32 - 1))
     }
@@ -240,15 +244,16 @@ impl Scene {
     /// [`SceneError::UnknownShape`], [`SceneError::InvalidMargin`] or
     /// [`SceneError::TooManyBodies`]; the scene is then unchanged.
     pub fn add_body(&mut self, desc: &BodyDesc) -> Result<BodyId, SceneError> {
-        let shape = self
-            .shape(desc.shape)
+        let local = *self
+            .shape_boxes
+            .get(desc.shape.0 as usize)
             .ok_or(SceneError::UnknownShape(desc.shape))?;
         let margin = desc.margin.unwrap_or(self.default_margin);
         check_margin(margin)?;
         if self.live >= self.limits.max_bodies || self.bodies.len() >= u32::MAX as usize {
             return Err(SceneError::TooManyBodies(self.limits.max_bodies));
         }
-        let world_bounds = world_bounds(shape, &desc.pose);
+        let world_bounds = local.world(&desc.pose);
         self.bodies.push(Some(Body {
             shape: desc.shape,
             pose: desc.pose,
@@ -302,11 +307,15 @@ impl Scene {
     /// # Errors
     /// [`SceneError::UnknownBody`].
     pub fn set_pose(&mut self, id: BodyId, pose: Pose) -> Result<(), SceneError> {
-        let shape_id = self.body_mut(id)?.shape;
-        let bounds = world_bounds(&self.shapes[shape_id.0 as usize], &pose);
+        let body = self.body(id).ok_or(SceneError::UnknownBody(id))?;
+        // Unmoved: the world box is still right.
+        if body.pose == pose {
+            return Ok(());
+        }
+        let local = self.shape_boxes[body.shape.0 as usize];
         let body = self.body_mut(id)?;
         body.pose = pose;
-        body.world_bounds = bounds;
+        body.world_bounds = local.world(&pose);
         Ok(())
     }
 
@@ -356,7 +365,7 @@ impl Scene {
             let shape = self
                 .shape(body.shape)
                 .ok_or_else(|| format!("body {} names unknown shape {}", id.0, body.shape.0))?;
-            if body.world_bounds != world_bounds(shape, &body.pose) {
+            if body.world_bounds != LocalBox::of(shape).world(&body.pose) {
                 return Err(format!("body {} has a stale world box", id.0));
             }
         }
@@ -375,8 +384,32 @@ impl Scene {
 }
 
 /// The world box of `shape` at `pose` (conservative: the local box moved and re-boxed).
-fn world_bounds(shape: &Shape, pose: &Pose) -> Aabb {
-    shape.local_bounds().transformed(&pose.to_isometry())
+/// A shape's local box, and whether every rotation leaves it unchanged (a sphere's), so a
+/// new pose only moves it.
+#[derive(Debug, Clone, Copy)]
+struct LocalBox {
+    aabb: Aabb,
+    rotation_invariant: bool,
+}
+
+impl LocalBox {
+    fn of(shape: &Shape) -> Self {
+        Self {
+            aabb: shape.local_bounds(),
+            rotation_invariant: matches!(shape, Shape::Sphere(_)),
+        }
+    }
+
+    /// The world box at `pose`, padded by the rounding slack (conservative).
+    fn world(&self, pose: &Pose) -> Aabb {
+        if self.rotation_invariant {
+            // A ball about the local origin: its box about the position.
+            let half = self.aabb.half_extents();
+            let slack = conservative_slack(pose.position.abs().max_element() + half.max_element());
+            return Aabb::from_center_half_extents(pose.position, half + DVec3::splat(slack));
+        }
+        self.aabb.transformed(&pose.to_isometry())
+    }
 }
 
 fn check_margin(margin: f64) -> Result<(), SceneError> {
@@ -441,7 +474,12 @@ mod tests {
             let b = *s.body(body).unwrap();
             // Surface samples of the shape, moved by the pose, must lie in the world box.
             let local: Vec<DVec3> = match s.shape(id).unwrap() {
-                Shape::Sphere(sp) => vec![DVec3::X * sp.radius, -DVec3::Z * sp.radius],
+                // The ball's world extremes (its box is computed without the rotation).
+                Shape::Sphere(sp) => [DVec3::X, DVec3::Y, DVec3::Z]
+                    .into_iter()
+                    .flat_map(|axis| [axis, -axis])
+                    .map(|dir| b.pose.rotation.inverse() * dir * sp.radius)
+                    .collect(),
                 Shape::Capsule(c) => {
                     vec![DVec3::Z * (c.half_height + c.radius), DVec3::X * c.radius]
                 }

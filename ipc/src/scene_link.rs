@@ -183,6 +183,11 @@ impl<S: Service> SceneLink<S> {
         self.notify_sent()
     }
 
+    /// Sets how long receiving polls before it blocks: see [`ResultFeed::set_spin`].
+    pub fn set_result_spin(&mut self, spin: Duration) {
+        self.feed.set_spin(spin);
+    }
+
     /// The next result frame if one has arrived, without waiting.
     ///
     /// # Errors
