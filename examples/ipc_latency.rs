@@ -20,7 +20,8 @@
 //! with every body moving, and a frame misses its deadline when its answer is not back
 //! within the budget after publication, or the daemon says it missed the budget.
 //!
-//! The bodies are spheres of radius 0.5 m on a 3 m grid with 0.1 m margins: nothing is
+//! The bodies are spheres of radius 0.5 m on a 3 m grid with 0.1 m margins, each moving on
+//! a small circle (every pose changes every frame, raw and daemon alike): nothing is
 //! close, so the round trip is the frame path itself.
 
 use clap::{Parser, ValueEnum};
@@ -160,7 +161,8 @@ fn measure(args: &Args) -> Result<(), Box<dyn Error>> {
             }
         }
         for i in 0..block {
-            let (rtt, header) = daemon_round_trip(&link, seq + i as u64, args, 0.0)?;
+            let (rtt, header) =
+                daemon_round_trip(&link, seq + i as u64, args, (seq + i as u64) as f64 * 1e-3)?;
             if measured {
                 daemon_trips.record(rtt, &header);
             }
