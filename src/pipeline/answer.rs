@@ -14,7 +14,7 @@ use crate::geometry::Sphere;
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
-    intersects_mesh_mesh,
+    intersects_mesh_mesh, within_distance_mesh_mesh,
 };
 use crate::scene::{Body, MeshShape};
 use std::ops::ControlFlow;
@@ -97,11 +97,12 @@ fn witness_contact(result: &PairResult, distance: f64) -> ContactPoint {
     }
 }
 
-/// Mesh–mesh (meshes are surfaces): the exact distance when the query needs one (`CLOSE`,
-/// `DISTANCE`; warm-started from the pair's `cache`), the reduced intersection set when it asks `CONTACTS`,
+/// Mesh–mesh (meshes are surfaces): the exact distance when the query needs one (`CLOSE`
+/// for pairs within their margins, `DISTANCE` for all; warm-started from the pair's `cache`), the reduced intersection set when it asks `CONTACTS`,
 /// else (`OVERLAP` alone) [`intersects_mesh_mesh`], which stops at the first proof.
 ///
-/// Without a distance, a touching pair's record says distance 0 (intersecting surfaces),
+/// A `CLOSE` pair beyond its margins (and no `DISTANCE` asked) says distance `+∞`: it is
+/// not reported, and it touches nothing. Without a distance, a touching pair's record says distance 0 (intersecting surfaces),
 /// error bound 0, and takes its witnesses and normal from the first contact when contacts
 /// were asked; with `OVERLAP` alone it has none (points and normal all zero).
 pub(super) fn mesh_mesh(
@@ -126,6 +127,35 @@ pub(super) fn mesh_mesh(
         first_contact: 0,
         contact_count: 0,
     };
+    // `CLOSE` without `DISTANCE` needs the distance only of pairs within their margins: a
+    // tolerance query, which stops at the first triangle pair close enough, rules the
+    // others out (its lower bounds prune far pairs near the roots). Its float distances
+    // could call a grazing contact apart, so when touching matters (`OVERLAP`,
+    // `CONTACTS`) the exact predicates confirm before the pair is dismissed.
+    let margins = a.margin + b.margin;
+    if query.close
+        && !query.distance
+        && !within_distance_mesh_mesh(
+            &ma.distance_tree,
+            &mb.distance_tree,
+            &pose_ab,
+            margins,
+            &mut scratch.traversal,
+        )
+        && !((query.overlap || query.contacts)
+            && intersects_mesh_mesh(
+                &ma.overlap_tree,
+                &mb.overlap_tree,
+                &pose_ab,
+                &mut scratch.traversal,
+            ))
+    {
+        result.distance = f64::INFINITY;
+        return Answer {
+            result,
+            touching: false,
+        };
+    }
     let mut touching = None;
     if query.close || query.distance {
         let d = distance_mesh_mesh(
