@@ -10,12 +10,12 @@
 #[path = "support/daemon.rs"]
 mod daemon_harness;
 
-use daemon_harness::{Daemon, body};
+use daemon_harness::{Daemon, body, pose_at};
 use iceoryx2::prelude::ipc;
 use proxima_ipc::client::{Client, Primitive};
 use proxima_ipc::error::ControlError;
 use proxima_ipc::scene_link::SceneLink;
-use proxima_ipc::wire::{ErrorCode, PoseRecord, query};
+use proxima_ipc::wire::{ErrorCode, query};
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 use std::sync::mpsc;
@@ -27,15 +27,6 @@ const TIMEOUT: Duration = Duration::from_secs(10);
 const CHILD_ROLE: &str = "PROXIMA_LIFECYCLE_CHILD";
 /// The grace period of the dead-client test's daemon.
 const GRACE: Duration = Duration::from_millis(1500);
-
-fn pose(body: u32, x: f64) -> PoseRecord {
-    PoseRecord {
-        body,
-        reserved: 0,
-        position: [x, 0.0, 0.0],
-        orientation: [0.0, 0.0, 0.0, 1.0],
-    }
-}
 
 /// A scene of two spheres of radius 0.5 (bodies 0 and 1, at x = 0 and x = 3), its id and
 /// frame link.
@@ -54,7 +45,7 @@ fn two_spheres(client: &Client<ipc::Service>) -> (u32, SceneLink<ipc::Service>) 
 /// Moves body 1 to `x` in frame `seq` and checks the answer: one overlapping pair at
 /// distance `x − 1` (the spheres overlap for every `x` used here).
 fn assert_frame_answered(link: &SceneLink<ipc::Service>, seq: u64, x: f64) {
-    link.publish_poses(seq, 0, query::CLOSE, &[pose(1, x)])
+    link.publish_poses(seq, 0, query::CLOSE, &[pose_at(1, x)])
         .unwrap();
     let answer = link
         .receive_results_for(seq, TIMEOUT)
@@ -103,7 +94,7 @@ fn child_client_role() {
         .expect("the child connects");
     let (scene, link) = two_spheres(&client);
     // Mid-frame: a pose frame is out, its results are never read.
-    link.publish_poses(1, 0, query::CLOSE, &[pose(1, 0.5)])
+    link.publish_poses(1, 0, query::CLOSE, &[pose_at(1, 0.5)])
         .unwrap();
     let mut out = std::io::stdout().lock();
     writeln!(out, "READY {scene}").unwrap();
@@ -265,7 +256,7 @@ fn sigterm_while_frames_flow_stops_the_daemon_with_status_zero() {
     let (mut seq, mut answered) = (20, 0);
     while !daemon.has_exited() && started.elapsed() < TIMEOUT {
         seq += 1;
-        link.publish_poses(seq, 0, query::CLOSE, &[pose(1, 0.5)])
+        link.publish_poses(seq, 0, query::CLOSE, &[pose_at(1, 0.5)])
             .unwrap();
         if link
             .receive_results_for(seq, Duration::from_millis(5))

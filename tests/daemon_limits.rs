@@ -9,7 +9,7 @@
 #[path = "support/daemon.rs"]
 mod daemon_harness;
 
-use daemon_harness::{Daemon, body};
+use daemon_harness::{Daemon, body, pose_at};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::prelude::{EventId, ipc};
@@ -54,15 +54,6 @@ impl ConfigFile {
 impl Drop for ConfigFile {
     fn drop(&mut self) {
         let _ = std::fs::remove_file(&self.path);
-    }
-}
-
-fn pose_record(body: u32, x: f64) -> PoseRecord {
-    PoseRecord {
-        body,
-        reserved: 0,
-        position: [x, 0.0, 0.0],
-        orientation: [0.0, 0.0, 0.0, 1.0],
     }
 }
 
@@ -125,7 +116,7 @@ impl TwoSpheres {
 
     /// Moves body 1 to `x1` (body 0 stays where it is) and returns the close pairs' distances.
     fn close_pairs_with_body_1_at(&mut self, x1: f64) -> Vec<f64> {
-        self.frame(&[pose_record(1, x1)])
+        self.frame(&[pose_at(1, x1)])
     }
 
     /// Sends a valid CLOSE frame of `records`; asserts it is answered Ok and returns the
@@ -420,14 +411,14 @@ fn forged_headers_and_unusable_poses_are_answered_with_their_code_and_touch_no_s
         count,
     };
     // Every bad frame would move body 0 of a scene away from body 1 if it were applied.
-    let away = pose_record(0, -5.0);
+    let away = pose_at(0, -5.0);
     let inf = PoseRecord {
         position: [0.0, f64::INFINITY, 0.0],
-        ..pose_record(1, 0.9)
+        ..pose_at(1, 0.9)
     };
     let zero_rotation = PoseRecord {
         orientation: [0.0; 4],
-        ..pose_record(1, 0.9)
+        ..pose_at(1, 0.9)
     };
     let cases: Vec<(&str, PoseFrameHeader, Vec<PoseRecord>, ErrorCode, u32)> = vec![
         (
@@ -470,7 +461,7 @@ fn forged_headers_and_unusable_poses_are_answered_with_their_code_and_touch_no_s
         (
             "count below the payload",
             header(0, 1),
-            vec![away, pose_record(1, 0.9)],
+            vec![away, pose_at(1, 0.9)],
             ErrorCode::MalformedMessage,
             u32::MAX,
         ),
@@ -536,7 +527,7 @@ fn forged_headers_and_unusable_poses_are_answered_with_their_code_and_touch_no_s
             frame_seq: bad.seq,
             ..header(0, 1)
         },
-        &[pose_record(1, 0.95)],
+        &[pose_at(1, 0.95)],
     );
     let answer = bad
         .link

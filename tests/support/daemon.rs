@@ -6,6 +6,7 @@
 
 use iceoryx2::prelude::ipc;
 use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion};
+use proxima_ipc::wire::PoseRecord;
 use std::process::{Child, Command, ExitStatus};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
@@ -192,5 +193,15 @@ pub fn body(shape: u32, x: f64) -> BodySpec {
         group: u32::MAX,
         mask: u32::MAX,
         margin: None,
+    }
+}
+
+/// The pose record of `body` at `(x, 0, 0)`, unrotated.
+pub fn pose_at(body: u32, x: f64) -> PoseRecord {
+    PoseRecord {
+        body,
+        reserved: 0,
+        position: [x, 0.0, 0.0],
+        orientation: [0.0, 0.0, 0.0, 1.0],
     }
 }
