@@ -14,10 +14,12 @@
 //! segment or point they span.
 
 mod closest_points;
+pub mod contact;
 pub mod mesh_mesh;
 mod triangle_overlap;
 pub mod triangle_triangle;
 
+pub use contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
 pub use triangle_triangle::{
     TriangleDistance, distance_triangle_triangle, intersection_segment_triangle_triangle,
     intersects_triangle_triangle,

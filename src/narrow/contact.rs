@@ -1,0 +1,151 @@
+//! The answers every pair query of the narrow phase gives: a signed distance with witness
+//! points, and a contact manifold.
+//!
+//! # Contract (DESIGN §4), for every pair of shapes A and B
+//! - Frame: everything is in the query frame, A's local frame; B is placed by `pose_ab`
+//!   (B's frame expressed in A's).
+//! - [`ShapeDistance::distance`] is signed: `> 0` the gap, `< 0` minus the penetration depth
+//!   (the length of the shortest translation of B that separates them), `0` touching.
+//! - [`ShapeDistance::normal`] is a unit vector from A to B: along `point_b − point_a` when
+//!   apart; the direction that shortest translation moves B when penetrating. Never NaN:
+//!   when no direction is defined (coincident centres) a fixed, documented choice is made.
+//! - `point_a` lies on A's surface, `point_b` on B's (to rounding), and
+//!   `point_b − point_a = distance · normal` (to rounding).
+//! - Symmetry: swapping A and B (with the inverse pose) gives the same distance, swapped
+//!   points and the opposite normal.
+//! - A [`Manifold`] holds at most [`MANIFOLD_POINTS`] points sharing one normal (A→B), each
+//!   with the points on both surfaces and its signed distance (`≤ 0` for touching or
+//!   penetrating points).
+
+use crate::math::DVec3;
+
+/// The most points a contact manifold holds.
+pub const MANIFOLD_POINTS: usize = 4;
+
+/// The signed distance between two shapes, with witnesses (see the [module docs](self)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeDistance {
+    /// Signed distance, metres (negative: penetration depth).
+    pub distance: f64,
+    /// Witness on A's surface, A's frame.
+    pub point_a: DVec3,
+    /// Witness on B's surface, A's frame.
+    pub point_b: DVec3,
+    /// Unit normal from A to B, A's frame.
+    pub normal: DVec3,
+}
+
+impl ShapeDistance {
+    /// The same answer seen from B: points swapped, normal reversed, mapped by `pose_ba`
+    /// (A's frame expressed in B's) into B's frame.
+    #[must_use]
+    pub fn flipped(&self, pose_ba: &crate::math::Isometry) -> Self {
+        Self {
+            distance: self.distance,
+            point_a: pose_ba.transform_point(self.point_b),
+            point_b: pose_ba.transform_point(self.point_a),
+            normal: pose_ba.transform_vector(-self.normal),
+        }
+    }
+}
+
+/// One point of a contact manifold, A's frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ManifoldPoint {
+    /// Point on A's surface.
+    pub point_a: DVec3,
+    /// Point on B's surface.
+    pub point_b: DVec3,
+    /// Signed distance along the manifold normal, metres (`≤ 0` touching or penetrating).
+    pub distance: f64,
+}
+
+/// Up to [`MANIFOLD_POINTS`] contact points with one normal (A→B), A's frame. Filled in
+/// place, so building one never allocates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Manifold {
+    /// Unit normal from A to B.
+    pub normal: DVec3,
+    points: [ManifoldPoint; MANIFOLD_POINTS],
+    len: usize,
+}
+
+impl Default for Manifold {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Manifold {
+    const NO_POINT: ManifoldPoint = ManifoldPoint {
+        point_a: DVec3::ZERO,
+        point_b: DVec3::ZERO,
+        distance: 0.0,
+    };
+
+    /// An empty manifold.
+    #[must_use]
+    pub const fn new() -> Self {
+        Self {
+            normal: DVec3::ZERO,
+            points: [Self::NO_POINT; MANIFOLD_POINTS],
+            len: 0,
+        }
+    }
+
+    /// Empties the manifold and sets its normal.
+    pub fn reset(&mut self, normal: DVec3) {
+        self.normal = normal;
+        self.len = 0;
+    }
+
+    /// Adds a point; returns `false` (and drops it) when the manifold is full.
+    pub fn push(&mut self, point: ManifoldPoint) -> bool {
+        if self.len == MANIFOLD_POINTS {
+            return false;
+        }
+        self.points[self.len] = point;
+        self.len += 1;
+        true
+    }
+
+    /// The points.
+    #[must_use]
+    pub fn points(&self) -> &[ManifoldPoint] {
+        &self.points[..self.len]
+    }
+
+    /// Number of points.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether it holds no point.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_manifold_keeps_at_most_four_points_and_resets() {
+        let mut m = Manifold::new();
+        for i in 0..6 {
+            let p = ManifoldPoint {
+                point_a: DVec3::splat(f64::from(i)),
+                point_b: DVec3::splat(f64::from(i)),
+                distance: -f64::from(i),
+            };
+            assert_eq!(m.push(p), i < 4);
+        }
+        assert_eq!(m.len(), 4);
+        assert_eq!(m.points()[3].distance, -3.0);
+        m.reset(DVec3::Z);
+        assert!(m.is_empty() && m.normal == DVec3::Z);
+    }
+}
