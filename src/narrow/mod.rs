@@ -16,6 +16,7 @@
 mod closest_points;
 pub mod contact;
 pub mod mesh_mesh;
+pub mod toi;
 mod triangle_overlap;
 pub mod triangle_triangle;
 
