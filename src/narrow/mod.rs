@@ -15,6 +15,7 @@
 
 mod closest_points;
 pub mod contact;
+pub mod convex_mesh;
 pub mod mesh_mesh;
 pub mod toi;
 mod triangle_overlap;
