@@ -16,7 +16,7 @@
 //! More than [`MANIFOLD_POINTS`] candidates are reduced to the deepest, the farthest from
 //! it, then the two that span the largest area.
 
-use super::core::{Core, Kind, Polygon};
+use super::core::{Core, Kind, Polygon, line_interval};
 use super::query::{FEATURE_RELATIVE, distance};
 use crate::math::DVec3;
 use crate::narrow::contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint};
@@ -131,14 +131,22 @@ fn clip_face(
             inc = clip_plane(&inc, side, side.dot(p));
         }
     }
-    let r = r_ref + other.radius;
     for q in inc.points() {
-        let s = (*q - ref_pts[0]).dot(f);
-        if s - r > slack {
+        // The incident surface point in the column of `q`: for a rounded core, where the
+        // line through `q` along `f` leaves it on the reference side.
+        let on_inc = if other.radius > 0.0 {
+            match line_interval(other, *q, -f) {
+                Some((_, exit)) => *q - f * exit,
+                None => continue,
+            }
+        } else {
+            *q
+        };
+        let s = (on_inc - ref_pts[0]).dot(f) - r_ref;
+        if s > slack {
             continue;
         }
-        let on_ref = *q - f * s + f * r_ref;
-        let on_inc = *q - f * other.radius;
+        let on_ref = on_inc - f * s;
         let (point_a, point_b) = if ref_is_a {
             (on_ref, on_inc)
         } else {
@@ -148,7 +156,7 @@ fn clip_face(
             out.pts[out.len] = ManifoldPoint {
                 point_a,
                 point_b,
-                distance: s - r,
+                distance: s,
             };
             out.len += 1;
         }
@@ -220,17 +228,23 @@ fn parallel_edges(a: &Core, b: &Core, n: DVec3, slack: f64, out: &mut Candidates
     let mut seg = fb;
     seg = clip_plane(&seg, u, t1);
     seg = clip_plane(&seg, -u, -t0);
-    let r = a.radius + b.radius;
     for q in seg.points() {
-        let on_a = fa.closest_point(*q);
-        let s = (*q - on_a).dot(n);
-        if s - r > slack || out.len == out.pts.len() {
+        // Both surface points on the line through `q` along `n`: B's where the line leaves
+        // B towards A, A's where it enters A from B's side.
+        let (Some((_, exit_b)), Some((enter_a, _))) =
+            (line_interval(b, *q, -n), line_interval(a, *q, -n))
+        else {
+            continue;
+        };
+        let (point_a, point_b) = (*q - n * enter_a, *q - n * exit_b);
+        let s = (point_b - point_a).dot(n);
+        if s > slack || out.len == out.pts.len() {
             continue;
         }
         out.pts[out.len] = ManifoldPoint {
-            point_a: on_a + n * a.radius,
-            point_b: *q - n * b.radius,
-            distance: s - r,
+            point_a,
+            point_b,
+            distance: s,
         };
         out.len += 1;
     }

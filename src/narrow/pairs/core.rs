@@ -164,9 +164,7 @@ impl Core {
         match self.kind {
             Kind::Point => self.verts[0],
             Kind::Segment => closest_point_segment(p, self.verts[0], self.verts[1]),
-            Kind::Triangle => {
-                closest_point_triangle(p, self.verts[0], self.verts[1], self.verts[2])
-            }
+            Kind::Triangle => closest_on_triangle(p, self.verts[0], self.verts[1], self.verts[2]),
             Kind::Box { center, axes, half } => {
                 let local = axes.transpose() * (p - center);
                 center + axes * local.clamp(-half, half)
@@ -212,12 +210,13 @@ impl Core {
             Kind::Box { center, axes, half } => {
                 // An axis is free (the feature spans it) when flipping its sign moves the
                 // point by at most `tol` along n.
-                let mut sign = [0.0; 3];
+                // Zero-size axes change nothing: they stay fixed.
+                let mut sign = [1.0; 3];
                 let mut free = [0usize; 2];
                 let mut nfree = 0;
                 for i in 0..3 {
                     let d = axes.col(i).dot(n);
-                    if 2.0 * half[i] * d.abs() <= tol && nfree < 2 {
+                    if half[i] > 0.0 && 2.0 * half[i] * d.abs() <= tol && nfree < 2 {
                         free[nfree] = i;
                         nfree += 1;
                     } else {
@@ -323,9 +322,9 @@ impl Polygon {
             1 => v[0],
             2 => closest_point_segment(p, v[0], v[1]),
             _ => {
-                let mut best = closest_point_triangle(p, v[0], v[1], v[2]);
+                let mut best = closest_on_triangle(p, v[0], v[1], v[2]);
                 for i in 3..v.len() {
-                    let q = closest_point_triangle(p, v[0], v[i - 1], v[i]);
+                    let q = closest_on_triangle(p, v[0], v[i - 1], v[i]);
                     if q.distance_squared(p) < best.distance_squared(p) {
                         best = q;
                     }
@@ -344,5 +343,98 @@ impl Polygon {
             _ => n,
         };
         (0..count).map(move |i| (self.pts[i], self.pts[(i + 1) % n]))
+    }
+}
+
+/// The point of the closed triangle `a, b, c` closest to `p`, robust for slivers.
+///
+/// NOTE: `closest_point_triangle` projects onto the plane of the rounding-noise normal of a
+/// (nearly) zero-area triangle and can return a point far off it (for example the
+/// triangle `a, b, a + 0.3 (b − a)` after a rotation). A face answer is only kept when it
+/// lies within the triangle's smallest altitude of its boundary, which every interior
+/// point does; otherwise the closest boundary point is the answer.
+#[must_use]
+pub(super) fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let face = closest_point_triangle(p, a, b, c);
+    let mut edge = closest_point_segment(p, a, b);
+    for (x, y) in [(b, c), (c, a)] {
+        let q = closest_point_segment(p, x, y);
+        if q.distance_squared(p) < edge.distance_squared(p) {
+            edge = q;
+        }
+    }
+    let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+    let altitude = if longest > 0.0 {
+        (b - a).cross(c - a).length() / longest
+    } else {
+        0.0
+    };
+    let boundary = (face - a).length().max((face - b).length()) * 4.0 * f64::EPSILON;
+    if face.distance_squared(p) < edge.distance_squared(p)
+        && face_to_boundary(face, a, b, c) <= altitude + boundary
+    {
+        face
+    } else {
+        edge
+    }
+}
+
+/// Distance from `q` to the boundary of triangle `a, b, c`.
+fn face_to_boundary(q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    [(a, b), (b, c), (c, a)]
+        .iter()
+        .map(|&(x, y)| closest_point_segment(q, x, y).distance(q))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The interval `[enter, exit]` of parameters `s` for which `o + v s` (unit `v`) lies in
+/// the rounded core (`None` when the line misses it). Only for point and segment cores
+/// (balls and capsules): the shapes whose surface a manifold point must be moved onto.
+#[must_use]
+pub(super) fn line_interval(core: &Core, o: DVec3, v: DVec3) -> Option<(f64, f64)> {
+    let r = core.radius;
+    let ball = |c: DVec3| {
+        let w = o - c;
+        let (bq, cq) = (w.dot(v), w.length_squared() - r * r);
+        let disc = bq * bq - cq;
+        (disc >= 0.0).then(|| (-bq - disc.sqrt(), -bq + disc.sqrt()))
+    };
+    let join = |x: Option<(f64, f64)>, y: Option<(f64, f64)>| match (x, y) {
+        (Some(x), Some(y)) => Some((x.0.min(y.0), x.1.max(y.1))),
+        (x, None) => x,
+        (None, y) => y,
+    };
+    match core.kind {
+        Kind::Point => ball(core.verts[0]),
+        Kind::Segment => {
+            let (a, b) = (core.verts[0], core.verts[1]);
+            let mut out = join(ball(a), ball(b));
+            let len = a.distance(b);
+            if len > 0.0 {
+                let u = (b - a) / len;
+                let (w, vp) = (o - a, v - u * v.dot(u));
+                let wp = w - u * w.dot(u);
+                let (qa, qb, qc) = (vp.length_squared(), wp.dot(vp), wp.length_squared() - r * r);
+                let disc = qb * qb - qa * qc;
+                if qa > 0.0 && disc >= 0.0 {
+                    let (s0, s1) = ((-qb - disc.sqrt()) / qa, (-qb + disc.sqrt()) / qa);
+                    // Keep the part whose foot on the axis is within the segment.
+                    let (t0, dt) = (w.dot(u), v.dot(u));
+                    let (mut lo, mut hi) = (s0, s1);
+                    if dt.abs() > 0.0 {
+                        let (e0, e1) = ((0.0 - t0) / dt, (len - t0) / dt);
+                        lo = lo.max(e0.min(e1));
+                        hi = hi.min(e0.max(e1));
+                    } else if !(0.0..=len).contains(&t0) {
+                        hi = lo - 1.0;
+                    }
+                    if lo <= hi {
+                        out = join(out, Some((lo, hi)));
+                    }
+                }
+            }
+            out
+        }
+        _ => None,
     }
 }

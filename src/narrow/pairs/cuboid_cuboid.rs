@@ -59,20 +59,30 @@ mod tests {
     #[test]
     fn crossed_edges_give_one_point_and_the_edge_axis() {
         let c = Cuboid::new(DVec3::splat(0.5));
-        let q = std::f64::consts::FRAC_PI_4;
-        // B rotated 45° about X then placed so its lower edge (along X) dips into the
-        // upper edge of A rotated... A's top-front edge along Y: rotate A? Use B about X
-        // and about Z so its lowest feature is an edge along Y-ish crossing A's edge.
-        let rot = DMat3::from_rotation_x(q);
-        let pose = Isometry::new(rot, DVec3::new(0.0, 0.5, 0.5 + 0.5 * 2f64.sqrt() - 0.1));
+        // A's edge along Y at x = z = 0.5 faces w = (1, 0, 1)/√2; B's local X edge at
+        // y = z = -0.5 is turned along (1, 0, -1)/√2 and faces -w, dipping 0.1 into A's.
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        let (w, v) = (DVec3::new(s, 0.0, s), DVec3::Y);
+        let rot = DMat3::from_cols(DVec3::new(s, 0.0, -s), (w + v) * s, (w - v) * s);
+        let rot = if rot.determinant() > 0.0 {
+            rot
+        } else {
+            DMat3::from_cols(rot.x_axis, (w - v) * s, (w + v) * s)
+        };
+        let centre = DVec3::new(0.5, 0.0, 0.5) + w * (s - 0.1);
+        let pose = Isometry::new(rot, centre);
         let d = distance_cuboid_cuboid(&c, &c, &pose);
+        assert!((d.distance + 0.1).abs() < 1e-14, "{d:?}");
+        assert!(d.normal.abs_diff_eq(w, 1e-14), "{d:?}");
         check::contract(&d, 1e-14);
         let mut m = Manifold::new();
         manifold_cuboid_cuboid(&c, &c, &pose, &mut m);
-        assert!(!m.is_empty() && m.len() <= 4);
-        // A genuine edge–edge crossing: B's edge along X over A's top edge along X rotated.
-        let rb = DMat3::from_rotation_x(q) * DMat3::from_rotation_y(q);
-        let _ = rb;
+        check::manifold(&m, 1, 1e-14);
+        assert!(
+            m.points()[0]
+                .point_a
+                .abs_diff_eq(DVec3::new(0.5, 0.0, 0.5), 1e-14)
+        );
     }
 
     #[test]
