@@ -276,6 +276,41 @@ fn depth_oracle(a: &Shape, b: &Shape, pose: &Isometry) -> f64 {
     best + a.radius() + b.radius()
 }
 
+/// Oracle for two boxes: the classic 15-axis separating-axis minimum overlap (3 + 3 face
+/// normals, 9 edge cross products), written out with half-extent projections.
+fn sat15(a: &Shape, b: &Shape, pose: &Isometry) -> f64 {
+    let (Shape::Cuboid(ba), Shape::Cuboid(bb)) = (a, b) else {
+        unreachable!()
+    };
+    let ua = [DVec3::X, DVec3::Y, DVec3::Z];
+    let ub = [
+        pose.rotation.x_axis,
+        pose.rotation.y_axis,
+        pose.rotation.z_axis,
+    ];
+    let mut axes: Vec<DVec3> = ua.iter().chain(&ub).copied().collect();
+    for x in ua {
+        for y in ub {
+            if let Some(c) = x
+                .cross(y)
+                .try_normalize()
+                .filter(|_| x.cross(y).length() > 1e-9)
+            {
+                axes.push(c);
+            }
+        }
+    }
+    let radius = |h: DVec3, u: &[DVec3; 3], n: DVec3| {
+        h.x * u[0].dot(n).abs() + h.y * u[1].dot(n).abs() + h.z * u[2].dot(n).abs()
+    };
+    axes.iter()
+        .map(|&n| {
+            radius(ba.half_extents, &ua, n) + radius(bb.half_extents, &ub, n)
+                - pose.translation.dot(n).abs()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 fn uniform(r: &mut TestRng, lo: f64, hi: f64) -> f64 {
     r.random_range(lo..=hi)
 }
@@ -459,10 +494,7 @@ fn check_case(a: &Shape, b: &Shape, pose: &Isometry, counts: &mut Counts, case: 
             "{where_}: off B"
         );
         let r = p.point_b - p.point_a - m.normal * p.distance;
-        assert!(
-            r.length() <= tol + 0.02 * d.distance.abs(),
-            "{where_}: residual {r}"
-        );
+        assert!(r.length() <= tol, "{where_}: residual {r}");
     }
 }
 
@@ -488,6 +520,7 @@ fn run_pair(rank_a: u8, rank_b: u8, cases: usize, seed: u64) {
         }
     }
     let (s, p) = (counts.separated, counts.penetrating);
+    eprintln!("pair {rank_a}-{rank_b}: {cases} cases, {s} separated, {p} touching or penetrating");
     assert!(
         s > cases / 10 && p > cases / 10,
         "separated {s}, penetrating {p} of {cases}"

@@ -6,11 +6,14 @@
 //!   [`FACE_ALIGNMENT`] of the contact normal, the better aligned such face is the
 //!   *reference*; the other core's *incident* feature (a box's face most opposed to it, the
 //!   triangle, the segment or the point) is clipped against the reference face's side planes
-//!   (Sutherland–Hodgman) and the clipped points no farther than the radii above the
-//!   reference plane become contacts, measured along the reference normal (Ericson §5.x;
-//!   Gregorius, *Robust Contact Creation for Physics Simulations*, GDC 2015).
-//! - **Parallel edges** (capsule–capsule, capsule along an edge): the incident segment is
-//!   clipped to the reference segment's extent: up to 2 points.
+//!   (Sutherland–Hodgman, Ericson §8.3.4); each clipped core point is moved onto the
+//!   incident surface along the reference normal (for a ball or capsule, where that line
+//!   leaves it: the point of the surface in that point's column), projected onto the
+//!   reference face, and kept when it is not above it (Gregorius, *Robust Contact Creation
+//!   for Physics Simulations*, GDC 2015). The manifold normal is the reference face's.
+//! - **Parallel edges** (capsule–capsule, capsule along an edge; within [`EDGE_PARALLEL`]):
+//!   B's segment is clipped to A's extent, and each end gives the two surface points on the
+//!   line through it along the normal: up to 2 points.
 //! - Otherwise (edge–edge, anything against a point): 1 point, the distance witnesses.
 //!
 //! More than [`MANIFOLD_POINTS`] candidates are reduced to the deepest, the farthest from
