@@ -452,6 +452,10 @@ fn check_case(a: &Shape, b: &Shape, pose: &Isometry, counts: &mut Counts, case: 
                 (-d.distance - want).abs() <= tol,
                 "{ctx}: depth oracle {want}"
             );
+            if a.solid_box() && b.solid_box() {
+                let sat = sat15(a, b, pose);
+                assert!((-d.distance - sat).abs() <= tol, "{ctx}: 15-axis SAT {sat}");
+            }
         }
     }
     if d.distance < -10.0 * tol {
