@@ -300,3 +300,59 @@ fn reduce(c: &Candidates, normal: DVec3) -> impl Iterator<Item = ManifoldPoint> 
         .filter(|&i| i != usize::MAX)
         .map(move |i| pts[i])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(x: f64, y: f64, depth: f64) -> ManifoldPoint {
+        let p = DVec3::new(x, y, 0.0);
+        ManifoldPoint {
+            point_a: p,
+            point_b: p,
+            distance: depth,
+        }
+    }
+
+    #[test]
+    fn reduction_keeps_the_deepest_point_and_a_wide_quad() {
+        let mut c = Candidates {
+            pts: [point(0.0, 0.0, 0.0); 8],
+            len: 0,
+        };
+        // An octagon, one vertex deeper than the rest.
+        for i in 0..8u8 {
+            let angle = f64::from(i) * std::f64::consts::FRAC_PI_4;
+            c.pts[usize::from(i)] =
+                point(angle.cos(), angle.sin(), if i == 3 { -0.2 } else { -0.1 });
+        }
+        c.len = 8;
+        let kept: Vec<ManifoldPoint> = reduce(&c, DVec3::Z).collect();
+        assert_eq!(kept.len(), 4);
+        assert_eq!(kept[0].distance, -0.2);
+        // Opposite vertices, then the widest: the quad is the inscribed square.
+        let area = |p: &[ManifoldPoint]| {
+            let mut sum = 0.0;
+            let mut q: Vec<DVec3> = p.iter().map(|m| m.point_a).collect();
+            q.sort_by(|u, v| u.y.atan2(u.x).total_cmp(&v.y.atan2(v.x)));
+            for i in 0..q.len() {
+                sum += q[i].cross(q[(i + 1) % q.len()]).z;
+            }
+            0.5 * sum
+        };
+        assert!((area(&kept) - 2.0).abs() < 1e-12, "{kept:?}");
+    }
+
+    #[test]
+    fn clipping_keeps_a_segment_a_segment() {
+        let mut seg = Polygon::default();
+        seg.push(DVec3::new(-2.0, 0.0, 0.0));
+        seg.push(DVec3::new(2.0, 0.0, 0.0));
+        let out = clip_plane(&seg, DVec3::X, 1.0);
+        assert_eq!(
+            out.points(),
+            &[DVec3::new(-2.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)]
+        );
+        assert_eq!(clip_plane(&seg, DVec3::X, -3.0).len, 0);
+    }
+}

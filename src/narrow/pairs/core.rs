@@ -438,3 +438,52 @@ pub(super) fn line_interval(core: &Core, o: DVec3, v: DVec3) -> Option<(f64, f64
         _ => None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rotated_sliver_triangle_gives_its_boundary_point_not_a_far_face_point() {
+        // a, b, a + 0.3 (b − a): zero area, but nonzero rounding-noise normal once moved.
+        let (a, b) = (
+            DVec3::new(1.1129978354549748, 1.064634792926294, 0.5880046958401757),
+            DVec3::new(0.9530983393859878, -0.631487841459155, 0.8594725286710976),
+        );
+        let t = Triangle::new(a, b, a + (b - a) * 0.3);
+        let rot = DMat3::from_quat(crate::math::DQuat::from_euler(
+            glam::EulerRot::ZYX,
+            0.3,
+            -1.1,
+            2.0,
+        ));
+        let pose = Isometry::new(rot, DVec3::new(-1.3, 0.5, -0.3));
+        let v = t.transformed(&pose).vertices();
+        let got = closest_on_triangle(DVec3::ZERO, v[0], v[1], v[2]);
+        let want = closest_point_segment(DVec3::ZERO, v[0], v[1]);
+        assert!(got.distance(want) < 1e-12, "{got} vs {want}");
+    }
+
+    #[test]
+    fn line_intervals_through_a_capsule_hit_the_cylinder_and_the_caps() {
+        let c = Core::capsule(&Capsule::new(1.0, 0.5), &Isometry::IDENTITY);
+        // Across the cylinder part.
+        let (s0, s1) = line_interval(&c, DVec3::new(-2.0, 0.0, 0.3), DVec3::X).unwrap();
+        assert!((s0 - 1.5).abs() < 1e-15 && (s1 - 2.5).abs() < 1e-15);
+        // Along the axis: through both caps.
+        let (s0, s1) = line_interval(&c, DVec3::new(0.0, 0.0, -3.0), DVec3::Z).unwrap();
+        assert!((s0 - 1.5).abs() < 1e-15 && (s1 - 4.5).abs() < 1e-15);
+        // Missing it.
+        assert!(line_interval(&c, DVec3::new(0.0, 0.6, 0.0), DVec3::X).is_none());
+    }
+
+    #[test]
+    fn support_features_of_zero_size_boxes_span_their_nonzero_axes() {
+        let rod = Core::cuboid(&Cuboid::new(DVec3::new(0.0, 0.0, 1.0)), &Isometry::IDENTITY);
+        assert_eq!(rod.support_feature(DVec3::X, 1e-12).len, 2);
+        assert_eq!(rod.support_feature(DVec3::Z, 1e-12).len, 1);
+        let cube = Core::cuboid(&Cuboid::new(DVec3::ONE), &Isometry::IDENTITY);
+        assert_eq!(cube.support_feature(DVec3::X, 1e-12).len, 4);
+        assert!(cube.best_face(DVec3::new(0.1, 0.0, -1.0)).unwrap().1 == -DVec3::Z);
+    }
+}

@@ -9,10 +9,10 @@
 //!   A→B when they touch or overlap, empty when apart.
 //!
 //! All of them share one engine: every primitive is a convex polytope *core* swept by a ball
-//! (a sphere a point, a capsule a segment, cuboid and triangle radius 0; [`core`]); the
+//! (a sphere a point, a capsule a segment, cuboid and triangle radius 0; `core`); the
 //! distance is the separating-axis test over the complete axis set of the two cores plus
-//! closed-form vertex/edge closest points ([`query`]); manifolds clip an incident feature
-//! against a reference face ([`clip`]). Exact to rounding, except the documented skip of
+//! closed-form vertex/edge closest points (`query`); manifolds clip an incident feature
+//! against a reference face (`clip`). Exact to rounding, except the documented skip of
 //! near-parallel cross axes (`≤ 1e-12` × extent).
 //!
 //! # Degenerate input, documented choices

@@ -199,3 +199,37 @@ pub(super) fn distance(a: &Core, b: &Core) -> ShapeDistance {
         normal,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Capsule, Sphere, Triangle};
+    use crate::math::Isometry;
+
+    #[test]
+    fn a_point_beside_a_coplanar_triangle_is_separated_by_an_in_plane_axis() {
+        // The Minkowski difference is flat here: the triangle normal alone shows overlap 0.
+        let t = Triangle::new(DVec3::ZERO, DVec3::X, DVec3::Y);
+        let a = Core::sphere(
+            &Sphere::new(0.0),
+            &Isometry::from_translation(DVec3::new(2.0, 2.0, 0.0)),
+        );
+        let b = Core::triangle(&t, &Isometry::IDENTITY);
+        assert!(best_axis(&a, &b).separation > 0.5);
+        let d = distance(&a, &b);
+        assert!((d.distance - 1.5 * 2f64.sqrt()).abs() < 1e-15, "{d:?}");
+    }
+
+    #[test]
+    fn coplanar_disjoint_segments_are_apart() {
+        let c = Capsule::new(1.0, 0.0);
+        let a = Core::capsule(&c, &Isometry::IDENTITY);
+        let pose = Isometry::new(
+            crate::math::DMat3::from_rotation_y(1.0),
+            DVec3::new(3.0, 0.0, 0.0),
+        );
+        let b = Core::capsule(&c, &pose);
+        assert!(best_axis(&a, &b).separation > 0.0);
+        assert!(distance(&a, &b).distance > 1.0);
+    }
+}

@@ -11,7 +11,9 @@ use crate::geometry::{Cuboid, Sphere};
 use crate::math::Isometry;
 use crate::narrow::contact::{Manifold, ShapeDistance};
 
-/// Signed distance from `a` to `b` placed by `pose_ab`, A's frame (see the module docs).
+/// Exact signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's), with
+/// witnesses and unit normal A→B, all in A's frame, as [`crate::narrow::contact`] states;
+/// negative: minus the penetration depth. Never NaN, degenerate sizes included.
 #[must_use]
 pub fn distance_sphere_cuboid(a: &Sphere, b: &Cuboid, pose_ab: &Isometry) -> ShapeDistance {
     query::distance(
@@ -20,7 +22,8 @@ pub fn distance_sphere_cuboid(a: &Sphere, b: &Cuboid, pose_ab: &Isometry) -> Sha
     )
 }
 
-/// Contact manifold of `a` and `b` placed by `pose_ab`, A's frame; empty when apart.
+/// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4
+/// points on both surfaces with one normal A→B, A's frame; empty when apart.
 pub fn manifold_sphere_cuboid(a: &Sphere, b: &Cuboid, pose_ab: &Isometry, out: &mut Manifold) {
     clip::manifold(
         &Core::sphere(a, &Isometry::IDENTITY),
