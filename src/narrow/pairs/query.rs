@@ -145,22 +145,31 @@ impl Features for Polygon {
 #[must_use]
 pub(super) fn closest_pair(a: &impl Features, b: &impl Features) -> (DVec3, DVec3) {
     let mut best = (f64::INFINITY, DVec3::ZERO, DVec3::ZERO);
-    let mut offer = |pa: DVec3, pb: DVec3| {
+    let offer = |best: &mut (f64, DVec3, DVec3), pa: DVec3, pb: DVec3| {
         let d = pa.distance_squared(pb);
         if d < best.0 {
-            best = (d, pa, pb);
+            *best = (d, pa, pb);
         }
     };
     for v in a.feature_vertices() {
-        offer(*v, b.feature_closest(*v));
+        offer(&mut best, *v, b.feature_closest(*v));
     }
     for v in b.feature_vertices() {
-        offer(a.feature_closest(*v), *v);
+        offer(&mut best, a.feature_closest(*v), *v);
     }
     for (p, q) in a.feature_edges() {
+        let (mid_a, half_a) = ((p + q) * 0.5, 0.5 * p.distance(q));
         for (r, s) in b.feature_edges() {
+            // PERF: an edge pair whose bounding spheres are already farther apart than the
+            // best pair so far cannot improve it (exact pruning; the vertex pairs above give
+            // a tight bound first).
+            let (mid_b, half_b) = ((r + s) * 0.5, 0.5 * r.distance(s));
+            let bound = mid_a.distance(mid_b) - half_a - half_b;
+            if bound > 0.0 && bound * bound > best.0 {
+                continue;
+            }
             let (pa, pb) = closest_points_segment_segment(p, q, r, s);
-            offer(pa, pb);
+            offer(&mut best, pa, pb);
         }
     }
     (best.1, best.2)
