@@ -10,6 +10,9 @@
 //! [`mesh_mesh`] builds the exact mesh–mesh queries (collision, contacts, distance,
 //! tolerance) on them by tandem traversal of two BVHs.
 //!
+//! [`pairs`] holds the closed-form distance and manifold queries between the primitives
+//! sphere, capsule, cuboid and triangle.
+//!
 //! Closed sets throughout: touching counts as intersecting, and zero-area triangles are the
 //! segment or point they span.
 
@@ -17,11 +20,20 @@ mod closest_points;
 pub mod contact;
 pub mod convex_mesh;
 pub mod mesh_mesh;
+pub mod pairs;
 pub mod toi;
 mod triangle_overlap;
 pub mod triangle_triangle;
 
 pub use contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+pub use pairs::{
+    distance_capsule_capsule, distance_capsule_cuboid, distance_capsule_triangle,
+    distance_cuboid_cuboid, distance_cuboid_triangle, distance_sphere_capsule,
+    distance_sphere_cuboid, distance_sphere_sphere, distance_sphere_triangle,
+    manifold_capsule_capsule, manifold_capsule_cuboid, manifold_capsule_triangle,
+    manifold_cuboid_cuboid, manifold_cuboid_triangle, manifold_sphere_capsule,
+    manifold_sphere_cuboid, manifold_sphere_sphere, manifold_sphere_triangle,
+};
 pub use triangle_triangle::{
     TriangleDistance, distance_triangle_triangle, intersection_segment_triangle_triangle,
     intersects_triangle_triangle,

@@ -1,0 +1,358 @@
+//! Contact manifolds of two placed cores, the engine behind every `manifold_*` function.
+//!
+//! # Algorithm
+//! From the signed distance ([`super::query::distance`]), when it is `≤ 0`:
+//! - **Face contact**: when a core has a face whose outward normal is within
+//!   [`FACE_ALIGNMENT`] of the contact normal, the better aligned such face is the
+//!   *reference*; the other core's *incident* feature (a box's face most opposed to it, the
+//!   triangle, the segment or the point) is clipped against the reference face's side planes
+//!   (Sutherland–Hodgman, Ericson §8.3.4); each clipped core point is moved onto the
+//!   incident surface along the reference normal (for a ball or capsule, where that line
+//!   leaves it: the point of the surface in that point's column), projected onto the
+//!   reference face, and kept when it is not above it (Gregorius, *Robust Contact Creation
+//!   for Physics Simulations*, GDC 2015). The manifold normal is the reference face's.
+//! - **Parallel edges** (capsule–capsule, capsule along an edge; within [`EDGE_PARALLEL`]):
+//!   B's segment is clipped to A's extent, and each end gives the two surface points on the
+//!   line through it along the normal: up to 2 points.
+//! - Otherwise (edge–edge, anything against a point): 1 point, the distance witnesses.
+//!
+//! More than [`MANIFOLD_POINTS`] candidates are reduced to the deepest, the farthest from
+//! it, then the two that span the largest area.
+
+use super::core::{Core, Kind, Polygon, line_interval};
+use super::query::{FEATURE_RELATIVE, distance};
+use crate::math::DVec3;
+use crate::narrow::contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint};
+
+/// Cosine between a face normal and the contact normal above which the face is a
+/// reference face (about 0.8°).
+pub(super) const FACE_ALIGNMENT: f64 = 0.9999;
+
+/// Sine of the angle under which two edges (and an edge and the contact plane) count as
+/// parallel for a two-point edge contact (about 0.6°).
+pub(super) const EDGE_PARALLEL: f64 = 1e-2;
+
+/// Candidate contact points before reduction.
+#[derive(Debug, Clone, Copy)]
+struct Candidates {
+    pts: [ManifoldPoint; 8],
+    len: usize,
+}
+
+/// Fills `out` with the contact manifold of two placed cores (module docs); empty when
+/// they are apart.
+pub(super) fn manifold(a: &Core, b: &Core, out: &mut Manifold) {
+    let d = distance(a, b);
+    out.reset(d.normal);
+    if d.distance > 0.0 {
+        return;
+    }
+    let slack = FEATURE_RELATIVE * a.scale().max(b.scale());
+    let mut cands = Candidates {
+        pts: [ManifoldPoint {
+            point_a: DVec3::ZERO,
+            point_b: DVec3::ZERO,
+            distance: 0.0,
+        }; 8],
+        len: 0,
+    };
+    let n = d.normal;
+    let face_a = a.best_face(n).filter(|f| f.2 >= FACE_ALIGNMENT);
+    let face_b = b.best_face(-n).filter(|f| f.2 >= FACE_ALIGNMENT);
+    let use_a = match (&face_a, &face_b) {
+        (Some(fa), Some(fb)) => Some(fa.2 >= fb.2),
+        (Some(_), None) => Some(true),
+        (None, Some(_)) => Some(false),
+        (None, None) => None,
+    };
+    match use_a {
+        Some(true) => {
+            let (poly, f, _) = face_a.unwrap_or_default();
+            out.normal = f;
+            clip_face(&poly, f, a.radius, b, true, slack, &mut cands);
+        }
+        Some(false) => {
+            let (poly, f, _) = face_b.unwrap_or_default();
+            out.normal = -f;
+            clip_face(&poly, f, b.radius, a, false, slack, &mut cands);
+        }
+        None => parallel_edges(a, b, n, slack, &mut cands),
+    }
+    if cands.len == 0 {
+        out.normal = n;
+        out.push(ManifoldPoint {
+            point_a: d.point_a,
+            point_b: d.point_b,
+            distance: d.distance,
+        });
+        return;
+    }
+    for p in reduce(&cands, out.normal) {
+        out.push(p);
+    }
+}
+
+/// The incident feature of `core` against a reference face of outward normal `f`.
+fn incident(core: &Core, f: DVec3) -> Polygon {
+    match core.kind {
+        Kind::Box { .. } => match core.best_face(-f) {
+            Some((poly, _, _)) => poly,
+            None => core.support_feature(-f, 0.0),
+        },
+        _ => {
+            let mut p = Polygon::default();
+            for v in core.vertices() {
+                p.push(*v);
+            }
+            p
+        }
+    }
+}
+
+/// Clips `other`'s incident feature against the reference face `poly` (outward normal `f`,
+/// radius `r_ref`), adding the points at most the radii above it. `ref_is_a` says which side
+/// the reference face is on.
+fn clip_face(
+    poly: &Polygon,
+    f: DVec3,
+    r_ref: f64,
+    other: &Core,
+    ref_is_a: bool,
+    slack: f64,
+    out: &mut Candidates,
+) {
+    let mut inc = incident(other, f);
+    let ref_pts = poly.points();
+    let centroid = ref_pts.iter().copied().sum::<DVec3>() / ref_pts.len() as f64;
+    for i in 0..ref_pts.len() {
+        let (p, q) = (ref_pts[i], ref_pts[(i + 1) % ref_pts.len()]);
+        let mut side = (q - p).cross(f);
+        if side.dot(centroid - p) > 0.0 {
+            side = -side;
+        }
+        if side.length_squared() > 0.0 {
+            inc = clip_plane(&inc, side, side.dot(p));
+        }
+    }
+    for q in inc.points() {
+        // The incident surface point in the column of `q`: for a rounded core, where the
+        // line through `q` along `f` leaves it on the reference side.
+        let on_inc = if other.radius > 0.0 {
+            match line_interval(other, *q, -f) {
+                Some((_, exit)) => *q - f * exit,
+                None => continue,
+            }
+        } else {
+            *q
+        };
+        let s = (on_inc - ref_pts[0]).dot(f) - r_ref;
+        if s > slack {
+            continue;
+        }
+        let on_ref = on_inc - f * s;
+        let (point_a, point_b) = if ref_is_a {
+            (on_ref, on_inc)
+        } else {
+            (on_inc, on_ref)
+        };
+        if out.len < out.pts.len() {
+            out.pts[out.len] = ManifoldPoint {
+                point_a,
+                point_b,
+                distance: s,
+            };
+            out.len += 1;
+        }
+    }
+}
+
+/// Sutherland–Hodgman: the part of `poly` with `side · x ≤ offset`. A segment stays a
+/// segment and a point a point.
+fn clip_plane(poly: &Polygon, side: DVec3, offset: f64) -> Polygon {
+    let mut out = Polygon::default();
+    let pts = poly.points();
+    let inside = |p: DVec3| side.dot(p) - offset;
+    match pts.len() {
+        0 => {}
+        1 => {
+            if inside(pts[0]) <= 0.0 {
+                out.push(pts[0]);
+            }
+        }
+        2 => {
+            let (da, db) = (inside(pts[0]), inside(pts[1]));
+            if da <= 0.0 && db <= 0.0 {
+                out = *poly;
+            } else if da <= 0.0 || db <= 0.0 {
+                let cut = pts[0] + (pts[1] - pts[0]) * (da / (da - db));
+                if da <= 0.0 {
+                    out.push(pts[0]);
+                    out.push(cut);
+                } else {
+                    out.push(cut);
+                    out.push(pts[1]);
+                }
+            }
+        }
+        n => {
+            for i in 0..n {
+                let (p, q) = (pts[i], pts[(i + 1) % n]);
+                let (dp, dq) = (inside(p), inside(q));
+                if dp <= 0.0 {
+                    out.push(p);
+                }
+                if (dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0) {
+                    out.push(p + (q - p) * (dp / (dp - dq)));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Two parallel edge features (both ⟂ the normal) give up to two points; else none.
+fn parallel_edges(a: &Core, b: &Core, n: DVec3, slack: f64, out: &mut Candidates) {
+    let fa = a.support_feature(n, EDGE_PARALLEL * a.extent());
+    let fb = b.support_feature(-n, EDGE_PARALLEL * b.extent());
+    if fa.len != 2 || fb.len != 2 {
+        return;
+    }
+    let (da, db) = (fa.pts[1] - fa.pts[0], fb.pts[1] - fb.pts[0]);
+    let (la, lb) = (da.length(), db.length());
+    if la == 0.0
+        || lb == 0.0
+        || da.cross(db).length() > EDGE_PARALLEL * la * lb
+        || da.dot(n).abs() > EDGE_PARALLEL * la
+    {
+        return;
+    }
+    let u = da / la;
+    let (t0, t1) = (fa.pts[0].dot(u), fa.pts[1].dot(u));
+    let mut seg = fb;
+    seg = clip_plane(&seg, u, t1);
+    seg = clip_plane(&seg, -u, -t0);
+    for q in seg.points() {
+        // Both surface points on the line through `q` along `n`: B's where the line leaves
+        // B towards A, A's where it enters A from B's side.
+        let (Some((_, exit_b)), Some((enter_a, _))) =
+            (line_interval(b, *q, -n), line_interval(a, *q, -n))
+        else {
+            continue;
+        };
+        let (point_a, point_b) = (*q - n * enter_a, *q - n * exit_b);
+        let s = (point_b - point_a).dot(n);
+        if s > slack || out.len == out.pts.len() {
+            continue;
+        }
+        out.pts[out.len] = ManifoldPoint {
+            point_a,
+            point_b,
+            distance: s,
+        };
+        out.len += 1;
+    }
+}
+
+/// At most [`MANIFOLD_POINTS`] of the candidates: the deepest, the farthest from it, the
+/// one spanning the largest triangle with those, then the one adding the most area.
+fn reduce(c: &Candidates, normal: DVec3) -> impl Iterator<Item = ManifoldPoint> {
+    let pts = &c.pts[..c.len];
+    let mut chosen = [usize::MAX; MANIFOLD_POINTS];
+    if pts.len() <= MANIFOLD_POINTS {
+        for (i, slot) in chosen.iter_mut().enumerate().take(pts.len()) {
+            *slot = i;
+        }
+    } else {
+        let pos = |i: usize| pts[i].point_a;
+        let argmax = |score: &dyn Fn(usize) -> f64, chosen: &[usize]| {
+            (0..pts.len())
+                .filter(|i| !chosen.contains(i))
+                .max_by(|&i, &j| score(i).total_cmp(&score(j)))
+                .unwrap_or(0)
+        };
+        chosen[0] = argmax(&|i| -pts[i].distance, &chosen);
+        let p0 = pos(chosen[0]);
+        chosen[1] = argmax(&|i| pos(i).distance_squared(p0), &chosen);
+        let p1 = pos(chosen[1]);
+        let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(normal);
+        chosen[2] = argmax(&|i| area(p0, p1, pos(i)).abs(), &chosen);
+        let p2 = pos(chosen[2]);
+        // Orient the triangle counter-clockwise about the normal, then the fourth point is
+        // the one farthest outside one of its edges.
+        let (p1, p2) = if area(p0, p1, p2) >= 0.0 {
+            (p1, p2)
+        } else {
+            (p2, p1)
+        };
+        chosen[3] = argmax(
+            &|i| {
+                let q = pos(i);
+                (-area(p0, p1, q))
+                    .max(-area(p1, p2, q))
+                    .max(-area(p2, p0, q))
+            },
+            &chosen,
+        );
+    }
+    let pts = c.pts;
+    chosen
+        .into_iter()
+        .filter(|&i| i != usize::MAX)
+        .map(move |i| pts[i])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(x: f64, y: f64, depth: f64) -> ManifoldPoint {
+        let p = DVec3::new(x, y, 0.0);
+        ManifoldPoint {
+            point_a: p,
+            point_b: p,
+            distance: depth,
+        }
+    }
+
+    #[test]
+    fn reduction_keeps_the_deepest_point_and_a_wide_quad() {
+        let mut c = Candidates {
+            pts: [point(0.0, 0.0, 0.0); 8],
+            len: 0,
+        };
+        // An octagon, one vertex deeper than the rest.
+        for i in 0..8u8 {
+            let angle = f64::from(i) * std::f64::consts::FRAC_PI_4;
+            c.pts[usize::from(i)] =
+                point(angle.cos(), angle.sin(), if i == 3 { -0.2 } else { -0.1 });
+        }
+        c.len = 8;
+        let kept: Vec<ManifoldPoint> = reduce(&c, DVec3::Z).collect();
+        assert_eq!(kept.len(), 4);
+        assert_eq!(kept[0].distance, -0.2);
+        // Opposite vertices, then the widest: the quad is the inscribed square.
+        let area = |p: &[ManifoldPoint]| {
+            let mut sum = 0.0;
+            let mut q: Vec<DVec3> = p.iter().map(|m| m.point_a).collect();
+            q.sort_by(|u, v| u.y.atan2(u.x).total_cmp(&v.y.atan2(v.x)));
+            for i in 0..q.len() {
+                sum += q[i].cross(q[(i + 1) % q.len()]).z;
+            }
+            0.5 * sum
+        };
+        assert!((area(&kept) - 2.0).abs() < 1e-12, "{kept:?}");
+    }
+
+    #[test]
+    fn clipping_keeps_a_segment_a_segment() {
+        let mut seg = Polygon::default();
+        seg.push(DVec3::new(-2.0, 0.0, 0.0));
+        seg.push(DVec3::new(2.0, 0.0, 0.0));
+        let out = clip_plane(&seg, DVec3::X, 1.0);
+        assert_eq!(
+            out.points(),
+            &[DVec3::new(-2.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)]
+        );
+        assert_eq!(clip_plane(&seg, DVec3::X, -3.0).len, 0);
+    }
+}
