@@ -15,11 +15,15 @@
 
 mod closest_points;
 pub mod contact;
+pub mod gjk;
 pub mod mesh_mesh;
 mod triangle_overlap;
 pub mod triangle_triangle;
 
 pub use contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+pub use gjk::{
+    GjkCache, GjkOutcome, GjkParams, GjkResult, Rounded, gjk_distance, signed_distance_convex,
+};
 pub use triangle_triangle::{
     TriangleDistance, distance_triangle_triangle, intersection_segment_triangle_triangle,
     intersects_triangle_triangle,
