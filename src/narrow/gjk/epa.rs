@@ -266,7 +266,17 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         let tol = floor(scale);
         let h = p.w.dot(best.normal);
         if h - best.dist <= params.rel_tol * best.dist.abs() + tol {
-            return converged(&ws.vertices, &best, iterations);
+            // Coplanar faces tie on distance; the witnesses need the one whose triangle holds
+            // the origin's projection.
+            let near = best.dist + (tol + 1e-9 * scale).max(h - best.dist);
+            let f = ws
+                .faces
+                .iter()
+                .filter(|f| f.dist <= near)
+                .map(|f| (inside(&ws.vertices, f), f))
+                .max_by(|x, y| x.0.total_cmp(&y.0))
+                .map_or(best, |(_, f)| *f);
+            return converged(&ws.vertices, &f, iterations);
         }
         if ws.vertices.len() == MAX_VERTICES {
             break;
@@ -335,19 +345,35 @@ fn span_size(vs: &[SupportPoint]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The smallest barycentric coordinate of the origin's projection on face `f` (≥ 0: inside).
+fn inside(vs: &[SupportPoint], f: &Face) -> f64 {
+    let l = barycentric(vs, f);
+    if l.iter().all(|x| x.is_finite()) {
+        l[0].min(l[1]).min(l[2])
+    } else {
+        f64::NEG_INFINITY
+    }
+}
+
+fn barycentric(vs: &[SupportPoint], f: &Face) -> [f64; 3] {
+    let [p0, p1, p2] = f.v.map(|i| vs[i as usize].w);
+    let n = f.normal;
+    let q = n * f.dist;
+    let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(n);
+    let total = area(p0, p1, p2);
+    [
+        area(q, p1, p2) / total,
+        area(p0, q, p2) / total,
+        area(p0, p1, q) / total,
+    ]
+}
+
 /// The answer from the confirmed nearest face: the origin's projection on it, in
 /// barycentric coordinates, gives the witnesses.
 fn converged(vs: &[SupportPoint], f: &Face, iterations: u32) -> EpaResult {
     let [p0, p1, p2] = f.v.map(|i| vs[i as usize]);
     let n = f.normal;
-    let q = n * f.dist;
-    let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(n);
-    let total = area(p0.w, p1.w, p2.w);
-    let mut l = [
-        area(q, p1.w, p2.w) / total,
-        area(p0.w, q, p2.w) / total,
-        area(p0.w, p1.w, q) / total,
-    ];
+    let mut l = barycentric(vs, f);
     if !l.iter().all(|x| x.is_finite()) {
         l = [1.0 / 3.0; 3];
     }
