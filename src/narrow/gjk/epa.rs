@@ -267,12 +267,13 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         let h = p.w.dot(best.normal);
         if h - best.dist <= params.rel_tol * best.dist.abs() + tol {
             // Coplanar faces tie on distance; the witnesses need the one whose triangle holds
-            // the origin's projection.
+            // the origin's projection. Only faces in the confirmed plane qualify: a face
+            // through the origin at another angle has distance 0 too but no certificate.
             let near = best.dist + (tol + 1e-9 * scale).max(h - best.dist);
             let f = ws
                 .faces
                 .iter()
-                .filter(|f| f.dist <= near)
+                .filter(|f| f.dist <= near && f.normal.dot(best.normal) >= 1.0 - 1e-9)
                 .map(|f| (inside(&ws.vertices, f), f))
                 .max_by(|x, y| x.0.total_cmp(&y.0))
                 .map_or(best, |(_, f)| *f);

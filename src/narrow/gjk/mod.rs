@@ -95,6 +95,10 @@ pub struct GjkResult {
     pub point_a: DVec3,
     /// Witness on B (A's frame); `point_a − point_b = v`.
     pub point_b: DVec3,
+    /// Unit normal A→B (`−v / |v|`, from the plane of the final simplex when it is a
+    /// triangle, which is accurate even when `|v|` is rounding-sized); zero when
+    /// penetrating.
+    pub normal: DVec3,
     /// Iterations (support calls after the first).
     pub iterations: u32,
     /// The final simplex (EPA's start when penetrating).
@@ -232,9 +236,45 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         },
         point_a: c.a,
         point_b: c.b,
+        normal: if outcome == GjkOutcome::Penetrating {
+            DVec3::ZERO
+        } else {
+            separating_normal(&simplex, v)
+        },
         iterations,
         simplex,
     }
+}
+
+/// `−v / |v|`; for a triangle simplex holding `v` inside, the triangle's unit normal
+/// (the same direction in exact arithmetic, since `v` is then the origin's projection on its
+/// plane, but computed from edges of the shapes' size instead of the rounding-sized `v`).
+fn separating_normal(simplex: &Simplex, v: DVec3) -> DVec3 {
+    let minus_v = -v.normalize_or_zero();
+    if simplex.len() == 3 {
+        let p = simplex.points();
+        let (e1, e2) = (p[1].w - p[0].w, p[2].w - p[0].w);
+        let n = e1.cross(e2);
+        if n.length_squared() > 1e-6 * e1.length_squared() * e2.length_squared() {
+            let n = n.normalize();
+            return if n.dot(minus_v) < 0.0 { -n } else { n };
+        }
+    }
+    minus_v
+}
+
+/// Whether `n` is an outward normal of `A − B` at the origin, to rounding: the support
+/// value `h(n)` is within the rounding floor of 0 (or below).
+fn certifies_touching<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    a: &A,
+    b: &B,
+    pose_ab: &Isometry,
+    params: &GjkParams,
+    n: DVec3,
+) -> bool {
+    let p = support(a, b, pose_ab, n);
+    let floor = params.abs_tol + ROUNDING_ULPS * f64::EPSILON * magnitude(&p);
+    p.w.dot(n) <= floor
 }
 
 /// A convex shape seen as a core (a support map) swept by a ball of `radius` metres.
@@ -303,9 +343,16 @@ pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
 ) -> (ShapeDistance, ConvexOutcome) {
     let g = gjk_distance(a.core, b.core, pose_ab, params, cache);
     let (core, normal, epa) = match g.outcome {
-        GjkOutcome::Separated | GjkOutcome::DidNotConverge => {
-            let n = (g.point_b - g.point_a) / g.distance;
-            ((g.distance, g.point_a, g.point_b), n, None::<EpaOutcome>)
+        GjkOutcome::Separated | GjkOutcome::DidNotConverge => (
+            (g.distance, g.point_a, g.point_b),
+            g.normal,
+            None::<EpaOutcome>,
+        ),
+        GjkOutcome::Touching
+            if g.normal != DVec3::ZERO
+                && certifies_touching(a.core, b.core, pose_ab, params, g.normal) =>
+        {
+            ((g.distance, g.point_a, g.point_b), g.normal, None)
         }
         GjkOutcome::Touching | GjkOutcome::Penetrating => {
             let e = epa::penetration(a.core, b.core, pose_ab, &g.simplex, params, workspace);

@@ -189,3 +189,88 @@ fn the_accelerated_variant_and_a_warm_start_agree_with_plain_gjk() {
     }
     assert!(stalled < 40, "{stalled} runs hit the iteration cap");
 }
+
+#[test]
+fn sphere_centres_on_a_box_face_edge_or_corner_give_the_radius_as_depth() {
+    let cube = Cuboid::new(DVec3::new(1.0, 0.5, 0.25));
+    let h = cube.half_extents;
+    let mut r = rng(5);
+    for i in 0..3000 {
+        // A surface point: clamp a random point to the surface, on 1, 2 or 3 faces.
+        let mut c = point_in_cube(&mut r, 1.0) * h;
+        for k in 0..=(i % 3) {
+            let axis = (i / 3 + k) % 3;
+            c[axis] = h[axis].copysign(c[axis]);
+        }
+        // Every other case a hair off the surface (inside or out): GJK's "touching".
+        let hair = if i % 2 == 0 {
+            DVec3::ZERO
+        } else {
+            point_in_cube(&mut r, 1e-13)
+        };
+        let pose = Isometry::from_translation(c + hair);
+        let radius = 0.1;
+        let (d, out) = query(
+            &Rounded::plain(&cube),
+            &Rounded::sphere(&Sphere::new(radius)),
+            &pose,
+        );
+        assert!((d.distance + radius).abs() < 1e-12, "{c}: {d:?} {out:?}");
+        check_contract(&d, 1e-12);
+        // The normal points out of the box at c (into the face's outer normal cone). A hair
+        // off an edge or a corner, GJK's direction `−v/|v|` carries the rounding of a
+        // 1e-13-long `v`: about 1e-16 / |v| radians.
+        let outside = ((c + hair).abs() - h).max(DVec3::ZERO).length();
+        let slack = if outside > 0.0 {
+            (1e-15 / outside).clamp(1e-9, 1.0)
+        } else {
+            1e-9
+        };
+        // Moving the sphere by the depth along the normal leaves it touching, not inside.
+        let moved = c + hair + d.normal * radius;
+        let gap = (moved.abs() - h).max(DVec3::ZERO).length();
+        assert!(
+            (gap - radius).abs() < radius * slack * slack + 1e-12,
+            "{c}: {d:?} {out:?}"
+        );
+        for k in 0..3 {
+            if (c[k].abs() - h[k]).abs() > 0.0 {
+                assert!(d.normal[k].abs() < slack, "{c}: {d:?} {out:?}");
+            } else {
+                assert!(d.normal[k] * c[k] >= -slack, "{c}: {d:?} {out:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn capsules_with_crossing_cores_penetrate_by_both_radii_across_both_axes() {
+    let mut r = rng(6);
+    for _ in 0..2000 {
+        let (a, b) = (Capsule::new(0.6, 0.2), Capsule::new(0.9, 0.1));
+        // B's core crosses A's core at a random point of both.
+        let q = crate::test_support::rotation(&mut r);
+        let on_a = DVec3::new(0.0, 0.0, 0.5 * point_in_cube(&mut r, 1.0).z);
+        let along_b = 0.8 * point_in_cube(&mut r, 1.0).z;
+        let t = on_a - q * DVec3::new(0.0, 0.0, along_b);
+        let pose = Pose::new(t, q).to_isometry();
+        let (sa, sb) = (capsule_core(&a), capsule_core(&b));
+        let (d, out) = query(
+            &Rounded::new(&sa, a.radius),
+            &Rounded::new(&sb, b.radius),
+            &pose,
+        );
+        assert!(
+            (d.distance + a.radius + b.radius).abs() < 1e-9,
+            "{d:?} {out:?}"
+        );
+        check_contract(&d, 1e-9);
+        let axis = DVec3::Z.cross(q * DVec3::Z);
+        if axis.length() > 1e-3 {
+            assert!(
+                d.normal.cross(axis.normalize()).length() < 1e-6,
+                "{d:?} {out:?}"
+            );
+        }
+    }
+}
