@@ -16,15 +16,54 @@
 #[path = "support/mod.rs"]
 mod support;
 
+use proxima::geometry::{Capsule, Segment, Sphere};
 use proxima::geometry::{Cone, ConvexPolyhedron, Cuboid, Cylinder, SupportMap, Triangle};
 use proxima::math::{DQuat, DVec3, Isometry, Pose};
 use proxima::narrow::gjk::{
     ConvexOutcome, EpaOutcome, EpaWorkspace, GjkCache, GjkOutcome, GjkParams, Rounded,
     gjk_distance, signed_distance_convex,
 };
+use proxima::narrow::gjk::{POINT, capsule_core};
 use proxima::narrow::{ShapeDistance, distance_triangle_triangle};
 use rand::Rng;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use support::{TestRng, isometry, meshes, point_in_cube, rng, rotation};
+
+/// Counts this thread's allocations, to prove that a warmed-up query allocates nothing.
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+// SAFETY: forwards to the system allocator; the counter is a const-initialised thread local,
+// which never allocates.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as ours.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+        // SAFETY: same contract as ours.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
 
 /// A polytope as vertices (for support values) and surface triangles (for distances).
 struct Poly {
@@ -47,6 +86,14 @@ impl Poly {
             .map(|t| Triangle::new(v[t[0] as usize], v[t[1] as usize], v[t[2] as usize]))
             .collect();
         Self::from_triangles(v.to_vec(), t)
+    }
+
+    fn of_segment(s: &Segment) -> Self {
+        Self::from_triangles(vec![s.a, s.b], vec![Triangle::new(s.a, s.b, s.b)])
+    }
+
+    fn of_point(p: DVec3) -> Self {
+        Self::from_triangles(vec![p], vec![Triangle::new(p, p, p)])
     }
 
     fn from_triangles(vertices: Vec<DVec3>, triangles: Vec<Triangle>) -> Self {
@@ -206,7 +253,7 @@ fn random_box(r: &mut TestRng, lo: f64, hi: f64) -> Cuboid {
 fn box_pairs_match_the_triangle_and_sat_oracles() {
     let mut r = rng(10);
     let (mut apart, mut deep) = (0, 0);
-    for _ in 0..1500 {
+    for _ in 0..4000 {
         let (ca, cb) = (random_box(&mut r, 0.1, 1.0), random_box(&mut r, 0.1, 1.0));
         let pose = isometry(&mut r, 1.8);
         let (d, out) = plain(&ca, &cb, &pose);
@@ -218,7 +265,7 @@ fn box_pairs_match_the_triangle_and_sat_oracles() {
         }
     }
     println!("boxes: {apart} apart, {deep} penetrating");
-    assert!(apart > 300 && deep > 300);
+    assert!(apart > 1000 && deep > 1000);
 }
 
 fn random_hull(r: &mut TestRng, n: usize, flat: bool) -> ConvexPolyhedron {
@@ -238,7 +285,7 @@ fn random_hull(r: &mut TestRng, n: usize, flat: bool) -> ConvexPolyhedron {
 fn hulls_of_random_clouds_match_the_oracles_and_move_apart_by_their_depth() {
     let mut r = rng(11);
     let (mut apart, mut deep) = (0, 0);
-    for i in 0..400 {
+    for i in 0..1200 {
         // Small clouds for penetration (the axis oracle is quadratic in edges), large ones too.
         let n = if i % 4 == 0 {
             r.random_range(60..200)
@@ -277,14 +324,14 @@ fn hulls_of_random_clouds_match_the_oracles_and_move_apart_by_their_depth() {
         }
     }
     println!("hulls: {apart} apart, {deep} penetrating");
-    assert!(apart > 80 && deep > 80);
+    assert!(apart > 200 && deep > 200);
 }
 
 #[test]
 fn flat_hulls_against_boxes_match_the_oracles() {
     let mut r = rng(12);
     let (mut apart, mut deep) = (0, 0);
-    for _ in 0..400 {
+    for _ in 0..1000 {
         let flat = random_hull(&mut r, 12, true);
         assert_eq!(flat.dimension(), 2);
         let cube = random_box(&mut r, 0.2, 0.8);
@@ -308,11 +355,11 @@ fn flat_hulls_against_boxes_match_the_oracles() {
         }
     }
     println!("flat: {apart} apart, {deep} penetrating");
-    assert!(apart > 50 && deep > 50);
+    assert!(apart > 100 && deep > 100);
 }
 
 #[test]
-fn identical_boxes_slightly_offset_give_the_offset_as_depth() {
+fn identical_boxes_slightly_offset_match_the_sat_depth() {
     let mut r = rng(13);
     for i in 0..1000 {
         let c = random_box(&mut r, 0.2, 1.0);
@@ -379,13 +426,14 @@ fn sample_directions(r: &mut TestRng, n: usize) -> Vec<DVec3> {
 fn cylinders_and_cones_agree_with_membership_and_sampled_support_functions() {
     let mut r = rng(15);
     let dirs = sample_directions(&mut r, 2000);
-    let (mut apart, mut deep) = (0, 0);
-    let params = GjkParams::default();
-    for i in 0..300 {
+    let (mut apart, mut deep, mut fallbacks, mut stalled) = (0, 0, 0, 0);
+    for i in 0..2000 {
         let cyl = Cylinder::new(r.random_range(0.2..1.0), r.random_range(0.2..1.0));
         let cone = Cone::new(r.random_range(0.2..1.0), r.random_range(0.2..1.0));
         let pose = isometry(&mut r, 1.8);
         let (d, out) = plain(&cyl, &cone, &pose);
+        fallbacks += usize::from(out.epa == Some(EpaOutcome::Fallback));
+        stalled += usize::from(out.gjk == GjkOutcome::DidNotConverge);
         check_contract(&d, 1e-7);
         let tol = 1e-6;
         let ov = |n: DVec3| {
@@ -413,22 +461,23 @@ fn cylinders_and_cones_agree_with_membership_and_sampled_support_functions() {
             "{out:?} {} vs sampled {best}",
             -d.distance
         );
-        let _ = params;
         if d.distance > 0.0 {
             apart += 1;
         } else {
             deep += 1;
         }
     }
-    println!("curved: {apart} apart, {deep} penetrating");
-    assert!(apart > 50 && deep > 50);
+    println!(
+        "curved: {apart} apart, {deep} penetrating, {fallbacks} EPA fallbacks, {stalled} GJK at the cap"
+    );
+    assert!(apart > 300 && deep > 300);
 }
 
 #[test]
 fn answers_are_invariant_under_swap_sign_of_q_distance_from_origin_and_scale() {
     let mut r = rng(16);
     let (mut apart, mut deep) = (0, 0);
-    for i in 0..1000 {
+    for i in 0..3000 {
         let pts_a: Vec<DVec3> = (0..12).map(|_| point_in_cube(&mut r, 1.0)).collect();
         let pts_b: Vec<DVec3> = (0..12).map(|_| point_in_cube(&mut r, 0.7)).collect();
         let (qa, qb) = (rotation(&mut r), rotation(&mut r));
@@ -533,4 +582,117 @@ fn warm_start_and_acceleration_agree_with_cold_plain_gjk_on_hulls() {
         }
     }
     assert!(apart > 100 && deep > 100, "{apart} {deep}");
+}
+
+/// Checks a rounded pair (polytope cores) against the oracles on the cores.
+fn check_rounded(
+    a: &Poly,
+    ra: f64,
+    b_local: &Poly,
+    rb: f64,
+    d: &ShapeDistance,
+    pose: &Isometry,
+) -> bool {
+    let b = b_local.moved(pose);
+    check_contract(d, 1e-9);
+    let depth = depth_oracle(a, &b);
+    let core = if depth < 0.0 {
+        triangle_oracle(a, &b)
+    } else {
+        -depth
+    };
+    let want = core - ra - rb;
+    assert!(
+        (d.distance - want).abs() < 1e-9,
+        "{} vs {want} (core {core})",
+        d.distance
+    );
+    // Moving B by −distance along the normal makes the cores' gap ra + rb: the normal
+    // realises the answer.
+    assert!((-overlap(a, &b, d.normal) - core).abs() < 1e-9 || core > 0.0);
+    want > 0.0
+}
+
+#[test]
+fn capsules_against_boxes_and_spheres_against_hulls_match_the_core_oracles() {
+    let mut r = rng(18);
+    let (mut apart, mut deep) = (0, 0);
+    for i in 0..2000 {
+        let pose = isometry(&mut r, 1.2);
+        if i % 2 == 0 {
+            let cube = random_box(&mut r, 0.1, 0.8);
+            let cap = Capsule::new(r.random_range(0.0..0.8), r.random_range(0.05..0.4));
+            let seg = capsule_core(&cap);
+            let (d, _) = query(
+                &Rounded::plain(&cube),
+                &Rounded::new(&seg, cap.radius),
+                &pose,
+                &GjkParams::default(),
+            );
+            if check_rounded(
+                &Poly::of_box(&cube),
+                0.0,
+                &Poly::of_segment(&seg),
+                cap.radius,
+                &d,
+                &pose,
+            ) {
+                apart += 1;
+            } else {
+                deep += 1;
+            }
+        } else {
+            let hull = random_hull(&mut r, 8 + i % 24, false);
+            let ball = Sphere::new(r.random_range(0.05..0.5));
+            let (d, _) = query(
+                &Rounded::sphere(&ball),
+                &Rounded::plain(&hull),
+                &pose,
+                &GjkParams::default(),
+            );
+            if check_rounded(
+                &Poly::of_point(DVec3::ZERO),
+                ball.radius,
+                &Poly::of_hull(&hull),
+                0.0,
+                &d,
+                &pose,
+            ) {
+                apart += 1;
+            } else {
+                deep += 1;
+            }
+        }
+    }
+    println!("rounded: {apart} apart, {deep} penetrating");
+    assert!(apart > 300 && deep > 300);
+    let _ = &POINT;
+}
+
+#[test]
+fn warmed_up_queries_allocate_nothing() {
+    let mut r = rng(19);
+    let hulls: Vec<ConvexPolyhedron> = (0..8)
+        .map(|i| random_hull(&mut r, 10 + 20 * i, false))
+        .collect();
+    let poses: Vec<Isometry> = (0..500).map(|_| isometry(&mut r, 1.5)).collect();
+    let mut ws = EpaWorkspace::new();
+    let mut cache = GjkCache::default();
+    let params = GjkParams::default();
+    let before = allocations();
+    let mut deep = 0;
+    for (k, pose) in poses.iter().enumerate() {
+        let (a, b) = (&hulls[k % 8], &hulls[(k / 8) % 8]);
+        let (d, _) = signed_distance_convex(
+            &Rounded::plain(a),
+            &Rounded::plain(b),
+            pose,
+            &params,
+            &mut cache,
+            &mut ws,
+        );
+        deep += usize::from(d.distance < 0.0);
+    }
+    assert_eq!(allocations() - before, 0);
+    assert!(deep > 50, "{deep}");
 }
