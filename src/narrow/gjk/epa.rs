@@ -15,7 +15,12 @@
 //! the polytope's face normals evaluated so far (or, without a tetrahedron, among the normals
 //! of the span's complement), depth `max(h(n), 0)`. Translating B by that depth along `n`
 //! always separates the shapes, so the fallback over-estimates the depth, never under.
-//! Its witnesses are the support point of A along `n` and that point minus `depth · n`.
+//! Its witnesses keep `point_a − point_b = depth · normal` exactly: `point_a` is a point of A
+//! (the origin's projection on the face of that normal, or GJK's common point of A and B
+//! when no tetrahedron could be built) and `point_b = point_a − depth · normal`, which may
+//! lie off B's surface by the depth's uncertainty. Without a tetrahedron `A − B` is flat
+//! through the origin and the depth is 0 (to rounding), so both witnesses are GJK's common
+//! point.
 //!
 //! Buffers live in an [`EpaWorkspace`] of fixed capacity, so a query allocates nothing.
 
@@ -25,7 +30,7 @@ use crate::geometry::SupportMap;
 use crate::math::{DVec3, Isometry, orthonormal_basis};
 
 /// Most polytope vertices.
-const MAX_VERTICES: usize = 128;
+const MAX_VERTICES: usize = 256;
 /// Most polytope faces (a closed triangulation of `V` vertices has `2V − 4`).
 const MAX_FACES: usize = 2 * MAX_VERTICES;
 
@@ -104,14 +109,12 @@ impl Fallback {
         }
     }
 
-    fn offer(&mut self, n: DVec3, p: &SupportPoint) {
+    /// Offers direction `n` with its support point `p`; `a` is a point of A that the
+    /// witnesses start from if `n` wins.
+    fn offer(&mut self, n: DVec3, p: &SupportPoint, a: DVec3) {
         let h = p.w.dot(n);
         if h < self.h {
-            *self = Self {
-                h,
-                normal: n,
-                a: p.a,
-            };
+            *self = Self { h, normal: n, a };
         }
     }
 
@@ -164,6 +167,7 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     ws.vertices.clear();
     ws.faces.clear();
     ws.vertices.extend_from_slice(simplex.points());
+    let common = simplex.closest().a;
     let mut scale = ws
         .vertices
         .iter()
@@ -217,7 +221,7 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             if !p.w.is_finite() {
                 continue;
             }
-            fallback.offer(d, &p);
+            fallback.offer(d, &p, common);
             let off = off_span(vs, p.w);
             if best.is_none_or(|(o, _)| off > o) {
                 best = Some((off, p));
@@ -261,11 +265,11 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         if !p.w.is_finite() {
             break;
         }
-        fallback.offer(best.normal, &p);
+        fallback.offer(best.normal, &p, face_point_a(&ws.vertices, &best));
         scale = scale.max(p.a.abs().max_element().max(p.b.abs().max_element()));
         let tol = floor(scale);
         let h = p.w.dot(best.normal);
-        if h - best.dist <= params.rel_tol * best.dist.abs() + tol {
+        if h - best.dist <= params.epa_rel_tol * best.dist.abs() + tol {
             // Coplanar faces tie on distance; the witnesses need the one whose triangle holds
             // the origin's projection. Only faces in the confirmed plane qualify: a face
             // through the origin at another angle has distance 0 too but no certificate.
@@ -367,6 +371,12 @@ fn barycentric(vs: &[SupportPoint], f: &Face) -> [f64; 3] {
         area(p0, q, p2) / total,
         area(p0, p1, q) / total,
     ]
+}
+
+/// A's witness for face `f`: the origin's projection on it, in barycentric coordinates
+/// (clamped), applied to A's support points.
+fn face_point_a(vs: &[SupportPoint], f: &Face) -> DVec3 {
+    converged(vs, f, 0).point_a
 }
 
 /// The answer from the confirmed nearest face: the origin's projection on it, in
