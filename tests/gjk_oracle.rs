@@ -743,3 +743,152 @@ fn grazing_pairs_moved_along_the_normal_to_tiny_gaps_keep_exact_distances() {
     }
     assert!(apart > 500 && deep > 500, "{apart} {deep}");
 }
+
+mod parry_cross_check {
+    //! parry3d-f64 0.31 on the same pairs. Where parry and we differ by more than 1e-6, the
+    //! oracle must side with us; the disagreements are counted and printed.
+    use super::*;
+    use parry3d_f64::math::{Pose as ParryPose, Rotation as ParryRotation, Vector as ParryVector};
+    use parry3d_f64::query::contact;
+    use parry3d_f64::shape::{
+        ConvexPolyhedron as ParryHull, Cuboid as ParryCuboid, Cylinder as ParryCylinder, Shape,
+    };
+
+    fn v(p: DVec3) -> ParryVector {
+        ParryVector::new(p.x, p.y, p.z)
+    }
+
+    fn parry_pose(p: &Pose) -> ParryPose {
+        let q = p.rotation;
+        ParryPose::from_parts(v(p.position), ParryRotation::from_xyzw(q.x, q.y, q.z, q.w))
+    }
+
+    /// parry's signed distance (a large prediction so separated pairs answer too).
+    fn parry_distance(a: &dyn Shape, b: &dyn Shape, pose_ab: &Pose) -> f64 {
+        contact(&ParryPose::IDENTITY, a, &parry_pose(pose_ab), b, 100.0)
+            .expect("supported pair")
+            .expect("within prediction")
+            .dist
+    }
+
+    #[test]
+    fn parry_and_proxima_disagree_only_where_the_oracle_sides_with_proxima() {
+        let mut r = rng(21);
+        let (mut cases, mut parry_wrong) = (0, 0);
+        let mut worst: f64 = 0.0;
+        for i in 0..1500 {
+            let pose = support::pose(&mut r, 1.6);
+            let iso = pose.to_isometry();
+            let (ours, parry, pa, pb) = if i % 2 == 0 {
+                let (ca, cb) = (random_box(&mut r, 0.1, 1.0), random_box(&mut r, 0.1, 1.0));
+                let p = parry_distance(
+                    &ParryCuboid::new(v(ca.half_extents)),
+                    &ParryCuboid::new(v(cb.half_extents)),
+                    &pose,
+                );
+                (
+                    plain(&ca, &cb, &iso).0,
+                    p,
+                    Poly::of_box(&ca),
+                    Poly::of_box(&cb),
+                )
+            } else {
+                let (ha, hb) = (
+                    random_hull(&mut r, 20, false),
+                    random_hull(&mut r, 12, false),
+                );
+                let to_parry = |h: &ConvexPolyhedron| {
+                    let pts: Vec<ParryVector> = h.vertices().iter().map(|&p| v(p)).collect();
+                    ParryHull::from_convex_hull(&pts).expect("parry hull")
+                };
+                let p = parry_distance(&to_parry(&ha), &to_parry(&hb), &pose);
+                (
+                    plain(&ha, &hb, &iso).0,
+                    p,
+                    Poly::of_hull(&ha),
+                    Poly::of_hull(&hb),
+                )
+            };
+            cases += 1;
+            let b = pb.moved(&iso);
+            let depth = depth_oracle(&pa, &b);
+            let truth = if depth < 0.0 {
+                triangle_oracle(&pa, &b)
+            } else {
+                -depth
+            };
+            assert!(
+                (ours.distance - truth).abs() < 1e-8,
+                "{} vs {truth}",
+                ours.distance
+            );
+            if (parry - truth).abs() > 1e-6 {
+                parry_wrong += 1;
+                worst = worst.max((parry - truth).abs());
+            }
+        }
+        println!(
+            "parry off the oracle by > 1e-6 in {parry_wrong} of {cases} polytope pairs (worst {worst:e})"
+        );
+    }
+
+    #[test]
+    fn parry_cylinders_agree_with_proxima_within_the_sampled_bounds() {
+        let mut r = rng(22);
+        // parry's cylinders stand on Y, ours on Z: B's parry pose is turned by X(−90°).
+        let y_to_z = DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2);
+        let dirs = sample_directions(&mut r, 2000);
+        let (mut cases, mut differ, mut parry_certainly_wrong) = (0, 0, 0);
+        let mut worst: f64 = 0.0;
+        for _ in 0..1000 {
+            let (ca, cb) = (
+                Cylinder::new(r.random_range(0.2..1.0), r.random_range(0.2..1.0)),
+                Cylinder::new(r.random_range(0.2..1.0), r.random_range(0.2..1.0)),
+            );
+            let pose = support::pose(&mut r, 1.8);
+            let iso = pose.to_isometry();
+            let ours = plain(&ca, &cb, &iso).0;
+            let pa = Pose::new(DVec3::ZERO, y_to_z);
+            let pb = Pose::new(pose.position, pose.rotation * y_to_z);
+            let parry = contact(
+                &parry_pose(&pa),
+                &ParryCylinder::new(ca.half_height, ca.radius),
+                &parry_pose(&pb),
+                &ParryCylinder::new(cb.half_height, cb.radius),
+                100.0,
+            )
+            .expect("supported")
+            .expect("within prediction")
+            .dist;
+            cases += 1;
+            // Sampled bound: −distance ≤ min over sampled n of the overlap along n.
+            let ov = |n: DVec3| {
+                ca.support(n).dot(n)
+                    + iso
+                        .transform_point(cb.support(iso.inverse_transform_vector(-n)))
+                        .dot(-n)
+            };
+            let best = dirs.iter().map(|&n| ov(n)).fold(f64::INFINITY, f64::min);
+            assert!(-ours.distance <= best + 1e-6);
+            // Certificates: the signed distance is ≥ −overlap(n) for every n (so ≥ −ov of
+            // our normal), and ≤ |point_b − point_a| when apart with witnesses in the shapes.
+            let lower = -ov(ours.normal);
+            assert!(ours.distance >= lower - 1e-9);
+            if (parry - ours.distance).abs() > 1e-6 {
+                differ += 1;
+                worst = worst.max((parry - ours.distance).abs());
+                let upper = (ours.distance > 0.0
+                    && in_cylinder(&ca, ours.point_a, 1e-9)
+                    && in_cylinder(&cb, iso.inverse_transform_point(ours.point_b), 1e-9))
+                .then_some(ours.distance);
+                if parry < lower - 1e-9 || upper.is_some_and(|u| parry > u + 1e-9) {
+                    parry_certainly_wrong += 1;
+                }
+            }
+        }
+        println!(
+            "parry differs from Proxima by > 1e-6 on {differ} of {cases} cylinder pairs \
+             (worst {worst:e}); in {parry_certainly_wrong} parry breaks a certified bound"
+        );
+    }
+}
