@@ -407,3 +407,65 @@ fn converged(vs: &[SupportPoint], f: &Face, iterations: u32) -> EpaResult {
         iterations,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Cuboid, Segment};
+    use crate::narrow::gjk::{GjkCache, GjkOutcome, gjk_distance};
+
+    fn run<A: SupportMap, B: SupportMap>(a: &A, b: &B, pose: &Isometry) -> EpaResult {
+        let params = GjkParams::default();
+        let g = gjk_distance(a, b, pose, &params, &mut GjkCache::default());
+        assert_eq!(g.outcome, GjkOutcome::Penetrating);
+        penetration(a, b, pose, &g.simplex, &params, &mut EpaWorkspace::new())
+    }
+
+    #[test]
+    fn concentric_boxes_are_blown_up_from_one_point_and_separate_along_the_thin_axis() {
+        let a = Cuboid::new(DVec3::new(1.0, 0.25, 2.0));
+        let e = run(&a, &a, &Isometry::IDENTITY);
+        assert_eq!(e.outcome, EpaOutcome::Converged);
+        assert!((e.depth - 0.5).abs() < 1e-15, "{e:?}");
+        assert!(e.normal.abs().abs_diff_eq(DVec3::Y, 1e-15), "{e:?}");
+        assert!((e.point_a - e.point_b - e.normal * e.depth).length() < 1e-15);
+    }
+
+    #[test]
+    fn crossing_segments_have_a_flat_difference_and_fall_back_to_zero_depth() {
+        let a = Segment::new(DVec3::new(-1.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0));
+        let b = Segment::new(DVec3::new(0.0, -1.0, 0.0), DVec3::new(0.0, 1.0, 0.0));
+        let pose = Isometry::from_translation(DVec3::new(0.25, 0.5, 0.0));
+        let e = run(&a, &b, &pose);
+        assert_eq!(e.outcome, EpaOutcome::Fallback);
+        assert_eq!(e.depth, 0.0);
+        assert!(e.normal.abs().abs_diff_eq(DVec3::Z, 1e-15), "{e:?}");
+        // Both witnesses at the crossing point.
+        assert!(
+            (e.point_a - DVec3::new(0.25, 0.0, 0.0)).length() < 1e-15,
+            "{e:?}"
+        );
+        assert_eq!(e.point_a, e.point_b);
+    }
+
+    #[test]
+    fn a_reused_workspace_gives_the_same_answers_as_a_fresh_one() {
+        let a = Cuboid::new(DVec3::new(1.0, 0.5, 0.3));
+        let b = Cuboid::new(DVec3::new(0.4, 0.6, 0.2));
+        let params = GjkParams::default();
+        let mut ws = EpaWorkspace::new();
+        for k in 0..50 {
+            let t = f64::from(k) * 0.02;
+            let rot = crate::math::DMat3::from_rotation_z(t)
+                * crate::math::DMat3::from_rotation_x(2.0 * t);
+            let pose = Isometry::new(rot, DVec3::new(t, 0.3 - t, 0.1));
+            let g = gjk_distance(&a, &b, &pose, &params, &mut GjkCache::default());
+            if g.outcome != GjkOutcome::Penetrating {
+                continue;
+            }
+            let reused = penetration(&a, &b, &pose, &g.simplex, &params, &mut ws);
+            let fresh = penetration(&a, &b, &pose, &g.simplex, &params, &mut EpaWorkspace::new());
+            assert_eq!(reused, fresh);
+        }
+    }
+}

@@ -274,3 +274,26 @@ fn capsules_with_crossing_cores_penetrate_by_both_radii_across_both_axes() {
         }
     }
 }
+
+#[test]
+fn an_iteration_cap_of_one_is_reported_with_a_real_upper_bound() {
+    let a = Cuboid::new(DVec3::new(1.0, 0.5, 0.25));
+    let b = crate::geometry::Cylinder::new(0.5, 0.3);
+    let pose = Pose::new(DVec3::new(2.0, 1.5, 0.7), DQuat::from_rotation_y(0.7)).to_isometry();
+    let capped = GjkParams {
+        max_iterations: 1,
+        ..GjkParams::default()
+    };
+    let g = gjk_distance(&a, &b, &pose, &capped, &mut GjkCache::default());
+    let full = gjk_distance(
+        &a,
+        &b,
+        &pose,
+        &GjkParams::default(),
+        &mut GjkCache::default(),
+    );
+    assert_eq!(g.outcome, GjkOutcome::DidNotConverge);
+    assert_eq!(full.outcome, GjkOutcome::Separated);
+    assert!(g.distance.is_finite() && g.distance >= full.distance);
+    assert!(((g.point_a - g.point_b).length() - g.distance).abs() < 1e-12);
+}
