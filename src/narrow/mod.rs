@@ -10,6 +10,10 @@
 //! [`mesh_mesh`] builds the exact mesh–mesh queries (collision, contacts, distance,
 //! tolerance) on them by tandem traversal of two BVHs.
 //!
+//! [`gjk`] answers any two convex shapes given by support maps: GJK distance, EPA
+//! penetration depth, and [`signed_distance_convex`] combining both under the
+//! [`contact`] contract.
+//!
 //! Closed sets throughout: touching counts as intersecting, and zero-area triangles are the
 //! segment or point they span.
 

@@ -80,10 +80,12 @@ pub struct GjkCache {
 pub enum GjkOutcome {
     /// The sets are apart by [`GjkResult::distance`] > rounding (converged to tolerance).
     Separated,
-    /// The distance is below the rounding floor (or `abs_tol`): touching, or overlapping
-    /// by less than rounding; witnesses are valid, the normal may be noise.
+    /// The distance is below the rounding floor (or `abs_tol`): the sets touch, or the
+    /// origin lies on GJK's simplex to rounding — they may then overlap deeply; only EPA
+    /// can tell. Witnesses are valid; the normal is certified only by
+    /// [`signed_distance_convex`], which checks it against the support functions.
     Touching,
-    /// The origin is inside GJK's simplex: the sets overlap (or touch exactly); the
+    /// The origin is exactly inside GJK's simplex: the sets overlap (or touch exactly); the
     /// distance is 0 and the depth is EPA's job.
     Penetrating,
     /// The iteration cap was hit; `distance` is an upper bound (it is a real distance
