@@ -1,6 +1,6 @@
 //! Narrow phase: exact queries between pairs of primitives.
 //!
-//! So far the triangle–triangle primitives that exact mesh–mesh queries are built on:
+//! The triangle–triangle primitives that exact mesh–mesh queries are built on:
 //! [`intersects_triangle_triangle`] (an exact boolean, decided by robust orientation
 //! predicates), [`intersection_segment_triangle_triangle`] and
 //! [`distance_triangle_triangle`] (distance with witness points). Both triangles are given in
@@ -13,12 +13,20 @@
 //! [`pairs`] holds the closed-form distance and manifold queries between the primitives
 //! sphere, capsule, cuboid and triangle.
 //!
+//! [`gjk`] answers any two convex shapes given by support maps: GJK distance, EPA
+//! penetration depth, and [`signed_distance_convex`] combining both under the
+//! [`contact`] contract.
+//!
+//! [`convex_mesh`] walks a mesh's BVH for a convex shape; [`toi`] finds the time of impact
+//! over a frame's motion by conservative advancement, on any of these distance queries.
+//!
 //! Closed sets throughout: touching counts as intersecting, and zero-area triangles are the
 //! segment or point they span.
 
 mod closest_points;
 pub mod contact;
 pub mod convex_mesh;
+pub mod gjk;
 pub mod mesh_mesh;
 pub mod pairs;
 pub mod toi;
@@ -26,6 +34,9 @@ mod triangle_overlap;
 pub mod triangle_triangle;
 
 pub use contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+pub use gjk::{
+    GjkCache, GjkOutcome, GjkParams, GjkResult, Rounded, gjk_distance, signed_distance_convex,
+};
 pub use pairs::{
     distance_capsule_capsule, distance_capsule_cuboid, distance_capsule_triangle,
     distance_cuboid_cuboid, distance_cuboid_triangle, distance_sphere_capsule,

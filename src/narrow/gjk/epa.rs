@@ -1,0 +1,473 @@
+//! Expanding polytope algorithm: the penetration depth of two overlapping convex sets.
+//!
+//! Starts from GJK's final simplex (which holds the origin), blows a point, segment or
+//! triangle up to a tetrahedron with support points along directions that leave its span,
+//! then repeatedly pushes out the face of the polytope nearest to the origin by the support
+//! point along its normal, until the support point is no farther than the face (to
+//! tolerance). The nearest face's plane then is the boundary of `A − B` nearest the origin:
+//! depth = its distance, normal A→B = its outward normal (van den Bergen, "Proximity queries
+//! and penetration depth computation on 3D game objects", GDC 2001).
+//!
+//! # Fallback
+//! When `A − B` has no volume (flat or needle shapes), when the polytope runs out of
+//! capacity or iterations, or when rounding breaks its convexity, the answer is
+//! [`EpaOutcome::Fallback`]: the direction `n` with the smallest support value `h(n)` among
+//! the polytope's face normals evaluated so far (or, without a tetrahedron, among the normals
+//! of the span's complement), depth `max(h(n), 0)`. Translating B by that depth along `n`
+//! always separates the shapes, so the fallback over-estimates the depth, never under.
+//! Its witnesses keep `point_a − point_b = depth · normal` exactly: `point_a` is a point of A
+//! (the origin's projection on the face of that normal, or GJK's common point of A and B
+//! when no tetrahedron could be built) and `point_b = point_a − depth · normal`, which may
+//! lie off B's surface by the depth's uncertainty. Without a tetrahedron `A − B` is flat
+//! through the origin and the depth is 0 (to rounding), so both witnesses are GJK's common
+//! point.
+//!
+//! Buffers live in an [`EpaWorkspace`] of fixed capacity, so a query allocates nothing.
+
+use super::simplex::{Simplex, SupportPoint};
+use super::{GjkParams, ROUNDING_ULPS, support};
+use crate::geometry::SupportMap;
+use crate::math::{DVec3, Isometry, orthonormal_basis};
+
+/// Most polytope vertices.
+const MAX_VERTICES: usize = 256;
+/// Most polytope faces (a closed triangulation of `V` vertices has `2V − 4`).
+const MAX_FACES: usize = 2 * MAX_VERTICES;
+
+/// How EPA ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EpaOutcome {
+    /// The nearest face was confirmed to tolerance.
+    Converged,
+    /// See the [module docs](self): an upper bound on the depth along a valid direction.
+    Fallback,
+}
+
+/// The answer of [`penetration`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EpaResult {
+    /// How it ended.
+    pub outcome: EpaOutcome,
+    /// Penetration depth, metres (≥ 0 up to rounding).
+    pub depth: f64,
+    /// Unit normal A→B: translating B by `depth · normal` makes the shapes touch.
+    pub normal: DVec3,
+    /// Deepest point of A (A's frame).
+    pub point_a: DVec3,
+    /// Deepest point of B (A's frame); `point_a − point_b = depth · normal`.
+    pub point_b: DVec3,
+    /// Polytope expansions.
+    pub iterations: u32,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Face {
+    v: [u32; 3],
+    normal: DVec3,
+    dist: f64,
+}
+
+/// Reused buffers of [`penetration`]; allocate once per thread.
+#[derive(Debug, Clone)]
+pub struct EpaWorkspace {
+    vertices: Vec<SupportPoint>,
+    faces: Vec<Face>,
+    edges: Vec<(u32, u32)>,
+}
+
+impl Default for EpaWorkspace {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl EpaWorkspace {
+    /// Buffers at full capacity.
+    #[must_use]
+    pub fn new() -> Self {
+        Self {
+            vertices: Vec::with_capacity(MAX_VERTICES),
+            faces: Vec::with_capacity(MAX_FACES),
+            edges: Vec::with_capacity(3 * MAX_FACES),
+        }
+    }
+}
+
+/// Tracks the best upper bound `h(n)` seen: the fallback answer.
+struct Fallback {
+    h: f64,
+    normal: DVec3,
+    a: DVec3,
+}
+
+impl Fallback {
+    fn new() -> Self {
+        Self {
+            h: f64::INFINITY,
+            normal: DVec3::Z,
+            a: DVec3::ZERO,
+        }
+    }
+
+    /// Offers direction `n` with its support point `p`; `a` is a point of A that the
+    /// witnesses start from if `n` wins.
+    fn offer(&mut self, n: DVec3, p: &SupportPoint, a: DVec3) {
+        let h = p.w.dot(n);
+        if h < self.h {
+            *self = Self { h, normal: n, a };
+        }
+    }
+
+    fn result(&self, iterations: u32) -> EpaResult {
+        let depth = self.h.max(0.0);
+        EpaResult {
+            outcome: EpaOutcome::Fallback,
+            depth,
+            normal: self.normal,
+            point_a: self.a,
+            point_b: self.a - self.normal * depth,
+            iterations,
+        }
+    }
+}
+
+fn face(vs: &[SupportPoint], v: [u32; 3]) -> Face {
+    let [a, b, c] = v.map(|i| vs[i as usize].w);
+    let n = (b - a).cross(c - a);
+    let len = n.length();
+    if len > 0.0 && len.is_finite() {
+        let normal = n / len;
+        // Average of the three offsets: less biased than any one vertex.
+        let dist = (normal.dot(a) + normal.dot(b) + normal.dot(c)) / 3.0;
+        Face { v, normal, dist }
+    } else {
+        Face {
+            v,
+            normal: DVec3::ZERO,
+            dist: f64::INFINITY,
+        }
+    }
+}
+
+/// The penetration depth of `a` and `b` (placed by `pose_ab`) from GJK's final `simplex`,
+/// whose convex hull holds the origin (GJK outcome `Penetrating` or `Touching`).
+///
+/// Never NaN for finite input; see the module docs for the fallback.
+#[must_use]
+pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    a: &A,
+    b: &B,
+    pose_ab: &Isometry,
+    simplex: &Simplex,
+    params: &GjkParams,
+    ws: &mut EpaWorkspace,
+) -> EpaResult {
+    let sup = |d: DVec3| support(a, b, pose_ab, d);
+    let mut fallback = Fallback::new();
+    ws.vertices.clear();
+    ws.faces.clear();
+    ws.vertices.extend_from_slice(simplex.points());
+    let common = simplex.closest().a;
+    let mut scale = ws
+        .vertices
+        .iter()
+        .map(|p| p.a.abs().max_element().max(p.b.abs().max_element()))
+        .fold(0.0, f64::max);
+    let floor = |scale: f64| params.abs_tol + ROUNDING_ULPS * f64::EPSILON * scale;
+
+    // Blow up to a tetrahedron.
+    while ws.vertices.len() < 4 {
+        let vs = &ws.vertices;
+        let tol = floor(scale);
+        let (dirs, n_dirs): ([DVec3; 6], usize) = match vs.len() {
+            1 => (
+                // +Z first: when A − B is a single point, every direction ties and the
+                // first wins, which is the documented normal of coincident shapes.
+                [
+                    DVec3::Z,
+                    DVec3::NEG_Z,
+                    DVec3::X,
+                    DVec3::NEG_X,
+                    DVec3::Y,
+                    DVec3::NEG_Y,
+                ],
+                6,
+            ),
+            2 => {
+                let e = vs[1].w - vs[0].w;
+                let (u, v) = orthonormal_basis(e.normalize_or(DVec3::Z));
+                let h = 0.5 * 3f64.sqrt();
+                (
+                    [
+                        u,
+                        u * -0.5 + v * h,
+                        u * -0.5 - v * h,
+                        -u,
+                        u * 0.5 - v * h,
+                        u * 0.5 + v * h,
+                    ],
+                    6,
+                )
+            }
+            _ => {
+                let n = (vs[1].w - vs[0].w)
+                    .cross(vs[2].w - vs[0].w)
+                    .normalize_or(DVec3::Z);
+                ([n, -n, n, n, n, n], 2)
+            }
+        };
+        // The candidate farthest from the current span.
+        let mut best: Option<(f64, SupportPoint)> = None;
+        for &d in &dirs[..n_dirs] {
+            let p = sup(d);
+            if !p.w.is_finite() {
+                continue;
+            }
+            fallback.offer(d, &p, common);
+            let off = off_span(vs, p.w);
+            if best.is_none_or(|(o, _)| off > o) {
+                best = Some((off, p));
+            }
+        }
+        match best {
+            Some((off, p)) if off > tol.max(1e-12 * span_size(vs)) => {
+                scale = scale.max(p.a.abs().max_element().max(p.b.abs().max_element()));
+                ws.vertices.push(p);
+            }
+            _ => return fallback.result(0),
+        }
+    }
+
+    // Four outward faces.
+    let centre = ws.vertices.iter().map(|p| p.w).sum::<DVec3>() / 4.0;
+    for f in [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]] {
+        let mut fc = face(&ws.vertices, f);
+        if fc.normal.dot(centre - ws.vertices[f[0] as usize].w) > 0.0 {
+            fc = face(&ws.vertices, [f[0], f[2], f[1]]);
+        }
+        ws.faces.push(fc);
+    }
+
+    let mut iterations = 0;
+    while iterations < params.max_iterations {
+        iterations += 1;
+        let Some((best_i, best)) = ws
+            .faces
+            .iter()
+            .copied()
+            .enumerate()
+            .min_by(|x, y| x.1.dist.total_cmp(&y.1.dist))
+        else {
+            break;
+        };
+        if !best.dist.is_finite() {
+            break;
+        }
+        let p = sup(best.normal);
+        if !p.w.is_finite() {
+            break;
+        }
+        fallback.offer(best.normal, &p, face_point_a(&ws.vertices, &best));
+        scale = scale.max(p.a.abs().max_element().max(p.b.abs().max_element()));
+        let tol = floor(scale);
+        let h = p.w.dot(best.normal);
+        if h - best.dist <= params.epa_rel_tol * best.dist.abs() + tol {
+            // Coplanar faces tie on distance; the witnesses need the one whose triangle holds
+            // the origin's projection. Only faces in the confirmed plane qualify: a face
+            // through the origin at another angle has distance 0 too but no certificate.
+            let near = best.dist + (tol + 1e-9 * scale).max(h - best.dist);
+            let f = ws
+                .faces
+                .iter()
+                .filter(|f| f.dist <= near && f.normal.dot(best.normal) >= 1.0 - 1e-9)
+                .map(|f| (inside(&ws.vertices, f), f))
+                .max_by(|x, y| x.0.total_cmp(&y.0))
+                .map_or(best, |(_, f)| *f);
+            return converged(&ws.vertices, &f, iterations);
+        }
+        if ws.vertices.len() == MAX_VERTICES {
+            break;
+        }
+        // Remove faces that see p; keep their boundary (edges not shared by two of them).
+        let new = ws.vertices.len() as u32;
+        ws.vertices.push(p);
+        ws.edges.clear();
+        let mut i = 0;
+        while i < ws.faces.len() {
+            let f = ws.faces[i];
+            let a = ws.vertices[f.v[0] as usize].w;
+            let sees = i == best_i || (f.normal != DVec3::ZERO && f.normal.dot(p.w - a) > tol);
+            if sees {
+                for k in 0..3 {
+                    let e = (f.v[k], f.v[(k + 1) % 3]);
+                    if let Some(j) = ws.edges.iter().position(|&x| x == (e.1, e.0)) {
+                        ws.edges.swap_remove(j);
+                    } else {
+                        ws.edges.push(e);
+                    }
+                }
+                ws.faces[i].dist = f64::NAN; // marked for removal
+            }
+            i += 1;
+        }
+        ws.faces.retain(|f| !f.dist.is_nan());
+        if ws.edges.len() < 3 || ws.faces.len() + ws.edges.len() > MAX_FACES {
+            break;
+        }
+        for k in 0..ws.edges.len() {
+            let (i, j) = ws.edges[k];
+            let f = face(&ws.vertices, [i, j, new]);
+            if f.dist < -tol {
+                // The origin fell outside: rounding broke the polytope.
+                return fallback.result(iterations);
+            }
+            ws.faces.push(f);
+        }
+    }
+    fallback.result(iterations)
+}
+
+/// Distance of `w` from the affine span of `vs` (1 to 3 points).
+fn off_span(vs: &[SupportPoint], w: DVec3) -> f64 {
+    let d = w - vs[0].w;
+    match vs.len() {
+        1 => d.length(),
+        2 => {
+            let e = (vs[1].w - vs[0].w).normalize_or_zero();
+            (d - e * d.dot(e)).length()
+        }
+        _ => {
+            let n = (vs[1].w - vs[0].w)
+                .cross(vs[2].w - vs[0].w)
+                .normalize_or_zero();
+            d.dot(n).abs()
+        }
+    }
+}
+
+/// Largest distance between the first point and the others.
+fn span_size(vs: &[SupportPoint]) -> f64 {
+    vs.iter()
+        .map(|p| (p.w - vs[0].w).length())
+        .fold(0.0, f64::max)
+}
+
+/// The smallest barycentric coordinate of the origin's projection on face `f` (≥ 0: inside).
+fn inside(vs: &[SupportPoint], f: &Face) -> f64 {
+    let l = barycentric(vs, f);
+    if l.iter().all(|x| x.is_finite()) {
+        l[0].min(l[1]).min(l[2])
+    } else {
+        f64::NEG_INFINITY
+    }
+}
+
+fn barycentric(vs: &[SupportPoint], f: &Face) -> [f64; 3] {
+    let [p0, p1, p2] = f.v.map(|i| vs[i as usize].w);
+    let n = f.normal;
+    let q = n * f.dist;
+    let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(n);
+    let total = area(p0, p1, p2);
+    [
+        area(q, p1, p2) / total,
+        area(p0, q, p2) / total,
+        area(p0, p1, q) / total,
+    ]
+}
+
+/// A's witness for face `f`: the origin's projection on it, in barycentric coordinates
+/// (clamped), applied to A's support points.
+fn face_point_a(vs: &[SupportPoint], f: &Face) -> DVec3 {
+    converged(vs, f, 0).point_a
+}
+
+/// The answer from the confirmed nearest face: the origin's projection on it, in
+/// barycentric coordinates, gives the witnesses.
+fn converged(vs: &[SupportPoint], f: &Face, iterations: u32) -> EpaResult {
+    let [p0, p1, p2] = f.v.map(|i| vs[i as usize]);
+    let n = f.normal;
+    let mut l = barycentric(vs, f);
+    if !l.iter().all(|x| x.is_finite()) {
+        l = [1.0 / 3.0; 3];
+    }
+    // Rounding can put the projection a hair outside the face: clamp and renormalise.
+    let l = l.map(|x| x.max(0.0));
+    let s: f64 = l.iter().sum();
+    let l = if s > 0.0 {
+        l.map(|x| x / s)
+    } else {
+        [1.0 / 3.0; 3]
+    };
+    let point_a = p0.a * l[0] + p1.a * l[1] + p2.a * l[2];
+    let point_b = p0.b * l[0] + p1.b * l[1] + p2.b * l[2];
+    EpaResult {
+        outcome: EpaOutcome::Converged,
+        depth: f.dist.max(0.0),
+        normal: n,
+        point_a,
+        point_b,
+        iterations,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::{Cuboid, Segment};
+    use crate::narrow::gjk::{GjkCache, GjkOutcome, gjk_distance};
+
+    fn run<A: SupportMap, B: SupportMap>(a: &A, b: &B, pose: &Isometry) -> EpaResult {
+        let params = GjkParams::default();
+        let g = gjk_distance(a, b, pose, &params, &mut GjkCache::default());
+        assert_eq!(g.outcome, GjkOutcome::Penetrating);
+        penetration(a, b, pose, &g.simplex, &params, &mut EpaWorkspace::new())
+    }
+
+    #[test]
+    fn concentric_boxes_are_blown_up_from_one_point_and_separate_along_the_thin_axis() {
+        let a = Cuboid::new(DVec3::new(1.0, 0.25, 2.0));
+        let e = run(&a, &a, &Isometry::IDENTITY);
+        assert_eq!(e.outcome, EpaOutcome::Converged);
+        assert!((e.depth - 0.5).abs() < 1e-15, "{e:?}");
+        assert!(e.normal.abs().abs_diff_eq(DVec3::Y, 1e-15), "{e:?}");
+        assert!((e.point_a - e.point_b - e.normal * e.depth).length() < 1e-15);
+    }
+
+    #[test]
+    fn crossing_segments_have_a_flat_difference_and_fall_back_to_zero_depth() {
+        let a = Segment::new(DVec3::new(-1.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0));
+        let b = Segment::new(DVec3::new(0.0, -1.0, 0.0), DVec3::new(0.0, 1.0, 0.0));
+        let pose = Isometry::from_translation(DVec3::new(0.25, 0.5, 0.0));
+        let e = run(&a, &b, &pose);
+        assert_eq!(e.outcome, EpaOutcome::Fallback);
+        assert_eq!(e.depth, 0.0);
+        assert!(e.normal.abs().abs_diff_eq(DVec3::Z, 1e-15), "{e:?}");
+        // Both witnesses at the crossing point.
+        assert!(
+            (e.point_a - DVec3::new(0.25, 0.0, 0.0)).length() < 1e-15,
+            "{e:?}"
+        );
+        assert_eq!(e.point_a, e.point_b);
+    }
+
+    #[test]
+    fn a_reused_workspace_gives_the_same_answers_as_a_fresh_one() {
+        let a = Cuboid::new(DVec3::new(1.0, 0.5, 0.3));
+        let b = Cuboid::new(DVec3::new(0.4, 0.6, 0.2));
+        let params = GjkParams::default();
+        let mut ws = EpaWorkspace::new();
+        for k in 0..50 {
+            let t = f64::from(k) * 0.02;
+            let rot = crate::math::DMat3::from_rotation_z(t)
+                * crate::math::DMat3::from_rotation_x(2.0 * t);
+            let pose = Isometry::new(rot, DVec3::new(t, 0.3 - t, 0.1));
+            let g = gjk_distance(&a, &b, &pose, &params, &mut GjkCache::default());
+            if g.outcome != GjkOutcome::Penetrating {
+                continue;
+            }
+            let reused = penetration(&a, &b, &pose, &g.simplex, &params, &mut ws);
+            let fresh = penetration(&a, &b, &pose, &g.simplex, &params, &mut EpaWorkspace::new());
+            assert_eq!(reused, fresh);
+        }
+    }
+}

@@ -1,0 +1,348 @@
+//! The GJK simplex and its sub-distance algorithm: the point of a simplex (1 to 4 points of
+//! the Minkowski difference) closest to the origin, and the smallest face that realises it.
+//!
+//! Signed-volume sub-distance after Montanari, Petrinic and Barbieri, "Improving the GJK
+//! algorithm for faster and more reliable distance queries between convex objects", ACM TOG
+//! 36(3), 2017: the barycentric coordinates of the origin's projection are ratios of signed
+//! volumes (tetrahedron) or of signed areas in the coordinate plane where the triangle's
+//! projection is largest (triangle); a vertex whose coordinate has the wrong sign sends the
+//! search to the faces that leave it out. Flat tetrahedra and needle triangles, whose
+//! determinants vanish, are replaced by the best of their faces, so no division by a zero
+//! (or rounding-sized) determinant ever happens and the result is never NaN.
+
+use crate::math::DVec3;
+
+/// A point of the Minkowski difference `A − B` with the support points that made it, all in
+/// A's frame: `w = a − b`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SupportPoint {
+    /// `a − b`, metres.
+    pub w: DVec3,
+    /// Point of A, metres.
+    pub a: DVec3,
+    /// Point of B, metres.
+    pub b: DVec3,
+}
+
+/// Up to four support points with the barycentric weights of the point closest to the origin.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Simplex {
+    points: [SupportPoint; 4],
+    lambda: [f64; 4],
+    len: usize,
+}
+
+/// Below this `sin²` of the angle between two edges a triangle counts as a needle.
+const FLAT_TRIANGLE: f64 = 1e-24;
+/// Below this multiple of `|e1| |e2| |e3|` a tetrahedron's volume counts as flat.
+const FLAT_TETRAHEDRON: f64 = 1e-13;
+
+/// The outcome of the sub-distance on some of the simplex's points.
+#[derive(Debug, Clone, Copy)]
+struct Reduced {
+    /// Indices into the simplex of the points kept.
+    idx: [usize; 4],
+    lambda: [f64; 4],
+    len: usize,
+    v: DVec3,
+}
+
+impl Reduced {
+    fn point(i: usize, p: &[DVec3; 4]) -> Self {
+        Self {
+            idx: [i, 0, 0, 0],
+            lambda: [1.0, 0.0, 0.0, 0.0],
+            len: 1,
+            v: p[i],
+        }
+    }
+
+    fn better(self, other: Self) -> Self {
+        if other.v.length_squared() < self.v.length_squared() {
+            other
+        } else {
+            self
+        }
+    }
+}
+
+impl Simplex {
+    /// The simplex of one point.
+    #[must_use]
+    pub fn single(p: SupportPoint) -> Self {
+        let mut s = Self::default();
+        s.points[0] = p;
+        s.lambda[0] = 1.0;
+        s.len = 1;
+        s
+    }
+
+    /// The points.
+    #[must_use]
+    pub fn points(&self) -> &[SupportPoint] {
+        &self.points[..self.len]
+    }
+
+    /// The barycentric weights of the closest point (same order as [`points`](Self::points)).
+    #[must_use]
+    pub fn weights(&self) -> &[f64] {
+        &self.lambda[..self.len]
+    }
+
+    /// Number of points (1 to 4).
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether it holds no point (only for `Default`).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Whether `w` is already one of the points (exactly).
+    #[must_use]
+    pub fn contains(&self, w: DVec3) -> bool {
+        self.points().iter().any(|p| p.w == w)
+    }
+
+    /// Adds a point (the simplex must hold fewer than 4).
+    pub fn push(&mut self, p: SupportPoint) {
+        debug_assert!(self.len < 4);
+        self.points[self.len] = p;
+        self.len += 1;
+    }
+
+    /// The closest point to the origin as the weighted sum of the points' `(w, a, b)`.
+    #[must_use]
+    pub fn closest(&self) -> SupportPoint {
+        let mut r = SupportPoint::default();
+        for (p, &l) in self.points().iter().zip(self.weights()) {
+            r.w += p.w * l;
+            r.a += p.a * l;
+            r.b += p.b * l;
+        }
+        r
+    }
+
+    /// Replaces the simplex by the smallest sub-simplex containing its point closest to the
+    /// origin, stores that point's weights and returns it (`w` part). A full tetrahedron is
+    /// kept only when it contains the origin; the result is then exactly zero.
+    pub fn reduce(&mut self) -> DVec3 {
+        let mut p = [DVec3::ZERO; 4];
+        for (q, s) in p.iter_mut().zip(self.points()) {
+            *q = s.w;
+        }
+        let r = match self.len {
+            1 => Reduced::point(0, &p),
+            2 => segment(&p, 0, 1),
+            3 => triangle(&p, [0, 1, 2]),
+            _ => tetrahedron(&p),
+        };
+        let old = self.points;
+        for k in 0..r.len {
+            self.points[k] = old[r.idx[k]];
+            self.lambda[k] = r.lambda[k];
+        }
+        self.len = r.len;
+        r.v
+    }
+}
+
+fn segment(p: &[DVec3; 4], i: usize, j: usize) -> Reduced {
+    let (a, b) = (p[i], p[j]);
+    let e = b - a;
+    let ee = e.length_squared();
+    if ee == 0.0 {
+        return Reduced::point(i, p);
+    }
+    let t = -a.dot(e) / ee;
+    if t <= 0.0 {
+        return Reduced::point(i, p);
+    }
+    if t >= 1.0 {
+        return Reduced::point(j, p);
+    }
+    Reduced {
+        idx: [i, j, 0, 0],
+        lambda: [1.0 - t, t, 0.0, 0.0],
+        len: 2,
+        v: a * (1.0 - t) + b * t,
+    }
+}
+
+/// Signed area of the 2-D triangle `(x, y, z)`.
+fn area2(x: [f64; 2], y: [f64; 2], z: [f64; 2]) -> f64 {
+    (y[0] - x[0]) * (z[1] - x[1]) - (y[1] - x[1]) * (z[0] - x[0])
+}
+
+fn same_sign(a: f64, b: f64) -> bool {
+    (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0)
+}
+
+fn triangle(p: &[DVec3; 4], t: [usize; 3]) -> Reduced {
+    let (a, b, c) = (p[t[0]], p[t[1]], p[t[2]]);
+    let (e1, e2) = (b - a, c - a);
+    let n = e1.cross(e2);
+    let nn = n.length_squared();
+    let edges = |skip: &[bool; 3]| {
+        let mut best: Option<Reduced> = None;
+        for (k, &s) in skip.iter().enumerate() {
+            if s {
+                let r = segment(p, t[(k + 1) % 3], t[(k + 2) % 3]);
+                best = Some(best.map_or(r, |b| b.better(r)));
+            }
+        }
+        best
+    };
+    if nn <= FLAT_TRIANGLE * e1.length_squared() * e2.length_squared() || nn.is_nan() {
+        return edges(&[true; 3]).expect("three edges");
+    }
+    // Projection of the origin on the plane, then 2-D areas in the plane of largest
+    // projected area (Montanari's S2D).
+    let p0 = n * (a.dot(n) / nn);
+    let m = n.abs().max_position();
+    let (u, v) = ((m + 1) % 3, (m + 2) % 3);
+    let q = |x: DVec3| [x[u], x[v]];
+    let (qa, qb, qc, qo) = (q(a), q(b), q(c), q(p0));
+    let c_ = [area2(qo, qb, qc), area2(qa, qo, qc), area2(qa, qb, qo)];
+    let total = c_[0] + c_[1] + c_[2];
+    let wrong = [
+        !same_sign(c_[0], total),
+        !same_sign(c_[1], total),
+        !same_sign(c_[2], total),
+    ];
+    if wrong == [false; 3] {
+        let l = [c_[0] / total, c_[1] / total, c_[2] / total];
+        return Reduced {
+            idx: [t[0], t[1], t[2], 0],
+            lambda: [l[0], l[1], l[2], 0.0],
+            len: 3,
+            v: p0,
+        };
+    }
+    edges(&wrong).expect("a wrong sign names an edge")
+}
+
+fn tetrahedron(p: &[DVec3; 4]) -> Reduced {
+    let [a, b, c, d] = *p;
+    let vol = |x: DVec3, y: DVec3, z: DVec3, w: DVec3| (y - x).dot((z - x).cross(w - x));
+    let o = DVec3::ZERO;
+    let c_ = [
+        vol(o, b, c, d),
+        vol(a, o, c, d),
+        vol(a, b, o, d),
+        vol(a, b, c, o),
+    ];
+    let total = c_.iter().sum::<f64>();
+    let size = (b - a).length() * (c - a).length() * (d - a).length();
+    let faces = |skip: [bool; 4]| {
+        let mut best: Option<Reduced> = None;
+        for (k, &s) in skip.iter().enumerate() {
+            if s {
+                let f = [(k + 1) % 4, (k + 2) % 4, (k + 3) % 4];
+                let r = triangle(p, f);
+                best = Some(best.map_or(r, |b| b.better(r)));
+            }
+        }
+        best.expect("a skipped vertex names a face")
+    };
+    if total.abs() <= FLAT_TETRAHEDRON * size || total.is_nan() {
+        return faces([true; 4]);
+    }
+    let wrong = c_.map(|x| !same_sign(x, total));
+    if wrong == [false; 4] {
+        return Reduced {
+            idx: [0, 1, 2, 3],
+            lambda: c_.map(|x| x / total),
+            len: 4,
+            v: DVec3::ZERO,
+        };
+    }
+    faces(wrong)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn simplex(ws: &[DVec3]) -> Simplex {
+        let mut s = Simplex::single(SupportPoint {
+            w: ws[0],
+            ..Default::default()
+        });
+        for &w in &ws[1..] {
+            s.push(SupportPoint {
+                w,
+                ..Default::default()
+            });
+        }
+        s
+    }
+
+    #[test]
+    fn a_segment_across_the_origin_reduces_to_its_foot() {
+        let mut s = simplex(&[DVec3::new(-1.0, 1.0, 0.0), DVec3::new(1.0, 1.0, 0.0)]);
+        assert_eq!(s.reduce(), DVec3::new(0.0, 1.0, 0.0));
+        assert_eq!(s.len(), 2);
+    }
+
+    #[test]
+    fn a_triangle_above_the_origin_keeps_all_three_points() {
+        let mut s = simplex(&[
+            DVec3::new(-1.0, -1.0, 2.0),
+            DVec3::new(1.0, -1.0, 2.0),
+            DVec3::new(0.0, 1.0, 2.0),
+        ]);
+        let v = s.reduce();
+        assert!((v - DVec3::new(0.0, 0.0, 2.0)).length() < 1e-15);
+        assert_eq!(s.len(), 3);
+        assert!((s.weights().iter().sum::<f64>() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_tetrahedron_around_the_origin_gives_zero_and_one_beside_gives_a_vertex() {
+        let around = [
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+        ];
+        let mut s = simplex(&around);
+        assert_eq!(s.reduce(), DVec3::ZERO);
+        assert_eq!(s.len(), 4);
+        let beside: Vec<DVec3> = around.iter().map(|&p| p + DVec3::splat(3.0)).collect();
+        let mut s = simplex(&beside);
+        let v = s.reduce();
+        // Nearest: the face on the plane x + y + z = 8.
+        assert_eq!(s.len(), 3);
+        assert!((v - DVec3::splat(8.0 / 3.0)).length() < 1e-14, "{v}");
+    }
+
+    #[test]
+    fn flat_and_repeated_simplices_give_finite_answers() {
+        // Four coplanar points, a repeated point, a needle triangle.
+        let cases: [&[DVec3]; 3] = [
+            &[
+                DVec3::new(-1.0, -1.0, 1.0),
+                DVec3::new(1.0, -1.0, 1.0),
+                DVec3::new(1.0, 1.0, 1.0),
+                DVec3::new(-1.0, 1.0, 1.0),
+            ],
+            &[DVec3::new(1.0, 2.0, 3.0), DVec3::new(1.0, 2.0, 3.0)],
+            &[
+                DVec3::new(1.0, 0.0, 1.0),
+                DVec3::new(2.0, 0.0, 1.0),
+                DVec3::new(3.0, 1e-30, 1.0),
+            ],
+        ];
+        for ws in cases {
+            let mut s = simplex(ws);
+            let v = s.reduce();
+            assert!(v.is_finite(), "{ws:?} → {v}");
+            let best = ws.iter().map(|p| p.length()).fold(f64::INFINITY, f64::min);
+            assert!(v.length() <= best + 1e-15);
+        }
+    }
+}

@@ -1,0 +1,300 @@
+//! Unit tests of GJK/EPA on shapes with closed-form answers. The brute-force oracles over
+//! hulls, boxes and random poses are in `tests/gjk_oracle.rs`.
+
+use super::*;
+use crate::geometry::Cuboid;
+use crate::math::{DQuat, Pose};
+use crate::test_support::{isometry, point_in_cube, rng};
+
+fn query<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    a: &Rounded<'_, A>,
+    b: &Rounded<'_, B>,
+    pose: &Isometry,
+) -> (ShapeDistance, ConvexOutcome) {
+    signed_distance_convex(
+        a,
+        b,
+        pose,
+        &GjkParams::default(),
+        &mut GjkCache::default(),
+        &mut EpaWorkspace::new(),
+    )
+}
+
+fn check_contract(d: &ShapeDistance, tol: f64) {
+    assert!(d.distance.is_finite() && d.normal.is_finite(), "{d:?}");
+    assert!((d.normal.length() - 1.0).abs() < 1e-9, "{d:?}");
+    let gap = d.point_b - d.point_a - d.normal * d.distance;
+    assert!(gap.length() <= tol, "witnesses off by {gap}: {d:?}");
+}
+
+#[test]
+fn spheres_at_random_poses_match_the_centre_distance_minus_radii() {
+    let mut r = rng(1);
+    let (mut apart, mut deep) = (0, 0);
+    for _ in 0..2000 {
+        let (ra, rb) = (
+            0.1 + point_in_cube(&mut r, 1.0).x.abs(),
+            0.1 + point_in_cube(&mut r, 1.0).y.abs(),
+        );
+        let pose = isometry(&mut r, 2.0);
+        let (a, b) = (Sphere::new(ra), Sphere::new(rb));
+        let (d, _) = query(&Rounded::sphere(&a), &Rounded::sphere(&b), &pose);
+        let want = pose.translation.length() - ra - rb;
+        assert!(
+            (d.distance - want).abs() < 1e-12,
+            "{} vs {want}",
+            d.distance
+        );
+        check_contract(&d, 1e-12);
+        assert!((d.normal - pose.translation.normalize()).length() < 1e-9);
+        if want > 0.0 { apart += 1 } else { deep += 1 }
+    }
+    assert!(apart > 100 && deep > 100, "{apart} {deep}");
+}
+
+#[test]
+fn concentric_spheres_answer_the_sum_of_radii_with_a_fixed_normal() {
+    let (d, _) = query(
+        &Rounded::sphere(&Sphere::new(1.0)),
+        &Rounded::sphere(&Sphere::new(2.0)),
+        &Isometry::IDENTITY,
+    );
+    assert_eq!(d.distance, -3.0);
+    assert_eq!(d.normal, DVec3::Z);
+    check_contract(&d, 1e-15);
+}
+
+#[test]
+fn a_sphere_against_a_box_matches_the_clamped_point_distance() {
+    let mut r = rng(2);
+    let (mut apart, mut deep) = (0, 0);
+    let cube = Cuboid::new(DVec3::new(1.0, 0.5, 0.25));
+    for _ in 0..2000 {
+        let c = point_in_cube(&mut r, 2.0);
+        let radius = 0.3;
+        let pose = Isometry::from_translation(c);
+        let (d, _) = query(
+            &Rounded::plain(&cube),
+            &Rounded::sphere(&Sphere::new(radius)),
+            &pose,
+        );
+        let h = cube.half_extents;
+        let outside = (c.abs() - h).max(DVec3::ZERO).length();
+        let inside = (h - c.abs()).min_element();
+        let want = if outside > 0.0 { outside } else { -inside } - radius;
+        assert!(
+            (d.distance - want).abs() < 1e-9,
+            "{c}: {} vs {want}",
+            d.distance
+        );
+        check_contract(&d, 1e-9);
+        if want > 0.0 { apart += 1 } else { deep += 1 }
+    }
+    assert!(apart > 100 && deep > 100, "{apart} {deep}");
+}
+
+#[test]
+fn capsules_match_the_segment_segment_distance() {
+    let mut r = rng(3);
+    let (mut apart, mut deep) = (0, 0);
+    for _ in 0..2000 {
+        let (a, b) = (Capsule::new(0.7, 0.2), Capsule::new(0.4, 0.3));
+        let pose = isometry(&mut r, 1.5);
+        let (sa, sb) = (capsule_core(&a), capsule_core(&b));
+        let (d, _) = query(
+            &Rounded::new(&sa, a.radius),
+            &Rounded::new(&sb, b.radius),
+            &pose,
+        );
+        let sb_in_a = Segment::new(pose.transform_point(sb.a), pose.transform_point(sb.b));
+        let (_, _, p, q) = crate::geometry::closest_points_segment_segment(&sa, &sb_in_a);
+        let core = (q - p).length();
+        if core > 1e-6 {
+            let want = core - a.radius - b.radius;
+            assert!((d.distance - want).abs() < 1e-9, "{} vs {want}", d.distance);
+            check_contract(&d, 1e-9);
+            if want > 0.0 { apart += 1 } else { deep += 1 }
+        } else {
+            // Crossing cores: depth at least the radii.
+            assert!(d.distance <= -(a.radius + b.radius) + 1e-9);
+        }
+    }
+    assert!(apart > 100 && deep > 100, "{apart} {deep}");
+}
+
+#[test]
+fn boxes_face_to_face_touch_at_zero_without_nan() {
+    let a = Cuboid::new(DVec3::splat(1.0));
+    for (t, rot) in [
+        (DVec3::new(2.0, 0.0, 0.0), DQuat::IDENTITY),
+        (DVec3::new(0.0, 2.0, 0.3), DQuat::IDENTITY),
+        (DVec3::new(0.5, 0.2, 2.0), DQuat::from_rotation_z(0.3)),
+    ] {
+        let pose = Pose::new(t, rot).to_isometry();
+        let (d, out) = query(&Rounded::plain(&a), &Rounded::plain(&a), &pose);
+        assert!(d.distance.abs() < 1e-12, "{d:?} {out:?}");
+        check_contract(&d, 1e-12);
+        assert!(d.normal.dot(t.normalize()) > 0.5, "{d:?}");
+    }
+}
+
+#[test]
+fn the_accelerated_variant_and_a_warm_start_agree_with_plain_gjk() {
+    let mut r = rng(4);
+    let a = Cuboid::new(DVec3::new(1.0, 0.3, 0.6));
+    let seg = capsule_core(&Capsule::new(0.5, 0.2));
+    let cyl = crate::geometry::Cylinder::new(0.5, 0.2);
+    let fast = GjkParams {
+        accelerated: true,
+        ..GjkParams::default()
+    };
+    let (mut warm_seg, mut warm_cyl) = (GjkCache::default(), GjkCache::default());
+    let mut stalled = 0;
+    for _ in 0..2000 {
+        let pose = isometry(&mut r, 2.0);
+        // Polytopes: GJK terminates exactly, so all three agree to rounding.
+        let plain = gjk_distance(
+            &a,
+            &seg,
+            &pose,
+            &GjkParams::default(),
+            &mut GjkCache::default(),
+        );
+        let acc = gjk_distance(&a, &seg, &pose, &fast, &mut GjkCache::default());
+        let w = gjk_distance(&a, &seg, &pose, &GjkParams::default(), &mut warm_seg);
+        for other in [acc, w] {
+            assert_eq!(plain.outcome, other.outcome, "{plain:?} {other:?}");
+            assert!((plain.distance - other.distance).abs() <= 1e-12 * (1.0 + plain.distance));
+        }
+        // A curved side: convergence is linear, a few runs hit the cap; answers agree to
+        // the cap's accuracy.
+        let plain = gjk_distance(
+            &a,
+            &cyl,
+            &pose,
+            &GjkParams::default(),
+            &mut GjkCache::default(),
+        );
+        let acc = gjk_distance(&a, &cyl, &pose, &fast, &mut GjkCache::default());
+        let w = gjk_distance(&a, &cyl, &pose, &GjkParams::default(), &mut warm_cyl);
+        for other in [acc, w] {
+            stalled += usize::from(other.outcome == GjkOutcome::DidNotConverge);
+            assert_eq!(
+                plain.distance > 0.0,
+                other.distance > 0.0,
+                "{plain:?} {other:?}"
+            );
+            assert!((plain.distance - other.distance).abs() <= 1e-7 * (1.0 + plain.distance));
+        }
+    }
+    assert!(stalled < 40, "{stalled} runs hit the iteration cap");
+}
+
+#[test]
+fn sphere_centres_on_a_box_face_edge_or_corner_give_the_radius_as_depth() {
+    let cube = Cuboid::new(DVec3::new(1.0, 0.5, 0.25));
+    let h = cube.half_extents;
+    let mut r = rng(5);
+    for i in 0..3000 {
+        // A surface point: clamp a random point to the surface, on 1, 2 or 3 faces.
+        let mut c = point_in_cube(&mut r, 1.0) * h;
+        for k in 0..=(i % 3) {
+            let axis = (i / 3 + k) % 3;
+            c[axis] = h[axis].copysign(c[axis]);
+        }
+        // Every other case a hair off the surface (inside or out): GJK's "touching".
+        let hair = if i % 2 == 0 {
+            DVec3::ZERO
+        } else {
+            point_in_cube(&mut r, 1e-13)
+        };
+        let pose = Isometry::from_translation(c + hair);
+        let radius = 0.1;
+        let (d, out) = query(
+            &Rounded::plain(&cube),
+            &Rounded::sphere(&Sphere::new(radius)),
+            &pose,
+        );
+        assert!((d.distance + radius).abs() < 1e-12, "{c}: {d:?} {out:?}");
+        check_contract(&d, 1e-12);
+        // The normal points out of the box at c (into the face's outer normal cone). A hair
+        // off an edge or a corner, GJK's direction `−v/|v|` carries the rounding of a
+        // 1e-13-long `v`: about 1e-16 / |v| radians.
+        let outside = ((c + hair).abs() - h).max(DVec3::ZERO).length();
+        let slack = if outside > 0.0 {
+            (1e-15 / outside).clamp(1e-9, 1.0)
+        } else {
+            1e-9
+        };
+        // Moving the sphere by the depth along the normal leaves it touching, not inside.
+        let moved = c + hair + d.normal * radius;
+        let gap = (moved.abs() - h).max(DVec3::ZERO).length();
+        assert!(
+            (gap - radius).abs() < radius * slack * slack + 1e-12,
+            "{c}: {d:?} {out:?}"
+        );
+        for k in 0..3 {
+            if (c[k].abs() - h[k]).abs() > 0.0 {
+                assert!(d.normal[k].abs() < slack, "{c}: {d:?} {out:?}");
+            } else {
+                assert!(d.normal[k] * c[k] >= -slack, "{c}: {d:?} {out:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn capsules_with_crossing_cores_penetrate_by_both_radii_across_both_axes() {
+    let mut r = rng(6);
+    for _ in 0..2000 {
+        let (a, b) = (Capsule::new(0.6, 0.2), Capsule::new(0.9, 0.1));
+        // B's core crosses A's core at a random point of both.
+        let q = crate::test_support::rotation(&mut r);
+        let on_a = DVec3::new(0.0, 0.0, 0.5 * point_in_cube(&mut r, 1.0).z);
+        let along_b = 0.8 * point_in_cube(&mut r, 1.0).z;
+        let t = on_a - q * DVec3::new(0.0, 0.0, along_b);
+        let pose = Pose::new(t, q).to_isometry();
+        let (sa, sb) = (capsule_core(&a), capsule_core(&b));
+        let (d, out) = query(
+            &Rounded::new(&sa, a.radius),
+            &Rounded::new(&sb, b.radius),
+            &pose,
+        );
+        assert!(
+            (d.distance + a.radius + b.radius).abs() < 1e-9,
+            "{d:?} {out:?}"
+        );
+        check_contract(&d, 1e-9);
+        let axis = DVec3::Z.cross(q * DVec3::Z);
+        if axis.length() > 1e-3 {
+            assert!(
+                d.normal.cross(axis.normalize()).length() < 1e-6,
+                "{d:?} {out:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn an_iteration_cap_of_one_is_reported_with_a_real_upper_bound() {
+    let a = Cuboid::new(DVec3::new(1.0, 0.5, 0.25));
+    let b = crate::geometry::Cylinder::new(0.5, 0.3);
+    let pose = Pose::new(DVec3::new(2.0, 1.5, 0.7), DQuat::from_rotation_y(0.7)).to_isometry();
+    let capped = GjkParams {
+        max_iterations: 1,
+        ..GjkParams::default()
+    };
+    let g = gjk_distance(&a, &b, &pose, &capped, &mut GjkCache::default());
+    let full = gjk_distance(
+        &a,
+        &b,
+        &pose,
+        &GjkParams::default(),
+        &mut GjkCache::default(),
+    );
+    assert_eq!(g.outcome, GjkOutcome::DidNotConverge);
+    assert_eq!(full.outcome, GjkOutcome::Separated);
+    assert!(g.distance.is_finite() && g.distance >= full.distance);
+    assert!(((g.point_a - g.point_b).length() - g.distance).abs() < 1e-12);
+}
