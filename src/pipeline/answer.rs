@@ -1,22 +1,24 @@
-//! The answer for one candidate pair, per pair of shape kinds, doing only what the frame's
-//! [`Query`] asks: sphere–sphere in closed form, mesh–mesh by exact BVH queries, every other
-//! pair the conservative box answer (TODO(#5): the exact narrow phase replaces it).
+//! The answer for one candidate pair, doing only what the frame's [`Query`] asks:
+//! mesh–mesh by exact BVH queries (warm starts, contact sets), every other pair through the
+//! [`dispatch`](super::dispatch)er; the conservative box answer remains only as the worker
+//! pool's fallback when answering a pair panicked (a bug, never client input).
 //!
 //! Each function returns the pair's [`Answer`] and, when the query asks for contacts and the
 //! pair touches, appends its manifold (at most [`MAX_CONTACTS_PER_PAIR`] points) to
 //! `contacts`. Whether the pair is *reported* is decided by the caller from the answer.
 
 use super::contacts::{MAX_CONTACTS_PER_PAIR, reduce_manifold};
+use super::dispatch::{self, NarrowScratch};
 use super::{ContactPoint, PairResult, Query};
 use crate::bounding::Aabb;
 use crate::broad::CandidatePair;
-use crate::geometry::Sphere;
 use crate::math::{DVec3, Pose, conservative_slack};
+use crate::narrow::contact::Manifold;
 use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
     intersects_mesh_mesh, within_distance_mesh_mesh,
 };
-use crate::scene::{Body, MeshShape};
+use crate::scene::{Body, MeshShape, Shape};
 use std::ops::ControlFlow;
 
 /// One pair's answer before the report decision.
@@ -52,34 +54,54 @@ impl MeshScratch {
     }
 }
 
-/// Sphere–sphere in closed form: everything is cheap, so every field is always filled.
-/// Contacts: one point, the two witnesses, `distance = −depth`.
-pub(super) fn sphere_sphere(
+/// Every pair but mesh–mesh, through the [`dispatch`](super::dispatch)er: the exact signed
+/// distance (closed forms, GJK/EPA, or a convex shape against a mesh's triangles) when the
+/// query needs a distance or a touching decision, and the manifold when it asks contacts
+/// and the shapes touch. Everything in world frame; exact to the methods' tolerance (error
+/// bound: GJK's relative tolerance times the distance plus 64 ulps of the coordinates).
+pub(super) fn direct(
     pair: &CandidatePair,
-    (a, sa): (&Body, &Sphere),
-    (b, sb): (&Body, &Sphere),
+    (a, sa): (&Body, &Shape),
+    (b, sb): (&Body, &Shape),
     query: Query,
+    scratch: &mut NarrowScratch,
+    manifold: &mut Manifold,
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
-    let (ca, cb) = (a.pose.position, b.pose.position);
-    let normal = (cb - ca).try_normalize().unwrap_or(DVec3::X);
+    let pose_ab = Pose::relative(&a.pose, &b.pose);
+    let d = dispatch::distance(sa, sb, &pose_ab, scratch);
+    let scale = d
+        .point_a
+        .abs()
+        .max_element()
+        .max(d.point_b.abs().max_element())
+        + a.pose.position.abs().max_element();
     let result = PairResult {
         a: pair.a,
         b: pair.b,
-        distance: ca.distance(cb) - sa.radius - sb.radius,
-        error_bound: conservative_slack(
-            ca.abs().max_element() + cb.abs().max_element() + sa.radius + sb.radius,
-        ),
-        point_a: ca + normal * sa.radius,
-        point_b: cb - normal * sb.radius,
-        normal,
+        distance: d.distance,
+        error_bound: 1e-10 * d.distance.abs() + 64.0 * f64::EPSILON * scale,
+        point_a: a.pose.transform_point(d.point_a),
+        point_b: a.pose.transform_point(d.point_b),
+        normal: a.pose.transform_vector(d.normal),
         exact: true,
         first_contact: 0,
         contact_count: 0,
     };
-    let touching = result.distance <= 0.0;
+    let touching = d.distance <= 0.0;
     if query.contacts && touching {
-        contacts.push(witness_contact(&result, result.distance));
+        dispatch::manifold(sa, sb, &pose_ab, scratch, manifold);
+        let normal = a.pose.transform_vector(manifold.normal);
+        for p in manifold.points() {
+            contacts.push(ContactPoint {
+                pair: 0,
+                point_a: a.pose.transform_point(p.point_a),
+                point_b: a.pose.transform_point(p.point_b),
+                normal,
+                distance: p.distance,
+                error_bound: result.error_bound,
+            });
+        }
     }
     Answer { result, touching }
 }

@@ -56,16 +56,19 @@
 
 mod answer;
 mod contacts;
+mod dispatch;
 pub mod workers;
 
 pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
 
 use crate::broad::{CandidatePair, Proxy, SortAndSweep};
 use crate::math::DVec3;
+use crate::narrow::contact::Manifold;
 use crate::narrow::mesh_mesh::DistanceCache;
 use crate::scene::MeshShape;
 use crate::scene::{Body, BodyId, Scene, Shape};
 use answer::{Answer, MeshScratch};
+use dispatch::{NarrowScratch, Route};
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
@@ -236,6 +239,10 @@ pub struct PipelineWorkspace {
     outcomes: Vec<MeshOutcome>,
     /// Contact scratch of one pair answered on this thread for the pool.
     job_contacts: Vec<ContactPoint>,
+    /// The dispatcher's scratch (GJK/EPA, convex–mesh traversal).
+    narrow: NarrowScratch,
+    /// One pair's manifold, before it joins the frame's contacts.
+    manifold: Manifold,
 }
 
 impl PipelineWorkspace {
@@ -275,6 +282,8 @@ pub fn step(
         workers,
         outcomes,
         job_contacts,
+        narrow,
+        manifold,
         ..
     } = workspace;
     mesh_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
@@ -308,29 +317,27 @@ pub fn step(
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let first_contact = results.contacts.len();
         let contacts = &mut results.contacts;
-        let mut answer = match (shape(scene, a), shape(scene, b)) {
-            (Shape::Sphere(sa), Shape::Sphere(sb)) => {
-                answer::sphere_sphere(pair, (a, sa), (b, sb), query, contacts)
+        let (sa, sb) = (shape(scene, a), shape(scene, b));
+        let mut answer = match (dispatch::route(sa, sb), parallel) {
+            (Route::Direct, _) => {
+                answer::direct(pair, (a, sa), (b, sb), query, narrow, manifold, contacts)
             }
-            (Shape::Mesh(ma), Shape::Mesh(mb)) => match parallel {
-                Some(_) => {
-                    let outcome = pooled.next().expect("one pool outcome per mesh pair");
-                    debug_assert_eq!(outcome.slot as usize, slot);
-                    contacts.extend_from_slice(outcome.contacts());
-                    mesh_caches.insert(*pair, outcome.cache);
-                    outcome.answer
-                }
-                None => answer::mesh_mesh(
-                    pair,
-                    (a, ma),
-                    (b, mb),
-                    query,
-                    mesh_caches.entry(*pair).or_default(),
-                    mesh,
-                    contacts,
-                ),
-            },
-            _ => answer::boxes(pair, &a.world_bounds, &b.world_bounds, query, contacts),
+            (Route::MeshMesh(..), Some(_)) => {
+                let outcome = pooled.next().expect("one pool outcome per mesh pair");
+                debug_assert_eq!(outcome.slot as usize, slot);
+                contacts.extend_from_slice(outcome.contacts());
+                mesh_caches.insert(*pair, outcome.cache);
+                outcome.answer
+            }
+            (Route::MeshMesh(ma, mb), None) => answer::mesh_mesh(
+                pair,
+                (a, ma),
+                (b, mb),
+                query,
+                mesh_caches.entry(*pair).or_default(),
+                mesh,
+                contacts,
+            ),
         };
         if !answer.result.exact {
             completeness = Completeness::Truncated { level: 0 };
@@ -373,12 +380,10 @@ fn mesh_pair<'s>(
     scene: &'s Scene,
     pair: &CandidatePair,
 ) -> Option<(&'s Arc<MeshShape>, &'s Arc<MeshShape>)> {
-    match (
-        shape(scene, body(scene, pair.a)),
-        shape(scene, body(scene, pair.b)),
-    ) {
-        (Shape::Mesh(a), Shape::Mesh(b)) => Some((a, b)),
-        _ => None,
+    let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+    match dispatch::route(shape(scene, a), shape(scene, b)) {
+        Route::MeshMesh(ma, mb) => Some((ma, mb)),
+        Route::Direct => None,
     }
 }
 
@@ -397,6 +402,7 @@ fn shape<'s>(scene: &'s Scene, body: &Body) -> &'s Shape {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bounding::Aabb;
     use crate::geometry::{Cuboid, Sphere};
     use crate::math::Pose;
     use crate::narrow::mesh_mesh::{
@@ -717,59 +723,135 @@ mod tests {
         assert!(results.contacts.is_empty());
     }
 
+    /// One shape of every kind, in random poses: every pair is answered exactly, the same
+    /// whichever body is A (distance equal, normal reversed, witnesses swapped), with a
+    /// world-frame answer equal to the query run in A's frame and mapped by A's pose, and
+    /// both touching and separated pairs occur.
     #[test]
-    fn pairs_without_an_exact_narrow_phase_get_a_conservative_box_answer() {
-        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
-        let a = add(
-            &mut scene,
-            Shape::Sphere(Sphere::new(0.5)),
-            DVec3::ZERO,
-            0.1,
-        );
-        let b = add(
-            &mut scene,
-            Shape::Cuboid(Cuboid::new(DVec3::splat(0.5))),
-            DVec3::new(1.05, 0.3, 0.0),
-            0.1,
-        );
+    fn every_pair_of_shape_kinds_is_exact_and_the_same_from_either_side() {
+        use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cylinder};
+        let hull: Vec<DVec3> = meshes::uv_sphere(0.4, 6, 4).vertices().to_vec();
+        let kinds = [
+            Shape::Sphere(Sphere::new(0.3)),
+            Shape::Capsule(Capsule::new(0.3, 0.2)),
+            Shape::Cuboid(Cuboid::new(DVec3::new(0.3, 0.2, 0.4))),
+            Shape::Cylinder(Cylinder::new(0.3, 0.25)),
+            Shape::Cone(Cone::new(0.3, 0.3)),
+            Shape::Convex(Arc::new(ConvexPolyhedron::try_from_points(&hull).unwrap())),
+            Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.4, 0.12, 16, 8)))),
+        ];
+        let mut rng = rng(83);
         let mut workspace = PipelineWorkspace::default();
-        let mut results = FrameResults::default();
-        let report = step(&scene, Query::CLOSE, &mut workspace, &mut results);
-        assert_eq!(report.completeness, Completeness::Truncated { level: 0 });
-        assert_eq!(results.pairs.len(), 1);
-        let r = results.pairs[0];
-        assert_eq!((r.a, r.b, r.exact), (a.0, b.0, false));
-        // True distance: sphere centre to the box face x = 0.55, minus the radius.
-        let truth = 0.55 - 0.5;
-        assert!(r.distance <= truth && (r.distance - truth).abs() <= r.error_bound);
-        // The boxes do not touch: no overlap, no contacts.
-        let report = step(
-            &scene,
-            Query::OVERLAP.union(Query::CONTACTS),
-            &mut workspace,
-            &mut results,
+        let mut scratch = NarrowScratch::default();
+        let (mut touching, mut apart) = (0, 0);
+        for case in 0..700 {
+            let (i, j) = (case % kinds.len(), (case / kinds.len()) % kinds.len());
+            let (pa, pb) = (
+                Pose::new(point_in_cube(&mut rng, 3.0), rotation(&mut rng)),
+                Pose::new(point_in_cube(&mut rng, 0.6), rotation(&mut rng)),
+            );
+            let pb = Pose::new(pa.position + pb.position, pb.rotation);
+            let answer =
+                |first: &Shape, second: &Shape, p1: Pose, p2: Pose, ws: &mut PipelineWorkspace| {
+                    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+                    add(&mut scene, first.clone(), DVec3::ZERO, 10.0);
+                    add(&mut scene, second.clone(), DVec3::ZERO, 10.0);
+                    scene.set_pose(BodyId(0), p1).unwrap();
+                    scene.set_pose(BodyId(1), p2).unwrap();
+                    let results = run(&scene, Query::CLOSE.union(Query::CONTACTS), ws);
+                    assert_eq!(
+                        results.pairs.len(),
+                        1,
+                        "case {case}: margins cover the pair"
+                    );
+                    (results.pairs[0], results.contacts.clone())
+                };
+            let (ab, contacts) = answer(&kinds[i], &kinds[j], pa, pb, &mut workspace);
+            let (ba, _) = answer(&kinds[j], &kinds[i], pb, pa, &mut workspace);
+            assert!(ab.exact, "case {case}");
+            let tol = 1e-7;
+            assert!(
+                (ab.distance - ba.distance).abs() <= tol,
+                "case {case} ({i},{j}): {} vs {}",
+                ab.distance,
+                ba.distance
+            );
+            assert!(
+                (ab.normal + ba.normal).length() <= 1e-5 || ab.distance <= 0.0,
+                "case {case}"
+            );
+            assert!((ab.normal.length() - 1.0).abs() < 1e-9, "case {case}");
+            // World answer = A-frame answer mapped by A's pose.
+            let local = dispatch::distance(
+                &kinds[i],
+                &kinds[j],
+                &Pose::relative(&pa, &pb),
+                &mut scratch,
+            );
+            assert!(
+                (local.distance - ab.distance).abs() <= 1e-12 + ab.error_bound,
+                "case {case}"
+            );
+            assert!(
+                pa.transform_point(local.point_a).distance(ab.point_a) <= 1e-9,
+                "case {case}"
+            );
+            if ab.distance <= 0.0 {
+                assert!(
+                    !contacts.is_empty(),
+                    "case {case} ({i},{j}): touching without contacts"
+                );
+                assert!(
+                    contacts
+                        .iter()
+                        .all(|c| c.distance <= 1e-9 && c.normal.is_finite())
+                );
+                touching += 1;
+            } else {
+                assert!(contacts.is_empty(), "case {case}");
+                apart += 1;
+            }
+        }
+        assert!(
+            touching > 100 && apart > 100,
+            "touching {touching}, apart {apart}"
         );
-        assert_eq!(
-            (report.candidates, report.pairs, report.contacts),
-            (1, 0, 0)
-        );
-        // Boxes overlapping (the shapes too): one conservative contact covering the depth.
-        scene
-            .set_pose(b, Pose::from_translation(DVec3::new(0.8, 0.0, 0.0)))
-            .unwrap();
-        step(&scene, Query::CONTACTS, &mut workspace, &mut results);
-        let (r, c) = (results.pairs[0], results.contacts[0]);
-        assert_eq!(
-            (results.pairs.len(), results.contacts.len(), r.contact_count),
-            (1, 1, 1)
-        );
-        let depth = 0.5 - (0.8 - 0.5);
-        assert!(c.distance == 0.0 && depth <= c.error_bound);
-        assert_eq!(c.normal, r.normal);
     }
 
-    /// A small body near the edge of a wide floor: the box normal is the floor's normal (the
-    /// axis of least overlap, or of the gap), not the direction between the box centres.
+    /// The worker pool's fallback (a pair whose query panicked) is the box answer: a lower
+    /// bound of the distance within its error bound, a contact covering the depth.
+    #[test]
+    fn the_box_answer_is_conservative() {
+        let sphere = Aabb::new(DVec3::splat(-0.5), DVec3::splat(0.5));
+        let cube_at = |x: f64| {
+            Aabb::new(
+                DVec3::new(x - 0.5, -0.2, -0.5),
+                DVec3::new(x + 0.5, 0.8, 0.5),
+            )
+        };
+        let pair = CandidatePair { a: 0, b: 1 };
+        let mut contacts = Vec::new();
+        let far = answer::boxes(&pair, &sphere, &cube_at(1.05), Query::CLOSE, &mut contacts);
+        // True distance: sphere centre to the box face x = 0.55, minus the radius.
+        let truth = 0.55 - 0.5;
+        assert!(!far.result.exact && !far.touching);
+        assert!(
+            far.result.distance <= truth && truth - far.result.distance <= far.result.error_bound
+        );
+        let near = answer::boxes(
+            &pair,
+            &sphere,
+            &cube_at(0.8),
+            Query::CONTACTS,
+            &mut contacts,
+        );
+        let depth = 0.5 - (0.8 - 0.5);
+        assert!(near.touching && contacts.len() == 1);
+        assert!(contacts[0].distance == 0.0 && depth <= contacts[0].error_bound);
+    }
+
+    /// A small body near the edge of a wide floor gets the floor's normal, not the direction
+    /// between the centres.
     #[test]
     fn box_answers_take_their_normal_from_the_axis_that_separates_soonest() {
         for (height, a_below) in [(0.45, true), (0.55, true), (0.45, false), (0.55, false)] {

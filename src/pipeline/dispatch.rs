@@ -1,0 +1,425 @@
+//! The dispatcher: the only place that matches on the *pair* of shape kinds. It picks the
+//! query for each pair, flips pairs given in non-canonical order (a closed form exists for
+//! one order only) and answers in A's frame; the pipeline converts to world once.
+//!
+//! | pair | distance | manifold |
+//! |---|---|---|
+//! | sphere, capsule, cuboid among themselves | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
+//! | a cylinder, cone or convex hull with any convex shape | GJK on the cores, EPA when they overlap ([`crate::narrow::gjk`]) | one point: the signed-distance witnesses |
+//! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, reduced to 4 points, with the normal of the deepest |
+//! | mesh–mesh | [`Route::MeshMesh`]: the BVH tandem queries with warm starts and the worker pool | intersection segments, reduced |
+//!
+//! Canonical order: sphere < capsule < cuboid < cylinder < cone < convex < mesh. GJK is
+//! symmetric, so its pairs are answered in the order given.
+//!
+//! # Meshes are surfaces
+//! A convex shape against a mesh is answered against the mesh's triangles (two-sided, no
+//! thickness): the signed distance is the smallest over the triangles, negative when the
+//! shape reaches through some triangle. A shape entirely inside a closed mesh without
+//! touching its surface is apart from it, as for mesh–mesh.
+
+use super::contacts::reduce_manifold;
+use crate::bounding::{BoundingVolume, Obb, Rss};
+use crate::geometry::{Segment, SupportMap, Triangle};
+use crate::math::{DVec3, Isometry, Pose};
+use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
+use crate::narrow::convex_mesh::{
+    ConvexMeshWorkspace, for_each_overlapping_triangle, nearest_triangle,
+};
+use crate::narrow::gjk::{
+    EpaWorkspace, GjkCache, GjkParams, POINT, Rounded, signed_distance_convex,
+};
+use crate::narrow::mesh_mesh::{
+    DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh,
+};
+use crate::narrow::pairs;
+use crate::scene::{MeshShape, Shape};
+use std::ops::ControlFlow;
+use std::sync::Arc;
+
+/// GJK/EPA settings of the pipeline: GJK's defaults (relative tolerance 1e-10).
+const GJK: GjkParams = GjkParams {
+    rel_tol: 1e-10,
+    epa_rel_tol: 1e-10,
+    abs_tol: 0.0,
+    max_iterations: 128,
+    accelerated: false,
+};
+
+/// Scratch of the dispatcher for one thread (no allocation once grown).
+#[derive(Debug, Default)]
+pub(super) struct NarrowScratch {
+    epa: EpaWorkspace,
+    convex_mesh: ConvexMeshWorkspace,
+    mesh_mesh: MeshMeshWorkspace,
+    /// A triangle's manifold, while a convex–mesh manifold is gathered.
+    triangle_manifold: Manifold,
+    /// Every triangle contact of a convex–mesh manifold, before reduction.
+    points: Vec<ManifoldPoint>,
+    normals: Vec<DVec3>,
+    positions: Vec<DVec3>,
+    kept: Vec<usize>,
+}
+
+/// Every convex kind, as a pattern (every kind but the mesh).
+macro_rules! convex {
+    () => {
+        Shape::Sphere(_)
+            | Shape::Capsule(_)
+            | Shape::Cuboid(_)
+            | Shape::Cylinder(_)
+            | Shape::Cone(_)
+            | Shape::Convex(_)
+    };
+}
+
+/// How the pipeline answers a pair.
+pub(super) enum Route<'s> {
+    /// Two meshes: the BVH tandem queries (warm starts, worker pool, manifold of the
+    /// intersection set).
+    MeshMesh(&'s Arc<MeshShape>, &'s Arc<MeshShape>),
+    /// Everything else: [`distance`] and [`manifold`].
+    Direct,
+}
+
+/// The route of the pair `(a, b)`.
+pub(super) fn route<'s>(a: &'s Shape, b: &'s Shape) -> Route<'s> {
+    match (a, b) {
+        (Shape::Mesh(ma), Shape::Mesh(mb)) => Route::MeshMesh(ma, mb),
+        (convex!(), convex!() | Shape::Mesh(_)) | (Shape::Mesh(_), convex!()) => Route::Direct,
+    }
+}
+
+/// The signed distance of `a` and `b` placed by `pose_ab`, A's frame (see the module docs
+/// for the query each pair gets). Mesh–mesh pairs get a cold exact distance here; the
+/// pipeline sends them down [`Route::MeshMesh`] instead.
+pub(super) fn distance(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Pose,
+    scratch: &mut NarrowScratch,
+) -> ShapeDistance {
+    use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
+    let iso = pose_ab.to_isometry();
+    match (a, b) {
+        (S(x), S(y)) => pairs::distance_sphere_sphere(x, y, &iso),
+        (S(x), C(y)) => pairs::distance_sphere_capsule(x, y, &iso),
+        (S(x), B(y)) => pairs::distance_sphere_cuboid(x, y, &iso),
+        (C(x), C(y)) => pairs::distance_capsule_capsule(x, y, &iso),
+        (C(x), B(y)) => pairs::distance_capsule_cuboid(x, y, &iso),
+        (B(x), B(y)) => pairs::distance_cuboid_cuboid(x, y, &iso),
+        (C(_), S(_)) | (B(_), S(_) | C(_)) => {
+            flip(&distance(b, a, &pose_ab.inverse(), scratch), &iso)
+        }
+        (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
+            convex_distance(a, b, &iso, scratch)
+        }
+        (convex!(), M(mesh)) => shape_mesh_distance(a, mesh, pose_ab, scratch),
+        (M(_), convex!()) => flip(&distance(b, a, &pose_ab.inverse(), scratch), &iso),
+        (M(x), M(y)) => {
+            let d = distance_mesh_mesh(
+                &x.distance_tree,
+                &y.distance_tree,
+                pose_ab,
+                &DistanceParams::EXACT,
+                &mut DistanceCache::new(),
+                &mut scratch.mesh_mesh,
+            );
+            ShapeDistance {
+                distance: d.distance,
+                point_a: d.point_a,
+                point_b: d.point_b,
+                normal: (d.point_b - d.point_a).try_normalize().unwrap_or(DVec3::X),
+            }
+        }
+    }
+}
+
+/// The contact manifold of `a` and `b` placed by `pose_ab`, A's frame, into `out` (emptied
+/// first; stays empty when they are apart). Mesh–mesh pairs go down [`Route::MeshMesh`].
+pub(super) fn manifold(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Pose,
+    scratch: &mut NarrowScratch,
+    out: &mut Manifold,
+) {
+    use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
+    let iso = pose_ab.to_isometry();
+    out.reset(DVec3::ZERO);
+    match (a, b) {
+        (S(x), S(y)) => pairs::manifold_sphere_sphere(x, y, &iso, out),
+        (S(x), C(y)) => pairs::manifold_sphere_capsule(x, y, &iso, out),
+        (S(x), B(y)) => pairs::manifold_sphere_cuboid(x, y, &iso, out),
+        (C(x), C(y)) => pairs::manifold_capsule_capsule(x, y, &iso, out),
+        (C(x), B(y)) => pairs::manifold_capsule_cuboid(x, y, &iso, out),
+        (B(x), B(y)) => pairs::manifold_cuboid_cuboid(x, y, &iso, out),
+        (C(_), S(_)) | (B(_), S(_) | C(_)) | (M(_), convex!()) => {
+            manifold(b, a, &pose_ab.inverse(), scratch, out);
+            flip_manifold(out, &iso);
+        }
+        (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
+            let d = convex_distance(a, b, &iso, scratch);
+            witness_manifold(&d, out);
+        }
+        (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, scratch, out),
+        (M(x), M(y)) => {
+            // The pipeline answers mesh pairs on their own route; here, one point at the
+            // closest pair when they touch.
+            let d = distance(
+                &Shape::Mesh(Arc::clone(x)),
+                &Shape::Mesh(Arc::clone(y)),
+                pose_ab,
+                scratch,
+            );
+            witness_manifold(&d, out);
+        }
+    }
+}
+
+/// The answer of B against A turned into A against B: points swapped, normal reversed,
+/// mapped from B's frame into A's by `pose_ab`.
+fn flip(d: &ShapeDistance, pose_ab: &Isometry) -> ShapeDistance {
+    d.flipped(pose_ab)
+}
+
+/// [`flip`] for a manifold, in place.
+fn flip_manifold(m: &mut Manifold, pose_ab: &Isometry) {
+    let mut flipped = Manifold::new();
+    flipped.reset(pose_ab.transform_vector(-m.normal));
+    for p in m.points() {
+        flipped.push(ManifoldPoint {
+            point_a: pose_ab.transform_point(p.point_b),
+            point_b: pose_ab.transform_point(p.point_a),
+            distance: p.distance,
+        });
+    }
+    *m = flipped;
+}
+
+/// A one-point manifold from a signed distance: its witnesses, when the shapes touch.
+fn witness_manifold(d: &ShapeDistance, out: &mut Manifold) {
+    out.reset(d.normal);
+    if d.distance <= 0.0 {
+        out.push(ManifoldPoint {
+            point_a: d.point_a,
+            point_b: d.point_b,
+            distance: d.distance,
+        });
+    }
+}
+
+/// A convex shape as GJK sees it: a core and a radius (a sphere is a point swept by its
+/// radius, a capsule a segment; the others have no radius).
+enum Core<'s> {
+    Point,
+    Segment(Segment),
+    Support(&'s dyn SupportMap),
+}
+
+impl Core<'_> {
+    fn support_map(&self) -> &dyn SupportMap {
+        match self {
+            Core::Point => &POINT,
+            Core::Segment(s) => s,
+            Core::Support(s) => *s,
+        }
+    }
+}
+
+/// The core and radius of a convex shape; `None` for a mesh.
+fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
+    Some(match shape {
+        Shape::Sphere(s) => (Core::Point, s.radius),
+        Shape::Capsule(c) => (Core::Segment(c.segment()), c.radius),
+        Shape::Cuboid(b) => (Core::Support(b), 0.0),
+        Shape::Cylinder(c) => (Core::Support(c), 0.0),
+        Shape::Cone(c) => (Core::Support(c), 0.0),
+        Shape::Convex(c) => (Core::Support(c.as_ref()), 0.0),
+        Shape::Mesh(_) => return None,
+    })
+}
+
+/// GJK/EPA between two convex shapes (the caller's arm guarantees neither is a mesh).
+fn convex_distance(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    scratch: &mut NarrowScratch,
+) -> ShapeDistance {
+    let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_of(a), core_of(b)) else {
+        unreachable!("the dispatcher sends only convex pairs here");
+    };
+    let (ra, rb) = (
+        Rounded::new(core_a.support_map(), radius_a),
+        Rounded::new(core_b.support_map(), radius_b),
+    );
+    signed_distance_convex(
+        &ra,
+        &rb,
+        pose_ab,
+        &GJK,
+        &mut GjkCache::default(),
+        &mut scratch.epa,
+    )
+    .0
+}
+
+/// The signed distance of a convex shape (A's frame) and one triangle (A's frame).
+fn shape_triangle_distance(
+    shape: &Shape,
+    triangle: &Triangle,
+    epa: &mut EpaWorkspace,
+) -> ShapeDistance {
+    let identity = Isometry::IDENTITY;
+    match shape {
+        Shape::Sphere(s) => pairs::distance_sphere_triangle(s, triangle, &identity),
+        Shape::Capsule(c) => pairs::distance_capsule_triangle(c, triangle, &identity),
+        Shape::Cuboid(b) => pairs::distance_cuboid_triangle(b, triangle, &identity),
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
+            let Some((core, radius)) = core_of(shape) else {
+                unreachable!("meshes are not convex shapes");
+            };
+            signed_distance_convex(
+                &Rounded::new(core.support_map(), radius),
+                &Rounded::plain(triangle),
+                &identity,
+                &GJK,
+                &mut GjkCache::default(),
+                epa,
+            )
+            .0
+        }
+    }
+}
+
+/// The manifold of a convex shape and one triangle, both in A's frame.
+fn shape_triangle_manifold(
+    shape: &Shape,
+    triangle: &Triangle,
+    epa: &mut EpaWorkspace,
+    out: &mut Manifold,
+) {
+    let identity = Isometry::IDENTITY;
+    out.reset(DVec3::ZERO);
+    match shape {
+        Shape::Sphere(s) => pairs::manifold_sphere_triangle(s, triangle, &identity, out),
+        Shape::Capsule(c) => pairs::manifold_capsule_triangle(c, triangle, &identity, out),
+        Shape::Cuboid(b) => pairs::manifold_cuboid_triangle(b, triangle, &identity, out),
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
+            let d = shape_triangle_distance(shape, triangle, epa);
+            witness_manifold(&d, out);
+        }
+    }
+}
+
+/// A bounding volume of type `B` around a convex shape, its local frame: fitted to the
+/// corners of the shape's local box (a box contains the shape).
+fn shape_bound<B: BoundingVolume>(shape: &Shape) -> B {
+    let local = shape.local_bounds();
+    let corners: [DVec3; 8] = std::array::from_fn(|i| {
+        DVec3::new(
+            if i & 1 == 0 { local.min.x } else { local.max.x },
+            if i & 2 == 0 { local.min.y } else { local.max.y },
+            if i & 4 == 0 { local.min.z } else { local.max.z },
+        )
+    });
+    B::fit_points(&corners)
+}
+
+/// A convex shape against a mesh's triangles: the nearest (or deepest) triangle.
+fn shape_mesh_distance(
+    shape: &Shape,
+    mesh: &MeshShape,
+    pose_ab: &Pose,
+    scratch: &mut NarrowScratch,
+) -> ShapeDistance {
+    let NarrowScratch {
+        epa, convex_mesh, ..
+    } = scratch;
+    let bound = shape_bound::<Rss>(shape);
+    nearest_triangle(
+        &bound,
+        &mesh.distance_tree,
+        pose_ab,
+        convex_mesh,
+        |triangle| {
+            let d = shape_triangle_distance(shape, triangle, epa);
+            (d.distance, d)
+        },
+    )
+    .map_or(
+        // A mesh without triangles: nothing to touch.
+        ShapeDistance {
+            distance: f64::INFINITY,
+            point_a: DVec3::ZERO,
+            point_b: DVec3::ZERO,
+            normal: DVec3::X,
+        },
+        |(_, d)| d,
+    )
+}
+
+/// A convex shape against a mesh: the manifolds of every triangle the shape reaches,
+/// reduced to [`crate::narrow::MANIFOLD_POINTS`] points, under the normal of the deepest
+/// triangle contact (so contacts across internal edges of a flat region share the face's
+/// normal instead of tilted edge normals).
+fn shape_mesh_manifold(
+    shape: &Shape,
+    mesh: &MeshShape,
+    pose_ab: &Pose,
+    scratch: &mut NarrowScratch,
+    out: &mut Manifold,
+) {
+    let NarrowScratch {
+        epa,
+        convex_mesh,
+        triangle_manifold,
+        points,
+        normals,
+        positions,
+        kept,
+        ..
+    } = scratch;
+    points.clear();
+    normals.clear();
+    let bound = shape_bound::<Obb>(shape);
+    for_each_overlapping_triangle(
+        &bound,
+        &mesh.overlap_tree,
+        pose_ab,
+        convex_mesh,
+        |_, triangle| {
+            shape_triangle_manifold(shape, triangle, epa, triangle_manifold);
+            for p in triangle_manifold.points() {
+                points.push(*p);
+                normals.push(triangle_manifold.normal);
+            }
+            ControlFlow::Continue(())
+        },
+    );
+    out.reset(DVec3::ZERO);
+    let Some(deepest) =
+        (0..points.len()).min_by(|&i, &j| points[i].distance.total_cmp(&points[j].distance))
+    else {
+        return;
+    };
+    let normal = normals[deepest];
+    out.reset(normal);
+    positions.clear();
+    positions.extend(points.iter().map(|p| p.point_a));
+    reduce_manifold(positions, kept);
+    // The deepest point always stays.
+    if !kept.contains(&deepest) {
+        kept.pop();
+        kept.insert(0, deepest);
+    }
+    for &i in kept.iter() {
+        let p = points[i];
+        // Depth along the common normal.
+        let distance = (p.point_b - p.point_a).dot(normal).min(0.0);
+        out.push(ManifoldPoint { distance, ..p });
+    }
+}
