@@ -111,7 +111,7 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn Error>> {
             continue;
         };
         let round_trip = sent.elapsed();
-        let bounced = scene.bounce(frame.contacts());
+        let bounced = scene.bounce(frame.pairs(), frame.contacts());
         let line = FrameLine::new(seq, frame.header(), round_trip, bounced);
         drop(frame);
         summary.add(&line);

@@ -140,7 +140,7 @@ impl Summary {
             self.lost
         );
         println!(
-            "per frame: {:.1} close pairs, {:.1} contacts, {:.1} sphere bounces",
+            "per frame: {:.1} close pairs, {:.1} contacts, {:.1} bounces",
             per_frame(self.pairs),
             per_frame(self.contacts),
             per_frame(self.bounced)

@@ -3,9 +3,8 @@
 //! on circles through the box's centre so that they meet and interlock.
 //!
 //! The client integrates the motion itself, as a simulation would: the daemon only answers
-//! which bodies are close and where they touch. Spheres and tori are in different collision
-//! groups: the narrow phase for sphere–mesh pairs comes with issue #5, and until then such
-//! pairs would get only a conservative box answer.
+//! which bodies are close and where they touch. Spheres bounce off each other and off the
+//! tori (sphere–mesh contacts through the tori's BVHs); the tori follow their paths.
 
 use glam::{DQuat, DVec3};
 use proxima::geometry::TriMesh;
@@ -19,9 +18,9 @@ const BOX_HALF: f64 = 3.0;
 /// Close-pair margins, metres.
 const SPHERE_MARGIN: f64 = 0.05;
 const TORUS_MARGIN: f64 = 0.1;
-/// Collision groups: spheres pair with spheres, tori with tori.
-const SPHERES: u32 = 1;
-const TORI: u32 = 2;
+/// Collision groups: everything pairs with everything.
+const SPHERES: u32 = u32::MAX;
+const TORI: u32 = u32::MAX;
 /// Tori: tube centre-line radius, tube radius (metres), path radius (metres), count.
 const TORUS_MAJOR: f64 = 0.8;
 const TORUS_MINOR: f64 = 0.2;
@@ -173,30 +172,53 @@ impl DemoScene {
         }
     }
 
-    /// Bounces every pair of spheres that a contact record says touch and that approach
-    /// each other: an elastic collision of equal masses along the contact normal (A→B),
-    /// and each pushed out by half the depth. Returns how many pairs bounced.
-    pub fn bounce(&mut self, contacts: &[ResultRecord]) -> usize {
+    /// Bounces what the contact records say touch: two spheres approaching each other
+    /// collide elastically (equal masses) along the contact normal (A→B) and are pushed
+    /// apart by half the depth each; a sphere approaching a torus is reflected off it (the
+    /// torus, moved by its path, is immovable) and pushed out by the depth. Returns how many
+    /// pairs bounced. Each pair acts once, at its deepest contact.
+    pub fn bounce(&mut self, pairs: &[ResultRecord], contacts: &[ResultRecord]) -> usize {
         let mut bounced = 0;
-        for c in contacts {
-            let (Some(&i), Some(&j)) = (
-                self.sphere_of_body.get(c.body_a as usize),
-                self.sphere_of_body.get(c.body_b as usize),
-            ) else {
+        for pair in pairs {
+            let first = (pair.index as usize).min(contacts.len());
+            let end = (first + pair.count as usize).min(contacts.len());
+            let Some(c) = contacts[first..end]
+                .iter()
+                .min_by(|x, y| x.distance.total_cmp(&y.distance))
+            else {
                 continue;
             };
-            if i == usize::MAX || j == usize::MAX {
-                continue;
-            }
+            let sphere = |body: u32| {
+                self.sphere_of_body
+                    .get(body as usize)
+                    .copied()
+                    .filter(|&i| i != usize::MAX)
+            };
             let n = DVec3::from_array(c.normal);
-            let approach = (self.spheres[i].velocity - self.spheres[j].velocity).dot(n);
             let depth = (-c.distance).max(0.0);
-            self.spheres[i].position -= n * (depth / 2.0);
-            self.spheres[j].position += n * (depth / 2.0);
-            if approach > 0.0 {
-                self.spheres[i].velocity -= n * approach;
-                self.spheres[j].velocity += n * approach;
-                bounced += 1;
+            match (sphere(c.body_a), sphere(c.body_b)) {
+                (Some(i), Some(j)) => {
+                    let approach = (self.spheres[i].velocity - self.spheres[j].velocity).dot(n);
+                    self.spheres[i].position -= n * (depth / 2.0);
+                    self.spheres[j].position += n * (depth / 2.0);
+                    if approach > 0.0 {
+                        self.spheres[i].velocity -= n * approach;
+                        self.spheres[j].velocity += n * approach;
+                        bounced += 1;
+                    }
+                }
+                // One sphere and a torus: `out` points from the torus to the sphere.
+                (Some(i), None) | (None, Some(i)) => {
+                    let out = if sphere(c.body_b) == Some(i) { n } else { -n };
+                    let s = &mut self.spheres[i];
+                    s.position += out * depth;
+                    let into = s.velocity.dot(out);
+                    if into < 0.0 {
+                        s.velocity -= out * (2.0 * into);
+                        bounced += 1;
+                    }
+                }
+                (None, None) => {}
             }
         }
         bounced

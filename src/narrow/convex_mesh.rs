@@ -33,8 +33,9 @@ impl ConvexMeshWorkspace {
 /// The smallest value of `triangle_value` over the mesh's triangles (each given in A's
 /// frame), skipping every subtree whose volume's lower bound on the distance to the shape's
 /// volume `shape_bv` exceeds the best value so far (or 0, while the best is negative: a
-/// deeper penetration can hide in any subtree that overlaps the shape). `None` for a mesh
-/// with no triangle.
+/// deeper penetration can hide in any subtree that overlaps the shape) or `limit` (metres;
+/// `f64::INFINITY` for the exact minimum). `None` for a mesh with no triangle, or when no
+/// subtree comes within `limit`; a returned value above `limit` is only an upper bound.
 ///
 /// `triangle_value` must never be below the true distance between the shape and the
 /// triangle minus its own error (a signed distance, or a distance clamped at 0), so that the
@@ -43,6 +44,7 @@ pub fn nearest_triangle<B, T>(
     shape_bv: &B,
     tree: &Bvh<B>,
     pose_ab: &Pose,
+    limit: f64,
     workspace: &mut ConvexMeshWorkspace,
     mut triangle_value: impl FnMut(&Triangle) -> (f64, T),
 ) -> Option<(f64, T)>
@@ -66,8 +68,10 @@ where
         b: 0,
     });
     let prune = |bound: f64, best: &Option<(f64, T)>| {
-        best.as_ref()
-            .is_some_and(|(value, _)| bound > value.max(0.0))
+        bound
+            > best
+                .as_ref()
+                .map_or(limit, |(value, _)| value.max(0.0).min(limit))
     };
     while let Some(entry) = heap.pop() {
         if prune(entry.bound, &best) {
@@ -193,6 +197,7 @@ mod tests {
                 &ball_bv::<Rss>(center, radius),
                 &rss,
                 &pose_ab,
+                f64::INFINITY,
                 &mut workspace,
                 |t| (ball_triangle(center, radius, t), ()),
             )
@@ -202,11 +207,29 @@ mod tests {
                 &ball_bv::<Obb>(center, radius),
                 &obb,
                 &pose_ab,
+                f64::INFINITY,
                 &mut workspace,
                 |t| (ball_triangle(center, radius, t), ()),
             )
             .unwrap()
             .0;
+            // With a limit: the same answer when it is within the limit, else nothing or
+            // an upper bound above it.
+            let limit = rng.random_range(0.0..0.5);
+            let limited = nearest_triangle(
+                &ball_bv::<Rss>(center, radius),
+                &rss,
+                &pose_ab,
+                limit,
+                &mut workspace,
+                |t| (ball_triangle(center, radius, t), ()),
+            )
+            .map(|(d, ())| d);
+            if truth <= limit {
+                assert_eq!(limited, Some(truth), "case {case}");
+            } else {
+                assert!(limited.is_none_or(|d| d > limit), "case {case}");
+            }
             assert_eq!(found_rss, truth, "case {case}");
             assert_eq!(found_obb, truth, "case {case}");
             if truth < 0.0 {

@@ -69,7 +69,14 @@ pub(super) fn direct(
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     let pose_ab = Pose::relative(&a.pose, &b.pose);
-    let d = dispatch::distance(sa, sb, &pose_ab, scratch);
+    // Without DISTANCE, nothing beyond the margins is reported (and touching is within
+    // them): the query may stop at that limit.
+    let limit = if query.distance {
+        f64::INFINITY
+    } else {
+        a.margin + b.margin
+    };
+    let d = dispatch::distance(sa, sb, &pose_ab, limit, scratch);
     let scale = d
         .point_a
         .abs()

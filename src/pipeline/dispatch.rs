@@ -21,7 +21,7 @@
 use super::contacts::reduce_manifold;
 use crate::bounding::{BoundingVolume, Obb, Rss};
 use crate::geometry::{Segment, SupportMap, Triangle};
-use crate::math::{DVec3, Isometry, Pose};
+use crate::math::{DMat3, DVec3, Isometry, Pose};
 use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
 use crate::narrow::convex_mesh::{
     ConvexMeshWorkspace, for_each_overlapping_triangle, nearest_triangle,
@@ -91,12 +91,15 @@ pub(super) fn route<'s>(a: &'s Shape, b: &'s Shape) -> Route<'s> {
 }
 
 /// The signed distance of `a` and `b` placed by `pose_ab`, A's frame (see the module docs
-/// for the query each pair gets). Mesh–mesh pairs get a cold exact distance here; the
-/// pipeline sends them down [`Route::MeshMesh`] instead.
+/// for the query each pair gets), exact when it is at most `limit` metres; above the limit
+/// the answer may be only an upper bound (`distance > limit`, possibly `+∞`): a convex
+/// shape's walk of a mesh then stops early. Mesh–mesh pairs get a cold exact distance
+/// here; the pipeline sends them down [`Route::MeshMesh`] instead.
 pub(super) fn distance(
     a: &Shape,
     b: &Shape,
     pose_ab: &Pose,
+    limit: f64,
     scratch: &mut NarrowScratch,
 ) -> ShapeDistance {
     use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
@@ -109,14 +112,14 @@ pub(super) fn distance(
         (C(x), B(y)) => pairs::distance_capsule_cuboid(x, y, &iso),
         (B(x), B(y)) => pairs::distance_cuboid_cuboid(x, y, &iso),
         (C(_), S(_)) | (B(_), S(_) | C(_)) => {
-            flip(&distance(b, a, &pose_ab.inverse(), scratch), &iso)
+            flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso)
         }
         (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
             convex_distance(a, b, &iso, scratch)
         }
-        (convex!(), M(mesh)) => shape_mesh_distance(a, mesh, pose_ab, scratch),
-        (M(_), convex!()) => flip(&distance(b, a, &pose_ab.inverse(), scratch), &iso),
+        (convex!(), M(mesh)) => shape_mesh_distance(a, mesh, pose_ab, limit, scratch),
+        (M(_), convex!()) => flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso),
         (M(x), M(y)) => {
             let d = distance_mesh_mesh(
                 &x.distance_tree,
@@ -172,6 +175,7 @@ pub(super) fn manifold(
                 &Shape::Mesh(Arc::clone(x)),
                 &Shape::Mesh(Arc::clone(y)),
                 pose_ab,
+                f64::INFINITY,
                 scratch,
             );
             witness_manifold(&d, out);
@@ -315,18 +319,54 @@ fn shape_triangle_manifold(
     }
 }
 
-/// A bounding volume of type `B` around a convex shape, its local frame: fitted to the
-/// corners of the shape's local box (a box contains the shape).
-fn shape_bound<B: BoundingVolume>(shape: &Shape) -> B {
+/// The tightest volume of a tree's type around a convex shape, its local frame, for the
+/// mesh BVH walk: its lower bounds prune the walk, so a loose one costs triangles.
+trait ShapeBound: BoundingVolume {
+    fn around(shape: &Shape) -> Self;
+}
+
+impl ShapeBound for Rss {
+    /// A ball or a capsule exactly; a box as its xy rectangle swept by its z half extent;
+    /// anything else the volume fitted to its local box's corners.
+    fn around(shape: &Shape) -> Self {
+        match shape {
+            Shape::Sphere(s) => Rss::new(DVec3::ZERO, DMat3::IDENTITY, [0.0, 0.0], s.radius),
+            // Axes (Z, X, Y): the rectangle's first axis along the capsule's segment.
+            Shape::Capsule(c) => Rss::new(
+                DVec3::ZERO,
+                DMat3::from_cols(DVec3::Z, DVec3::X, DVec3::Y),
+                [c.half_height, 0.0],
+                c.radius,
+            ),
+            Shape::Cuboid(b) => {
+                let h = b.half_extents;
+                Rss::new(DVec3::ZERO, DMat3::IDENTITY, [h.x, h.y], h.z)
+            }
+            Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
+                Rss::fit_points(&box_corners(shape))
+            }
+        }
+    }
+}
+
+impl ShapeBound for Obb {
+    /// The shape's local box.
+    fn around(shape: &Shape) -> Self {
+        let local = shape.local_bounds();
+        Obb::new(local.center(), DMat3::IDENTITY, local.half_extents())
+    }
+}
+
+/// The corners of a shape's local box.
+fn box_corners(shape: &Shape) -> [DVec3; 8] {
     let local = shape.local_bounds();
-    let corners: [DVec3; 8] = std::array::from_fn(|i| {
+    std::array::from_fn(|i| {
         DVec3::new(
             if i & 1 == 0 { local.min.x } else { local.max.x },
             if i & 2 == 0 { local.min.y } else { local.max.y },
             if i & 4 == 0 { local.min.z } else { local.max.z },
         )
-    });
-    B::fit_points(&corners)
+    })
 }
 
 /// A convex shape against a mesh's triangles: the nearest (or deepest) triangle.
@@ -334,16 +374,18 @@ fn shape_mesh_distance(
     shape: &Shape,
     mesh: &MeshShape,
     pose_ab: &Pose,
+    limit: f64,
     scratch: &mut NarrowScratch,
 ) -> ShapeDistance {
     let NarrowScratch {
         epa, convex_mesh, ..
     } = scratch;
-    let bound = shape_bound::<Rss>(shape);
+    let bound = Rss::around(shape);
     nearest_triangle(
         &bound,
         &mesh.distance_tree,
         pose_ab,
+        limit,
         convex_mesh,
         |triangle| {
             let d = shape_triangle_distance(shape, triangle, epa);
@@ -351,7 +393,7 @@ fn shape_mesh_distance(
         },
     )
     .map_or(
-        // A mesh without triangles: nothing to touch.
+        // A mesh without triangles, or nothing within the limit.
         ShapeDistance {
             distance: f64::INFINITY,
             point_a: DVec3::ZERO,
@@ -385,7 +427,7 @@ fn shape_mesh_manifold(
     } = scratch;
     points.clear();
     normals.clear();
-    let bound = shape_bound::<Obb>(shape);
+    let bound = Obb::around(shape);
     for_each_overlapping_triangle(
         &bound,
         &mesh.overlap_tree,

@@ -786,6 +786,7 @@ mod tests {
                 &kinds[i],
                 &kinds[j],
                 &Pose::relative(&pa, &pb),
+                f64::INFINITY,
                 &mut scratch,
             );
             assert!(
