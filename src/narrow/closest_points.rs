@@ -226,7 +226,7 @@ mod tests {
     /// about `1e-13` of its size: the best of the three edges' closest points (exact for
     /// answers on the boundary, and for zero-area triangles) and of a projected-gradient
     /// descent on the barycentric parameters from the best point of a dense grid (for
-    /// answers inside the face). Independent of the Voronoi-region method under test.
+    /// answers inside the face). Shares no code with the hinge-frame method under test.
     fn oracle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
         let mut best = [(a, b), (b, c), (c, a)]
             .iter()
