@@ -222,11 +222,13 @@ mod tests {
         assert_eq!((p, q), (v(1.0, 0.0, 0.0), v(0.0, 2.0, 0.0)));
     }
 
-    /// Oracle: an upper bound on the distance from `p` to the closed triangle, tight to
-    /// about `1e-13` of its size: the best of the three edges' closest points (exact for
-    /// answers on the boundary, and for zero-area triangles) and of a projected-gradient
-    /// descent on the barycentric parameters from the best point of a dense grid (for
-    /// answers inside the face). Shares no code with the hinge-frame method under test.
+    /// Oracle: an upper bound on the distance from `p` to the closed triangle (every
+    /// candidate is a point of it): the best of the three edges' closest points (exact for
+    /// answers on the boundary, and for zero-area triangles), a projected-gradient descent
+    /// on the barycentric parameters from the best point of a dense grid, and the clamped
+    /// least-squares point of [`least_squares_distance`] (for answers inside the face, where
+    /// the descent is slow on thin triangles). Shares no code with the hinge-frame method
+    /// under test; the test's own tolerance shows it is tight.
     fn oracle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
         let mut best = [(a, b), (b, c), (c, a)]
             .iter()
