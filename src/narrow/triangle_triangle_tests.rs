@@ -145,3 +145,98 @@ fn near_miss_at_large_offset_is_decided_exactly() {
     let on = Triangle::new(v(1e5 + 0.25, 1e5 + 0.25, z), b.b, b.c);
     assert!(both_ways(&a, &on));
 }
+
+/// The distance from the closed segment `p q` to triangle `t`, by golden-section search
+/// of `s ↦ dist(p + s (q − p), t)`, convex as the distance to a convex set along a line
+/// (an oracle independent of the feature-pair method: it needs only the point–triangle
+/// closest point, checked against its own oracle in `closest_points`).
+fn segment_triangle_distance_by_search(p: DVec3, q: DVec3, t: &Triangle) -> f64 {
+    let f = |s: f64| {
+        let x = p + (q - p) * s;
+        x.distance(super::closest_point_triangle(x, t.a, t.b, t.c))
+    };
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..120 {
+        let (m1, m2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
+        if f(m1) <= f(m2) {
+            hi = m2;
+        } else {
+            lo = m1;
+        }
+    }
+    f(0.0).min(f(1.0)).min(f((lo + hi) / 2.0))
+}
+
+#[test]
+fn distances_to_sliver_triangles_match_a_line_search_oracle() {
+    use crate::test_support::{point_in_cube, rng, rotation};
+    use rand::Rng;
+    let mut r = rng(0x5_11e4);
+    let (mut touching, mut apart) = (0, 0);
+    for case in 0..3000 {
+        // A: generic, or itself a sliver half of the time.
+        let a = {
+            let (x, y) = (point_in_cube(&mut r, 1.0), point_in_cube(&mut r, 1.0));
+            let z = if r.random_bool(0.5) {
+                x + (y - x) * r.random_range(-0.5..1.5)
+            } else {
+                point_in_cube(&mut r, 1.0)
+            };
+            Triangle::new(x, y, z)
+        };
+        // B: x, y, x + 0.3 (y − x) (zero area before placement) through a point near A.
+        let centre = a.a + (a.b - a.a) * r.random_range(0.0..0.7) + (a.c - a.a) * 0.2;
+        let half = point_in_cube(&mut r, 1.0);
+        let (x, y) = (centre - half, centre + half + point_in_cube(&mut r, 0.3));
+        let b = Triangle::new(x, y, x + (y - x) * r.random_range(-0.5..1.5));
+        let rot = crate::math::DMat3::from_quat(rotation(&mut r));
+        let offset = point_in_cube(&mut r, 20.0);
+        let place = |t: &Triangle| {
+            let m = |v: DVec3| rot * v + offset;
+            Triangle::new(m(t.a), m(t.b), m(t.c))
+        };
+        let (a, b) = (place(&a), place(&b));
+        let scale = a
+            .vertices()
+            .iter()
+            .chain(b.vertices().iter())
+            .fold(0.0f64, |m, v| m.max(v.abs().max_element()));
+        // B's hull is its longest edge (to rounding).
+        let edges = [(b.a, b.b), (b.b, b.c), (b.c, b.a)];
+        let (p, q) = edges
+            .into_iter()
+            .max_by(|e, f| e.0.distance(e.1).total_cmp(&f.0.distance(f.1)))
+            .unwrap();
+        let want = segment_triangle_distance_by_search(p, q, &a);
+        for (first, second, swapped) in [(&a, &b, false), (&b, &a, true)] {
+            let d = distance_triangle_triangle(first, second);
+            let (pa, pb) = if swapped {
+                (d.point_b, d.point_a)
+            } else {
+                (d.point_a, d.point_b)
+            };
+            let on_a = pa.distance(super::closest_point_triangle(pa, a.a, a.b, a.c));
+            let on_b = pb.distance(crate::narrow::closest_points::closest_point_segment(
+                pb, p, q,
+            ));
+            assert!(
+                (d.distance - want).abs() <= 1e-13 * scale
+                    && on_a <= 1e-13 * scale
+                    && on_b <= 1e-13 * scale
+                    && (pa.distance(pb) - d.distance).abs() <= 1e-13 * scale,
+                "case {case} (swapped {swapped}): {d:?}, oracle {want}, witnesses {on_a} \
+                 off A and {on_b} off B; A {a:?} B {b:?}"
+            );
+        }
+        if want <= 1e-13 * scale {
+            touching += 1;
+        } else {
+            apart += 1;
+        }
+    }
+    assert!(
+        touching > 100 && apart > 1000,
+        "{touching} touching, {apart} apart"
+    );
+}

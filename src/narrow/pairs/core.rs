@@ -164,7 +164,9 @@ impl Core {
         match self.kind {
             Kind::Point => self.verts[0],
             Kind::Segment => closest_point_segment(p, self.verts[0], self.verts[1]),
-            Kind::Triangle => closest_on_triangle(p, self.verts[0], self.verts[1], self.verts[2]),
+            Kind::Triangle => {
+                closest_point_triangle(p, self.verts[0], self.verts[1], self.verts[2])
+            }
             Kind::Box { center, axes, half } => {
                 let local = axes.transpose() * (p - center);
                 center + axes * local.clamp(-half, half)
@@ -322,9 +324,9 @@ impl Polygon {
             1 => v[0],
             2 => closest_point_segment(p, v[0], v[1]),
             _ => {
-                let mut best = closest_on_triangle(p, v[0], v[1], v[2]);
+                let mut best = closest_point_triangle(p, v[0], v[1], v[2]);
                 for i in 3..v.len() {
-                    let q = closest_on_triangle(p, v[0], v[i - 1], v[i]);
+                    let q = closest_point_triangle(p, v[0], v[i - 1], v[i]);
                     if q.distance_squared(p) < best.distance_squared(p) {
                         best = q;
                     }
@@ -344,47 +346,6 @@ impl Polygon {
         };
         (0..count).map(move |i| (self.pts[i], self.pts[(i + 1) % n]))
     }
-}
-
-/// The point of the closed triangle `a, b, c` closest to `p`, robust for slivers.
-///
-/// NOTE: `closest_point_triangle` projects onto the plane of the rounding-noise normal of a
-/// (nearly) zero-area triangle and can return a point far off it (for example the
-/// triangle `a, b, a + 0.3 (b − a)` after a rotation). A face answer is only kept when it
-/// lies within the triangle's smallest altitude of its boundary, which every interior
-/// point does; otherwise the closest boundary point is the answer.
-#[must_use]
-pub(super) fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
-    let face = closest_point_triangle(p, a, b, c);
-    let mut edge = closest_point_segment(p, a, b);
-    for (x, y) in [(b, c), (c, a)] {
-        let q = closest_point_segment(p, x, y);
-        if q.distance_squared(p) < edge.distance_squared(p) {
-            edge = q;
-        }
-    }
-    let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-    let altitude = if longest > 0.0 {
-        (b - a).cross(c - a).length() / longest
-    } else {
-        0.0
-    };
-    let boundary = (face - a).length().max((face - b).length()) * 4.0 * f64::EPSILON;
-    if face.distance_squared(p) < edge.distance_squared(p)
-        && face_to_boundary(face, a, b, c) <= altitude + boundary
-    {
-        face
-    } else {
-        edge
-    }
-}
-
-/// Distance from `q` to the boundary of triangle `a, b, c`.
-fn face_to_boundary(q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    [(a, b), (b, c), (c, a)]
-        .iter()
-        .map(|&(x, y)| closest_point_segment(q, x, y).distance(q))
-        .fold(f64::INFINITY, f64::min)
 }
 
 /// The interval `[enter, exit]` of parameters `s` for which `o + v s` (unit `v`) lies in
@@ -442,27 +403,6 @@ pub(super) fn line_interval(core: &Core, o: DVec3, v: DVec3) -> Option<(f64, f64
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_rotated_sliver_triangle_gives_its_boundary_point_not_a_far_face_point() {
-        // a, b, a + 0.3 (b − a): zero area, but nonzero rounding-noise normal once moved.
-        let (a, b) = (
-            DVec3::new(1.1129978354549748, 1.064634792926294, 0.5880046958401757),
-            DVec3::new(0.9530983393859878, -0.631487841459155, 0.8594725286710976),
-        );
-        let t = Triangle::new(a, b, a + (b - a) * 0.3);
-        let rot = DMat3::from_quat(crate::math::DQuat::from_euler(
-            glam::EulerRot::ZYX,
-            0.3,
-            -1.1,
-            2.0,
-        ));
-        let pose = Isometry::new(rot, DVec3::new(-1.3, 0.5, -0.3));
-        let v = t.transformed(&pose).vertices();
-        let got = closest_on_triangle(DVec3::ZERO, v[0], v[1], v[2]);
-        let want = closest_point_segment(DVec3::ZERO, v[0], v[1]);
-        assert!(got.distance(want) < 1e-12, "{got} vs {want}");
-    }
 
     #[test]
     fn line_intervals_through_a_capsule_hit_the_cylinder_and_the_caps() {
