@@ -386,8 +386,8 @@ fn separation(a: &Shape, b: &Shape, pose: &Isometry, n: DVec3) -> f64 {
 }
 
 /// The normal certifies the distance: the separation along it equals it. `size` is the
-/// shapes' size; rounding of witnesses makes a gap's direction uncertain by
-/// `~ε · size / |d|`, so the allowance grows for rounding-sized distances, up to the
+/// shapes' size; rounding of witnesses makes a core gap's direction uncertain by
+/// `~ε · size / gap`, so the allowance grows for rounding-sized core gaps, up to the
 /// engine's bound `ε / FEATURE_RELATIVE` (gaps under `1e-10 · size` take the SAT axis).
 fn check_certificate(
     r: &mut Report,
@@ -399,11 +399,14 @@ fn check_certificate(
     core_touch: f64,
 ) {
     let sep = separation(a, b, pose, d.normal);
-    let conditioning = (16.0 * EPS * size / d.distance.abs().max(EPS * size)).min(1e-5);
+    // The normal is the direction of the gap between the cores (a sphere's centre, a
+    // capsule's segment), so its conditioning is set by the core gap, not the distance.
+    let core_gap = (d.distance + a.core().1 + b.core().1).abs();
+    let conditioning = (16.0 * EPS * size / core_gap.max(EPS * size)).min(1e-5);
     let allowance = tol + conditioning * size + core_touch * 1e-5 * size;
     r.check((sep - d.distance).abs() <= allowance, || {
         format!(
-            "{what}: separation along the normal {sep:e} ≠ distance {:e} (allowance {allowance:e}) {d:?}",
+            "{what}: separation along the normal {sep:e} ≠ distance {:e} (allowance {allowance:e}) {d:?} A {a:?} B {b:?} pose {pose:?}",
             d.distance
         )
     });
@@ -1171,7 +1174,9 @@ fn check_random(
     if slid_past {
         r.slid_past += 1;
     }
-    r.check(overlaps || slid_past, || {
+    // A depth below ε: −(d + ε)·n moves B back the other way, past the contact.
+    let shallow = d.distance <= 0.0 && -d.distance < eps;
+    r.check(overlaps || slid_past || shallow, || {
         format!(
             "{what}: moved by −(d + ε)n: {:e}, want [−{eps:e}, 0) ({d:?}); separation \
              along its normal there {:e}; A {a:?} B {b:?} pose {pose:?}",
@@ -1513,4 +1518,122 @@ fn nearly_identical_triangles_match_the_exact_oracle() {
     );
     assert!(counts[0] > 100 && counts[1] > 100, "{counts:?}");
     r.finish("nearly identical triangles");
+}
+
+#[test]
+fn random_pairs_keep_their_answers_far_from_the_origin_and_at_every_scale() {
+    let mut r = Report::default();
+    let mut rg = rng(0xfa2);
+    let kinds: Vec<(u8, u8)> = (0..6u8)
+        .flat_map(|i| (i..6).map(move |j| (i, j)))
+        .filter(|&(i, j)| !(i == 3 && j == 3))
+        .collect();
+    let mut worst = 0.0f64;
+    for &(ka, kb) in &kinds {
+        for i in 0..60 {
+            let (a, b) = (random_shape(&mut rg, ka), random_shape(&mut rg, kb));
+            let pose = isometry(&mut rg, 1.5);
+            let size = a.extent() + b.extent() + pose.translation.length();
+            let closed0 = closed(&a, &b, &pose);
+            let gjk0 = gjk(&a, &b, &pose);
+            for offset in OFFSETS {
+                for s in SCALES {
+                    let (sa, sb) = (a.scaled(s), b.scaled(s));
+                    let local = Isometry::new(pose.rotation, pose.translation * s);
+                    let wa = world_pose(offset);
+                    let p = wa.inverse().compose(&wa.compose(&local));
+                    let tol = SCENE_RELATIVE * s * size + OFFSET_ULPS * EPS * offset;
+                    let what = format!(
+                        "{}–{} #{i} [offset {offset:e}, scale {s:e}]",
+                        KIND_NAMES[ka as usize], KIND_NAMES[kb as usize]
+                    );
+                    let mut runs = vec![(
+                        "GJK/EPA",
+                        gjk(&sa, &sb, &p),
+                        gjk0,
+                        tol + GJK_RELATIVE * s * size,
+                    )];
+                    if let (Some(c), Some(c0)) = (closed(&sa, &sb, &p), closed0) {
+                        runs.push(("closed form", c, c0, tol));
+                    }
+                    for (q, d, d0, tol) in runs {
+                        let what = format!("{what} {q}");
+                        check_contract(&mut r, &what, &sa, &sb, &p, &d, tol);
+                        check_certificate(&mut r, &what, (&sa, &sb, &p), &d, tol, s * size, 0.0);
+                        let err = (d.distance - s * d0.distance).abs();
+                        worst = worst.max(err / tol);
+                        r.check(err <= tol, || {
+                            format!("{what}: {:e} vs {:e} at the origin, scale 1 (err {err:e} > {tol:e})", d.distance, s * d0.distance)
+                        });
+                    }
+                }
+            }
+        }
+    }
+    println!("worst error / allowance: {worst}");
+    r.finish("far and scaled random pairs");
+}
+
+/// A rotation within `angle` of a random multiple of 90° about the axes (so faces and edges
+/// are nearly parallel), and a translation along a face normal, an edge or a corner
+/// direction with a tiny random perturbation.
+fn near_degenerate_pose(r: &mut TestRng) -> Isometry {
+    let quarter = std::f64::consts::FRAC_PI_2;
+    let base = rotation_about(DVec3::Z, quarter * f64::from(r.random_range(0..4)))
+        * rotation_about(DVec3::X, quarter * f64::from(r.random_range(0..4)));
+    let angle = 10f64.powi(-r.random_range(3..=12));
+    let axis = support::point_in_cube(r, 1.0).normalize_or(DVec3::X);
+    let rot = rotation_about(axis, angle) * base;
+    let dirs = [DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::ONE];
+    let dir = dirs[r.random_range(0..3)];
+    let wiggle = support::point_in_cube(r, 1.0) * 10f64.powi(-r.random_range(3..=12));
+    let t = dir * r.random_range(0.2..2.0) + wiggle;
+    Isometry::new(rot, t)
+}
+
+#[test]
+fn near_parallel_poses_agree_between_closed_forms_and_gjk() {
+    let mut r = Report::default();
+    let mut rg = rng(0xdead);
+    let mut worst = 0.0f64;
+    let mut counts = [0usize; 2];
+    for &(ka, kb) in &[(2u8, 2u8), (1, 2), (2, 3), (1, 1), (0, 2), (1, 3)] {
+        for i in 0..500 {
+            let (a, b) = (random_shape(&mut rg, ka), random_shape(&mut rg, kb));
+            let pose = near_degenerate_pose(&mut rg);
+            let size = a.extent() + b.extent() + pose.translation.length();
+            let what = format!(
+                "{}–{} #{i}",
+                KIND_NAMES[ka as usize], KIND_NAMES[kb as usize]
+            );
+            let g = check_random(
+                &mut r,
+                &format!("{what} GJK/EPA"),
+                (&a, &b, &pose),
+                &|a, b, p| gjk(a, b, p),
+                (GJK_RELATIVE * size, GJK_RELATIVE.sqrt()),
+                size,
+            );
+            let c = check_random(
+                &mut r,
+                &format!("{what} closed form"),
+                (&a, &b, &pose),
+                &|a, b, p| closed(a, b, p).unwrap(),
+                (1e-12 * size, 1e-6),
+                size,
+            );
+            let gap = (c.distance - g.distance).abs();
+            worst = worst.max(gap / size);
+            r.check(gap <= GJK_RELATIVE * size, || {
+                format!("{what}: closed form {c:?} vs GJK/EPA {g:?}; A {a:?} B {b:?} pose {pose:?}")
+            });
+            counts[usize::from(c.distance <= 0.0)] += 1;
+        }
+    }
+    println!(
+        "near-parallel: {} apart, {} penetrating; worst |closed − GJK| / size {worst:e}",
+        counts[0], counts[1]
+    );
+    assert!(counts[0] > 300 && counts[1] > 300, "{counts:?}");
+    r.finish("near-parallel poses");
 }
