@@ -704,7 +704,19 @@ fn box_scenes() -> Vec<Scene> {
         .cone(UP)
         .manifold(0),
     ];
-    for k in [1, 3, 5, 7, 9] {
+    v.push(
+        Scene::new(
+            "coincident boxes of different sizes",
+            boxed(0.5, 0.7, 0.9),
+            boxed(0.6, 0.2, 0.4),
+            Isometry::IDENTITY,
+        )
+        .want(-0.9)
+        .cone([0, 2, 0])
+        .manifold(4)
+        .undefined_normal(),
+    );
+    for k in [1, 3, 5, 7, 9, 12, 15] {
         let delta = 10f64.powi(-k);
         v.push(
             Scene::new(
@@ -1636,4 +1648,105 @@ fn near_parallel_poses_agree_between_closed_forms_and_gjk() {
     );
     assert!(counts[0] > 300 && counts[1] > 300, "{counts:?}");
     r.finish("near-parallel poses");
+}
+
+/// The closed-form manifold against the closed-form distance: present iff the shapes touch
+/// or overlap, the same normal, its deepest point as deep as the distance, every point on
+/// both surfaces with `point_b − point_a = distance · normal` and a distance `≤ 0`.
+fn check_manifold(
+    r: &mut Report,
+    what: &str,
+    (a, b, pose): (&Shape, &Shape, &Isometry),
+    d: &ShapeDistance,
+    tol: f64,
+) -> usize {
+    let Some(m) = closed_manifold(a, b, pose) else {
+        return 0;
+    };
+    if d.distance > tol {
+        r.check(m.is_empty(), || {
+            format!("{what}: apart by {:e} but {m:?}", d.distance)
+        });
+        return 0;
+    }
+    if d.distance < -tol {
+        r.check(!m.is_empty(), || {
+            format!("{what}: overlapping by {:e} but no manifold", d.distance)
+        });
+    }
+    if m.is_empty() {
+        return 0;
+    }
+    // pairs/clip.rs: a face within `FACE_ALIGNMENT` (cos 0.9999, 0.8°) of the distance's
+    // normal becomes the reference face and gives the manifold its normal; segment pairs
+    // within 0.6° of parallel give their clipped ends. So the manifold normal is within 0.8°
+    // of the distance's, and no point is deeper than the overlap along the manifold normal
+    // (points may be shallower: overhanging ends are clipped).
+    r.check(m.normal.dot(d.normal) >= 0.9999 - 1e-12, || {
+        format!(
+            "{what}: manifold normal {} vs distance normal {}",
+            m.normal, d.normal
+        )
+    });
+    let deepest = m
+        .points()
+        .iter()
+        .map(|p| p.distance)
+        .fold(f64::INFINITY, f64::min);
+    let along = separation(a, b, pose, m.normal);
+    r.check(deepest >= along - tol && deepest <= tol, || {
+        format!(
+            "{what}: deepest manifold point {deepest:e}, overlap along its normal {along:e}, distance {:e}: {m:?}",
+            d.distance
+        )
+    });
+    if m.len() == 1 && m.normal == d.normal {
+        r.check((deepest - d.distance).abs() <= tol, || {
+            format!("{what}: one-point manifold {m:?} vs distance {d:?}")
+        });
+    }
+    for p in m.points() {
+        let res = (p.point_b - p.point_a - m.normal * p.distance).length();
+        let on_a = a.surface_distance(p.point_a);
+        let on_b = b.surface_distance(pose.inverse_transform_point(p.point_b));
+        r.check(p.distance <= tol && res <= tol && on_a <= tol && on_b <= tol, || {
+            format!(
+                "{what}: manifold point {p:?} (residual {res:e}, off A {on_a:e}, off B {on_b:e}); {m:?} A {a:?} B {b:?} pose {pose:?}"
+            )
+        });
+    }
+    m.len()
+}
+
+#[test]
+fn manifolds_agree_with_the_distance_over_random_and_near_parallel_poses() {
+    let mut r = Report::default();
+    let mut rg = rng(0x3a4);
+    let mut sizes = [0usize; 5];
+    for (ka, kb) in (0..4u8).flat_map(|i| (i..4).map(move |j| (i, j))) {
+        if (ka, kb) == (3, 3) {
+            continue;
+        }
+        for i in 0..600 {
+            let (a, b) = (random_shape(&mut rg, ka), random_shape(&mut rg, kb));
+            let pose = if i % 2 == 0 {
+                isometry(&mut rg, 1.5)
+            } else {
+                near_degenerate_pose(&mut rg)
+            };
+            let size = a.extent() + b.extent() + pose.translation.length();
+            let what = format!(
+                "{}–{} #{i}",
+                KIND_NAMES[ka as usize], KIND_NAMES[kb as usize]
+            );
+            for (q, (a, b, p)) in [("", (&a, &b, pose)), (" swapped", (&b, &a, pose.inverse()))] {
+                let d = closed(a, b, &p).unwrap();
+                let n = check_manifold(&mut r, &format!("{what}{q}"), (a, b, &p), &d, 1e-9 * size);
+                sizes[n] += 1;
+            }
+        }
+    }
+    println!("manifold sizes 0..=4: {sizes:?}");
+    assert!(sizes[1..].iter().all(|&n| n > 20), "{sizes:?}");
+    r.finish("manifolds");
 }
