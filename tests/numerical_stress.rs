@@ -21,10 +21,39 @@
 //!   1e7): four coordinate roundings of `ε o / 2` each for the two translations and their
 //!   difference, twice over for the rotation applied to it.
 //! - GJK/EPA vs closed form: `GJK_RELATIVE · size` (GJK's relative tolerance is 1e-10).
+//!   Observed: 2e-11 (random poses), 6.4e-10 (near-parallel poses) of the size; the scale
+//!   and offset errors stay under 0.15 of their allowances.
+//! - Certificate: the separation along the returned normal (from the shapes' support
+//!   functions) equals the distance; it is the largest over all directions, so this proves
+//!   the normal optimal without an oracle. Allowance: the tolerance plus the conditioning
+//!   of a core gap's direction, `16 ε · size / gap` (capped at 1e-5, the engine's own
+//!   `ε / FEATURE_RELATIVE` bound).
+//!
+//! Random poses (every closed-form pair and the GJK kinds cylinder and hull): contract,
+//! certificate, symmetry, closed form vs GJK/EPA, and the metamorphic check (moving B by
+//! `−(d ± ε)·n` flips the state; see `check_random` for the one geometric exception, which
+//! is certified rather than excused); the same far from the origin, scaled, and in
+//! near-parallel poses; closed-form manifolds against the distance; `q` vs `−q`.
 //!
 //! Triangle pairs: 50,000 integer pairs (overlapping, near misses with relative gaps down to
-//! ~1e-12, disjoint) against the exact integer SAT of `support/exact_sat.rs`, for
+//! ~1e-13, disjoint) against the exact integer SAT of `support/exact_sat.rs`, for
 //! `intersects_triangle_triangle` (zero disagreements) and `distance_triangle_triangle`.
+//!
+//! # Wrong answers found
+//! - GJK (fixed): a point 4.7e-10 m off the face of a 2e4 m box got a normal tilted by
+//!   3.4e-3 rad (segment simplex, `v` as a convex combination with a far endpoint); see
+//!   `gjk_normal_of_a_point_just_off_a_huge_box_is_the_face_normal`.
+//!
+//! # Accuracy limits found (documented behaviour, allowed for above with stated bounds)
+//! - Closed forms: a core gap above `1e-10 · size` takes its direction from the witness
+//!   difference, so near-touching cores (a sphere centre on a box face to rounding, faces
+//!   touching 1e-11 m apart at scale 1e-2) get normals tilted by up to `ε · size / gap`
+//!   (3.5e-7 rad seen), while the SAT axis would be exact.
+//! - GJK/EPA against a cylinder: witnesses lie up to ~1e-7 of the size inside the surfaces
+//!   (the sagitta of EPA's chords); normals agree between orders only to ~1e-5.
+//! - Manifolds: a face within 0.8° of the distance's normal gives the manifold its normal,
+//!   so manifold and distance normals differ by up to 0.8°.
+//! - Coincident centres: the closed forms choose `+X`, GJK/EPA `+Z` (both documented).
 #[path = "support/mod.rs"]
 mod support;
 
@@ -307,9 +336,10 @@ impl Report {
 
     fn finish(self, name: &str) {
         println!(
-            "{name}: {} checks, {} failures",
+            "{name}: {} checks, {} failures, {} certified slide-pasts",
             self.checks,
-            self.failures.len()
+            self.failures.len(),
+            self.slid_past
         );
         let mut kinds = std::collections::BTreeMap::<String, usize>::new();
         for f in &self.failures {
