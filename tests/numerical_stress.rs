@@ -1110,7 +1110,11 @@ fn gjk_normal_of_a_point_just_off_a_huge_box_is_the_face_normal() {
 /// sizes 0.05 … 1, with degenerate sizes (points, zero-length or zero-radius capsules, flat
 /// boxes, needle triangles, flat hulls) one time in ten.
 fn random_shape(r: &mut TestRng, kind: u8) -> Shape {
-    let size = |r: &mut TestRng| r.random_range(0.05..1.0);
+    random_shape_sized(r, kind, &|r: &mut TestRng| r.random_range(0.05..1.0))
+}
+
+/// [`random_shape`] with sizes drawn by `size`.
+fn random_shape_sized(r: &mut TestRng, kind: u8, size: &dyn Fn(&mut TestRng) -> f64) -> Shape {
     let degenerate = r.random_bool(0.1);
     match kind {
         0 => Shape::Sphere(Sphere::new(if degenerate { 0.0 } else { size(r) })),
@@ -1848,4 +1852,56 @@ fn manifold_of_a_zero_radius_capsule_lies_on_its_segment() {
         );
         assert!(p.distance >= along - 1e-12, "{p:?} deeper than {along:e}");
     }
+}
+
+#[test]
+fn shapes_of_very_different_sizes_agree_between_closed_forms_and_gjk() {
+    // Every size log-uniform in 1e-4 … 1e2 m: needles, plates, a pebble on a wall.
+    let mut r = Report::default();
+    let mut rg = rng(0x51e);
+    let log_size = |r: &mut TestRng| 10f64.powf(r.random_range(-4.0..2.0));
+    let mut counts = [0usize; 2];
+    let mut worst = 0.0f64;
+    for (ka, kb) in (0..3u8).flat_map(|i| (i..3).map(move |j| (i, j))) {
+        for i in 0..300 {
+            let a = random_shape_sized(&mut rg, ka, &log_size);
+            let b = random_shape_sized(&mut rg, kb, &log_size);
+            let reach = (a.extent() + b.extent()).max(1e-4);
+            let pose = isometry(&mut rg, 1.0);
+            let pose = Isometry::new(pose.rotation, pose.translation * reach);
+            let size = reach + pose.translation.length();
+            let what = format!(
+                "{}–{} #{i}",
+                KIND_NAMES[ka as usize], KIND_NAMES[kb as usize]
+            );
+            let g = check_random(
+                &mut r,
+                &format!("{what} GJK/EPA"),
+                (&a, &b, &pose),
+                &|a, b, p| gjk(a, b, p),
+                (GJK_RELATIVE * size, GJK_RELATIVE.sqrt()),
+                size,
+            );
+            let c = check_random(
+                &mut r,
+                &format!("{what} closed form"),
+                (&a, &b, &pose),
+                &|a, b, p| closed(a, b, p).unwrap(),
+                (1e-12 * size, 1e-6),
+                size,
+            );
+            let gap = (c.distance - g.distance).abs();
+            worst = worst.max(gap / size);
+            r.check(gap <= GJK_RELATIVE * size, || {
+                format!("{what}: closed form {c:?} vs GJK/EPA {g:?}; A {a:?} B {b:?} pose {pose:?}")
+            });
+            counts[usize::from(c.distance <= 0.0)] += 1;
+        }
+    }
+    println!(
+        "mixed sizes: {} apart, {} penetrating; worst |closed − GJK| / size {worst:e}",
+        counts[0], counts[1]
+    );
+    assert!(counts[0] > 200 && counts[1] > 200, "{counts:?}");
+    r.finish("mixed sizes");
 }
