@@ -8,6 +8,10 @@
 //!   minimum; stress cases at offsets 1e5 and scales 1e-3..1e3.
 mod support;
 
+#[path = "support/exact_sat.rs"]
+mod exact_sat;
+
+use exact_sat::{I3, exact_sat, sub};
 use proxima::geometry::Triangle;
 use proxima::math::{DQuat, DVec3};
 use proxima::narrow::{
@@ -20,67 +24,10 @@ use support::{TestRng, rng, rotation};
 // ---------------------------------------------------------------------------------------
 // Exact integer oracle.
 
-type I3 = [i128; 3];
-
-fn sub(a: I3, b: I3) -> I3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: I3, b: I3) -> I3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: I3, b: I3) -> i128 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// Whether the closed hulls of `a` and `b` meet, by exact SAT.
-///
-/// Disjoint compact convex sets are strictly separated along `p - q` for their closest
-/// pair; `p` and `q` lie in the relative interiors of faces (vertex, edge or the triangle)
-/// and `p - q` is orthogonal to both faces' directions. So it is parallel to one of: a
-/// triangle normal, `e × f` for two edges, a vertex difference `v - w`, or
-/// `e × ((v - w) × e)` (an edge and the plane it spans with a vertex pair, which covers
-/// vertex–edge and parallel edge–edge pairs). Testing all of these is complete, degenerate
-/// triangles included; zero axes separate nothing and are harmless.
+/// Whether the closed triangles meet, by the exact integer SAT of `support/exact_sat.rs`
+/// (complete axis set, degenerate triangles included; see its docs for why it is complete).
 fn sat_intersects(a: &[I3; 3], b: &[I3; 3]) -> bool {
-    let edges = |t: &[I3; 3]| [sub(t[1], t[0]), sub(t[2], t[1]), sub(t[0], t[2])];
-    let (ea, eb) = (edges(a), edges(b));
-    let separates = |axis: I3| {
-        let pa = a.map(|p| dot(axis, p));
-        let pb = b.map(|p| dot(axis, p));
-        let (amin, amax) = (*pa.iter().min().unwrap(), *pa.iter().max().unwrap());
-        let (bmin, bmax) = (*pb.iter().min().unwrap(), *pb.iter().max().unwrap());
-        amax < bmin || bmax < amin
-    };
-    if separates(cross(ea[0], ea[1])) || separates(cross(eb[0], eb[1])) {
-        return false;
-    }
-    for e in ea {
-        for f in eb {
-            if separates(cross(e, f)) {
-                return false;
-            }
-        }
-    }
-    for v in a {
-        for w in b {
-            let d = sub(*v, *w);
-            if separates(d) {
-                return false;
-            }
-            for e in ea.iter().chain(eb.iter()) {
-                if separates(cross(*e, cross(d, *e))) {
-                    return false;
-                }
-            }
-        }
-    }
-    true
+    exact_sat(a, b).intersects
 }
 
 fn to_triangle(t: &[I3; 3]) -> Triangle {

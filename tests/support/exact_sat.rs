@@ -12,6 +12,7 @@
 //!
 //! Magnitudes: with coordinates `|x| ≤ 2^24` the largest product is below `2^105`, well
 //! inside `i128`; [`exact_sat`] debug-asserts that bound.
+#![allow(dead_code)] // each including test file uses a different part of it
 
 /// An integer point.
 pub type I3 = [i128; 3];
@@ -19,11 +20,13 @@ pub type I3 = [i128; 3];
 /// Coordinates above this (absolute) may overflow the `i128` products.
 pub const MAX_COORDINATE: i128 = 1 << 24;
 
-fn sub(a: I3, b: I3) -> I3 {
+/// `a − b`.
+pub fn sub(a: I3, b: I3) -> I3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn cross(a: I3, b: I3) -> I3 {
+/// `a × b`.
+pub fn cross(a: I3, b: I3) -> I3 {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -31,7 +34,8 @@ fn cross(a: I3, b: I3) -> I3 {
     ]
 }
 
-fn dot(a: I3, b: I3) -> i128 {
+/// `a · b`.
+pub fn dot(a: I3, b: I3) -> i128 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
