@@ -925,3 +925,66 @@ fn needle_and_plate_boxes_of_mixed_sizes_match_the_oracles() {
     println!("mixed boxes: {apart} apart, {deep} penetrating");
     assert!(apart > 500 && deep > 300);
 }
+
+/// Hulls of 512 and 4,096 points on a sphere (the sizes where parry 0.31's EPA depths
+/// differed from ours by up to 8.7 cm in `benches/narrow_phase.rs`): the depth must separate
+/// the shapes when B moves by it along the normal, and must be no deeper than the overlap
+/// along any of 2,000 sampled directions (each an upper bound of the true depth).
+#[test]
+fn large_hull_depths_separate_and_are_no_deeper_than_any_sampled_direction() {
+    let mut rng = rng(2_626);
+    let mut epa = EpaWorkspace::new();
+    for n in [512usize, 4096] {
+        let cloud = |rng: &mut TestRng| -> Vec<DVec3> {
+            (0..n).map(|_| rotation(rng) * DVec3::Z).collect()
+        };
+        let (a, b) = (
+            ConvexPolyhedron::try_from_points(&cloud(&mut rng)).unwrap(),
+            ConvexPolyhedron::try_from_points(&cloud(&mut rng)).unwrap(),
+        );
+        let (ra, rb) = (Rounded::plain(&a), Rounded::plain(&b));
+        let (mut penetrating, mut apart) = (0, 0);
+        for case in 0..120 {
+            let pose = Pose::new(point_in_cube(&mut rng, 1.5), rotation(&mut rng));
+            let iso = pose.to_isometry();
+            let params = GjkParams::default();
+            let (d, _) =
+                signed_distance_convex(&ra, &rb, &iso, &params, &mut GjkCache::default(), &mut epa);
+            if d.distance >= 0.0 {
+                apart += 1;
+                continue;
+            }
+            penetrating += 1;
+            let depth = -d.distance;
+            let moved = Pose::new(pose.position + d.normal * (depth + 1e-9), pose.rotation);
+            let (after, _) = signed_distance_convex(
+                &ra,
+                &rb,
+                &moved.to_isometry(),
+                &params,
+                &mut GjkCache::default(),
+                &mut epa,
+            );
+            assert!(
+                after.distance >= -1e-9,
+                "n {n} case {case}: {}",
+                after.distance
+            );
+            for _ in 0..2_000 {
+                let u = rotation(&mut rng) * DVec3::Z;
+                let reach_a = a.support(u).dot(u);
+                let reach_b = iso
+                    .transform_point(b.support(iso.inverse_transform_vector(-u)))
+                    .dot(u);
+                assert!(
+                    depth <= reach_a - reach_b + 1e-9,
+                    "n {n} case {case}: depth {depth} deeper than along {u}"
+                );
+            }
+        }
+        assert!(
+            penetrating > 50 && apart > 5,
+            "n {n}: {penetrating} / {apart}"
+        );
+    }
+}
