@@ -56,7 +56,7 @@
 //!   (the sagitta of EPA's chords); normals agree between orders only to ~1e-5.
 //! - Manifolds: a face within 0.8° of the distance's normal gives the manifold its normal,
 //!   so manifold and distance normals differ by up to 0.8°.
-//! - Coincident centres: the closed forms choose `+X`, GJK/EPA `+Z` (both documented).
+//! - Coincident centres: the closed forms and GJK/EPA both choose `+X` (documented).
 #[path = "support/mod.rs"]
 mod support;
 

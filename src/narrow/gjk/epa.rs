@@ -181,15 +181,16 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         let tol = floor(scale);
         let (dirs, n_dirs): ([DVec3; 6], usize) = match vs.len() {
             1 => (
-                // +Z first: when A − B is a single point, every direction ties and the
-                // first wins, which is the documented normal of coincident shapes.
+                // +X first: when A − B is a single point, every direction ties and the
+                // first wins, which is the documented normal of coincident shapes (the
+                // closed forms' choice too).
                 [
-                    DVec3::Z,
-                    DVec3::NEG_Z,
                     DVec3::X,
                     DVec3::NEG_X,
                     DVec3::Y,
                     DVec3::NEG_Y,
+                    DVec3::Z,
+                    DVec3::NEG_Z,
                 ],
                 6,
             ),

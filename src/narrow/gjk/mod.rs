@@ -361,7 +361,8 @@ pub struct ConvexOutcome {
 /// [`crate::narrow::contact`]: GJK on the cores; when they overlap or touch, EPA on the
 /// cores; then the radii are subtracted along the normal.
 ///
-/// When no normal is defined (both shapes reduce to the same point), the normal is `+Z`.
+/// When no normal is defined (both shapes reduce to the same point), the normal is `+X`,
+/// as the closed forms of [`crate::narrow::pairs`] choose.
 #[must_use]
 pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     a: &Rounded<'_, A>,
@@ -404,7 +405,7 @@ pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     let normal = if normal.is_finite() && normal != DVec3::ZERO {
         normal.normalize()
     } else {
-        DVec3::Z
+        DVec3::X
     };
     let (d, pa, pb) = core;
     let answer = ShapeDistance {

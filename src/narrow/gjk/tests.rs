@@ -61,7 +61,7 @@ fn concentric_spheres_answer_the_sum_of_radii_with_a_fixed_normal() {
         &Isometry::IDENTITY,
     );
     assert_eq!(d.distance, -3.0);
-    assert_eq!(d.normal, DVec3::Z);
+    assert_eq!(d.normal, DVec3::X);
     check_contract(&d, 1e-15);
 }
 
