@@ -131,6 +131,15 @@ fn support<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     }
 }
 
+/// How a converged search ends: touching when the distance is rounding noise, else apart.
+fn settled(distance: f64, floor: f64) -> GjkOutcome {
+    if distance <= floor {
+        GjkOutcome::Touching
+    } else {
+        GjkOutcome::Separated
+    }
+}
+
 fn magnitude(p: &SupportPoint) -> f64 {
     p.a.abs().max_element().max(p.b.abs().max_element())
 }
@@ -202,11 +211,7 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
                 accelerated = false;
                 continue;
             }
-            outcome = if dist <= floor {
-                GjkOutcome::Touching
-            } else {
-                GjkOutcome::Separated
-            };
+            outcome = settled(dist, floor);
             break;
         }
         last_w = p.w;
@@ -220,11 +225,7 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
                 accelerated = false;
                 continue;
             }
-            outcome = if dist <= floor {
-                GjkOutcome::Touching
-            } else {
-                GjkOutcome::Separated
-            };
+            outcome = settled(dist, floor);
             break;
         }
         v = v_new;
