@@ -43,9 +43,9 @@
 //! - GJK (fixed): a point 4.7e-10 m off the face of a 2e4 m box got a normal tilted by
 //!   3.4e-3 rad (segment simplex, `v` as a convex combination with a far endpoint); see
 //!   `gjk_normal_of_a_point_just_off_a_huge_box_is_the_face_normal`.
-//! - Closed-form manifolds (open, test ignored): a zero-radius capsule in a near-parallel
-//!   edge contact gets manifold points `√ε · size` (≈ 4e-9 m) off its segment and that much
-//!   too deep; see `manifold_of_a_zero_radius_capsule_lies_on_its_segment`.
+//! - Closed-form manifolds (fixed): a zero-radius capsule in a near-parallel edge contact
+//!   got manifold points `√ε · size` (≈ 4e-9 m) off its segment and that much too deep;
+//!   see `manifold_of_a_zero_radius_capsule_lies_on_its_segment`.
 //!
 //! # Accuracy limits found (documented behaviour, allowed for above with stated bounds)
 //! - Closed forms: a core gap above `1e-10 · size` takes its direction from the witness
@@ -1784,11 +1784,6 @@ fn manifolds_agree_with_the_distance_over_random_and_near_parallel_poses() {
                 "{}–{} #{i}",
                 KIND_NAMES[ka as usize], KIND_NAMES[kb as usize]
             );
-            // Known bug, see `manifold_of_a_zero_radius_capsule_lies_on_its_segment` (ignored).
-            let segment = |s: &Shape| matches!(s, Shape::Capsule(c) if c.radius == 0.0);
-            if segment(&a) || segment(&b) {
-                continue;
-            }
             for (q, (a, b, p)) in [("", (&a, &b, pose)), (" swapped", (&b, &a, pose.inverse()))] {
                 let d = closed(a, b, &p).unwrap();
                 let n = check_manifold(&mut r, &format!("{what}{q}"), (a, b, &p), &d, 1e-9 * size);
@@ -1801,19 +1796,13 @@ fn manifolds_agree_with_the_distance_over_random_and_near_parallel_poses() {
     r.finish("manifolds");
 }
 
-/// BUG (pairs/clip.rs `parallel_edges` via core.rs `line_interval`): for a capsule of radius
-/// 0 (a segment) in a near-parallel edge contact, each manifold point is where the line
-/// through a point of B's segment along the normal enters A; for a zero radius that line
-/// meets the segment only to rounding, and the square root of the rounding-sized
-/// discriminant places `point_a` up to `√ε · size` (3.7e-9 … 5.3e-9 m here) off the
-/// segment, with the point that much deeper than the overlap along the normal (or drops it
-/// when the discriminant rounds negative). Found by
-/// `manifolds_agree_with_the_distance_over_random_and_near_parallel_poses`, which skips
-/// zero-radius capsules until this is fixed. A fix needs the closest approach to the axis
-/// (no square root) when the radius is 0, with a tolerance for near-miss lines: not a
-/// one-line change in another helper's engine, so it is left to the pairs owner.
+/// Regression (pairs/clip.rs `parallel_edges`): for a capsule of radius 0 (a segment) in a
+/// near-parallel edge contact, each manifold point was where the line through a point of
+/// B's segment along the normal enters A; for a zero radius that line meets the segment
+/// only to rounding, and the square root of the rounding-sized discriminant placed
+/// `point_a` up to `√ε · size` (3.7e-9 … 5.3e-9 m) off the segment, that much too deep (or
+/// dropped it). A bare segment now takes its point nearest the line.
 #[test]
-#[ignore = "bug: zero-radius capsule manifold points sit √ε·size off the segment"]
 fn manifold_of_a_zero_radius_capsule_lies_on_its_segment() {
     let a = Shape::Capsule(Capsule::new(0.5584642893519626, 0.0));
     let b = Shape::Capsule(Capsule::new(0.7925042290861127, 0.42192255807751683));

@@ -234,12 +234,18 @@ fn parallel_edges(a: &Core, b: &Core, n: DVec3, slack: f64, out: &mut Candidates
     for q in seg.points() {
         // Both surface points on the line through `q` along `n`: B's where the line leaves
         // B towards A, A's where it enters A from B's side.
-        let (Some((_, exit_b)), Some((enter_a, _))) =
-            (line_interval(b, *q, -n), line_interval(a, *q, -n))
-        else {
+        // A bare core's point may sit beside the column through `q`: the other point is
+        // then taken in the column through it, so the pair lies along the normal.
+        let pair = if is_bare(a) {
+            column_point(a, *q, n, Column::Entering)
+                .and_then(|pa| Some((pa, column_point(b, pa, n, Column::Leaving)?)))
+        } else {
+            column_point(b, *q, n, Column::Leaving)
+                .and_then(|pb| Some((column_point(a, pb, n, Column::Entering)?, pb)))
+        };
+        let Some((point_a, point_b)) = pair else {
             continue;
         };
-        let (point_a, point_b) = (*q - n * enter_a, *q - n * exit_b);
         let s = (point_b - point_a).dot(n);
         if s > slack || out.len == out.pts.len() {
             continue;
@@ -251,6 +257,52 @@ fn parallel_edges(a: &Core, b: &Core, n: DVec3, slack: f64, out: &mut Candidates
         };
         out.len += 1;
     }
+}
+
+/// A point or segment core without radius: nothing for a line to cross.
+fn is_bare(core: &Core) -> bool {
+    core.radius == 0.0 && matches!(core.kind, Kind::Point | Kind::Segment)
+}
+
+/// Which end of a rounded core's chord a column point takes.
+#[derive(Clone, Copy)]
+enum Column {
+    /// Where the line through `q` along `−n` enters the core (A's side, facing B).
+    Entering,
+    /// Where it leaves the core (B's side, facing A).
+    Leaving,
+}
+
+/// The point of `core`'s surface in the column through `q` along the normal `n`.
+///
+/// A rounded core (radius > 0): where the line meets its surface ([`line_interval`]).
+/// A bare point or segment (radius 0) has no width for a line to cross: a discriminant of
+/// pure rounding would put the point `√ε·size` off it, or drop it. Its point nearest the
+/// line is taken instead, which lies on it exactly.
+fn column_point(core: &Core, q: DVec3, n: DVec3, end: Column) -> Option<DVec3> {
+    if !is_bare(core) {
+        let (enter, exit) = line_interval(core, q, -n)?;
+        let s = match end {
+            Column::Entering => enter,
+            Column::Leaving => exit,
+        };
+        return Some(q - n * s);
+    }
+    let a = core.verts[0];
+    let d = if matches!(core.kind, Kind::Segment) {
+        core.verts[1] - a
+    } else {
+        DVec3::ZERO
+    };
+    // Components across the line; the closest segment point minimises their length.
+    let (w, dp) = (a - q, d - n * d.dot(n));
+    let wp = w - n * w.dot(n);
+    let t = if dp.length_squared() > 0.0 {
+        (-wp.dot(dp) / dp.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    Some(a + d * t)
 }
 
 /// At most [`MANIFOLD_POINTS`] of the candidates: the deepest, the farthest from it, the
