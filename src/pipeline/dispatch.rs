@@ -27,7 +27,8 @@ use crate::narrow::convex_mesh::{
     ConvexMeshWorkspace, for_each_overlapping_triangle, nearest_triangle,
 };
 use crate::narrow::gjk::{
-    EpaWorkspace, GjkCache, GjkParams, POINT, Rounded, signed_distance_convex,
+    EpaWorkspace, GjkCache, GjkOutcome, GjkParams, POINT, Rounded, gjk_distance,
+    signed_distance_convex,
 };
 use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh,
@@ -108,9 +109,15 @@ pub(super) fn distance(
         (S(x), S(y)) => pairs::distance_sphere_sphere(x, y, &iso),
         (S(x), C(y)) => pairs::distance_sphere_capsule(x, y, &iso),
         (S(x), B(y)) => pairs::distance_sphere_cuboid(x, y, &iso),
-        (C(x), C(y)) => pairs::distance_capsule_capsule(x, y, &iso),
-        (C(x), B(y)) => pairs::distance_capsule_cuboid(x, y, &iso),
-        (B(x), B(y)) => pairs::distance_cuboid_cuboid(x, y, &iso),
+        (C(x), C(y)) => {
+            beyond(a, b, &iso, limit).unwrap_or_else(|| pairs::distance_capsule_capsule(x, y, &iso))
+        }
+        (C(x), B(y)) => {
+            beyond(a, b, &iso, limit).unwrap_or_else(|| pairs::distance_capsule_cuboid(x, y, &iso))
+        }
+        (B(x), B(y)) => {
+            beyond(a, b, &iso, limit).unwrap_or_else(|| pairs::distance_cuboid_cuboid(x, y, &iso))
+        }
         (C(_), S(_)) | (B(_), S(_) | C(_)) => {
             flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso)
         }
@@ -181,6 +188,39 @@ pub(super) fn manifold(
             witness_manifold(&d, out);
         }
     }
+}
+
+/// Relative accuracy of GJK's distance when it reports the shapes apart (its default
+/// relative tolerance, with room for rounding).
+const GJK_RELATIVE_ERROR: f64 = 1e-9;
+
+/// GJK's answer when it proves the shapes farther apart than `limit` (a pair that will not
+/// be reported, so the exact closed form need not run: GJK costs a fraction of the
+/// closed forms' feature search when they are apart); `None` when they may be within it.
+/// Its distance is then exact to GJK's tolerance, above the limit as [`distance`] allows.
+fn beyond(a: &Shape, b: &Shape, pose_ab: &Isometry, limit: f64) -> Option<ShapeDistance> {
+    if !limit.is_finite() {
+        return None;
+    }
+    let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_of(a), core_of(b)) else {
+        return None;
+    };
+    let g = gjk_distance(
+        core_a.support_map(),
+        core_b.support_map(),
+        pose_ab,
+        &GJK,
+        &mut GjkCache::default(),
+    );
+    let distance = g.distance - radius_a - radius_b;
+    let scale = g.point_a.abs().max_element() + g.point_b.abs().max_element() + g.distance;
+    let certain = distance - GJK_RELATIVE_ERROR * scale > limit;
+    (g.outcome == GjkOutcome::Separated && certain).then(|| ShapeDistance {
+        distance,
+        point_a: g.point_a + g.normal * radius_a,
+        point_b: g.point_b - g.normal * radius_b,
+        normal: g.normal,
+    })
 }
 
 /// The answer of B against A turned into A against B: points swapped, normal reversed,

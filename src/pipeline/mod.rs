@@ -819,6 +819,83 @@ mod tests {
         );
     }
 
+    /// Boxes and capsules with small margins, CLOSE only: a pair is reported exactly when
+    /// its closed-form distance is within the margins, with that distance (pairs GJK proves
+    /// farther than the margins skip the closed form, and must never hide a close one).
+    #[test]
+    fn close_pairs_of_boxes_and_capsules_are_exactly_those_within_their_margins() {
+        use crate::geometry::Capsule;
+        use crate::narrow::pairs;
+        let mut rng = rng(89);
+        let mut workspace = PipelineWorkspace::default();
+        let (mut reported, mut skipped_candidates) = (0, 0);
+        for case in 0..3_000 {
+            let shape = |rng: &mut crate::test_support::TestRng| {
+                if rng.random_range(0..2) == 0 {
+                    Shape::Cuboid(Cuboid::new(DVec3::new(
+                        rng.random_range(0.05..0.5),
+                        rng.random_range(0.05..0.5),
+                        rng.random_range(0.05..0.5),
+                    )))
+                } else {
+                    Shape::Capsule(Capsule::new(
+                        rng.random_range(0.0..0.5),
+                        rng.random_range(0.02..0.3),
+                    ))
+                }
+            };
+            let (sa, sb) = (shape(&mut rng), shape(&mut rng));
+            let (ma, mb) = (rng.random_range(0.0..0.1), rng.random_range(0.0..0.1));
+            let (pa, pb) = (
+                Pose::new(point_in_cube(&mut rng, 0.2), rotation(&mut rng)),
+                Pose::new(point_in_cube(&mut rng, 0.9), rotation(&mut rng)),
+            );
+            let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+            add(&mut scene, sa.clone(), DVec3::ZERO, ma);
+            add(&mut scene, sb.clone(), DVec3::ZERO, mb);
+            scene.set_pose(BodyId(0), pa).unwrap();
+            scene.set_pose(BodyId(1), pb).unwrap();
+            let mut results = FrameResults::default();
+            let report = step(&scene, Query::CLOSE, &mut workspace, &mut results);
+            let iso = Pose::relative(&pa, &pb).to_isometry();
+            let truth = match (&sa, &sb) {
+                (Shape::Cuboid(x), Shape::Cuboid(y)) => pairs::distance_cuboid_cuboid(x, y, &iso),
+                (Shape::Capsule(x), Shape::Cuboid(y)) => pairs::distance_capsule_cuboid(x, y, &iso),
+                (Shape::Cuboid(x), Shape::Capsule(y)) => {
+                    let d = pairs::distance_capsule_cuboid(y, x, &iso.inverse());
+                    d.flipped(&iso)
+                }
+                (Shape::Capsule(x), Shape::Capsule(y)) => {
+                    pairs::distance_capsule_capsule(x, y, &iso)
+                }
+                _ => unreachable!(),
+            }
+            .distance;
+            match results.pairs.as_slice() {
+                [r] => {
+                    assert!(
+                        truth <= ma + mb + 1e-12,
+                        "case {case}: far pair {truth} reported"
+                    );
+                    assert!((r.distance - truth).abs() <= 1e-12, "case {case}");
+                    reported += 1;
+                }
+                [] => {
+                    assert!(
+                        truth > ma + mb - 1e-12,
+                        "case {case}: close pair {truth} missed"
+                    );
+                    skipped_candidates += report.candidates as usize;
+                }
+                more => panic!("case {case}: {} pairs", more.len()),
+            }
+        }
+        assert!(
+            reported > 300 && skipped_candidates > 300,
+            "reported {reported}, candidates beyond their margins {skipped_candidates}"
+        );
+    }
+
     /// The worker pool's fallback (a pair whose query panicked) is the box answer: a lower
     /// bound of the distance within its error bound, a contact covering the depth.
     #[test]
