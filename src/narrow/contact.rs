@@ -93,6 +93,20 @@ impl Manifold {
         }
     }
 
+    /// The one-point manifold of a signed distance: its witnesses under its normal when the
+    /// shapes touch or overlap (`distance ≤ 0`), else empty with that normal. Pairs whose
+    /// manifold is one point build it so, and then it always agrees with the distance.
+    pub fn set_from_distance(&mut self, d: &ShapeDistance) {
+        self.reset(d.normal);
+        if d.distance <= 0.0 {
+            self.push(ManifoldPoint {
+                point_a: d.point_a,
+                point_b: d.point_b,
+                distance: d.distance,
+            });
+        }
+    }
+
     /// Empties the manifold and sets its normal.
     pub fn reset(&mut self, normal: DVec3) {
         self.normal = normal;

@@ -172,7 +172,7 @@ pub(super) fn manifold(
         (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
             let d = convex_distance(a, b, &iso, scratch);
-            witness_manifold(&d, out);
+            out.set_from_distance(&d);
         }
         (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, scratch, out),
         (M(x), M(y)) => {
@@ -185,7 +185,7 @@ pub(super) fn manifold(
                 f64::INFINITY,
                 scratch,
             );
-            witness_manifold(&d, out);
+            out.set_from_distance(&d);
         }
     }
 }
@@ -241,18 +241,6 @@ fn flip_manifold(m: &mut Manifold, pose_ab: &Isometry) {
         });
     }
     *m = flipped;
-}
-
-/// A one-point manifold from a signed distance: its witnesses, when the shapes touch.
-fn witness_manifold(d: &ShapeDistance, out: &mut Manifold) {
-    out.reset(d.normal);
-    if d.distance <= 0.0 {
-        out.push(ManifoldPoint {
-            point_a: d.point_a,
-            point_b: d.point_b,
-            distance: d.distance,
-        });
-    }
 }
 
 /// A convex shape as GJK sees it: a core and a radius (a sphere is a point swept by its
@@ -354,7 +342,7 @@ fn shape_triangle_manifold(
         Shape::Cuboid(b) => pairs::manifold_cuboid_triangle(b, triangle, &identity, out),
         Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
             let d = shape_triangle_distance(shape, triangle, epa);
-            witness_manifold(&d, out);
+            out.set_from_distance(&d);
         }
     }
 }

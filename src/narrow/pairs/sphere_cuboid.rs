@@ -8,7 +8,7 @@
 
 use crate::geometry::{Cuboid, Sphere};
 use crate::math::{DVec3, Isometry};
-use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
+use crate::narrow::contact::{Manifold, ShapeDistance};
 
 /// Exact signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's), with
 /// witnesses and unit normal A→B, all in A's frame, as [`crate::narrow::contact`] states;
@@ -62,16 +62,7 @@ pub fn distance_sphere_cuboid(a: &Sphere, b: &Cuboid, pose_ab: &Isometry) -> Sha
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4
 /// points on both surfaces with one normal A→B, A's frame; empty when apart.
 pub fn manifold_sphere_cuboid(a: &Sphere, b: &Cuboid, pose_ab: &Isometry, out: &mut Manifold) {
-    // One point, the distance's witnesses: the manifold and the distance always agree.
-    let d = distance_sphere_cuboid(a, b, pose_ab);
-    out.reset(d.normal);
-    if d.distance <= 0.0 {
-        out.push(ManifoldPoint {
-            point_a: d.point_a,
-            point_b: d.point_b,
-            distance: d.distance,
-        });
-    }
+    out.set_from_distance(&distance_sphere_cuboid(a, b, pose_ab));
 }
 
 #[cfg(test)]
