@@ -97,7 +97,7 @@ pub(super) fn direct(
     };
     let touching = d.distance <= 0.0;
     if query.contacts && touching {
-        dispatch::manifold(sa, sb, &pose_ab, scratch, manifold);
+        dispatch::manifold(sa, sb, &pose_ab, &d, scratch, manifold);
         let normal = a.pose.transform_vector(manifold.normal);
         for p in manifold.points() {
             contacts.push(ContactPoint {

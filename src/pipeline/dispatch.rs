@@ -147,11 +147,15 @@ pub(super) fn distance(
 }
 
 /// The contact manifold of `a` and `b` placed by `pose_ab`, A's frame, into `out` (emptied
-/// first; stays empty when they are apart). Mesh–mesh pairs go down [`Route::MeshMesh`].
+/// first; stays empty when they are apart). `d` is their signed distance from
+/// [`distance`] (exact when they touch): pairs whose manifold is one point take it from
+/// `d` instead of running their query again. Mesh–mesh pairs go down [`Route::MeshMesh`];
+/// here they too get the one point of `d`.
 pub(super) fn manifold(
     a: &Shape,
     b: &Shape,
     pose_ab: &Pose,
+    d: &ShapeDistance,
     scratch: &mut NarrowScratch,
     out: &mut Manifold,
 ) {
@@ -159,34 +163,22 @@ pub(super) fn manifold(
     let iso = pose_ab.to_isometry();
     out.reset(DVec3::ZERO);
     match (a, b) {
-        (S(x), S(y)) => pairs::manifold_sphere_sphere(x, y, &iso, out),
-        (S(x), C(y)) => pairs::manifold_sphere_capsule(x, y, &iso, out),
-        (S(x), B(y)) => pairs::manifold_sphere_cuboid(x, y, &iso, out),
         (C(x), C(y)) => pairs::manifold_capsule_capsule(x, y, &iso, out),
         (C(x), B(y)) => pairs::manifold_capsule_cuboid(x, y, &iso, out),
         (B(x), B(y)) => pairs::manifold_cuboid_cuboid(x, y, &iso, out),
         (C(_), S(_)) | (B(_), S(_) | C(_)) | (M(_), convex!()) => {
-            manifold(b, a, &pose_ab.inverse(), scratch, out);
+            let pose_ba = pose_ab.inverse();
+            let d_ba = d.flipped(&pose_ba.to_isometry());
+            manifold(b, a, &pose_ba, &d_ba, scratch, out);
             flip_manifold(out, &iso);
         }
-        (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
-        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
-            let d = convex_distance(a, b, &iso, scratch);
-            out.set_from_distance(&d);
-        }
+        // One point: sphere pairs (their closed-form manifolds are the distance's
+        // witnesses), GJK pairs, and mesh–mesh off the pipeline's route.
+        (S(_), S(_) | C(_) | B(_))
+        | (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!())
+        | (M(_), M(_)) => out.set_from_distance(d),
         (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, scratch, out),
-        (M(x), M(y)) => {
-            // The pipeline answers mesh pairs on their own route; here, one point at the
-            // closest pair when they touch.
-            let d = distance(
-                &Shape::Mesh(Arc::clone(x)),
-                &Shape::Mesh(Arc::clone(y)),
-                pose_ab,
-                f64::INFINITY,
-                scratch,
-            );
-            out.set_from_distance(&d);
-        }
     }
 }
 
