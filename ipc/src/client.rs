@@ -1252,11 +1252,7 @@ mod tests {
         assert!(client.create_scene().is_ok());
         drop((client, responder));
         // iceoryx2 leaves one small global-management segment per prefix behind.
-        for entry in std::fs::read_dir("/dev/shm").unwrap().flatten() {
-            if entry.file_name().to_string_lossy().starts_with(&prefix) {
-                std::fs::remove_file(entry.path()).unwrap();
-            }
-        }
+        crate::daemon_process::remove_shared_memory(&prefix);
     }
 
     #[test]

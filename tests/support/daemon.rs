@@ -171,16 +171,8 @@ pub fn signal(pid: u32, signal: &str) {
         .status();
 }
 
-/// Removes the `/dev/shm` files of iceoryx2 prefix `prefix`.
-pub fn remove_shared_memory(prefix: &str) {
-    if let Ok(entries) = std::fs::read_dir("/dev/shm") {
-        for entry in entries.flatten() {
-            if entry.file_name().to_string_lossy().starts_with(prefix) {
-                let _ = std::fs::remove_file(entry.path());
-            }
-        }
-    }
-}
+/// Removes the `/dev/shm` files of iceoryx2 prefix `prefix` (the client crate's helper).
+pub use proxima_ipc::daemon_process::remove_shared_memory;
 
 /// A dynamic body of `shape` at `(x, 0, 0)`, unrotated, pairing with everything, with the
 /// scene's default margin.
