@@ -1,7 +1,8 @@
 //! Contact manifolds of two placed cores, the engine behind every `manifold_*` function.
 //!
 //! # Algorithm
-//! From the signed distance ([`super::query::distance`]), when it is `≤ 0`:
+//! From the signed distance ([`super::query::distance`]), when it is `≤ 0` (shapes apart
+//! along a separating axis skip it):
 //! - **Face contact**: when a core has a face whose outward normal is within
 //!   [`FACE_ALIGNMENT`] of the contact normal, the better aligned such face is the
 //!   *reference*; the other core's *incident* feature (a box's face most opposed to it, the
@@ -20,9 +21,9 @@
 //! it, then the two that span the largest area.
 
 use super::core::{Core, Kind, Polygon, line_interval};
-use super::query::{FEATURE_RELATIVE, distance};
+use super::query::{FEATURE_RELATIVE, best_axis, distance_with_axis};
 use crate::math::DVec3;
-use crate::narrow::contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint};
+use crate::narrow::contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
 
 /// Cosine between a face normal and the contact normal above which the face is a
 /// reference face (about 0.8°).
@@ -42,12 +43,25 @@ struct Candidates {
 /// Fills `out` with the contact manifold of two placed cores (module docs); empty when
 /// they are apart.
 pub(super) fn manifold(a: &Core, b: &Core, out: &mut Manifold) {
-    let d = distance(a, b);
+    let axis = best_axis(a, b);
+    let slack = FEATURE_RELATIVE * a.scale().max(b.scale());
+    if axis.separation - a.radius - b.radius > slack {
+        // PERF: apart along an axis by more than rounding (so the distance is positive
+        // too): no closest pair needed.
+        out.reset(axis.normal);
+        return;
+    }
+    manifold_from_distance(a, b, &distance_with_axis(a, b, &axis), out);
+}
+
+/// [`manifold`] given the cores' signed distance `d` (from [`super::query`], or from a
+/// pair's own faster path with the same contract).
+pub(super) fn manifold_from_distance(a: &Core, b: &Core, d: &ShapeDistance, out: &mut Manifold) {
+    let slack = FEATURE_RELATIVE * a.scale().max(b.scale());
     out.reset(d.normal);
     if d.distance > 0.0 {
         return;
     }
-    let slack = FEATURE_RELATIVE * a.scale().max(b.scale());
     let mut cands = Candidates {
         pts: [ManifoldPoint {
             point_a: DVec3::ZERO,

@@ -195,6 +195,13 @@ impl Core {
     /// `(min, max)` of the vertices projected on `axis`.
     #[must_use]
     pub fn project(&self, axis: DVec3) -> (f64, f64) {
+        if let Kind::Box { center, axes, half } = self.kind {
+            // PERF: the centre's projection ± the half extents' reach, 3 dot products
+            // instead of 8 (the separating-axis test projects on up to 15 axes).
+            let c = center.dot(axis);
+            let reach = (axes.transpose() * axis).abs().dot(half);
+            return (c - reach, c + reach);
+        }
         self.vertices()
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
