@@ -9,9 +9,18 @@
 //! Ids are scoped to their scene and never reused while the scene lives (DESIGN §9: no
 //! assumption that would block splitting scenes across daemons).
 //!
+//! # Frames and motion
+//! A scene counts the frames answered over it ([`Scene::end_frame`], called once a frame's
+//! results are out). A body's motion over the current frame ([`Scene::frame_motion`]) runs
+//! from the pose it had when the last frame was answered to its pose now: a body not moved
+//! since is at rest, and a body added since the last answered frame is at rest too (its
+//! first pose is not a pose any frame saw, so no sweep is invented from it). Time of impact
+//! and swept boxes ([`Scene::swept_proxies`]) read it.
+//!
 //! # Invariants
 //! Checked by [`Scene::validate`]: every live body names a registered shape; its world box
-//! is its shape's local box moved by its pose; the count of live bodies matches.
+//! is its shape's local box moved by its pose; no body's frame stamps are ahead of the
+//! scene's frame count; the count of live bodies matches.
 
 use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
 pub use crate::broad::CollisionFilter;
@@ -19,6 +28,7 @@ use crate::broad::Proxy;
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
 use crate::math::{DVec3, Pose, conservative_slack};
+use crate::narrow::toi::{FrameMotion, swept_bounds};
 use std::fmt;
 use std::sync::Arc;
 
@@ -135,6 +145,13 @@ pub struct Body {
     pub margin: f64,
     /// The shape's local box moved by `pose` (world frame), without the margin.
     pub world_bounds: Aabb,
+    /// The pose this frame's motion starts from, when `moved_in` is the scene's current
+    /// frame (see [`Scene::frame_motion`]).
+    frame_start: Pose,
+    /// The frame in which `frame_start` was recorded (the body's first move in it).
+    moved_in: u64,
+    /// The frame in which the body was added (it is at rest during that frame).
+    added_in: u64,
 }
 
 /// Limits that keep one client from exhausting the daemon.
@@ -198,6 +215,8 @@ pub struct Scene {
     /// reused).
     bodies: Vec<Option<Body>>,
     live: u32,
+    /// Frames answered so far ([`Scene::end_frame`]): the current frame's number.
+    frame: u64,
     default_margin: f64,
     limits: SceneLimits,
 }
@@ -214,6 +233,7 @@ impl Scene {
             shape_boxes: Vec::new(),
             bodies: Vec::new(),
             live: 0,
+            frame: 0,
             default_margin,
             limits,
         })
@@ -261,6 +281,9 @@ impl Scene {
             filter: desc.filter,
             margin,
             world_bounds,
+            frame_start: desc.pose,
+            moved_in: self.frame,
+            added_in: self.frame,
         }));
         self.live += 1;
         Ok(BodyId(self.bodies.len() as u32 - 1))
@@ -302,7 +325,8 @@ impl Scene {
     }
 
     /// Moves a body to `pose` (already validated: see [`Pose::try_new`]) and updates its
-    /// world box.
+    /// world box. The first move of a frame also records where the frame's motion starts
+    /// (see [`Scene::frame_motion`]).
     ///
     /// # Errors
     /// [`SceneError::UnknownBody`].
@@ -314,10 +338,74 @@ impl Scene {
         };
         // Unmoved: the world box is still right.
         if body.pose != pose {
+            // A plain copy of a pose stored frames ago (no store-forwarding hazard), once
+            // per body and frame.
+            if body.moved_in != self.frame {
+                body.frame_start = body.pose;
+                body.moved_in = self.frame;
+            }
             body.world_bounds = self.shape_boxes[body.shape.0 as usize].world(&pose);
             body.pose = pose;
         }
         Ok(())
+    }
+
+    /// Ends the current frame: every body's pose now is where its motion over the next
+    /// frame starts. The daemon calls it once a frame's results are published; O(1).
+    pub fn end_frame(&mut self) {
+        self.frame += 1;
+    }
+
+    /// The motion of `body` (a live body of this scene) over the current frame: from its
+    /// pose when the last frame was answered ([`Scene::end_frame`]) to its pose now, world
+    /// frame. At rest when it has not moved since, or was added since.
+    #[must_use]
+    pub fn frame_motion(&self, body: &Body) -> FrameMotion {
+        if body.moved_in == self.frame && body.added_in != self.frame {
+            FrameMotion {
+                start: body.frame_start,
+                end: body.pose,
+            }
+        } else {
+            FrameMotion::at_rest(body.pose)
+        }
+    }
+
+    /// The largest distance of a point of `body`'s shape from the body's origin that can
+    /// move by rotating, metres: 0 for a sphere (rotation about its centre moves nothing),
+    /// else the farthest vertex or local box corner. Bounds the speed of a turning shape.
+    #[must_use]
+    pub fn reach(&self, body: &Body) -> f64 {
+        self.shape_boxes[body.shape.0 as usize].reach
+    }
+
+    /// Like [`Scene::proxies`], but each box covers the body's whole motion over the
+    /// current frame ([`swept_bounds`] of [`Scene::frame_motion`], merged with the world
+    /// box), grown by its margin: the broad-phase input of time of impact. A body at rest
+    /// gets exactly its [`Scene::proxies`] box.
+    ///
+    /// # Allocation
+    /// None once `out` holds as many proxies as there are bodies.
+    pub fn swept_proxies(&self, out: &mut Vec<Proxy>) {
+        out.clear();
+        out.extend(self.bodies().map(|(id, body)| {
+            let motion = self.frame_motion(body);
+            let bounds = if motion.start == motion.end {
+                body.world_bounds
+            } else {
+                let local = &self.shape_boxes[body.shape.0 as usize];
+                let local_box = Aabb::from_center_half_extents(local.center, local.half);
+                // The end boxes are padded for rounding by `transformed`; the world box
+                // (the end pose) keeps the sphere's own padding.
+                swept_bounds(&local_box, local.reach, &motion).merged(&body.world_bounds)
+            };
+            Proxy {
+                body: id.0,
+                bounds: bounds.grown(body.margin),
+                is_static: body.motion == Motion::Static,
+                filter: body.filter,
+            }
+        }));
     }
 
     /// The live body with id `id`.
@@ -369,6 +457,9 @@ impl Scene {
             if body.world_bounds != LocalBox::of(shape).world(&body.pose) {
                 return Err(format!("body {} has a stale world box", id.0));
             }
+            if body.moved_in > self.frame || body.added_in > body.moved_in {
+                return Err(format!("body {} has frame stamps out of order", id.0));
+            }
         }
         if live != self.live {
             return Err(format!("{live} live bodies, {} counted", self.live));
@@ -392,15 +483,26 @@ struct LocalBox {
     center: DVec3,
     half: DVec3,
     rotation_invariant: bool,
+    /// See [`Scene::reach`].
+    reach: f64,
 }
 
 impl LocalBox {
     fn of(shape: &Shape) -> Self {
         let aabb = shape.local_bounds();
+        let farthest = |points: &[DVec3]| points.iter().map(|p| p.length()).fold(0.0, f64::max);
+        let reach = match shape {
+            Shape::Sphere(_) => 0.0,
+            Shape::Convex(c) => farthest(c.vertices()),
+            Shape::Mesh(m) => farthest(m.mesh.vertices()),
+            _ => aabb.min.abs().max(aabb.max.abs()).length(),
+        };
         Self {
             center: aabb.center(),
             half: aabb.half_extents(),
             rotation_invariant: matches!(shape, Shape::Sphere(_)),
+            // Rounding of the lengths: never below the truth.
+            reach: reach * (1.0 + 4.0 * f64::EPSILON),
         }
     }
 
