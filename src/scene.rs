@@ -687,6 +687,105 @@ mod tests {
         assert_eq!(pairs, [crate::broad::CandidatePair { a: a.0, b: b.0 }]);
     }
 
+    /// Motion starts where the last answered frame left a body: bodies added since and
+    /// bodies not moved since are at rest, a second move in one frame keeps the start, and
+    /// each swept box holds the body's world box at every sampled time of its motion (a
+    /// resting body's is exactly its proxy box).
+    #[test]
+    fn frame_motion_starts_at_the_last_answered_pose_and_swept_boxes_cover_it() {
+        let mut s = Scene::try_new(0.05, SceneLimits::STANDARD).unwrap();
+        let torus = meshes::torus(1.0, 0.25, 12, 6);
+        let shapes = [
+            Shape::Sphere(Sphere::new(0.5)),
+            Shape::Capsule(Capsule::new(1.0, 0.25)),
+            Shape::Cuboid(Cuboid::new(DVec3::new(0.1, 2.0, 0.3))),
+            Shape::Cone(Cone::new(0.7, 0.2)),
+            Shape::Mesh(Arc::new(MeshShape::new(torus))),
+        ];
+        let ids: Vec<ShapeId> = shapes
+            .iter()
+            .map(|sh| s.register_shape(sh.clone()).unwrap())
+            .collect();
+        let mut rng = rng(43);
+        let (mut proxies, mut swept) = (Vec::new(), Vec::new());
+        for case in 0..300 {
+            let shape = ids[case % ids.len()];
+            let (p0, p1, p2, p3) = (
+                pose(&mut rng, 10.0),
+                pose(&mut rng, 10.0),
+                pose(&mut rng, 10.0),
+                pose(&mut rng, 10.0),
+            );
+            let id = s.add_body(&desc(shape, p0)).unwrap();
+            // Added this frame: at rest even when moved.
+            s.set_pose(id, p1).unwrap();
+            assert_eq!(
+                s.frame_motion(s.body(id).unwrap()),
+                FrameMotion::at_rest(p1)
+            );
+            s.end_frame();
+            assert_eq!(
+                s.frame_motion(s.body(id).unwrap()),
+                FrameMotion::at_rest(p1)
+            );
+            s.set_pose(id, p2).unwrap();
+            s.set_pose(id, p3).unwrap();
+            let motion = s.frame_motion(s.body(id).unwrap());
+            assert_eq!(motion, FrameMotion { start: p1, end: p3 }, "case {case}");
+            s.proxies(&mut proxies);
+            s.swept_proxies(&mut swept);
+            let body = *s.body(id).unwrap();
+            // The swept box without the margin (plus rounding room).
+            let sweep = swept.iter().find(|p| p.body == id.0).unwrap().bounds;
+            let inner = DVec3::splat(body.margin - 1e-9);
+            let sweep = Aabb::new(sweep.min + inner, sweep.max - inner);
+            let local = s.shape(shape).unwrap().local_bounds();
+            for i in 0..=32 {
+                let at = motion.pose_at(f64::from(i) / 32.0);
+                // Extreme points of the shape at time t: its vertices, its local box's
+                // corners (their distance from the origin is the reach), a ball's poles.
+                let points: Vec<DVec3> = match s.shape(shape).unwrap() {
+                    Shape::Sphere(b) => [DVec3::X, DVec3::Y, DVec3::Z]
+                        .into_iter()
+                        .flat_map(|d| [at.position + d * b.radius, at.position - d * b.radius])
+                        .collect(),
+                    Shape::Mesh(m) => m
+                        .mesh
+                        .vertices()
+                        .iter()
+                        .map(|&v| at.transform_point(v))
+                        .collect(),
+                    _ => (0..8)
+                        .map(|c| {
+                            let pick =
+                                |bit: u32, lo: f64, hi: f64| if c & bit == 0 { lo } else { hi };
+                            at.transform_point(DVec3::new(
+                                pick(1, local.min.x, local.max.x),
+                                pick(2, local.min.y, local.max.y),
+                                pick(4, local.min.z, local.max.z),
+                            ))
+                        })
+                        .collect(),
+                };
+                for p in points {
+                    assert!(sweep.contains_point(p), "case {case}: t = {i}/32");
+                }
+            }
+            s.end_frame();
+            // Not moved since: at rest, and the swept box is the proxy box.
+            s.set_pose(id, p3).unwrap();
+            assert_eq!(
+                s.frame_motion(s.body(id).unwrap()),
+                FrameMotion::at_rest(p3)
+            );
+            s.proxies(&mut proxies);
+            s.swept_proxies(&mut swept);
+            assert_eq!(proxies, swept);
+            assert_eq!(s.validate(), Ok(()));
+            s.remove_body(id).unwrap();
+        }
+    }
+
     #[test]
     fn filters_pair_only_when_both_groups_meet_the_other_mask() {
         let (a, b) = (
