@@ -34,7 +34,15 @@ pub const TOI_TOLERANCE: f64 = 1e-6;
 /// Most distance queries per pair and frame before the search reports how far it got.
 const MAX_ITERATIONS: u32 = 256;
 
-/// The time of impact of one pair, world frame (see the [module docs](self)).
+/// The time of impact of one pair over the frame's motion, world frame.
+///
+/// `time ∈ [0, 1]` is the fraction of the motion from each body's pose when the last frame
+/// was answered to its pose now (position linear, orientation shortest-arc slerp). The
+/// pair comes within contact when its signed distance is at most the sum of its margins.
+/// Conservative: no time before `time` has the pair within contact, and (when `reached`)
+/// at `time` it is within its margins plus [`TOI_TOLERANCE`]; `time = 0` when it already
+/// is at the start. Pairs that stay farther apart than their margins report nothing. See
+/// the [pipeline docs](super#time-of-impact).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PairToi {
     /// The smaller body id.
