@@ -9,9 +9,18 @@
 //! Ids are scoped to their scene and never reused while the scene lives (DESIGN §9: no
 //! assumption that would block splitting scenes across daemons).
 //!
+//! # Frames and motion
+//! A scene counts the frames answered over it ([`Scene::end_frame`], called once a frame's
+//! results are out). A body's motion over the current frame ([`Scene::frame_motion`]) runs
+//! from the pose it had when the last frame was answered to its pose now: a body not moved
+//! since is at rest, and a body added since the last answered frame is at rest too (its
+//! first pose is not a pose any frame saw, so no sweep is invented from it). Time of impact
+//! and swept boxes ([`Scene::swept_proxies`]) read it.
+//!
 //! # Invariants
 //! Checked by [`Scene::validate`]: every live body names a registered shape; its world box
-//! is its shape's local box moved by its pose; the count of live bodies matches.
+//! is its shape's local box moved by its pose; no body's frame stamps are ahead of the
+//! scene's frame count; the count of live bodies matches.
 
 use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
 pub use crate::broad::CollisionFilter;
@@ -19,6 +28,7 @@ use crate::broad::Proxy;
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
 use crate::math::{DVec3, Pose, conservative_slack};
+use crate::narrow::toi::{FrameMotion, swept_bounds};
 use std::fmt;
 use std::sync::Arc;
 
@@ -135,6 +145,13 @@ pub struct Body {
     pub margin: f64,
     /// The shape's local box moved by `pose` (world frame), without the margin.
     pub world_bounds: Aabb,
+    /// The pose this frame's motion starts from, when `moved_in` is the scene's current
+    /// frame (see [`Scene::frame_motion`]).
+    frame_start: Pose,
+    /// The frame in which `frame_start` was recorded (the body's first move in it).
+    moved_in: u64,
+    /// The frame in which the body was added (it is at rest during that frame).
+    added_in: u64,
 }
 
 /// Limits that keep one client from exhausting the daemon.
@@ -198,6 +215,8 @@ pub struct Scene {
     /// reused).
     bodies: Vec<Option<Body>>,
     live: u32,
+    /// Frames answered so far ([`Scene::end_frame`]): the current frame's number.
+    frame: u64,
     default_margin: f64,
     limits: SceneLimits,
 }
@@ -214,6 +233,7 @@ impl Scene {
             shape_boxes: Vec::new(),
             bodies: Vec::new(),
             live: 0,
+            frame: 0,
             default_margin,
             limits,
         })
@@ -261,6 +281,9 @@ impl Scene {
             filter: desc.filter,
             margin,
             world_bounds,
+            frame_start: desc.pose,
+            moved_in: self.frame,
+            added_in: self.frame,
         }));
         self.live += 1;
         Ok(BodyId(self.bodies.len() as u32 - 1))
@@ -302,7 +325,8 @@ impl Scene {
     }
 
     /// Moves a body to `pose` (already validated: see [`Pose::try_new`]) and updates its
-    /// world box.
+    /// world box. The first move of a frame also records where the frame's motion starts
+    /// (see [`Scene::frame_motion`]).
     ///
     /// # Errors
     /// [`SceneError::UnknownBody`].
@@ -314,10 +338,74 @@ impl Scene {
         };
         // Unmoved: the world box is still right.
         if body.pose != pose {
+            // A plain copy of a pose stored frames ago (no store-forwarding hazard), once
+            // per body and frame.
+            if body.moved_in != self.frame {
+                body.frame_start = body.pose;
+                body.moved_in = self.frame;
+            }
             body.world_bounds = self.shape_boxes[body.shape.0 as usize].world(&pose);
             body.pose = pose;
         }
         Ok(())
+    }
+
+    /// Ends the current frame: every body's pose now is where its motion over the next
+    /// frame starts. The daemon calls it once a frame's results are published; O(1).
+    pub fn end_frame(&mut self) {
+        self.frame += 1;
+    }
+
+    /// The motion of `body` (a live body of this scene) over the current frame: from its
+    /// pose when the last frame was answered ([`Scene::end_frame`]) to its pose now, world
+    /// frame. At rest when it has not moved since, or was added since.
+    #[must_use]
+    pub fn frame_motion(&self, body: &Body) -> FrameMotion {
+        if body.moved_in == self.frame && body.added_in != self.frame {
+            FrameMotion {
+                start: body.frame_start,
+                end: body.pose,
+            }
+        } else {
+            FrameMotion::at_rest(body.pose)
+        }
+    }
+
+    /// The largest distance of a point of `body`'s shape from the body's origin that can
+    /// move by rotating, metres: 0 for a sphere (rotation about its centre moves nothing),
+    /// else the farthest vertex or local box corner. Bounds the speed of a turning shape.
+    #[must_use]
+    pub fn reach(&self, body: &Body) -> f64 {
+        self.shape_boxes[body.shape.0 as usize].reach
+    }
+
+    /// Like [`Scene::proxies`], but each box covers the body's whole motion over the
+    /// current frame ([`swept_bounds`] of [`Scene::frame_motion`], merged with the world
+    /// box), grown by its margin: the broad-phase input of time of impact. A body at rest
+    /// gets exactly its [`Scene::proxies`] box.
+    ///
+    /// # Allocation
+    /// None once `out` holds as many proxies as there are bodies.
+    pub fn swept_proxies(&self, out: &mut Vec<Proxy>) {
+        out.clear();
+        out.extend(self.bodies().map(|(id, body)| {
+            let motion = self.frame_motion(body);
+            let bounds = if motion.start == motion.end {
+                body.world_bounds
+            } else {
+                let local = &self.shape_boxes[body.shape.0 as usize];
+                let local_box = Aabb::from_center_half_extents(local.center, local.half);
+                // The end boxes are padded for rounding by `transformed`; the world box
+                // (the end pose) keeps the sphere's own padding.
+                swept_bounds(&local_box, local.reach, &motion).merged(&body.world_bounds)
+            };
+            Proxy {
+                body: id.0,
+                bounds: bounds.grown(body.margin),
+                is_static: body.motion == Motion::Static,
+                filter: body.filter,
+            }
+        }));
     }
 
     /// The live body with id `id`.
@@ -369,6 +457,9 @@ impl Scene {
             if body.world_bounds != LocalBox::of(shape).world(&body.pose) {
                 return Err(format!("body {} has a stale world box", id.0));
             }
+            if body.moved_in > self.frame || body.added_in > body.moved_in {
+                return Err(format!("body {} has frame stamps out of order", id.0));
+            }
         }
         if live != self.live {
             return Err(format!("{live} live bodies, {} counted", self.live));
@@ -392,15 +483,26 @@ struct LocalBox {
     center: DVec3,
     half: DVec3,
     rotation_invariant: bool,
+    /// See [`Scene::reach`].
+    reach: f64,
 }
 
 impl LocalBox {
     fn of(shape: &Shape) -> Self {
         let aabb = shape.local_bounds();
+        let farthest = |points: &[DVec3]| points.iter().map(|p| p.length()).fold(0.0, f64::max);
+        let reach = match shape {
+            Shape::Sphere(_) => 0.0,
+            Shape::Convex(c) => farthest(c.vertices()),
+            Shape::Mesh(m) => farthest(m.mesh.vertices()),
+            _ => aabb.min.abs().max(aabb.max.abs()).length(),
+        };
         Self {
             center: aabb.center(),
             half: aabb.half_extents(),
             rotation_invariant: matches!(shape, Shape::Sphere(_)),
+            // Rounding of the lengths: never below the truth.
+            reach: reach * (1.0 + 4.0 * f64::EPSILON),
         }
     }
 
@@ -583,6 +685,105 @@ mod tests {
         let mut pairs = Vec::new();
         crate::broad::pairs_brute_force(&proxies, &mut pairs);
         assert_eq!(pairs, [crate::broad::CandidatePair { a: a.0, b: b.0 }]);
+    }
+
+    /// Motion starts where the last answered frame left a body: bodies added since and
+    /// bodies not moved since are at rest, a second move in one frame keeps the start, and
+    /// each swept box holds the body's world box at every sampled time of its motion (a
+    /// resting body's is exactly its proxy box).
+    #[test]
+    fn frame_motion_starts_at_the_last_answered_pose_and_swept_boxes_cover_it() {
+        let mut s = Scene::try_new(0.05, SceneLimits::STANDARD).unwrap();
+        let torus = meshes::torus(1.0, 0.25, 12, 6);
+        let shapes = [
+            Shape::Sphere(Sphere::new(0.5)),
+            Shape::Capsule(Capsule::new(1.0, 0.25)),
+            Shape::Cuboid(Cuboid::new(DVec3::new(0.1, 2.0, 0.3))),
+            Shape::Cone(Cone::new(0.7, 0.2)),
+            Shape::Mesh(Arc::new(MeshShape::new(torus))),
+        ];
+        let ids: Vec<ShapeId> = shapes
+            .iter()
+            .map(|sh| s.register_shape(sh.clone()).unwrap())
+            .collect();
+        let mut rng = rng(43);
+        let (mut proxies, mut swept) = (Vec::new(), Vec::new());
+        for case in 0..300 {
+            let shape = ids[case % ids.len()];
+            let (p0, p1, p2, p3) = (
+                pose(&mut rng, 10.0),
+                pose(&mut rng, 10.0),
+                pose(&mut rng, 10.0),
+                pose(&mut rng, 10.0),
+            );
+            let id = s.add_body(&desc(shape, p0)).unwrap();
+            // Added this frame: at rest even when moved.
+            s.set_pose(id, p1).unwrap();
+            assert_eq!(
+                s.frame_motion(s.body(id).unwrap()),
+                FrameMotion::at_rest(p1)
+            );
+            s.end_frame();
+            assert_eq!(
+                s.frame_motion(s.body(id).unwrap()),
+                FrameMotion::at_rest(p1)
+            );
+            s.set_pose(id, p2).unwrap();
+            s.set_pose(id, p3).unwrap();
+            let motion = s.frame_motion(s.body(id).unwrap());
+            assert_eq!(motion, FrameMotion { start: p1, end: p3 }, "case {case}");
+            s.proxies(&mut proxies);
+            s.swept_proxies(&mut swept);
+            let body = *s.body(id).unwrap();
+            // The swept box without the margin (plus rounding room).
+            let sweep = swept.iter().find(|p| p.body == id.0).unwrap().bounds;
+            let inner = DVec3::splat(body.margin - 1e-9);
+            let sweep = Aabb::new(sweep.min + inner, sweep.max - inner);
+            let local = s.shape(shape).unwrap().local_bounds();
+            for i in 0..=32 {
+                let at = motion.pose_at(f64::from(i) / 32.0);
+                // Extreme points of the shape at time t: its vertices, its local box's
+                // corners (their distance from the origin is the reach), a ball's poles.
+                let points: Vec<DVec3> = match s.shape(shape).unwrap() {
+                    Shape::Sphere(b) => [DVec3::X, DVec3::Y, DVec3::Z]
+                        .into_iter()
+                        .flat_map(|d| [at.position + d * b.radius, at.position - d * b.radius])
+                        .collect(),
+                    Shape::Mesh(m) => m
+                        .mesh
+                        .vertices()
+                        .iter()
+                        .map(|&v| at.transform_point(v))
+                        .collect(),
+                    _ => (0..8)
+                        .map(|c| {
+                            let pick =
+                                |bit: u32, lo: f64, hi: f64| if c & bit == 0 { lo } else { hi };
+                            at.transform_point(DVec3::new(
+                                pick(1, local.min.x, local.max.x),
+                                pick(2, local.min.y, local.max.y),
+                                pick(4, local.min.z, local.max.z),
+                            ))
+                        })
+                        .collect(),
+                };
+                for p in points {
+                    assert!(sweep.contains_point(p), "case {case}: t = {i}/32");
+                }
+            }
+            s.end_frame();
+            // Not moved since: at rest, and the swept box is the proxy box.
+            s.set_pose(id, p3).unwrap();
+            assert_eq!(
+                s.frame_motion(s.body(id).unwrap()),
+                FrameMotion::at_rest(p3)
+            );
+            s.proxies(&mut proxies);
+            s.swept_proxies(&mut swept);
+            assert_eq!(proxies, swept);
+            assert_eq!(s.validate(), Ok(()));
+            s.remove_body(id).unwrap();
+        }
     }
 
     #[test]

@@ -1,8 +1,9 @@
 //! Pose frames in, result frames out, through the real `proximad` over shared memory:
 //! for every combination of query flags the result frame holds exactly what the in-process
 //! pipeline returns on the same scene and poses (pairs, then contacts linked by
-//! index/count); bad frames are answered with their code and the offending body while other
-//! clients keep being served; undefined, empty and not-yet-implemented flags are refused.
+//! index/count, then time-of-impact records over the motion since the previous frame);
+//! bad frames are answered with their code and the offending body while other clients keep
+//! being served; undefined and empty flags are refused.
 
 #[path = "support/daemon.rs"]
 mod daemon_harness;
@@ -42,6 +43,7 @@ fn flags(q: Query) -> u32 {
         (q.close, query::CLOSE),
         (q.distance, query::DISTANCE),
         (q.contacts, query::CONTACTS),
+        (q.toi, query::TOI),
     ]
     .iter()
     .filter(|(on, _)| *on)
@@ -112,8 +114,26 @@ fn twin_scenes(client: &Client<ipc::Service>) -> TwinScenes {
 
 /// Field-by-field equality of a result frame's records with the in-process results.
 fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame: u64) {
-    let (pairs, contacts) = records.split_at(expected.pairs.len());
-    assert_eq!(contacts.len(), expected.contacts.len(), "frame {frame}");
+    let (pairs, rest) = records.split_at(expected.pairs.len());
+    let (contacts, tois) = rest.split_at(expected.contacts.len());
+    assert_eq!(tois.len(), expected.tois.len(), "frame {frame}");
+    for (got, want) in tois.iter().zip(&expected.tois) {
+        let want = ResultRecord {
+            kind: RecordKind::Toi as u32,
+            body_a: want.a,
+            body_b: want.b,
+            index: 0,
+            count: u32::from(want.reached),
+            reserved: 0,
+            distance: want.distance,
+            error_bound: want.error_bound,
+            point_a: want.point_a.to_array(),
+            point_b: want.point_b.to_array(),
+            normal: want.normal.to_array(),
+            time: want.time,
+        };
+        assert_eq!(*got, want, "frame {frame}");
+    }
     for (got, want) in pairs.iter().zip(&expected.pairs) {
         let want = ResultRecord {
             kind: RecordKind::Pair as u32,
@@ -127,6 +147,7 @@ fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame:
             point_a: want.point_a.to_array(),
             point_b: want.point_b.to_array(),
             normal: want.normal.to_array(),
+            time: 0.0,
         };
         assert_eq!(*got, want, "frame {frame}");
     }
@@ -144,6 +165,7 @@ fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame:
             point_a: want.point_a.to_array(),
             point_b: want.point_b.to_array(),
             normal: want.normal.to_array(),
+            time: 0.0,
         };
         assert_eq!(*got, want, "frame {frame}");
     }
@@ -195,6 +217,7 @@ fn every_query_combination_gets_the_in_process_pipelines_answer_over_shared_memo
             close: bits & 2 != 0,
             distance: bits & 4 != 0,
             contacts: bits & 8 != 0,
+            toi: false,
         })
         .collect();
     for frame in 1..=45u64 {
@@ -216,6 +239,8 @@ fn every_query_combination_gets_the_in_process_pipelines_answer_over_shared_memo
             oracle.set_pose(BodyId(r.body), pose).unwrap();
         }
         let report: StepReport = step(&oracle, q, &mut workspace, &mut expected);
+        // The daemon ends the frame once answered: the next one's motion starts here.
+        oracle.end_frame();
         let result = link
             .receive_results_for(frame, TIMEOUT)
             .unwrap()
@@ -261,7 +286,7 @@ fn every_query_combination_gets_the_in_process_pipelines_answer_over_shared_memo
 }
 
 #[test]
-fn empty_undefined_and_unimplemented_query_flags_are_refused_and_the_scene_is_untouched() {
+fn empty_and_undefined_query_flags_are_refused_and_the_scene_is_untouched() {
     let daemon = Daemon::start();
     let client = daemon.client();
     let scene_id = client.create_scene().unwrap();
@@ -276,13 +301,7 @@ fn empty_undefined_and_unimplemented_query_flags_are_refused_and_the_scene_is_un
         daemon.client().open_scene(scene_id).unwrap(),
     );
     let mut seq = 0;
-    for bad in [
-        0,
-        query::TOI,
-        query::CLOSE | query::TOI,
-        1 << 5,
-        query::CLOSE | 1 << 31,
-    ] {
+    for bad in [0, query::TOI | 1 << 5, 1 << 5, query::CLOSE | 1 << 31] {
         seq += 1;
         // A refused frame must not move body 1 away.
         link.publish_poses(seq, 0, bad, &[pose_record(1, DVec3::new(5.0, 0.0, 0.0))])
@@ -395,4 +414,116 @@ fn a_bad_frame_is_answered_with_its_code_and_body_and_another_client_keeps_going
             pairs[0].distance
         );
     }
+}
+
+/// Coherent motion frame after frame (some bodies left where they are, so static ones
+/// pair with moving ones), queries with `TOI` alone and combined: the daemon's result
+/// frames hold record for record what the in-process pipeline gives on the same scene,
+/// whose frames end where the daemon's do. Times of impact both at the start (`t = 0`)
+/// and during the motion occur.
+#[test]
+fn toi_frames_over_shared_memory_match_the_in_process_pipeline_record_for_record() {
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let TwinScenes {
+        scene_id,
+        mut oracle,
+    } = twin_scenes(&client);
+    let link = client.open_scene(scene_id).unwrap();
+    let mut rng = support::rng(87);
+    let mut workspace = PipelineWorkspace::default();
+    let mut expected = FrameResults::default();
+    let queries = [
+        Query::TOI,
+        Query::CLOSE.union(Query::TOI),
+        Query::TOI.union(Query::CONTACTS).union(Query::DISTANCE),
+        Query::OVERLAP.union(Query::TOI),
+        Query::CLOSE,
+    ];
+    let mut poses: Vec<Pose> = (0..oracle.body_count())
+        .map(|_| {
+            Pose::new(
+                support::point_in_cube(&mut rng, 1.6),
+                support::rotation(&mut rng),
+            )
+        })
+        .collect();
+    let (mut at_start, mut during, mut toi_frames) = (0, 0, 0);
+    for frame in 1..=15u64 {
+        let q = queries[(frame as usize - 1) % queries.len()];
+        let mut records = Vec::new();
+        for (i, pose) in poses.iter_mut().enumerate() {
+            // Every fourth body rests this frame (after the first, which places them all).
+            if frame > 1 && (i + frame as usize).is_multiple_of(4) {
+                continue;
+            }
+            if frame > 1 {
+                let turn = DQuat::from_scaled_axis(support::point_in_cube(&mut rng, 0.3));
+                *pose = Pose::new(
+                    pose.position + support::point_in_cube(&mut rng, 0.35),
+                    (turn * pose.rotation).normalize(),
+                );
+            }
+            let r = pose.rotation;
+            records.push(PoseRecord {
+                orientation: [r.x, r.y, r.z, r.w],
+                ..pose_record(i as u32, pose.position)
+            });
+        }
+        link.publish_poses(frame, 0, flags(q), &records).unwrap();
+        for r in &records {
+            let [x, y, z, w] = r.orientation;
+            let pose =
+                Pose::try_new(DVec3::from(r.position), DQuat::from_xyzw(x, y, z, w)).unwrap();
+            oracle.set_pose(BodyId(r.body), pose).unwrap();
+        }
+        let report = step(&oracle, q, &mut workspace, &mut expected);
+        oracle.end_frame();
+        let result = link
+            .receive_results_for(frame, TIMEOUT)
+            .unwrap()
+            .expect("a result frame");
+        let header = result.header();
+        assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
+        assert_eq!(
+            (
+                header.candidate_count,
+                header.pair_count,
+                header.contact_count,
+                header.toi_count
+            ),
+            (
+                report.candidates.max(report.toi_candidates),
+                report.pairs,
+                report.contacts,
+                report.tois
+            ),
+            "frame {frame} {q:?}"
+        );
+        assert_eq!(
+            result.records().len(),
+            expected.pairs.len() + expected.contacts.len() + expected.tois.len()
+        );
+        assert_same_records(result.records(), &expected, frame);
+        assert_linked(&result);
+        assert_eq!(result.tois().len(), expected.tois.len());
+        assert!(
+            result
+                .tois()
+                .iter()
+                .all(|r| r.kind == RecordKind::Toi as u32 && (0.0..=1.0).contains(&r.time))
+        );
+        if q.toi {
+            toi_frames += 1;
+            assert!(report.toi_candidates >= report.candidates);
+        } else {
+            assert!(result.tois().is_empty());
+        }
+        at_start += expected.tois.iter().filter(|t| t.time == 0.0).count();
+        during += expected.tois.iter().filter(|t| t.time > 0.0).count();
+    }
+    assert!(
+        toi_frames == 12 && at_start > 10 && during > 5,
+        "TOI frames {toi_frames}, at the start {at_start}, during the motion {during}"
+    );
 }

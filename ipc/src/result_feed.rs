@@ -181,7 +181,7 @@ impl<S: Service> ResultFrame<S> {
         self.sample.user_header()
     }
 
-    /// Every record of the payload: the pairs, then the contacts.
+    /// Every record of the payload: the pairs, then the contacts, then the times of impact.
     #[must_use]
     pub fn records(&self) -> &[ResultRecord] {
         self.sample.payload()
@@ -200,6 +200,19 @@ impl<S: Service> ResultFrame<S> {
     pub fn contacts(&self) -> &[ResultRecord] {
         let header = self.header();
         split(self.records(), header.pair_count, header.contact_count).1
+    }
+
+    /// The time-of-impact records ([`query::TOI`](crate::wire::query::TOI)): the
+    /// `toi_count` after the contacts, fewer if the payload is shorter.
+    #[must_use]
+    pub fn tois(&self) -> &[ResultRecord] {
+        let header = self.header();
+        toi_records(
+            self.records(),
+            header.pair_count,
+            header.contact_count,
+            header.toi_count,
+        )
     }
 
     /// The contact records of `pair` (one of [`pairs`](Self::pairs)): the `count` contacts
@@ -229,7 +242,52 @@ pub(crate) fn split(
     pair_count: u32,
     contact_count: u32,
 ) -> (&[ResultRecord], &[ResultRecord]) {
-    let clamp = |count: u32, len: usize| usize::try_from(count).map_or(len, |c| c.min(len));
     let (pairs, rest) = records.split_at(clamp(pair_count, records.len()));
     (pairs, &rest[..clamp(contact_count, rest.len())])
+}
+
+/// The `toi_count` records after the pairs and contacts of [`split`], clamped like it.
+pub(crate) fn toi_records(
+    records: &[ResultRecord],
+    pair_count: u32,
+    contact_count: u32,
+    toi_count: u32,
+) -> &[ResultRecord] {
+    let (pairs, contacts) = split(records, pair_count, contact_count);
+    let rest = &records[pairs.len() + contacts.len()..];
+    &rest[..clamp(toi_count, rest.len())]
+}
+
+/// `count`, at most `len`.
+fn clamp(count: u32, len: usize) -> usize {
+    usize::try_from(count).map_or(len, |c| c.min(len))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn toi_records_follow_the_contacts_and_never_exceed_the_slice() {
+        let records: Vec<_> = (0..6)
+            .map(|i| ResultRecord {
+                index: i,
+                ..ResultRecord::default()
+            })
+            .collect();
+        let counts = [0u32, 1, 2, 5, 6, 7, u32::MAX];
+        for len in 0..=records.len() {
+            for &p in &counts {
+                for &c in &counts {
+                    for &t in &counts {
+                        let tois = toi_records(&records[..len], p, c, t);
+                        let start = (p as usize).min(len);
+                        let start = start + (c as usize).min(len - start);
+                        let end = start + (t as usize).min(len - start);
+                        assert_eq!(tois, &records[start..end], "{len} {p} {c} {t}");
+                    }
+                }
+            }
+        }
+    }
 }

@@ -12,7 +12,7 @@
 //! | service | payload | user header |
 //! |---|---|---|
 //! | `<root>/<scene>/poses` (publish–subscribe) | `[PoseRecord]` | [`PoseFrameHeader`] |
-//! | `<root>/<scene>/results` (publish–subscribe) | `[ResultRecord]`: pairs, then contacts | [`ResultFrameHeader`] |
+//! | `<root>/<scene>/results` (publish–subscribe) | `[ResultRecord]`: pairs, then contacts, then times of impact | [`ResultFrameHeader`] |
 //! | `<root>/control` (request–response) | request `[u8]` (geometry, see [`ControlRequest`]), response [`ControlReply`] | request: [`ControlRequest`] |
 
 use iceoryx2::prelude::ZeroCopySend;
@@ -25,12 +25,12 @@ use iceoryx2::prelude::ZeroCopySend;
 /// the frame reports the union, once per pair, in `(body_a, body_b)` order, then the contacts
 /// of those pairs. Flags combine (`CLOSE | CONTACTS`: the close pairs, the touching ones with
 /// contacts); `OVERLAP` adds nothing to `CLOSE` or `DISTANCE`, whose records already say it
-/// (`distance ≤ 0`).
+/// (`distance ≤ 0`). [`TOI`](query::TOI) is answered over the frame's motion, with its own
+/// candidates and its own records after the contacts; it combines with every other flag.
 ///
 /// A frame with no flag set (`0`) asks for nothing and is refused with
 /// [`ErrorCode::MalformedMessage`] (its poses are not applied), so a forgotten flag is an
-/// error rather than an empty answer. A frame asking [`TOI`](query::TOI) is refused the same way until
-/// time of impact is implemented (the daemon logs the reason). Undefined bits are refused.
+/// error rather than an empty answer. Undefined bits are refused.
 ///
 /// Pairs answered by the conservative box answer (shape-kind pairs without an exact narrow
 /// phase yet; the frame says `Truncated`, level 0) are reported whenever the truth *may*
@@ -62,8 +62,25 @@ pub mod query {
     /// - box-answer pairs: one conservative point (the box witnesses and normal), distance 0
     ///   with the box answer's error bound, which covers the unknown depth.
     pub const CONTACTS: u32 = 1 << 3;
-    /// Time of impact over the motion since the previous frame. **Not implemented yet:**
-    /// frames asking it are refused with [`MalformedMessage`](super::ErrorCode::MalformedMessage).
+    /// Time of impact over the motion since the previous frame: one
+    /// [`Toi`](super::RecordKind::Toi) record for each pair that comes within contact
+    /// (distance ≤ the sum of the two margins) during the motion.
+    ///
+    /// - **Motion:** each body moves from its pose when the scene's previous frame was
+    ///   answered to its pose in this frame (bodies not listed, and bodies added since the
+    ///   previous frame, are at rest). `time ∈ [0, 1]` is the fraction of that motion:
+    ///   position interpolated linearly, orientation by slerp along the shorter arc.
+    /// - **Candidates:** pairs whose world boxes swept over the motion, grown by their
+    ///   margins, overlap (a superset of the other flags' candidates), so pairs that pass
+    ///   through each other between two frames are found.
+    /// - **Conservative:** the reported `time` is never later than the first time the pair
+    ///   is within its margins, and at `time` the pair is within its margins plus
+    ///   `error_bound` (the search tolerance, 1e-6 m). A pair already within contact at
+    ///   the start reports `time = 0`; a pair that stays farther apart than its margins
+    ///   throughout reports nothing.
+    /// - **Record:** `distance`, `point_a`, `point_b` and `normal` (A→B) at the poses of
+    ///   `time`, world frame; `count` 1, or 0 when the search stopped at its iteration limit
+    ///   (a long grazing motion; still conservative: no contact before `time`).
     pub const TOI: u32 = 1 << 4;
     /// Every flag defined by this protocol version; other bits are rejected.
     pub const ALL: u32 = OVERLAP | CLOSE | DISTANCE | CONTACTS | TOI;
@@ -242,10 +259,11 @@ pub struct ResultFrameHeader {
     /// Number of contact records after the pairs.
     pub contact_count: u32,
     /// Number of candidate pairs the broad phase handed to the narrow phase (pairs whose
-    /// margin-grown world boxes overlap), reported or not.
+    /// margin-grown world boxes overlap), reported or not; with [`query::TOI`], those whose
+    /// swept boxes overlap (a superset).
     pub candidate_count: u32,
-    /// Always 0.
-    pub reserved: u32,
+    /// Number of time-of-impact records after the contacts.
+    pub toi_count: u32,
     /// Time from the receipt of the pose frame to the publication of this one, nanoseconds.
     pub elapsed_ns: u64,
     /// Time per pipeline stage, nanoseconds, indexed by [`stage`].
@@ -260,6 +278,8 @@ pub enum RecordKind {
     Pair = 1,
     /// One point of a pair's contact manifold.
     Contact = 2,
+    /// A pair's time of impact over the frame's motion (see [`query::TOI`]).
+    Toi = 3,
 }
 
 /// A close pair or one contact point: both are a pair of points on the two bodies' surfaces,
@@ -275,6 +295,12 @@ pub enum RecordKind {
 ///   `point_a`/`point_b` the contact points on each surface, `normal` from A to B (the same
 ///   for every contact of a pair), `index` the pair's position among the pair records,
 ///   `count` 0. See [`query::CONTACTS`] for what each pair kind gives.
+/// - `Toi`: `body_a < body_b`; `time` the fraction of the frame's motion at first contact;
+///   `distance`, `point_a`/`point_b`, `normal` (A→B) at the poses of `time`;
+///   `error_bound` the search tolerance (at `time` the pair is within its margins plus
+///   it); `index` 0; `count` 1, or 0 when the search stopped early (see [`query::TOI`]).
+///
+/// `time` is 0 in `Pair` and `Contact` records.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]
 #[repr(C)]
 #[type_name("proxima::ResultRecord")]
@@ -301,6 +327,8 @@ pub struct ResultRecord {
     pub point_b: [f64; 3],
     /// Unit normal from A to B, world frame.
     pub normal: [f64; 3],
+    /// `Toi` records: fraction of the frame's motion, in `[0, 1]` (see the type docs).
+    pub time: f64,
 }
 
 /// What a [`ControlRequest`] asks the daemon to do.
@@ -518,4 +546,4 @@ const _: () = assert!(size_of::<ControlReply>() == 128);
 const _: () = assert!(size_of::<PoseFrameHeader>() == 32);
 const _: () = assert!(size_of::<PoseRecord>() == 64);
 const _: () = assert!(size_of::<ResultFrameHeader>() == 104);
-const _: () = assert!(size_of::<ResultRecord>() == 112);
+const _: () = assert!(size_of::<ResultRecord>() == 120);

@@ -43,8 +43,7 @@ const _: () = assert!(pipeline::MAX_CONTACTS_PER_PAIR as u32 == wire::MAX_CONTAC
 /// The [`Query`] a pose frame's `query_flags` ask for.
 ///
 /// Refused with [`ErrorCode::MalformedMessage`]: undefined bits; no flag at all (a frame
-/// that asks nothing is a client mistake, not an empty answer); `TOI` (not implemented yet,
-/// and answering without it would pretend).
+/// that asks nothing is a client mistake, not an empty answer).
 pub fn query(flags: u32) -> Result<Query, Rejection> {
     let refuse = |reason: String| Err(Rejection::new(ErrorCode::MalformedMessage, reason));
     if flags & !query::ALL != 0 {
@@ -53,14 +52,12 @@ pub fn query(flags: u32) -> Result<Query, Rejection> {
     if flags == 0 {
         return refuse("no query flags: the frame asks for nothing".to_owned());
     }
-    if flags & query::TOI != 0 {
-        return refuse("query flag TOI is not implemented yet".to_owned());
-    }
     Ok(Query {
         overlap: flags & query::OVERLAP != 0,
         close: flags & query::CLOSE != 0,
         distance: flags & query::DISTANCE != 0,
         contacts: flags & query::CONTACTS != 0,
+        toi: flags & query::TOI != 0,
     })
 }
 
@@ -224,23 +221,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_defined_flag_combination_but_toi_becomes_the_matching_query() {
+    fn every_defined_flag_combination_becomes_the_matching_query() {
+        let mut with_toi = 0;
         for flags in 1..=query::ALL {
-            match query(flags) {
-                Ok(q) => {
-                    assert_eq!(flags & query::TOI, 0);
-                    assert_eq!(q.overlap, flags & query::OVERLAP != 0);
-                    assert_eq!(q.close, flags & query::CLOSE != 0);
-                    assert_eq!(q.distance, flags & query::DISTANCE != 0);
-                    assert_eq!(q.contacts, flags & query::CONTACTS != 0);
-                }
-                Err(r) => {
-                    assert_ne!(flags & query::TOI, 0, "flags {flags:#x} refused");
-                    assert_eq!(r.code, ErrorCode::MalformedMessage);
-                    assert!(r.reason.contains("TOI"));
-                }
-            }
+            let q = query(flags).unwrap_or_else(|r| panic!("flags {flags:#x} refused: {r:?}"));
+            assert_eq!(q.overlap, flags & query::OVERLAP != 0);
+            assert_eq!(q.close, flags & query::CLOSE != 0);
+            assert_eq!(q.distance, flags & query::DISTANCE != 0);
+            assert_eq!(q.contacts, flags & query::CONTACTS != 0);
+            assert_eq!(q.toi, flags & query::TOI != 0);
+            with_toi += usize::from(q.toi);
         }
+        // TOI alone and with each of the 15 combinations of the others.
+        assert_eq!(with_toi, 16);
     }
 
     #[test]

@@ -1,6 +1,8 @@
 //! The frame path of one scene: receive a pose frame, ingest it (poses and query), run the
-//! pipeline for that query, write the result frame — pair records, then contact records —
-//! straight into a loaned shared-memory sample, publish, notify.
+//! pipeline for that query, write the result frame — pair records, then contact records,
+//! then time-of-impact records — straight into a loaned shared-memory sample, publish,
+//! notify. An answered frame ends the scene's frame ([`Scene::end_frame`]): its poses are
+//! where the next frame's motion starts (refused frames apply no pose and end nothing).
 //!
 //! The header carries the pipeline's own [`StepReport`]: broad and narrow timings
 //! (`stage_ns[BROAD]`, `stage_ns[NARROW]`), candidate, pair and contact counts; ingest and
@@ -16,8 +18,8 @@ use super::ingest::{FrameRejection, apply_pose_frame};
 use super::log::{Cause, Level, Logger, Subject};
 use crate::math::Pose;
 use crate::pipeline::{
-    self, Completeness, ContactPoint, FrameResults, PairResult, PipelineWorkspace, StepReport,
-    WorkerPool,
+    self, Completeness, ContactPoint, FrameResults, PairResult, PairToi, PipelineWorkspace,
+    StepReport, WorkerPool,
 };
 use crate::scene::{BodyId, Scene};
 use iceoryx2::port::notifier::Notifier;
@@ -124,6 +126,7 @@ impl<S: Service> SceneFrames<S> {
             result.stage_ns[wire::stage::INGEST] = ingest_ns;
             self.output.pairs.clear();
             self.output.contacts.clear();
+            self.output.tois.clear();
             match outcome {
                 Err(FrameRejection {
                     rejection: Rejection { code, reason },
@@ -145,6 +148,7 @@ impl<S: Service> SceneFrames<S> {
                 Ok(query) => {
                     let report =
                         pipeline::step(scene, query, &mut self.workspace, &mut self.output);
+                    scene.end_frame();
                     fill_header(&mut result, &report);
                 }
             }
@@ -161,14 +165,20 @@ impl<S: Service> SceneFrames<S> {
         budget_ns: u64,
     ) -> Result<(), String> {
         let publish_started = Instant::now();
-        let FrameResults { pairs, contacts } = &self.output;
+        let FrameResults {
+            pairs,
+            contacts,
+            tois,
+        } = &self.output;
+        let tois_from = pairs.len() + contacts.len();
         let mut sample = self
             .results
-            .loan_slice_uninit(pairs.len() + contacts.len())
+            .loan_slice_uninit(tois_from + tois.len())
             .map_err(|e| format!("results loan: {e:?}"))?
             .write_from_fn(|i| match pairs.get(i) {
                 Some(pair) => pair_record(pair),
-                None => contact_record(pairs, &contacts[i - pairs.len()]),
+                None if i < tois_from => contact_record(pairs, &contacts[i - pairs.len()]),
+                None => toi_record(&tois[i - tois_from]),
             });
         header.stage_ns[wire::stage::PUBLISH] = elapsed_ns(publish_started);
         header.elapsed_ns = elapsed_ns(received);
@@ -198,9 +208,11 @@ fn fill_header(header: &mut ResultFrameHeader, report: &StepReport) {
     };
     header.stage_ns[wire::stage::BROAD] = report.broad_ns;
     header.stage_ns[wire::stage::NARROW] = report.narrow_ns;
-    header.candidate_count = report.candidates;
+    // With TOI the swept candidates, a superset of the others.
+    header.candidate_count = report.candidates.max(report.toi_candidates);
     header.pair_count = report.pairs;
     header.contact_count = report.contacts;
+    header.toi_count = report.tois;
 }
 
 fn pair_record(r: &PairResult) -> ResultRecord {
@@ -216,6 +228,7 @@ fn pair_record(r: &PairResult) -> ResultRecord {
         point_a: r.point_a.to_array(),
         point_b: r.point_b.to_array(),
         normal: r.normal.to_array(),
+        time: 0.0,
     }
 }
 
@@ -234,5 +247,24 @@ fn contact_record(pairs: &[PairResult], c: &ContactPoint) -> ResultRecord {
         point_a: c.point_a.to_array(),
         point_b: c.point_b.to_array(),
         normal: c.normal.to_array(),
+        time: 0.0,
+    }
+}
+
+/// The record of a pair's time of impact (`count` 1 when the search reached contact).
+fn toi_record(r: &PairToi) -> ResultRecord {
+    ResultRecord {
+        kind: RecordKind::Toi as u32,
+        body_a: r.a,
+        body_b: r.b,
+        index: 0,
+        count: u32::from(r.reached),
+        reserved: 0,
+        distance: r.distance,
+        error_bound: r.error_bound,
+        point_a: r.point_a.to_array(),
+        point_b: r.point_b.to_array(),
+        normal: r.normal.to_array(),
+        time: r.time,
     }
 }

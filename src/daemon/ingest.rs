@@ -224,7 +224,7 @@ mod tests {
             ),
             (ErrorCode::MalformedMessage, None)
         );
-        for flags in [0, query::TOI, query::CLOSE | query::TOI] {
+        for flags in [0, 1 << 5, query::TOI | 1 << 31] {
             assert_eq!(
                 bad(
                     vec![record(0, 1.0)],

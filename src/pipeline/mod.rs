@@ -12,6 +12,7 @@
 //! | [`Query::overlap`] | the shapes touch or intersect (distance ≤ 0) | [`intersects_mesh_mesh`](crate::narrow::mesh_mesh::intersects_mesh_mesh), stops at the first proof |
 //! | [`Query::distance`] | every candidate pair, also beyond the margins, with its exact signed distance | exact distance |
 //! | [`Query::contacts`] | touching pairs, each with its manifold ([`ContactPoint`]s, at most [`MAX_CONTACTS_PER_PAIR`]) | every intersecting triangle pair ([`contacts_mesh_mesh`](crate::narrow::mesh_mesh::contacts_mesh_mesh)), then [`reduce_manifold`] |
+//! | [`Query::toi`] | pairs that come within their margins during the frame's motion, each with its time of impact ([`PairToi`], in [`FrameResults::tois`]) | exact distance per conservative-advancement step |
 //!
 //! Flags combine: `CLOSE | CONTACTS` reports the close pairs, and the touching ones among
 //! them carry contacts. `OVERLAP` adds nothing to `CLOSE` or `DISTANCE` (their records
@@ -35,6 +36,21 @@
 //! [`PairResult::first_contact`] and [`PairResult::contact_count`] locate a pair's contacts
 //! in [`FrameResults::contacts`]; each [`ContactPoint::pair`] names its pair back.
 //!
+//! # Time of impact
+//! `TOI` answers over the frame's *motion*: each body moves from its pose when the last
+//! frame was answered ([`Scene::end_frame`]) to its pose now, `t ∈ [0, 1]` the fraction of
+//! that motion (position linear, orientation shortest-arc slerp:
+//! [`FrameMotion`](crate::narrow::toi::FrameMotion)), world frame. Its candidates come from
+//! a second broad phase over the bodies' *swept* boxes ([`Scene::swept_proxies`]: the box
+//! of the whole motion, grown by the margin), a superset of the other flags' candidates, so
+//! pairs that pass through each other between two frames are found. Each candidate gets a
+//! conservative-advancement search over the dispatcher's signed distance: the reported `t`
+//! is never later than the first time the pair is within its margins, and the pair is then
+//! within its margins plus [`TOI_TOLERANCE`]; `t = 0` when it already is at the start;
+//! pairs that never come within their margins are not reported (see [`PairToi`]). Its
+//! records are separate from the pair records: a frame asking `CLOSE | TOI` gets both,
+//! each by its own rule.
+//!
 //! # Design note: determinism and ordering
 //! The same scene and query give the same results: the broad phase yields pairs sorted by
 //! `(a, b)`, each pair is answered independently in that order, and nothing depends on
@@ -57,9 +73,11 @@
 mod answer;
 mod contacts;
 mod dispatch;
+mod toi;
 pub mod workers;
 
 pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
+pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{CandidatePair, Proxy, SortAndSweep};
 use crate::math::DVec3;
@@ -87,6 +105,8 @@ pub struct Query {
     pub distance: bool,
     /// Contact manifolds of touching pairs.
     pub contacts: bool,
+    /// Time of impact over the frame's motion (see the [module docs](self)).
+    pub toi: bool,
 }
 
 impl Query {
@@ -96,6 +116,7 @@ impl Query {
         close: false,
         distance: false,
         contacts: false,
+        toi: false,
     };
     /// Only `overlap`.
     pub const OVERLAP: Self = Self {
@@ -117,6 +138,11 @@ impl Query {
         contacts: true,
         ..Self::NONE
     };
+    /// Only `toi`.
+    pub const TOI: Self = Self {
+        toi: true,
+        ..Self::NONE
+    };
 
     /// Both queries' flags.
     #[must_use]
@@ -126,7 +152,13 @@ impl Query {
             close: self.close || other.close,
             distance: self.distance || other.distance,
             contacts: self.contacts || other.contacts,
+            toi: self.toi || other.toi,
         }
+    }
+
+    /// Whether any flag answered at the current poses (all but `toi`) is set.
+    const fn at_current_poses(self) -> bool {
+        self.overlap || self.close || self.distance || self.contacts
     }
 
     /// Whether a pair with this answer and these margins is reported.
@@ -181,13 +213,17 @@ pub struct ContactPoint {
     pub error_bound: f64,
 }
 
-/// The reported pairs and their contacts, reused across frames (cleared by [`step`]).
+/// The reported pairs, their contacts and times of impact, reused across frames (cleared
+/// by [`step`]).
 #[derive(Debug, Default)]
 pub struct FrameResults {
     /// Reported pairs in `(a, b)` order.
     pub pairs: Vec<PairResult>,
     /// Every reported pair's contacts, in pair order.
     pub contacts: Vec<ContactPoint>,
+    /// With [`Query::toi`]: the pairs that come within contact during the frame's motion,
+    /// in `(a, b)` order.
+    pub tois: Vec<PairToi>,
 }
 
 /// Whether a frame's answers are all exact.
@@ -207,12 +243,20 @@ pub enum Completeness {
 pub struct StepReport {
     /// Whether every answer is exact.
     pub completeness: Completeness,
-    /// Broad phase (proxies and candidate pairs), nanoseconds.
+    /// Broad phase (proxies and candidate pairs; with `toi` also the swept ones),
+    /// nanoseconds.
     pub broad_ns: u64,
-    /// Narrow phase (every candidate's answer and manifold), nanoseconds.
+    /// Narrow phase (every candidate's answer and manifold, and time of impact),
+    /// nanoseconds.
     pub narrow_ns: u64,
-    /// Candidate pairs from the broad phase.
+    /// Candidate pairs from the broad phase over the current boxes (0 when only `toi` is
+    /// asked).
     pub candidates: u32,
+    /// With `toi`: candidate pairs from the broad phase over the swept boxes (a superset of
+    /// `candidates`), else 0.
+    pub toi_candidates: u32,
+    /// Time-of-impact records (`results.tois.len()`).
+    pub tois: u32,
     /// Reported pairs (`results.pairs.len()`).
     pub pairs: u32,
     /// Contact points (`results.contacts.len()`).
@@ -243,6 +287,12 @@ pub struct PipelineWorkspace {
     narrow: NarrowScratch,
     /// One pair's manifold, before it joins the frame's contacts.
     manifold: Manifold,
+    /// Swept boxes of the bodies (time of impact).
+    swept: Vec<Proxy>,
+    /// The broad phase over the swept boxes, with its own order kept between frames.
+    swept_sweep: SortAndSweep,
+    /// Candidate pairs of the swept boxes.
+    toi_candidates: Vec<CandidatePair>,
 }
 
 impl PipelineWorkspace {
@@ -268,10 +318,23 @@ pub fn step(
     let started = Instant::now();
     results.pairs.clear();
     results.contacts.clear();
-    scene.proxies(&mut workspace.proxies);
-    workspace
-        .sweep
-        .pairs(&workspace.proxies, &mut workspace.candidates);
+    results.tois.clear();
+    if query.at_current_poses() {
+        scene.proxies(&mut workspace.proxies);
+        workspace
+            .sweep
+            .pairs(&workspace.proxies, &mut workspace.candidates);
+    } else {
+        workspace.candidates.clear();
+    }
+    if query.toi {
+        scene.swept_proxies(&mut workspace.swept);
+        workspace
+            .swept_sweep
+            .pairs(&workspace.swept, &mut workspace.toi_candidates);
+    } else {
+        workspace.toi_candidates.clear();
+    }
     let broad_ns = elapsed_ns(started);
     let started = Instant::now();
     let mut completeness = Completeness::Exact;
@@ -284,6 +347,7 @@ pub fn step(
         job_contacts,
         narrow,
         manifold,
+        toi_candidates,
         ..
     } = workspace;
     mesh_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
@@ -357,13 +421,22 @@ pub fn step(
             results.contacts.truncate(first_contact);
         }
     }
+    for pair in toi_candidates.iter() {
+        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+        let shapes = (shape(scene, a), shape(scene, b));
+        if let Some(toi) = toi::pair_toi(scene, pair, (a, shapes.0), (b, shapes.1), narrow) {
+            results.tois.push(toi);
+        }
+    }
     StepReport {
         completeness,
         broad_ns,
         narrow_ns: elapsed_ns(started),
         candidates: index(candidates.len()),
+        toi_candidates: index(toi_candidates.len()),
         pairs: index(results.pairs.len()),
         contacts: index(results.contacts.len()),
+        tois: index(results.tois.len()),
     }
 }
 
@@ -434,6 +507,7 @@ mod tests {
             close: bits & 2 != 0,
             distance: bits & 4 != 0,
             contacts: bits & 8 != 0,
+            toi: false,
         })
     }
 
