@@ -26,7 +26,8 @@ pub const FLAT_EDGE_ANGLE: f64 = 1e-5;
 /// Marks an edge without a single neighbour in [`TriangleEdges::neighbours`].
 pub const NO_NEIGHBOUR: u32 = u32::MAX;
 
-/// How the surface bends across an edge, seen from a triangle's front side.
+/// How the surface bends across an edge, seen from a triangle's front side (the side its
+/// normal `(b − a) × (c − a)` points to); from the back, convex and concave swap.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EdgeKind {
     /// No single neighbour with a normal: a boundary edge, an edge shared by three or more
@@ -72,7 +73,12 @@ pub struct TriangleEdges {
     pub neighbour_normals: [DVec3; 3],
 }
 
-/// Edge adjacency and bends of a whole mesh (see the [module docs](self)).
+/// Edge adjacency and bends of a whole mesh: for each triangle its [`TriangleEdges`], and
+/// for each vertex whether an edge at it is bent or open. Kinds are seen from each
+/// triangle's front (counter-clockwise) side; neighbours wound the other way are compared
+/// through their reversed normals. The narrow phase uses it to remove ghost normals: a
+/// per-triangle contact's edge or vertex normal across a flat or concave edge is not a
+/// normal of the surface.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshEdges {
     triangles: Vec<TriangleEdges>,
