@@ -633,18 +633,20 @@ mod tests {
     }
 
     /// Boxes (and balls, capsules, cylinders) resting on, sunk into or hovering over a
-    /// triangulated floor, in many positions with small tilts: the manifold's normal is the
+    /// triangulated floor (at its frame's origin, or 1e5 m from it), in many positions with
+    /// small tilts: the manifold's normal is the
     /// floor's, and its deepest point is the brute-force deepest penetration along it over
     /// every triangle the shape touches (which is also the sunk depth itself). The raw
     /// per-triangle normals do tilt, even the deepest triangle's (the normal the manifold
     /// took before ghost removal): the ghosts are there to remove.
     #[test]
     fn shapes_on_a_triangulated_floor_only_get_the_floor_normal_and_its_depth() {
-        let floor = mesh_shape(meshes::grid(5.0, 10));
-        let Shape::Mesh(mesh) = &floor else {
-            unreachable!()
-        };
-        let triangles = meshes::triangles(&mesh.mesh);
+        // The same floor at the origin and 1e5 m away in its own frame.
+        let far = DVec3::new(1e5, -1e5, 0.0);
+        let floors = [DVec3::ZERO, far].map(|offset| {
+            let mesh = meshes::grid(5.0, 10).translated(offset);
+            (offset, meshes::triangles(&mesh), mesh_shape(mesh))
+        });
         let mut rng = rng(501);
         let mut scratch = NarrowScratch::default();
         let (mut touching, mut apart, mut ghosts, mut deepest_ghosts) = (0, 0, 0, 0);
@@ -668,9 +670,10 @@ mod tests {
             };
             let lowest = support_value(&shape, tilt.inverse() * -DVec3::Z);
             let gap = rng.random_range(-0.08..0.02);
-            let shape_pose = Pose::new(DVec3::new(xy.0, xy.1, lowest + gap), tilt);
+            let (offset, triangles, floor) = &floors[usize::from(case % 4 == 3)];
+            let shape_pose = Pose::new(*offset + DVec3::new(xy.0, xy.1, lowest + gap), tilt);
             let pose_ab = Pose::relative(&shape_pose, &Pose::IDENTITY);
-            let (d, m) = answer(&shape, &floor, &pose_ab, &mut scratch);
+            let (d, m) = answer(&shape, floor, &pose_ab, &mut scratch);
             let down = pose_ab.transform_vector(-DVec3::Z);
             if d.distance > 0.0 {
                 apart += 1;
@@ -856,8 +859,9 @@ mod tests {
         );
     }
 
-    /// Every convex kind against a torus, a flat grid, a finely cut box and a triangle soup
-    /// (open and non-manifold edges, inconsistent winding) at random poses: the manifold
+    /// Every convex kind against a torus, a flat grid, a finely cut box, a triangle soup
+    /// (open and non-manifold edges, inconsistent winding) and a box with zero-area
+    /// triangles mixed in, at random poses: the manifold
     /// keeps the contact contract, is empty exactly when the shapes are apart, and is the
     /// same (to rounding) whether it reuses the distance walk or walks the tree itself.
     #[test]
@@ -868,11 +872,16 @@ mod tests {
             mesh_shape(meshes::grid(1.5, 8)),
             mesh_shape(meshes::subdivided_cuboid(DVec3::new(0.8, 0.6, 0.7), 3)),
             mesh_shape(meshes::triangle_soup(&mut rng, 60, 1.0, 0.5)),
+            mesh_shape(meshes::with_zero_area_triangles(
+                &mut rng,
+                DVec3::splat(0.9),
+                30,
+            )),
         ];
         let mut scratch = NarrowScratch::default();
         let mut fresh = NarrowScratch::default();
         let (mut touching, mut apart) = (0, 0);
-        for case in 0..2400 {
+        for case in 0..3000 {
             let mesh = &meshes[case % meshes.len()];
             let shape = random_convex(&mut rng, 0.5, 6);
             let pose_ab = Pose::new(point_in_cube(&mut rng, 1.6), rotation(&mut rng));
