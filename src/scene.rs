@@ -26,6 +26,7 @@ use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
 pub use crate::broad::CollisionFilter;
 use crate::broad::Proxy;
 use crate::bvh::{BuildParams, Bvh};
+use crate::geometry::mesh::MeshEdges;
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::toi::{FrameMotion, swept_bounds};
@@ -50,13 +51,17 @@ pub struct MeshShape {
     pub overlap_tree: Bvh<Obb>,
     /// Binned-SAH tree of RSSs.
     pub distance_tree: Bvh<Rss>,
+    /// Edge adjacency and bends, for convex–mesh contacts without ghost normals.
+    pub edges: MeshEdges,
 }
 
 impl MeshShape {
-    /// Builds both trees over `mesh` (offline work: about 1 s for 70,000 triangles).
+    /// Builds both trees over `mesh` (offline work: about 1 s for 70,000 triangles) and
+    /// its edge adjacency.
     #[must_use]
     pub fn new(mesh: TriMesh) -> Self {
         Self {
+            edges: MeshEdges::new(&mesh),
             overlap_tree: Bvh::from_mesh(&mesh, &BuildParams::BINNED_SAH),
             distance_tree: Bvh::from_mesh(&mesh, &BuildParams::BINNED_SAH),
             mesh,

@@ -30,8 +30,8 @@ impl ConvexMeshWorkspace {
     }
 }
 
-/// The smallest value of `triangle_value` over the mesh's triangles (each given in A's
-/// frame), skipping every subtree whose volume's lower bound on the distance to the shape's
+/// The smallest value of `triangle_value` over the mesh's triangles (each given with its id
+/// in the mesh and in A's frame), skipping every subtree whose volume's lower bound on the distance to the shape's
 /// volume `shape_bv` exceeds the best value so far (or 0, while the best is negative: a
 /// deeper penetration can hide in any subtree that overlaps the shape) or `limit` (metres;
 /// `f64::INFINITY` for the exact minimum). `None` for a mesh with no triangle, or when no
@@ -40,13 +40,17 @@ impl ConvexMeshWorkspace {
 /// `triangle_value` must never be below the true distance between the shape and the
 /// triangle minus its own error (a signed distance, or a distance clamped at 0), so that the
 /// volumes' lower bounds stay valid for it.
+///
+/// Every triangle whose value is `≤ 0` is visited when `limit ≥ 0` (the walk stops only at
+/// subtrees whose lower bound is positive), so a caller may collect the triangles the shape
+/// touches during this walk instead of walking again.
 pub fn nearest_triangle<B, T>(
     shape_bv: &B,
     tree: &Bvh<B>,
     pose_ab: &Pose,
     limit: f64,
     workspace: &mut ConvexMeshWorkspace,
-    mut triangle_value: impl FnMut(&Triangle) -> (f64, T),
+    mut triangle_value: impl FnMut(u32, &Triangle) -> (f64, T),
 ) -> Option<(f64, T)>
 where
     B: BoundingVolume,
@@ -81,7 +85,7 @@ where
         if node.is_leaf() {
             for slot in node.slots() {
                 let triangle = tree.triangles()[slot].transformed(&iso_ab);
-                let (value, answer) = triangle_value(&triangle);
+                let (value, answer) = triangle_value(tree.triangle_id(slot), &triangle);
                 if best.as_ref().is_none_or(|(b, _)| value < *b) {
                     best = Some((value, answer));
                 }
@@ -199,7 +203,7 @@ mod tests {
                 &pose_ab,
                 f64::INFINITY,
                 &mut workspace,
-                |t| (ball_triangle(center, radius, t), ()),
+                |_, t| (ball_triangle(center, radius, t), ()),
             )
             .unwrap()
             .0;
@@ -209,7 +213,7 @@ mod tests {
                 &pose_ab,
                 f64::INFINITY,
                 &mut workspace,
-                |t| (ball_triangle(center, radius, t), ()),
+                |_, t| (ball_triangle(center, radius, t), ()),
             )
             .unwrap()
             .0;
@@ -222,7 +226,7 @@ mod tests {
                 &pose_ab,
                 limit,
                 &mut workspace,
-                |t| (ball_triangle(center, radius, t), ()),
+                |_, t| (ball_triangle(center, radius, t), ()),
             )
             .map(|(d, ())| d);
             if truth <= limit {

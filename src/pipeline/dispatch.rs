@@ -18,14 +18,14 @@
 //! shape reaches through some triangle. A shape entirely inside a closed mesh without
 //! touching its surface is apart from it, as for mesh–mesh.
 
-use super::contacts::reduce_manifold;
+#[path = "mesh_contacts.rs"]
+mod mesh_contacts;
+
 use crate::bounding::{BoundingVolume, Obb, Rss};
 use crate::geometry::{Segment, SupportMap, Triangle};
 use crate::math::{DMat3, DVec3, Isometry, Pose};
 use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
-use crate::narrow::convex_mesh::{
-    ConvexMeshWorkspace, for_each_overlapping_triangle, nearest_triangle,
-};
+use crate::narrow::convex_mesh::ConvexMeshWorkspace;
 use crate::narrow::gjk::{
     EpaWorkspace, GjkCache, GjkOutcome, GjkParams, POINT, Rounded, gjk_distance,
     signed_distance_convex,
@@ -35,7 +35,7 @@ use crate::narrow::mesh_mesh::{
 };
 use crate::narrow::pairs;
 use crate::scene::{MeshShape, Shape};
-use std::ops::ControlFlow;
+use mesh_contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 use std::sync::Arc;
 
 /// GJK/EPA settings of the pipeline: GJK's defaults (relative tolerance 1e-10).
@@ -53,13 +53,8 @@ pub(super) struct NarrowScratch {
     epa: EpaWorkspace,
     convex_mesh: ConvexMeshWorkspace,
     mesh_mesh: MeshMeshWorkspace,
-    /// A triangle's manifold, while a convex–mesh manifold is gathered.
-    triangle_manifold: Manifold,
-    /// Every triangle contact of a convex–mesh manifold, before reduction.
-    points: Vec<ManifoldPoint>,
-    normals: Vec<DVec3>,
-    positions: Vec<DVec3>,
-    kept: Vec<usize>,
+    /// Convex–mesh contacts: the distance walk's touching triangles and the manifold's.
+    mesh_contacts: MeshContactScratch,
 }
 
 /// Every convex kind, as a pattern (every kind but the mesh).
@@ -178,7 +173,7 @@ pub(super) fn manifold(
         | (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!())
         | (M(_), M(_)) => out.set_from_distance(d),
-        (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, scratch, out),
+        (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, d, scratch, out),
     }
 }
 
@@ -387,101 +382,4 @@ fn box_corners(shape: &Shape) -> [DVec3; 8] {
             if i & 4 == 0 { local.min.z } else { local.max.z },
         )
     })
-}
-
-/// A convex shape against a mesh's triangles: the nearest (or deepest) triangle.
-fn shape_mesh_distance(
-    shape: &Shape,
-    mesh: &MeshShape,
-    pose_ab: &Pose,
-    limit: f64,
-    scratch: &mut NarrowScratch,
-) -> ShapeDistance {
-    let NarrowScratch {
-        epa, convex_mesh, ..
-    } = scratch;
-    let bound = Rss::around(shape);
-    nearest_triangle(
-        &bound,
-        &mesh.distance_tree,
-        pose_ab,
-        limit,
-        convex_mesh,
-        |triangle| {
-            let d = shape_triangle_distance(shape, triangle, epa);
-            (d.distance, d)
-        },
-    )
-    .map_or(
-        // A mesh without triangles, or nothing within the limit.
-        ShapeDistance {
-            distance: f64::INFINITY,
-            point_a: DVec3::ZERO,
-            point_b: DVec3::ZERO,
-            normal: DVec3::X,
-        },
-        |(_, d)| d,
-    )
-}
-
-/// A convex shape against a mesh: the manifolds of every triangle the shape reaches,
-/// reduced to [`crate::narrow::MANIFOLD_POINTS`] points, under the normal of the deepest
-/// triangle contact (so contacts across internal edges of a flat region share the face's
-/// normal instead of tilted edge normals).
-fn shape_mesh_manifold(
-    shape: &Shape,
-    mesh: &MeshShape,
-    pose_ab: &Pose,
-    scratch: &mut NarrowScratch,
-    out: &mut Manifold,
-) {
-    let NarrowScratch {
-        epa,
-        convex_mesh,
-        triangle_manifold,
-        points,
-        normals,
-        positions,
-        kept,
-        ..
-    } = scratch;
-    points.clear();
-    normals.clear();
-    let bound = Obb::around(shape);
-    for_each_overlapping_triangle(
-        &bound,
-        &mesh.overlap_tree,
-        pose_ab,
-        convex_mesh,
-        |_, triangle| {
-            shape_triangle_manifold(shape, triangle, epa, triangle_manifold);
-            for p in triangle_manifold.points() {
-                points.push(*p);
-                normals.push(triangle_manifold.normal);
-            }
-            ControlFlow::Continue(())
-        },
-    );
-    out.reset(DVec3::ZERO);
-    let Some(deepest) =
-        (0..points.len()).min_by(|&i, &j| points[i].distance.total_cmp(&points[j].distance))
-    else {
-        return;
-    };
-    let normal = normals[deepest];
-    out.reset(normal);
-    positions.clear();
-    positions.extend(points.iter().map(|p| p.point_a));
-    reduce_manifold(positions, kept);
-    // The deepest point always stays.
-    if !kept.contains(&deepest) {
-        kept.pop();
-        kept.insert(0, deepest);
-    }
-    for &i in kept.iter() {
-        let p = points[i];
-        // Depth along the common normal.
-        let distance = (p.point_b - p.point_a).dot(normal).min(0.0);
-        out.push(ManifoldPoint { distance, ..p });
-    }
 }
