@@ -6,7 +6,7 @@
 //! |---|---|---|
 //! | sphere, capsule, cuboid among themselves | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
 //! | a cylinder, cone or convex hull with any convex shape | GJK on the cores, EPA when they overlap ([`crate::narrow::gjk`]) | one point: the signed-distance witnesses |
-//! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, reduced to 4 points, with the normal of the deepest |
+//! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`super::mesh_contacts`]) |
 //! | mesh–mesh | [`Route::MeshMesh`]: the BVH tandem queries with warm starts and the worker pool | intersection segments, reduced |
 //!
 //! Canonical order: sphere < capsule < cuboid < cylinder < cone < convex < mesh. GJK is
@@ -18,12 +18,9 @@
 //! shape reaches through some triangle. A shape entirely inside a closed mesh without
 //! touching its surface is apart from it, as for mesh–mesh.
 
-#[path = "mesh_contacts.rs"]
-mod mesh_contacts;
-
-use crate::bounding::{BoundingVolume, Obb, Rss};
-use crate::geometry::{Segment, SupportMap, Triangle};
-use crate::math::{DMat3, DVec3, Isometry, Pose};
+use super::mesh_contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
+use crate::geometry::{Segment, SupportMap};
+use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
 use crate::narrow::gjk::{
@@ -35,11 +32,10 @@ use crate::narrow::mesh_mesh::{
 };
 use crate::narrow::pairs;
 use crate::scene::{MeshShape, Shape};
-use mesh_contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 use std::sync::Arc;
 
 /// GJK/EPA settings of the pipeline: GJK's defaults (relative tolerance 1e-10).
-const GJK: GjkParams = GjkParams {
+pub(super) const GJK: GjkParams = GjkParams {
     rel_tol: 1e-10,
     epa_rel_tol: 1e-10,
     abs_tol: 0.0,
@@ -50,11 +46,11 @@ const GJK: GjkParams = GjkParams {
 /// Scratch of the dispatcher for one thread (no allocation once grown).
 #[derive(Debug, Default)]
 pub(super) struct NarrowScratch {
-    epa: EpaWorkspace,
-    convex_mesh: ConvexMeshWorkspace,
+    pub(super) epa: EpaWorkspace,
+    pub(super) convex_mesh: ConvexMeshWorkspace,
     mesh_mesh: MeshMeshWorkspace,
     /// Convex–mesh contacts: the distance walk's touching triangles and the manifold's.
-    mesh_contacts: MeshContactScratch,
+    pub(super) mesh_contacts: MeshContactScratch,
 }
 
 /// Every convex kind, as a pattern (every kind but the mesh).
@@ -232,14 +228,14 @@ fn flip_manifold(m: &mut Manifold, pose_ab: &Isometry) {
 
 /// A convex shape as GJK sees it: a core and a radius (a sphere is a point swept by its
 /// radius, a capsule a segment; the others have no radius).
-enum Core<'s> {
+pub(super) enum Core<'s> {
     Point,
     Segment(Segment),
     Support(&'s dyn SupportMap),
 }
 
 impl Core<'_> {
-    fn support_map(&self) -> &dyn SupportMap {
+    pub(super) fn support_map(&self) -> &dyn SupportMap {
         match self {
             Core::Point => &POINT,
             Core::Segment(s) => s,
@@ -249,7 +245,7 @@ impl Core<'_> {
 }
 
 /// The core and radius of a convex shape; `None` for a mesh.
-fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
+pub(super) fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
     Some(match shape {
         Shape::Sphere(s) => (Core::Point, s.radius),
         Shape::Capsule(c) => (Core::Segment(c.segment()), c.radius),
@@ -284,102 +280,4 @@ fn convex_distance(
         &mut scratch.epa,
     )
     .0
-}
-
-/// The signed distance of a convex shape (A's frame) and one triangle (A's frame).
-fn shape_triangle_distance(
-    shape: &Shape,
-    triangle: &Triangle,
-    epa: &mut EpaWorkspace,
-) -> ShapeDistance {
-    let identity = Isometry::IDENTITY;
-    match shape {
-        Shape::Sphere(s) => pairs::distance_sphere_triangle(s, triangle, &identity),
-        Shape::Capsule(c) => pairs::distance_capsule_triangle(c, triangle, &identity),
-        Shape::Cuboid(b) => pairs::distance_cuboid_triangle(b, triangle, &identity),
-        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
-            let Some((core, radius)) = core_of(shape) else {
-                unreachable!("meshes are not convex shapes");
-            };
-            signed_distance_convex(
-                &Rounded::new(core.support_map(), radius),
-                &Rounded::plain(triangle),
-                &identity,
-                &GJK,
-                &mut GjkCache::default(),
-                epa,
-            )
-            .0
-        }
-    }
-}
-
-/// The manifold of a convex shape and one triangle, both in A's frame.
-fn shape_triangle_manifold(
-    shape: &Shape,
-    triangle: &Triangle,
-    epa: &mut EpaWorkspace,
-    out: &mut Manifold,
-) {
-    let identity = Isometry::IDENTITY;
-    out.reset(DVec3::ZERO);
-    match shape {
-        Shape::Sphere(s) => pairs::manifold_sphere_triangle(s, triangle, &identity, out),
-        Shape::Capsule(c) => pairs::manifold_capsule_triangle(c, triangle, &identity, out),
-        Shape::Cuboid(b) => pairs::manifold_cuboid_triangle(b, triangle, &identity, out),
-        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
-            let d = shape_triangle_distance(shape, triangle, epa);
-            out.set_from_distance(&d);
-        }
-    }
-}
-
-/// The tightest volume of a tree's type around a convex shape, its local frame, for the
-/// mesh BVH walk: its lower bounds prune the walk, so a loose one costs triangles.
-trait ShapeBound: BoundingVolume {
-    fn around(shape: &Shape) -> Self;
-}
-
-impl ShapeBound for Rss {
-    /// A ball or a capsule exactly; a box as its xy rectangle swept by its z half extent;
-    /// anything else the volume fitted to its local box's corners.
-    fn around(shape: &Shape) -> Self {
-        match shape {
-            Shape::Sphere(s) => Rss::new(DVec3::ZERO, DMat3::IDENTITY, [0.0, 0.0], s.radius),
-            // Axes (Z, X, Y): the rectangle's first axis along the capsule's segment.
-            Shape::Capsule(c) => Rss::new(
-                DVec3::ZERO,
-                DMat3::from_cols(DVec3::Z, DVec3::X, DVec3::Y),
-                [c.half_height, 0.0],
-                c.radius,
-            ),
-            Shape::Cuboid(b) => {
-                let h = b.half_extents;
-                Rss::new(DVec3::ZERO, DMat3::IDENTITY, [h.x, h.y], h.z)
-            }
-            Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
-                Rss::fit_points(&box_corners(shape))
-            }
-        }
-    }
-}
-
-impl ShapeBound for Obb {
-    /// The shape's local box.
-    fn around(shape: &Shape) -> Self {
-        let local = shape.local_bounds();
-        Obb::new(local.center(), DMat3::IDENTITY, local.half_extents())
-    }
-}
-
-/// The corners of a shape's local box.
-fn box_corners(shape: &Shape) -> [DVec3; 8] {
-    let local = shape.local_bounds();
-    std::array::from_fn(|i| {
-        DVec3::new(
-            if i & 1 == 0 { local.min.x } else { local.max.x },
-            if i & 2 == 0 { local.min.y } else { local.max.y },
-            if i & 4 == 0 { local.min.z } else { local.max.z },
-        )
-    })
 }

@@ -49,14 +49,18 @@
 //! shapes whose triangle manifold is one point (spheres and the GJK shapes). A pair beyond
 //! contact (distance `> 0`) gets an empty manifold with no walk at all.
 
-use super::super::contacts::reduce_manifold;
-use super::{NarrowScratch, ShapeBound, core_of, shape_triangle_distance, shape_triangle_manifold};
+use super::contacts::reduce_manifold;
+use super::dispatch::{GJK, NarrowScratch, core_of};
+use crate::bounding::BoundingVolume;
 use crate::bounding::{Obb, Rss};
 use crate::geometry::Triangle;
 use crate::geometry::mesh::{EdgeKind, NO_NEIGHBOUR};
+use crate::math::DMat3;
 use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
 use crate::narrow::convex_mesh::{for_each_overlapping_triangle, nearest_triangle};
+use crate::narrow::gjk::{EpaWorkspace, GjkCache, Rounded, signed_distance_convex};
+use crate::narrow::pairs;
 use crate::scene::{MeshShape, Shape};
 use std::ops::ControlFlow;
 
@@ -531,9 +535,110 @@ fn feature(t: &Triangle, witness: DVec3) -> Feature {
     }
 }
 
+// ---------------------------------------------------------------------------------------
+// One convex shape against one triangle, and the shape's volume for the tree walks.
+
+/// The signed distance of a convex shape (A's frame) and one triangle (A's frame).
+pub(super) fn shape_triangle_distance(
+    shape: &Shape,
+    triangle: &Triangle,
+    epa: &mut EpaWorkspace,
+) -> ShapeDistance {
+    let identity = Isometry::IDENTITY;
+    match shape {
+        Shape::Sphere(s) => pairs::distance_sphere_triangle(s, triangle, &identity),
+        Shape::Capsule(c) => pairs::distance_capsule_triangle(c, triangle, &identity),
+        Shape::Cuboid(b) => pairs::distance_cuboid_triangle(b, triangle, &identity),
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
+            let Some((core, radius)) = core_of(shape) else {
+                unreachable!("meshes are not convex shapes");
+            };
+            signed_distance_convex(
+                &Rounded::new(core.support_map(), radius),
+                &Rounded::plain(triangle),
+                &identity,
+                &GJK,
+                &mut GjkCache::default(),
+                epa,
+            )
+            .0
+        }
+    }
+}
+
+/// The manifold of a convex shape and one triangle, both in A's frame.
+pub(super) fn shape_triangle_manifold(
+    shape: &Shape,
+    triangle: &Triangle,
+    epa: &mut EpaWorkspace,
+    out: &mut Manifold,
+) {
+    let identity = Isometry::IDENTITY;
+    out.reset(DVec3::ZERO);
+    match shape {
+        Shape::Sphere(s) => pairs::manifold_sphere_triangle(s, triangle, &identity, out),
+        Shape::Capsule(c) => pairs::manifold_capsule_triangle(c, triangle, &identity, out),
+        Shape::Cuboid(b) => pairs::manifold_cuboid_triangle(b, triangle, &identity, out),
+        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
+            let d = shape_triangle_distance(shape, triangle, epa);
+            out.set_from_distance(&d);
+        }
+    }
+}
+
+/// The tightest volume of a tree's type around a convex shape, its local frame, for the
+/// mesh BVH walk: its lower bounds prune the walk, so a loose one costs triangles.
+trait ShapeBound: BoundingVolume {
+    fn around(shape: &Shape) -> Self;
+}
+
+impl ShapeBound for Rss {
+    /// A ball or a capsule exactly; a box as its xy rectangle swept by its z half extent;
+    /// anything else the volume fitted to its local box's corners.
+    fn around(shape: &Shape) -> Self {
+        match shape {
+            Shape::Sphere(s) => Rss::new(DVec3::ZERO, DMat3::IDENTITY, [0.0, 0.0], s.radius),
+            // Axes (Z, X, Y): the rectangle's first axis along the capsule's segment.
+            Shape::Capsule(c) => Rss::new(
+                DVec3::ZERO,
+                DMat3::from_cols(DVec3::Z, DVec3::X, DVec3::Y),
+                [c.half_height, 0.0],
+                c.radius,
+            ),
+            Shape::Cuboid(b) => {
+                let h = b.half_extents;
+                Rss::new(DVec3::ZERO, DMat3::IDENTITY, [h.x, h.y], h.z)
+            }
+            Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
+                Rss::fit_points(&box_corners(shape))
+            }
+        }
+    }
+}
+
+impl ShapeBound for Obb {
+    /// The shape's local box.
+    fn around(shape: &Shape) -> Self {
+        let local = shape.local_bounds();
+        Obb::new(local.center(), DMat3::IDENTITY, local.half_extents())
+    }
+}
+
+/// The corners of a shape's local box.
+fn box_corners(shape: &Shape) -> [DVec3; 8] {
+    let local = shape.local_bounds();
+    std::array::from_fn(|i| {
+        DVec3::new(
+            if i & 1 == 0 { local.min.x } else { local.max.x },
+            if i & 2 == 0 { local.min.y } else { local.max.y },
+            if i & 4 == 0 { local.min.z } else { local.max.z },
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
-    use super::super::{distance, manifold};
+    use super::super::dispatch::{distance, manifold};
     use super::*;
     use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
     use crate::math::DQuat;

@@ -73,6 +73,7 @@
 mod answer;
 mod contacts;
 mod dispatch;
+mod mesh_contacts;
 mod toi;
 pub mod workers;
 
