@@ -37,9 +37,11 @@ impl ConvexMeshWorkspace {
 /// `f64::INFINITY` for the exact minimum). `None` for a mesh with no triangle, or when no
 /// subtree comes within `limit`; a returned value above `limit` is only an upper bound.
 ///
-/// `triangle_value` must never be below the true distance between the shape and the
-/// triangle minus its own error (a signed distance, or a distance clamped at 0), so that the
-/// volumes' lower bounds stay valid for it.
+/// `triangle_value(id, triangle, threshold)` must never be below the true distance between
+/// the shape and the triangle minus its own error (a signed distance, or a distance clamped
+/// at 0), so that the volumes' lower bounds stay valid for it; it may answer `None` when it
+/// proves the value above `threshold` (metres, the walk's current pruning bound: such a
+/// triangle cannot change the answer), skipping its exact query.
 ///
 /// Every triangle whose value is `≤ 0` is visited when `limit ≥ 0` (the walk stops only at
 /// subtrees whose lower bound is positive), so a caller may collect the triangles the shape
@@ -50,7 +52,7 @@ pub fn nearest_triangle<B, T>(
     pose_ab: &Pose,
     limit: f64,
     workspace: &mut ConvexMeshWorkspace,
-    mut triangle_value: impl FnMut(u32, &Triangle) -> (f64, T),
+    mut triangle_value: impl FnMut(u32, &Triangle, f64) -> Option<(f64, T)>,
 ) -> Option<(f64, T)>
 where
     B: BoundingVolume,
@@ -71,12 +73,12 @@ where
         a: 0,
         b: 0,
     });
-    let prune = |bound: f64, best: &Option<(f64, T)>| {
-        bound
-            > best
-                .as_ref()
-                .map_or(limit, |(value, _)| value.max(0.0).min(limit))
+    // Above this a subtree or triangle cannot change the answer (see the docs).
+    let threshold = |best: &Option<(f64, T)>| {
+        best.as_ref()
+            .map_or(limit, |(value, _)| value.max(0.0).min(limit))
     };
+    let prune = |bound: f64, best: &Option<(f64, T)>| bound > threshold(best);
     while let Some(entry) = heap.pop() {
         if prune(entry.bound, &best) {
             break;
@@ -85,7 +87,11 @@ where
         if node.is_leaf() {
             for slot in node.slots() {
                 let triangle = tree.triangles()[slot].transformed(&iso_ab);
-                let (value, answer) = triangle_value(tree.triangle_id(slot), &triangle);
+                let Some((value, answer)) =
+                    triangle_value(tree.triangle_id(slot), &triangle, threshold(&best))
+                else {
+                    continue;
+                };
                 if best.as_ref().is_none_or(|(b, _)| value < *b) {
                     best = Some((value, answer));
                 }
@@ -203,7 +209,7 @@ mod tests {
                 &pose_ab,
                 f64::INFINITY,
                 &mut workspace,
-                |_, t| (ball_triangle(center, radius, t), ()),
+                |_, t, _| Some((ball_triangle(center, radius, t), ())),
             )
             .unwrap()
             .0;
@@ -213,7 +219,7 @@ mod tests {
                 &pose_ab,
                 f64::INFINITY,
                 &mut workspace,
-                |_, t| (ball_triangle(center, radius, t), ()),
+                |_, t, _| Some((ball_triangle(center, radius, t), ())),
             )
             .unwrap()
             .0;
@@ -226,7 +232,13 @@ mod tests {
                 &pose_ab,
                 limit,
                 &mut workspace,
-                |_, t| (ball_triangle(center, radius, t), ()),
+                // Triangles whose plane alone keeps the ball beyond the threshold are
+                // skipped, as the pipeline's walk does.
+                |_, t, threshold| {
+                    let n = (t.b - t.a).cross(t.c - t.a).normalize_or_zero();
+                    let plane_gap = n.dot(center - t.a).abs() - radius;
+                    (plane_gap <= threshold).then(|| (ball_triangle(center, radius, t), ()))
+                },
             )
             .map(|(d, ())| d);
             if truth <= limit {

@@ -53,6 +53,7 @@ use super::contacts::reduce_manifold;
 use super::dispatch::{GJK, NarrowScratch, core_of};
 use crate::bounding::BoundingVolume;
 use crate::bounding::{Obb, Rss};
+use crate::geometry::SupportMap;
 use crate::geometry::Triangle;
 use crate::geometry::mesh::{EdgeKind, NO_NEIGHBOUR};
 use crate::math::DMat3;
@@ -131,19 +132,26 @@ pub(super) fn shape_mesh_distance(
         ..
     } = mesh_contacts;
     touching.clear();
+    let Some((core, radius)) = core_of(shape) else {
+        unreachable!("the dispatcher sends only convex shapes here");
+    };
     let found = nearest_triangle(
         &Rss::around(shape),
         &mesh.distance_tree,
         pose_ab,
         limit,
         convex_mesh,
-        |id, triangle| {
+        |id, triangle, threshold| {
+            if plane_separation(core.support_map(), radius, triangle) > threshold {
+                // PERF: the triangle's plane keeps it beyond anything that could matter.
+                return None;
+            }
             *triangle_queries += 1;
             let d = shape_triangle_distance(shape, triangle, epa);
             if d.distance <= 0.0 {
                 touching.push((id, *triangle, d));
             }
-            (d.distance, d)
+            Some((d.distance, d))
         },
     );
     // With a negative limit the walk may skip touching triangles: no record then.
@@ -158,6 +166,22 @@ pub(super) fn shape_mesh_distance(
         },
         |(_, d)| d,
     )
+}
+
+/// How far apart the shape (a core swept by `radius`, at the origin of A's frame) and the
+/// plane of `triangle` (A's frame) are, metres: a lower bound on their distance (the plane
+/// holds the triangle); `-∞` for a zero-area triangle.
+fn plane_separation(core: &dyn SupportMap, radius: f64, triangle: &Triangle) -> f64 {
+    let Some(n) = (triangle.b - triangle.a)
+        .cross(triangle.c - triangle.a)
+        .try_normalize()
+    else {
+        return f64::NEG_INFINITY;
+    };
+    // The plane is `n · x = offset`; the shape reaches `h(±n)` towards it.
+    let offset = n.dot(triangle.a);
+    let toward = if offset >= 0.0 { n } else { -n };
+    offset.abs() - core.support(toward).dot(toward) - radius
 }
 
 /// A convex shape against a mesh: the contacts of every triangle the shape touches, ghost

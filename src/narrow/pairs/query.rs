@@ -11,7 +11,8 @@
 //!    cores are disjoint, and when they overlap minus it is their exact penetration depth
 //!    (Gottschalk, Lin, Manocha, *OBBTree*, SIGGRAPH 1996; Ericson, *Real-Time Collision
 //!    Detection*, §4.4 and §5.2.1). Cross products shorter than [`AXIS_RELATIVE`] times the
-//!    product of the lengths are skipped (error bound in its docs).
+//!    product of the lengths are skipped (error bound in its docs). The test stops at the
+//!    first axis the cores are apart on: apart, step 2 needs no more.
 //! 2. **Disjoint cores**: the closest pair of two convex polytopes is realised by a vertex
 //!    against the other polytope, or by interior points of two non-parallel edges; the
 //!    segment between those is then perpendicular to both, so it lies along their cross
@@ -20,6 +21,10 @@
 //!    (closest point in closed form) and, for every pair of edge directions, the support
 //!    features along their cross product (when the cores are apart along it) — for two
 //!    boxes 16 vertex clamps and at most 9 segment pairs instead of all 144 edge pairs.
+//!    Against a triangle, vertices farther from its plane than the best pair are skipped.
+//!    Rounded cores (a sphere's point, a capsule's segment) are mostly apart even when the
+//!    shapes touch, so for them this step runs first, without step 1: its pair is kept
+//!    when the cores are apart along the pair's own direction, which proves them disjoint.
 //! 3. **Overlapping cores**: depth and normal from step 1; witnesses are the closest points
 //!    of the two support features once B is moved out by the depth (they touch).
 //! 4. **Radii**: the result is the core distance minus both radii, with the witnesses moved
@@ -45,10 +50,18 @@ pub(super) struct Axis {
 /// The separating-axis test over the complete candidate set (module docs, step 1).
 #[must_use]
 pub(super) fn best_axis(a: &Core, b: &Core) -> Axis {
+    best_axis_or_first_above(a, b, f64::INFINITY)
+}
+
+/// [`best_axis`], or the first axis found apart by more than `enough` metres (all that is
+/// needed to know the cores are apart).
+#[must_use]
+pub(super) fn best_axis_or_first_above(a: &Core, b: &Core, enough: f64) -> Axis {
     let mut best = Axis {
         normal: DVec3::X,
         separation: f64::NEG_INFINITY,
     };
+    // Offers axis `u`; true when the best is then apart by more than `enough`.
     let mut try_axis = |u: DVec3| {
         let (lo_a, hi_a) = a.project(u);
         let (lo_b, hi_b) = b.project(u);
@@ -61,9 +74,12 @@ pub(super) fn best_axis(a: &Core, b: &Core) -> Axis {
         if separation > best.separation {
             best = Axis { normal, separation };
         }
+        best.separation > enough
     };
     for f in a.faces[..a.nf].iter().chain(&b.faces[..b.nf]) {
-        try_axis(*f);
+        if try_axis(*f) {
+            return best;
+        }
     }
     let crossed = |d: DVec3, e: DVec3| {
         let c = d.cross(e);
@@ -71,8 +87,10 @@ pub(super) fn best_axis(a: &Core, b: &Core) -> Axis {
     };
     for d in &a.dirs[..a.nd] {
         for e in &b.dirs[..b.nd] {
-            if let Some(u) = crossed(*d, *e) {
-                try_axis(u);
+            if let Some(u) = crossed(*d, *e)
+                && try_axis(u)
+            {
+                return best;
             }
         }
     }
@@ -101,12 +119,16 @@ pub(super) fn best_axis(a: &Core, b: &Core) -> Axis {
         for fixed in [DVec3::X, DVec3::Y, DVec3::Z] {
             planes[np] = fixed;
             np += 1;
-            try_axis(fixed);
+            if try_axis(fixed) {
+                return best;
+            }
         }
         for m in &planes[..np] {
             for d in dirs.clone() {
-                if let Some(u) = crossed(*m, *d) {
-                    try_axis(u);
+                if let Some(u) = crossed(*m, *d)
+                    && try_axis(u)
+                {
+                    return best;
                 }
             }
         }
@@ -179,12 +201,8 @@ pub(super) fn closest_pair(a: &Polygon, b: &Polygon) -> (DVec3, DVec3) {
 #[must_use]
 fn closest_pair_disjoint(a: &Core, b: &Core, tiny: f64) -> (DVec3, DVec3) {
     let mut best = BestPair::default();
-    for v in a.vertices() {
-        best.offer(*v, b.closest_point(*v));
-    }
-    for v in b.vertices() {
-        best.offer(a.closest_point(*v), *v);
-    }
+    offer_vertices(a, b, &mut best, false);
+    offer_vertices(b, a, &mut best, true);
     for d in &a.dirs[..a.nd] {
         for e in &b.dirs[..b.nd] {
             let c = d.cross(*e);
@@ -221,10 +239,73 @@ fn closest_pair_disjoint(a: &Core, b: &Core, tiny: f64) -> (DVec3, DVec3) {
     (best.on_a, best.on_b)
 }
 
+/// Offers every vertex of `from` with its closest point on `to` (`swapped`: `from` is B).
+/// A vertex farther from a triangle's plane than the best pair so far is skipped (its
+/// distance to the triangle is at least that: exact pruning), nearest to the plane first.
+fn offer_vertices(from: &Core, to: &Core, best: &mut BestPair, swapped: bool) {
+    let offer = |best: &mut BestPair, v: DVec3| {
+        let q = to.closest_point(v);
+        if swapped {
+            best.offer(q, v);
+        } else {
+            best.offer(v, q);
+        }
+    };
+    let vertices = from.vertices();
+    if !(matches!(to.kind, Kind::Triangle) && to.nf == 1 && vertices.len() > 2) {
+        vertices.iter().for_each(|v| offer(best, *v));
+        return;
+    }
+    // PERF: a box's far corners against a mesh triangle (the convex–mesh walk's hot case).
+    let (n, origin) = (to.faces[0], to.verts[0]);
+    let mut order = [(0.0, 0usize); 8];
+    for (i, v) in vertices.iter().enumerate() {
+        order[i] = (n.dot(*v - origin).abs(), i);
+    }
+    let order = &mut order[..vertices.len()];
+    order.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    for &(plane_gap, i) in order.iter() {
+        if plane_gap * plane_gap >= best.distance_squared {
+            break;
+        }
+        offer(best, vertices[i]);
+    }
+}
+
 /// The signed distance between two placed cores, A's frame (module docs).
 #[must_use]
 pub(super) fn distance(a: &Core, b: &Core) -> ShapeDistance {
-    distance_with_axis(a, b, &best_axis(a, b))
+    if a.radius + b.radius > 0.0
+        && let Some(d) = apart_certified(a, b)
+    {
+        return d;
+    }
+    // Apart along any axis is enough for the closest pair; overlapping needs the best.
+    distance_with_axis(a, b, &best_axis_or_first_above(a, b, 0.0))
+}
+
+/// The answer for cores proven apart without the separating-axis test: the closest pair
+/// the cores would have if they were disjoint, kept when the separation along its own
+/// direction is positive (which proves they are: overlapping cores have no separating
+/// direction, and then the closest pair of [`closest_pair_disjoint`] is exact). `None`
+/// when that proof fails. Rounded shapes in contact mostly have apart cores (they touch
+/// through their radii), so this skips the test for them.
+fn apart_certified(a: &Core, b: &Core) -> Option<ShapeDistance> {
+    let tiny = FEATURE_RELATIVE * a.scale().max(b.scale());
+    let (on_a, on_b) = closest_pair_disjoint(a, b, tiny);
+    let gap = on_a.distance(on_b);
+    if gap <= tiny {
+        return None;
+    }
+    let n = (on_b - on_a) / gap;
+    let separation = b.project(n).0 - a.project(n).1;
+    (separation > 0.0).then(|| {
+        let axis = Axis {
+            normal: n,
+            separation,
+        };
+        apart(a.radius, b.radius, on_a, on_b, &axis, tiny)
+    })
 }
 
 /// [`distance`] given the cores' best separating axis (from [`best_axis`], or from a
