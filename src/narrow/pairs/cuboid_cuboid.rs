@@ -19,7 +19,6 @@ use super::core::{AXIS_RELATIVE, Core};
 use super::query::{self, Axis, FEATURE_RELATIVE};
 use crate::geometry::Cuboid;
 use crate::math::{DMat3, DVec3, Isometry};
-use crate::narrow::closest_points::closest_points_segment_segment;
 use crate::narrow::contact::{Manifold, ShapeDistance};
 
 /// Exact signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's), with
@@ -192,14 +191,20 @@ impl Boxes {
                     continue;
                 }
                 let u = axis.normal;
-                let edge_a = support_edge(ha, i, u, self.tiny)?;
-                let edge_b = support_edge(hb, j, rt * -u, self.tiny)?;
-                let (p, q) = closest_points_segment_segment(
-                    edge_a[0],
-                    edge_a[1],
-                    r * edge_b[0] + t,
-                    r * edge_b[1] + t,
-                );
+                let centre_a = support_edge_centre(ha, i, u, self.tiny)?;
+                let centre_b = t + r * support_edge_centre(hb, j, rt * -u, self.tiny)?;
+                // The closest points of the edges' lines (unit directions, Ericson §5.1.8):
+                // only a pair inside both edges matters, any other is no closer than a
+                // corner pair offered above. Not parallel (`cross_axis`), so `1 − b² > 0`.
+                let (dir_a, dir_b) = (DVec3::AXES[i], r.col(j));
+                let w = centre_a - centre_b;
+                let (b, c, f) = (dir_a.dot(dir_b), dir_a.dot(w), dir_b.dot(w));
+                let s = (b * f - c) / (1.0 - b * b);
+                let s_b = f + s * b;
+                if s.abs() > ha[i] || s_b.abs() > hb[j] {
+                    continue;
+                }
+                let (p, q) = (centre_a + dir_a * s, centre_b + dir_b * s_b);
                 let d = p.distance_squared(q);
                 if d < best.0 {
                     best = (d, p, q);
@@ -218,10 +223,10 @@ fn cross_axis(i: usize, v: DVec3) -> Option<DVec3> {
     (c.length() > AXIS_RELATIVE).then(|| c.normalize())
 }
 
-/// The edge along axis `i` of the box of half extents `h` (its own frame) that supports
-/// direction `u` (`u ⟂` axis `i`); `None` when `u` is within `tiny` of a face normal (the
-/// support feature is a face).
-fn support_edge(h: DVec3, i: usize, u: DVec3, tiny: f64) -> Option<[DVec3; 2]> {
+/// The centre of the edge along axis `i` of the box of half extents `h` (its own frame)
+/// that supports direction `u` (`u ⟂` axis `i`); `None` when `u` is within `tiny` of a face
+/// normal (the support feature is a face).
+fn support_edge_centre(h: DVec3, i: usize, u: DVec3, tiny: f64) -> Option<DVec3> {
     let mut p = DVec3::ZERO;
     for k in 0..3 {
         if k != i {
@@ -231,10 +236,7 @@ fn support_edge(h: DVec3, i: usize, u: DVec3, tiny: f64) -> Option<[DVec3; 2]> {
             p[k] = if u[k] >= 0.0 { h[k] } else { -h[k] };
         }
     }
-    let (mut lo, mut hi) = (p, p);
-    lo[i] = -h[i];
-    hi[i] = h[i];
-    Some([lo, hi])
+    Some(p)
 }
 
 #[cfg(test)]
