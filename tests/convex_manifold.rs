@@ -1,0 +1,440 @@
+//! Multi-point manifolds of the GJK pairs ([`proxima::narrow::convex_manifold`]) against
+//! independent oracles:
+//! - analytic resting contacts: a box face down on the same box given as a hull (depths and
+//!   the overlap square), a cylinder standing on a box (rim points, one depth), a cylinder
+//!   lying on a box (the two ends of its side line);
+//! - boxes given as hulls of their corners against the closed-form box–box manifold: same
+//!   number of points (when it has two or more) and the same deepest depth;
+//! - every GJK kind against every convex kind, resting and random poses: the contact
+//!   contract of every point, with each shape's own surface function as the on-surface
+//!   oracle (hull: its largest plane distance; cylinder, cone, box, sphere, capsule:
+//!   closed-form).
+#[path = "support/mod.rs"]
+mod support;
+
+use proxima::geometry::{
+    Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Segment, Sphere, SupportMap,
+};
+use proxima::math::{DMat3, DQuat, DVec3, Isometry};
+use proxima::narrow::convex_manifold::{ContactFeatures, manifold_convex_convex};
+use proxima::narrow::gjk::{
+    EpaWorkspace, GjkCache, GjkParams, POINT, Rounded, signed_distance_convex,
+};
+use proxima::narrow::{Manifold, ShapeDistance, manifold_cuboid_cuboid};
+use rand::Rng;
+use support::{TestRng, rng, rotation};
+
+const GJK: GjkParams = GjkParams {
+    rel_tol: 1e-10,
+    epa_rel_tol: 1e-10,
+    abs_tol: 0.0,
+    max_iterations: 128,
+    accelerated: false,
+};
+
+/// The shapes under test, with their own surface oracles.
+#[derive(Debug, Clone)]
+enum Solid {
+    Sphere(Sphere),
+    Capsule(Capsule, Segment),
+    Cuboid(Cuboid),
+    Cylinder(Cylinder),
+    Cone(Cone),
+    Hull(ConvexPolyhedron),
+}
+
+impl Solid {
+    fn features(&self) -> &dyn ContactFeatures {
+        match self {
+            Solid::Sphere(s) => s,
+            Solid::Capsule(c, _) => c,
+            Solid::Cuboid(b) => b,
+            Solid::Cylinder(c) => c,
+            Solid::Cone(c) => c,
+            Solid::Hull(h) => h,
+        }
+    }
+
+    fn rounded(&self) -> Rounded<'_, dyn SupportMap> {
+        match self {
+            Solid::Sphere(s) => Rounded::new(&POINT as &dyn SupportMap, s.radius),
+            Solid::Capsule(c, seg) => Rounded::new(seg as &dyn SupportMap, c.radius),
+            Solid::Cuboid(b) => Rounded::plain(b as &dyn SupportMap),
+            Solid::Cylinder(c) => Rounded::plain(c as &dyn SupportMap),
+            Solid::Cone(c) => Rounded::plain(c as &dyn SupportMap),
+            Solid::Hull(h) => Rounded::plain(h as &dyn SupportMap),
+        }
+    }
+
+    /// Support value along unit `n` (local frame), radius included.
+    fn h(&self, n: DVec3) -> f64 {
+        let r = self.rounded();
+        r.core.support(n).dot(n) + r.radius
+    }
+
+    /// A function of a local point that is 0 on the surface, negative inside, and within
+    /// the point's distance from the surface in magnitude (closed forms, not the code under
+    /// test).
+    fn surface(&self, p: DVec3) -> f64 {
+        match self {
+            Solid::Sphere(s) => p.length() - s.radius,
+            Solid::Capsule(c, _) => {
+                let z = p.z.clamp(-c.half_height, c.half_height);
+                (p - DVec3::new(0.0, 0.0, z)).length() - c.radius
+            }
+            Solid::Cuboid(b) => (p.abs() - b.half_extents).max_element(),
+            Solid::Cylinder(c) => {
+                let rho = DVec3::new(p.x, p.y, 0.0).length();
+                (rho - c.radius).max(p.z.abs() - c.half_height)
+            }
+            Solid::Cone(c) => {
+                let (h, r) = (c.half_height, c.radius);
+                let rho = DVec3::new(p.x, p.y, 0.0).length();
+                let slant = (2.0 * h * rho + r * (p.z - h)) / (4.0 * h * h + r * r).sqrt();
+                slant.max(-p.z - h)
+            }
+            Solid::Hull(hull) => hull.max_plane_distance(p).expect("solid hulls only"),
+        }
+    }
+
+    /// Outward face normals to rest on (local frame); a random direction for shapes
+    /// without faces.
+    fn resting_direction(&self, r: &mut TestRng) -> DVec3 {
+        let axes = [
+            DVec3::X,
+            -DVec3::X,
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::Z,
+            -DVec3::Z,
+        ];
+        match self {
+            Solid::Cuboid(_) => axes[r.random_range(0..6)],
+            Solid::Cylinder(_) => axes[r.random_range(4..6)],
+            Solid::Cone(_) => -DVec3::Z,
+            Solid::Hull(h) => h.faces()[r.random_range(0..h.faces().len())].normal,
+            Solid::Sphere(_) | Solid::Capsule(..) => rotation(r) * DVec3::X,
+        }
+    }
+
+    fn size(&self) -> f64 {
+        [DVec3::X, DVec3::Y, DVec3::Z]
+            .iter()
+            .map(|&a| self.h(a) + self.h(-a))
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+fn capsule(half_height: f64, radius: f64) -> Solid {
+    let c = Capsule::new(half_height, radius);
+    Solid::Capsule(c, c.segment())
+}
+
+fn random_solid(r: &mut TestRng, kind: usize) -> Solid {
+    let mut s = || r.random_range(0.3..1.0);
+    match kind {
+        0 => Solid::Sphere(Sphere::new(s())),
+        1 => capsule(s(), s()),
+        2 => Solid::Cuboid(Cuboid::new(DVec3::new(s(), s(), s()))),
+        3 => Solid::Cylinder(Cylinder::new(s(), s())),
+        4 => Solid::Cone(Cone::new(s(), s())),
+        _ => {
+            let pts: Vec<DVec3> = (0..12)
+                .map(|_| {
+                    DVec3::new(
+                        r.random_range(-1.0..1.0),
+                        r.random_range(-1.0..1.0),
+                        r.random_range(-1.0..1.0),
+                    )
+                })
+                .collect();
+            Solid::Hull(ConvexPolyhedron::try_from_points(&pts).unwrap())
+        }
+    }
+}
+
+fn distance(a: &Solid, b: &Solid, pose_ab: &Isometry) -> ShapeDistance {
+    signed_distance_convex(
+        &a.rounded(),
+        &b.rounded(),
+        pose_ab,
+        &GJK,
+        &mut GjkCache::default(),
+        &mut EpaWorkspace::default(),
+    )
+    .0
+}
+
+fn manifold(a: &Solid, b: &Solid, pose_ab: &Isometry, d: &ShapeDistance) -> Manifold {
+    let mut m = Manifold::new();
+    manifold_convex_convex(a.features(), b.features(), pose_ab, d, &mut m);
+    m
+}
+
+fn hull_of_box(half: DVec3) -> ConvexPolyhedron {
+    let corners: Vec<DVec3> = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { -half.x } else { half.x },
+                if i & 2 == 0 { -half.y } else { half.y },
+                if i & 4 == 0 { -half.z } else { half.z },
+            )
+        })
+        .collect();
+    ConvexPolyhedron::try_from_points(&corners).unwrap()
+}
+
+/// B resting on A: B's face (or a random direction) `g` turned against A's face `f`,
+/// spun about it, shifted sideways by up to `lateral`, overlapping by `depth`.
+fn resting_pose(r: &mut TestRng, a: &Solid, b: &Solid, depth: f64, lateral: f64) -> Isometry {
+    let f = a.resting_direction(r);
+    let g = b.resting_direction(r);
+    let spin = DQuat::from_axis_angle(f, r.random_range(0.0..std::f64::consts::TAU));
+    let q = spin * DQuat::from_rotation_arc(g, -f);
+    let rot = DMat3::from_quat(q);
+    let t_f = a.h(f) + b.h(rot.transpose() * -f) - depth;
+    let side = (rotation(r) * DVec3::X).reject_from(f).normalize_or_zero();
+    let t = f * t_f + side * r.random_range(0.0..lateral);
+    Isometry::new(rot, t)
+}
+
+fn assert_contract(
+    a: &Solid,
+    b: &Solid,
+    pose: &Isometry,
+    d: &ShapeDistance,
+    m: &Manifold,
+    tol: f64,
+    what: &str,
+) {
+    assert!(m.len() <= 4);
+    assert_eq!(m.normal, d.normal, "{what}");
+    if d.distance > 0.0 {
+        assert!(m.is_empty(), "{what}: apart but {m:?}");
+        return;
+    }
+    assert!(!m.is_empty(), "{what}");
+    // The manifold cannot be more accurate than the distance it starts from: EPA's
+    // witnesses on curved shapes are off the surfaces by up to ~1e-7.
+    let d_error = a
+        .surface(d.point_a)
+        .abs()
+        .max(b.surface(pose.inverse_transform_point(d.point_b)).abs());
+    let tol = tol + 2.0 * d_error;
+    for p in m.points() {
+        assert!(p.point_a.is_finite() && p.point_b.is_finite() && p.distance.is_finite());
+        let residual = (p.point_b - p.point_a - m.normal * p.distance).length();
+        assert!(residual <= tol, "{what}: residual {residual:e} {m:?}");
+        assert!(p.distance <= tol, "{what}: {m:?}");
+        let sa = a.surface(p.point_a);
+        let sb = b.surface(pose.inverse_transform_point(p.point_b));
+        assert!(
+            sa.abs() <= tol && sb.abs() <= tol,
+            "{what}: off the surfaces {sa:e} {sb:e} {m:?}"
+        );
+    }
+    let deepest = m
+        .points()
+        .iter()
+        .map(|p| p.distance)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        (deepest - d.distance).abs() <= tol,
+        "{what}: deepest {deepest} vs {} {m:?}",
+        d.distance
+    );
+}
+
+#[test]
+fn a_cube_face_down_on_the_same_cube_as_a_hull_touches_at_four_points_of_the_overlap() {
+    let mut r = rng(501);
+    let hull = Solid::Hull(hull_of_box(DVec3::ONE));
+    let cube = Solid::Cuboid(Cuboid::new(DVec3::ONE));
+    for case in 0..2000 {
+        let angle = r.random_range(0.0..std::f64::consts::TAU);
+        let depth = r.random_range(0.0..0.2);
+        let shift = DVec3::new(r.random_range(-0.3..0.3), r.random_range(-0.3..0.3), 0.0);
+        let rot = DMat3::from_rotation_z(angle);
+        let pose = Isometry::new(rot, DVec3::new(0.0, 0.0, 2.0 - depth) + shift);
+        // Both orders: the hull below the cube, and the cube below the hull.
+        for (a, b) in [(&hull, &cube), (&cube, &hull)] {
+            let d = distance(a, b, &pose);
+            assert!((d.distance + depth).abs() < 1e-9, "case {case}: {d:?}");
+            let m = manifold(a, b, &pose, &d);
+            assert_eq!(m.len(), 4, "case {case}: {m:?}");
+            for p in m.points() {
+                assert!((p.distance + depth).abs() < 1e-9, "case {case}: {m:?}");
+                // In the overlap of A's top square and B's bottom square (xy).
+                let local = pose.inverse_transform_point(p.point_b);
+                assert!(p.point_a.x.abs().max(p.point_a.y.abs()) <= 1.0 + 1e-9);
+                assert!(
+                    local.x.abs().max(local.y.abs()) <= 1.0 + 1e-9,
+                    "case {case}"
+                );
+                assert!(
+                    (p.point_a.z - 1.0).abs() < 1e-9 && (local.z + 1.0).abs() < 1e-9,
+                    "case {case}"
+                );
+            }
+            assert_contract(a, b, &pose, &d, &m, 1e-9, "cube on hull");
+        }
+    }
+}
+
+#[test]
+fn a_cylinder_standing_on_a_box_touches_at_rim_points_of_one_depth() {
+    let mut r = rng(502);
+    let slab = Solid::Cuboid(Cuboid::new(DVec3::new(2.0, 2.0, 1.0)));
+    for case in 0..1000 {
+        let (h, rad) = (r.random_range(0.2..1.0), r.random_range(0.2..0.9));
+        let cyl = Solid::Cylinder(Cylinder::new(h, rad));
+        let depth = r.random_range(0.0..0.1);
+        let shift = DVec3::new(r.random_range(-1.0..1.0), r.random_range(-1.0..1.0), 0.0);
+        let rot = DMat3::from_rotation_z(r.random_range(0.0..std::f64::consts::TAU));
+        let pose = Isometry::new(rot, DVec3::new(0.0, 0.0, 1.0 + h - depth) + shift);
+        let d = distance(&slab, &cyl, &pose);
+        let m = manifold(&slab, &cyl, &pose, &d);
+        assert_eq!(m.len(), 4, "case {case}: {d:?} {m:?}");
+        for p in m.points() {
+            let local = pose.inverse_transform_point(p.point_b);
+            let rho = DVec3::new(local.x, local.y, 0.0).length();
+            assert!(
+                (rho - rad).abs() < 1e-9 && (local.z + h).abs() < 1e-9,
+                "case {case}"
+            );
+            assert!((p.distance + depth).abs() < 1e-9, "case {case}: {m:?}");
+        }
+        assert_contract(&slab, &cyl, &pose, &d, &m, 1e-9, "standing cylinder");
+    }
+}
+
+#[test]
+fn a_cylinder_lying_on_a_box_touches_at_the_two_ends_of_its_side_line() {
+    let mut r = rng(503);
+    let slab = Solid::Cuboid(Cuboid::new(DVec3::new(3.0, 3.0, 1.0)));
+    for case in 0..1000 {
+        let (h, rad) = (r.random_range(0.2..1.0), r.random_range(0.2..0.9));
+        let cyl = Solid::Cylinder(Cylinder::new(h, rad));
+        let depth = r.random_range(0.0..0.1);
+        let shift = DVec3::new(r.random_range(-1.0..1.0), r.random_range(-1.0..1.0), 0.0);
+        // Axis along X, spun about Z.
+        let rot = DMat3::from_rotation_z(r.random_range(0.0..std::f64::consts::TAU))
+            * DMat3::from_rotation_y(std::f64::consts::FRAC_PI_2)
+            * DMat3::from_rotation_z(r.random_range(0.0..std::f64::consts::TAU));
+        let pose = Isometry::new(rot, DVec3::new(0.0, 0.0, 1.0 + rad - depth) + shift);
+        let d = distance(&slab, &cyl, &pose);
+        let m = manifold(&slab, &cyl, &pose, &d);
+        assert_eq!(m.len(), 2, "case {case}: {d:?} {m:?}");
+        let mut ends: Vec<f64> = m
+            .points()
+            .iter()
+            .map(|p| pose.inverse_transform_point(p.point_b).z)
+            .collect();
+        ends.sort_by(f64::total_cmp);
+        assert!(
+            (ends[0] + h).abs() < 1e-9 && (ends[1] - h).abs() < 1e-9,
+            "case {case}: {ends:?}"
+        );
+        for p in m.points() {
+            assert!((p.distance + depth).abs() < 1e-9, "case {case}: {m:?}");
+        }
+        assert_contract(&slab, &cyl, &pose, &d, &m, 1e-9, "lying cylinder");
+    }
+}
+
+#[test]
+fn boxes_as_hulls_match_the_closed_form_box_manifold() {
+    let mut r = rng(504);
+    let (mut faces, mut edges, mut compared, mut tilted) = (0, 0, 0, 0);
+    for case in 0..4000 {
+        let mut size = || {
+            DVec3::new(
+                r.random_range(0.2..1.0),
+                r.random_range(0.2..1.0),
+                r.random_range(0.2..1.0),
+            )
+        };
+        let (ha, hb) = (size(), size());
+        let (ca, cb) = (Cuboid::new(ha), Cuboid::new(hb));
+        let (a, b) = (Solid::Hull(hull_of_box(ha)), Solid::Hull(hull_of_box(hb)));
+        let pose = if case % 2 == 0 {
+            let depth = r.random_range(0.0..0.1);
+            resting_pose(&mut r, &a, &b, depth, 0.3)
+        } else {
+            // Random orientation, moved along the closed-form normal into contact.
+            let rot = DMat3::from_quat(rotation(&mut r));
+            let t = rotation(&mut r) * DVec3::X * 3.0;
+            let far = Isometry::new(rot, t);
+            let d = proxima::narrow::distance_cuboid_cuboid(&ca, &cb, &far);
+            Isometry::new(rot, t - d.normal * (d.distance + r.random_range(0.0..0.1)))
+        };
+        let mut closed = Manifold::new();
+        manifold_cuboid_cuboid(&ca, &cb, &pose, &mut closed);
+        let d = distance(&a, &b, &pose);
+        let m = manifold(&a, &b, &pose, &d);
+        assert_contract(&a, &b, &pose, &d, &m, 1e-9, "box hulls");
+        if closed.is_empty() {
+            continue;
+        }
+        compared += 1;
+        let deepest = |m: &Manifold| {
+            m.points()
+                .iter()
+                .map(|p| p.distance)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let closed_d = proxima::narrow::distance_cuboid_cuboid(&ca, &cb, &pose);
+        // The closed form reports along its reference face's normal, which may differ from
+        // the distance's normal by up to 0.8°: its deepest depth is then along another
+        // direction, and the distance is the comparable value.
+        let same_normal = (closed.normal - closed_d.normal).length() <= 1e-9;
+        let expected = if same_normal {
+            deepest(&closed)
+        } else {
+            tilted += 1;
+            closed_d.distance
+        };
+        assert!(
+            (deepest(&m) - expected).abs() <= 1e-9,
+            "case {case}: {d:?} {closed_d:?} {m:?} vs {closed:?}"
+        );
+        if closed.len() >= 2 {
+            assert_eq!(m.len(), closed.len(), "case {case}: {m:?} vs {closed:?}");
+        }
+        if m.len() >= 3 {
+            faces += 1;
+        } else {
+            edges += 1;
+        }
+    }
+    eprintln!(
+        "compared {compared}: face {faces}, edge/vertex {edges}, closed-form normal tilted {tilted}"
+    );
+    assert!(faces > 1000 && edges > 1000, "faces {faces}, edges {edges}");
+}
+
+#[test]
+fn every_gjk_kind_against_every_convex_kind_keeps_the_contact_contract() {
+    let mut r = rng(505);
+    let mut counts = [0usize; 5]; // apart, 1, 2, 3, 4 points
+    for case in 0..6000 {
+        let gjk_kind = r.random_range(3..6);
+        let other = r.random_range(0..6);
+        let (x, y) = (random_solid(&mut r, gjk_kind), random_solid(&mut r, other));
+        let (a, b) = if r.random_bool(0.5) { (x, y) } else { (y, x) };
+        let pose = if case % 3 == 2 {
+            let rot = DMat3::from_quat(rotation(&mut r));
+            Isometry::new(rot, support::point_in_cube(&mut r, 1.2))
+        } else {
+            let depth = r.random_range(-0.01..0.1) * a.size().min(b.size());
+            resting_pose(&mut r, &a, &b, depth, 0.2)
+        };
+        let d = distance(&a, &b, &pose);
+        let m = manifold(&a, &b, &pose, &d);
+        let what = format!("case {case}: {a:?} / {b:?}");
+        assert_contract(&a, &b, &pose, &d, &m, 1e-8, &what);
+        counts[if d.distance > 0.0 { 0 } else { m.len() }] += 1;
+    }
+    eprintln!("apart, 1, 2, 3, 4 points: {counts:?}");
+    assert!(counts.iter().all(|&c| c > 100), "{counts:?}");
+}
