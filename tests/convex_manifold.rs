@@ -91,7 +91,8 @@ impl Solid {
                 let (h, r) = (c.half_height, c.radius);
                 let rho = DVec3::new(p.x, p.y, 0.0).length();
                 let slant = (2.0 * h * rho + r * (p.z - h)) / (4.0 * h * h + r * r).sqrt();
-                slant.max(-p.z - h)
+                // The radial bound matters only for a flat cone (a disc).
+                slant.max(-p.z - h).max(rho - r)
             }
             Solid::Hull(hull) => hull.max_plane_distance(p).expect("solid hulls only"),
         }
@@ -437,4 +438,168 @@ fn every_gjk_kind_against_every_convex_kind_keeps_the_contact_contract() {
     }
     eprintln!("apart, 1, 2, 3, 4 points: {counts:?}");
     assert!(counts.iter().all(|&c| c > 100), "{counts:?}");
+}
+
+/// Through the public pipeline: the dispatcher sends the GJK pairs here, and the world-frame
+/// contacts keep the contract far from the origin, under a rotated frame.
+#[test]
+fn resting_hulls_and_cylinders_get_four_world_contacts_from_the_pipeline() {
+    use proxima::math::Pose;
+    use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, step};
+    use proxima::scene::{BodyDesc, CollisionFilter, Motion, Scene, SceneLimits, Shape};
+    use std::sync::Arc;
+    let mut r = rng(506);
+    let mut checked = 0;
+    for case in 0..50 {
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let frame = Pose::new(DVec3::new(1e5, -2e5, 3e4), rotation(&mut r));
+        let mut add = |shape: Shape, local: Pose| {
+            let shape = scene.register_shape(shape).unwrap();
+            let desc = BodyDesc {
+                shape,
+                pose: frame.compose(&local),
+                motion: Motion::Dynamic,
+                filter: CollisionFilter::ALL,
+                margin: Some(0.0),
+            };
+            scene.add_body(&desc).unwrap()
+        };
+        let depth = r.random_range(1e-4..0.05);
+        let spin = |r: &mut TestRng| DQuat::from_rotation_z(r.random_range(0.0..6.3));
+        add(
+            Shape::Cuboid(Cuboid::new(DVec3::new(4.0, 2.0, 1.0))),
+            Pose::IDENTITY,
+        );
+        add(
+            Shape::Convex(Arc::new(hull_of_box(DVec3::splat(0.5)))),
+            Pose::new(DVec3::new(-2.0, 0.0, 1.5 - depth), spin(&mut r)),
+        );
+        add(
+            Shape::Cylinder(Cylinder::new(0.5, 0.6)),
+            Pose::new(DVec3::new(2.0, 0.0, 1.5 - depth), spin(&mut r)),
+        );
+        let query = Query {
+            contacts: true,
+            ..Query::NONE
+        };
+        let mut results = FrameResults::default();
+        step(
+            &scene,
+            query,
+            &mut PipelineWorkspace::default(),
+            &mut results,
+        );
+        assert_eq!(results.pairs.len(), 2, "case {case}: {:?}", results.pairs);
+        for pair in &results.pairs {
+            assert_eq!(pair.contact_count, 4, "case {case}: {pair:?}");
+            let first = pair.first_contact as usize;
+            for c in &results.contacts[first..first + 4] {
+                let residual = c.point_b - c.point_a - c.normal * c.distance;
+                // World coordinates near 2e5 m: rounding of the frame change is ~1e-10.
+                assert!(residual.length() < 1e-9, "case {case}: {c:?}");
+                assert!((c.distance + depth).abs() < 1e-9, "case {case}: {c:?}");
+                let up = frame.transform_vector(DVec3::Z);
+                assert!((c.normal - up).length() < 1e-9, "case {case}: {c:?}");
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 400);
+}
+
+#[test]
+fn swapping_the_shapes_gives_the_same_count_and_deepest_depth() {
+    let mut r = rng(507);
+    let (mut multi, mut compared) = (0, 0);
+    for case in 0..3000 {
+        let (kx, ky) = (r.random_range(3..6), r.random_range(0..6));
+        let (x, y) = (random_solid(&mut r, kx), random_solid(&mut r, ky));
+        let depth = r.random_range(0.0..0.1) * x.size().min(y.size());
+        let pose = resting_pose(&mut r, &x, &y, depth, 0.2);
+        let d = distance(&x, &y, &pose);
+        if d.distance > 0.0 {
+            continue;
+        }
+        let inverse = {
+            let rot = pose.rotation.transpose();
+            Isometry::new(rot, -(rot * pose.translation))
+        };
+        let d_swapped = d.flipped(&inverse);
+        let (m, m_swapped) = (
+            manifold(&x, &y, &pose, &d),
+            manifold(&y, &x, &inverse, &d_swapped),
+        );
+        // Discs are inscribed polygons turned differently as reference and as incident
+        // feature, so only polytope pairs must give the same count both ways.
+        let polytope = |s: &Solid| matches!(s, Solid::Hull(_) | Solid::Cuboid(_));
+        if polytope(&x) && polytope(&y) {
+            assert_eq!(m.len(), m_swapped.len(), "case {case}: {m:?} {m_swapped:?}");
+            compared += 1;
+        }
+        let deepest = |m: &Manifold| {
+            m.points()
+                .iter()
+                .map(|p| p.distance)
+                .fold(f64::INFINITY, f64::min)
+        };
+        assert!(
+            (deepest(&m) - deepest(&m_swapped)).abs() <= 1e-12 * (1.0 + d.distance.abs()) + 1e-12
+        );
+        multi += usize::from(m.len() >= 3);
+    }
+    assert!(multi > 500 && compared > 300, "{multi} {compared}");
+}
+
+#[test]
+fn degenerate_shapes_keep_the_contact_contract() {
+    let mut r = rng(508);
+    let flat_pentagon: Vec<DVec3> = (0..5)
+        .map(|k| {
+            let t = f64::from(k) * std::f64::consts::TAU / 5.0;
+            DVec3::new(0.6 * t.cos(), 0.6 * t.sin(), 0.0)
+        })
+        .collect();
+    let degenerate = [
+        Solid::Cylinder(Cylinder::new(0.5, 0.0)),
+        Solid::Cylinder(Cylinder::new(0.0, 0.5)),
+        Solid::Cone(Cone::new(0.0, 0.5)),
+        Solid::Cone(Cone::new(0.5, 0.0)),
+        Solid::Hull(ConvexPolyhedron::try_from_points(&flat_pentagon).unwrap()),
+        Solid::Cuboid(Cuboid::new(DVec3::new(0.5, 0.5, 0.0))),
+        Solid::Sphere(Sphere::new(0.0)),
+        capsule(0.0, 0.4),
+    ];
+    let mut counts = [0usize; 5];
+    for case in 0..4000 {
+        let a = degenerate[r.random_range(0..degenerate.len())].clone();
+        let kind = r.random_range(2..6);
+        let b = random_solid(&mut r, kind);
+        let (a, b) = if r.random_bool(0.5) { (a, b) } else { (b, a) };
+        let pose = if case % 2 == 0 {
+            let depth = r.random_range(-0.01..0.05);
+            resting_pose(&mut r, &a, &b, depth, 0.2)
+        } else {
+            Isometry::new(
+                DMat3::from_quat(rotation(&mut r)),
+                support::point_in_cube(&mut r, 1.0),
+            )
+        };
+        let d = distance(&a, &b, &pose);
+        let m = manifold(&a, &b, &pose, &d);
+        assert_contract(
+            &a,
+            &b,
+            &pose,
+            &d,
+            &m,
+            1e-8,
+            &format!("case {case}: {a:?} / {b:?}"),
+        );
+        counts[if d.distance > 0.0 { 0 } else { m.len() }] += 1;
+    }
+    eprintln!("degenerate: apart, 1, 2, 3, 4 points: {counts:?}");
+    assert!(
+        counts[0] > 100 && counts[1] > 100 && counts[4] > 100,
+        "{counts:?}"
+    );
 }
