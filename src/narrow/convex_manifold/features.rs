@@ -231,8 +231,8 @@ impl ContactFeatures for Cuboid {
     fn feature_towards(&self, v: DVec3, out: &mut Polygon) {
         if self.face_towards(v, out).is_none() {
             out.clear();
-            // A flat box (a rectangle seen edge-on, a segment, a point): its support
-            // segment or point, by the sign pattern of `v` with ties kept as both ends.
+            // A flat box seen edge-on (or a segment, a point): its support corner, by the
+            // sign pattern of `v`.
             let h = self.half_extents;
             let corner = DVec3::new(h.x.copysign(v.x), h.y.copysign(v.y), h.z.copysign(v.z));
             out.push(corner);
@@ -314,8 +314,9 @@ impl ContactFeatures for ConvexPolyhedron {
         out.clear();
         if self.dimension() == 1 {
             // A segment hull: both ends (the depth test keeps the ones that touch).
-            out.push(self.vertices()[0]);
-            out.push(self.vertices()[1]);
+            for &p in self.vertices().iter().take(2) {
+                out.push(p);
+            }
         } else {
             out.push(self.support(v));
         }
