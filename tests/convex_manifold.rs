@@ -3,12 +3,16 @@
 //! - analytic resting contacts: a box face down on the same box given as a hull (depths and
 //!   the overlap square), a cylinder standing on a box (rim points, one depth), a cylinder
 //!   lying on a box (the two ends of its side line);
+//! - parallel lines: a cylinder, a capsule or a cone's slant lying along a cylinder's side
+//!   touches at the two ends of their overlap, at the analytic depth;
 //! - boxes given as hulls of their corners against the closed-form box–box manifold: same
 //!   number of points (when it has two or more) and the same deepest depth;
 //! - every GJK kind against every convex kind, resting and random poses: the contact
 //!   contract of every point, with each shape's own surface function as the on-surface
 //!   oracle (hull: its largest plane distance; cylinder, cone, box, sphere, capsule:
-//!   closed-form).
+//!   closed-form); degenerate shapes (segments, discs, flat hulls); the same count and
+//!   deepest depth with A and B swapped; and through the public pipeline far from the
+//!   origin.
 #[path = "support/mod.rs"]
 mod support;
 
@@ -602,4 +606,115 @@ fn degenerate_shapes_keep_the_contact_contract() {
         counts[0] > 100 && counts[1] > 100 && counts[4] > 100,
         "{counts:?}"
     );
+}
+
+/// A shape whose line feature lies along Z at distance `radius − depth` from A's axis, on
+/// the side `w` (unit, ⟂ Z), shifted by `shift` along Z: a cylinder's or capsule's axis
+/// parallel to Z, or a cone turned so that its slant runs along Z.
+fn parallel_pose(b: &Solid, w: DVec3, reach: f64, shift: f64, flip: bool) -> Isometry {
+    let up = if flip { -DVec3::Z } else { DVec3::Z };
+    match b {
+        Solid::Cone(c) => {
+            let (h, r) = (c.half_height, c.radius);
+            let slant = DVec3::new(r, 0.0, -2.0 * h).normalize();
+            let normal = DVec3::new(2.0 * h, 0.0, r).normalize();
+            let source = DMat3::from_cols(slant, normal, slant.cross(normal));
+            let target = DMat3::from_cols(up, -w, up.cross(-w));
+            let rot = target * source.transpose();
+            let apex = DVec3::new(0.0, 0.0, h);
+            // The slant's middle at the chosen place.
+            let middle = (apex + DVec3::new(r, 0.0, -h)) * 0.5;
+            Isometry::new(rot, w * reach + DVec3::Z * shift - rot * middle)
+        }
+        _ => {
+            let rot = DMat3::from_rotation_z(shift * 7.0)
+                * DMat3::from_rotation_x(if flip { std::f64::consts::PI } else { 0.0 });
+            let radius = match b {
+                Solid::Cylinder(c) => c.radius,
+                Solid::Capsule(c, _) => c.radius,
+                _ => unreachable!(),
+            };
+            Isometry::new(rot, w * (reach + radius) + DVec3::Z * shift)
+        }
+    }
+}
+
+#[test]
+fn parallel_cylinders_capsules_and_cone_slants_touch_at_the_two_ends_of_their_overlap() {
+    let mut r = rng(509);
+    let mut seen = [0usize; 3];
+    for case in 0..3000 {
+        let (ha, ra) = (r.random_range(0.3..1.0), r.random_range(0.2..0.8));
+        let cyl = Solid::Cylinder(Cylinder::new(ha, ra));
+        let kind = case % 3;
+        let other = match kind {
+            0 => Solid::Cylinder(Cylinder::new(
+                r.random_range(0.3..1.0),
+                r.random_range(0.2..0.8),
+            )),
+            1 => capsule(r.random_range(0.3..1.0), r.random_range(0.2..0.8)),
+            _ => Solid::Cone(Cone::new(
+                r.random_range(0.3..1.0),
+                r.random_range(0.2..0.8),
+            )),
+        };
+        // Half the length of the other's line feature along Z.
+        let half_line = match &other {
+            Solid::Cylinder(c) => c.half_height,
+            Solid::Capsule(c, _) => c.half_height,
+            Solid::Cone(c) => {
+                0.5 * (c.radius * c.radius + 4.0 * c.half_height * c.half_height).sqrt()
+            }
+            _ => unreachable!(),
+        };
+        let depth = r.random_range(0.0..0.1) * ra;
+        let angle = r.random_range(0.0..std::f64::consts::TAU);
+        let w = DVec3::new(angle.cos(), angle.sin(), 0.0);
+        let shift = r.random_range(-0.8..0.8) * (ha + half_line);
+        let pose = parallel_pose(&other, w, ra - depth, shift, r.random_bool(0.5));
+        let (lo, hi) = ((shift - half_line).max(-ha), (shift + half_line).min(ha));
+        let inverse = Isometry::new(
+            pose.rotation.transpose(),
+            -(pose.rotation.transpose() * pose.translation),
+        );
+        // Both orders: the cylinder as A, then as B.
+        for (a, b, iso, cyl_is_a) in [(&cyl, &other, pose, true), (&other, &cyl, inverse, false)] {
+            let d = distance(a, b, &iso);
+            assert!((d.distance + depth).abs() < 1e-9, "case {case}: {d:?}");
+            let m = manifold(a, b, &iso, &d);
+            assert_eq!(
+                m.len(),
+                2,
+                "case {case} ({kind}, A cylinder: {cyl_is_a}): {d:?} {m:?}"
+            );
+            // The ends' heights in the cylinder's frame.
+            let mut ends: Vec<f64> = m
+                .points()
+                .iter()
+                .map(|p| {
+                    if cyl_is_a {
+                        p.point_a.z
+                    } else {
+                        iso.inverse_transform_point(p.point_b).z
+                    }
+                })
+                .collect();
+            ends.sort_by(f64::total_cmp);
+            // The ends are pulled in by the columns' drift (depth × the normal's tilt from
+            // the lines, EPA's error on curved shapes: ~1e-6 rad) and rounding.
+            assert!(
+                ends[0] >= lo - 1e-12
+                    && ends[0] - lo < 1e-6
+                    && ends[1] <= hi + 1e-12
+                    && hi - ends[1] < 1e-6,
+                "case {case}: {ends:?} vs {lo} {hi}"
+            );
+            for p in m.points() {
+                assert!((p.distance + depth).abs() < 1e-9, "case {case}: {m:?}");
+            }
+            assert_contract(a, b, &iso, &d, &m, 1e-9, "parallel lines");
+        }
+        seen[kind] += 1;
+    }
+    assert!(seen.iter().all(|&c| c == 1000));
 }

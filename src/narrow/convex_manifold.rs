@@ -10,20 +10,19 @@
 //! 1. **Reference face**: A's face whose outward normal is closest to `n` and B's closest to
 //!    `−n` ([`ContactFeatures::face_towards`]); one counts when its cosine with the normal is
 //!    at least [`FACE_ALIGNMENT`] (about 0.8°, as the closed-form pairs); the better aligned
-//!    is the reference (A on ties). None: the single point of `d` (edge–edge, point
-//!    contacts, curved against curved).
+//!    is the reference (A on ties). None: see *Parallel lines* below, else the single
+//!    point of `d` (edge–edge, point contacts).
 //! 2. **Incident feature**: the other shape's feature out of which the reference normal
 //!    points back ([`ContactFeatures::feature_towards`]): a polytope's best face, a
 //!    cylinder's cap or side line, a cone's base or slant line, a capsule's segment, a
 //!    sphere's centre. It is clipped (Sutherland–Hodgman) against the reference face's side
 //!    planes, which contain the contact direction, so that moving a point along `n` never
 //!    leaves the face.
-//! 3. **Depth test**: each clipped core point is moved along the normal onto the incident
-//!    surface (by the radius for a sphere; where the ray leaves a capsule, exactly, for a
-//!    capsule's segment point, which is the radius only when the segment is ⟂ the
-//!    normal), then along `n` onto the reference
-//!    face's plane; it is kept when it is at most [`CONTACT_SLACK_RELATIVE`] × the scale
-//!    above that plane. Both points lie on the segment along `n`, so every kept point meets
+//! 3. **Depth test**: each clipped core point is moved along `n` onto the incident surface
+//!    (by the radius for a sphere; for a capsule's segment point, exactly where the ray
+//!    leaves the capsule, which is the radius only when the segment is ⟂ `n`), then along
+//!    `n` onto the reference face's plane; it is kept when it is at most
+//!    [`CONTACT_SLACK_RELATIVE`] × the scale above that plane. Both points lie on the segment along `n`, so every kept point meets
 //!    the contract of [`crate::narrow::contact`] (`point_b − point_a = distance · n`).
 //! 4. **Deepest point**: when `d`'s witnesses are deeper than every kept point by more than
 //!    the slack (a curved reference face's rim, a polytope vertex off the best incident
@@ -35,16 +34,24 @@
 //! The manifold's normal is `d.normal`, unchanged; apart shapes (`d.distance > 0`) get an
 //! empty manifold with it.
 //!
+//! # Parallel lines
+//! Without a reference face, two line features (a cylinder's side, a capsule's segment, a
+//! cone's slant) ⟂ `n` and parallel within [`LINE_PARALLEL`] (a pipe lying on a pipe)
+//! touch along a segment: the overlap of the two lines, its ends pulled in by the drift of
+//! a depth-long column along lines not exactly ⟂ `n` (so no column slips past a line's
+//! end), gives up to two points. Each is the pair on one column along `n`: one shape's
+//! surface point, and the other's extreme towards it on that column
+//! ([`ContactFeatures::column_top`], answered by cylinders and capsules; two cones' slants
+//! get the single point).
+//!
 //! # Tolerances
 //! - [`FACE_ALIGNMENT`]: the closed forms' value, so a box given as a hull gets the same
 //!   manifold as the box.
 //! - [`CONTACT_SLACK_RELATIVE`] = 1e-9: EPA's normal is accurate to its relative tolerance
 //!   (1e-10), so points of a face lying flat on another are at the same depth to about
 //!   1e-10 × size; ten times that keeps them all without keeping points measurably above.
-//!
-//! # Not covered (one point)
-//! Two parallel lines (a cylinder lying on a cylinder or a capsule, a cone's slant on a
-//! cylinder's side) have no reference face: they get the single point of `d`.
+//! - [`LINE_PARALLEL`] = 1e-2, as the closed forms' parallel edges; the columns make the
+//!   points exact whatever the angle, and the depth test drops the ends that do not touch.
 
 mod features;
 
@@ -60,6 +67,10 @@ pub const FACE_ALIGNMENT: f64 = 0.9999;
 /// How far above the reference plane (times the scale of the coordinates) a clipped point
 /// may lie and still be a contact point (module docs).
 pub const CONTACT_SLACK_RELATIVE: f64 = 1e-9;
+
+/// Sine of the angle under which two line features count as parallel, and a line as ⟂
+/// the normal (about 0.6°, as the closed-form pairs' edges).
+pub const LINE_PARALLEL: f64 = 1e-2;
 
 /// Candidate points: every clipped vertex plus the witness.
 const CANDIDATES: usize = 2 * FEATURE_POINTS + 1;
@@ -142,7 +153,7 @@ pub fn manifold_convex_convex<A: ContactFeatures + ?Sized, B: ContactFeatures + 
                 &mut cands,
             );
         }
-        None => {}
+        None => parallel_lines(a, b, pose_ab, d, slack, &mut cands),
     }
     let deepest = cands
         .points()
@@ -157,6 +168,86 @@ pub fn manifold_convex_convex<A: ContactFeatures + ?Sized, B: ContactFeatures + 
         });
     }
     reduce(cands.points(), n, out);
+}
+
+/// Two line features (a cylinder's side, a capsule's segment, a cone's slant) ⟂ `n` and
+/// parallel within [`LINE_PARALLEL`]: B's line clipped to A's extent along it, each end
+/// giving the two surface points on the column through it along `n`; one of the shapes must
+/// answer [`ContactFeatures::column_top`] (a cylinder or a capsule). Else nothing.
+fn parallel_lines<A: ContactFeatures + ?Sized, B: ContactFeatures + ?Sized>(
+    a: &A,
+    b: &B,
+    pose_ab: &Isometry,
+    d: &ShapeDistance,
+    slack: f64,
+    out: &mut Candidates,
+) {
+    let n = d.normal;
+    let (mut la, mut lb) = (Polygon::new(), Polygon::new());
+    a.feature_towards(n, &mut la);
+    b.feature_towards(pose_ab.inverse_transform_vector(-n), &mut lb);
+    for p in lb.points_mut() {
+        *p = pose_ab.transform_point(*p);
+    }
+    let ([a0, a1], [b0, b1]) = (la.points(), lb.points()) else {
+        return;
+    };
+    let (da, db) = (*a1 - *a0, *b1 - *b0);
+    let (len_a, len_b) = (da.length(), db.length());
+    if len_a == 0.0
+        || len_b == 0.0
+        || da.dot(n).abs() > LINE_PARALLEL * len_a
+        || db.dot(n).abs() > LINE_PARALLEL * len_b
+        || da.cross(db).length() > LINE_PARALLEL * len_a * len_b
+    {
+        return;
+    }
+    let u = da / len_a;
+    // The overlap of both lines along u. A column (along n, at most the depth long)
+    // drifts along a line not exactly ⟂ n or not exactly parallel to the other: the
+    // overlap's ends are pulled in by that drift (and rounding), so no column leaves a
+    // line's end, where the side surface stops.
+    let tilt =
+        da.dot(n).abs() / len_a + db.dot(n).abs() / len_b + da.cross(db).length() / (len_a * len_b);
+    let drift = (d.distance.abs() + slack) * tilt + slack;
+    let (lo, hi) = (
+        a0.dot(u).min(a1.dot(u)).max(b0.dot(u).min(b1.dot(u))) + drift,
+        a0.dot(u).max(a1.dot(u)).min(b0.dot(u).max(b1.dot(u))) - drift,
+    );
+    if lo > hi {
+        return;
+    }
+    let (mut seg, mut next) = (lb, Polygon::new());
+    clip_plane(&seg, u, hi, &mut next);
+    clip_plane(&next, -u, -lo, &mut seg);
+    // Either B's surface point at q and A's extreme towards B in its column, or (when A
+    // answers no column) A's surface point at q's place along A's line and B's extreme
+    // towards A in its column.
+    let b_local = |p: DVec3| pose_ab.inverse_transform_point(p);
+    let towards_a = pose_ab.inverse_transform_vector(-n);
+    for q in seg.points() {
+        let pair = if a.has_columns() {
+            let pb = pose_ab.transform_point(b.surface_along(b_local(*q), towards_a));
+            a.column_top(pb, n).map(|s| (pb + n * s, pb))
+        } else if b.has_columns() {
+            let pa = a.surface_along(*a0 + u * (*q - *a0).dot(u), n);
+            b.column_top(b_local(pa), towards_a)
+                .map(|s| (pa, pa - n * s))
+        } else {
+            None
+        };
+        let Some((point_a, point_b)) = pair else {
+            continue;
+        };
+        let distance = (point_b - point_a).dot(n);
+        if distance <= slack {
+            out.push(ManifoldPoint {
+                point_a,
+                point_b,
+                distance,
+            });
+        }
+    }
 }
 
 /// Whether a face outline has an area above rounding (a zero-size box's face, a cap of

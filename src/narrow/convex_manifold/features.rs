@@ -108,6 +108,21 @@ pub trait ContactFeatures {
         core_point + v * self.core_radius()
     }
 
+    /// The largest `s` (metres) with `p + s·v` in the shape (`p` a point and `v` a unit
+    /// vector, local frame): where the line through `p` along `v` leaves the shape, for
+    /// the shapes whose contact feature can be a line (cylinder, capsule); `None` when the
+    /// line misses the shape or the shape does not answer (the default).
+    #[must_use]
+    fn column_top(&self, _p: DVec3, _v: DVec3) -> Option<f64> {
+        None
+    }
+
+    /// Whether [`column_top`](Self::column_top) answers (cylinders and capsules).
+    #[must_use]
+    fn has_columns(&self) -> bool {
+        false
+    }
+
     /// The flat face of the core whose outward unit normal is closest to `n`: its outline
     /// (counter-clockwise seen from outside) into `out` and its normal; `None` (and `out`
     /// empty) when the shape has no face of positive area with at most [`FEATURE_POINTS`]
@@ -127,6 +142,55 @@ fn radial(v: DVec3) -> DVec3 {
     DVec3::new(v.x, v.y, 0.0)
         .try_normalize()
         .unwrap_or(DVec3::X)
+}
+
+/// How far past a cylinder's end (times its size and the point's coordinates) a column's
+/// exit through the side still counts as on the side: rounding of the rim.
+const RIM_RELATIVE: f64 = 1e-12;
+
+/// An interval of line parameters; `(−∞, ∞)` for all of them.
+type Interval = (f64, f64);
+
+/// The parameters `s` with `p + s·v` within `radius` of the Z axis; `None` when none.
+fn radial_interval(p: DVec3, v: DVec3, radius: f64) -> Option<Interval> {
+    let a = v.x * v.x + v.y * v.y;
+    let half_b = p.x * v.x + p.y * v.y;
+    let c = p.x * p.x + p.y * p.y - radius * radius;
+    if a == 0.0 {
+        return (c <= 0.0).then_some((f64::NEG_INFINITY, f64::INFINITY));
+    }
+    let disc = half_b * half_b - a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let root = disc.sqrt();
+    Some(((-half_b - root) / a, (-half_b + root) / a))
+}
+
+/// The parameters `s` with `|z + s·vz| ≤ half_height`; empty (`lo > hi`) when none.
+fn slab_interval(z: f64, vz: f64, half_height: f64) -> Interval {
+    if vz == 0.0 {
+        return if z.abs() <= half_height {
+            (f64::NEG_INFINITY, f64::INFINITY)
+        } else {
+            (1.0, -1.0)
+        };
+    }
+    let (s0, s1) = ((-half_height - z) / vz, (half_height - z) / vz);
+    (s0.min(s1), s0.max(s1))
+}
+
+/// The parameters `s` with `p + s·v` (`v` unit) in the ball of `radius` about the origin.
+fn ball_interval(p: DVec3, v: DVec3, radius: f64) -> Option<Interval> {
+    let half_b = p.dot(v);
+    let disc = half_b * half_b - (p.length_squared() - radius * radius);
+    (disc >= 0.0).then(|| (-half_b - disc.sqrt(), -half_b + disc.sqrt()))
+}
+
+/// The intersection of two intervals; `None` when empty.
+fn meet(x: Interval, y: Interval) -> Option<Interval> {
+    let (lo, hi) = (x.0.max(y.0), x.1.min(y.1));
+    (lo <= hi).then_some((lo, hi))
 }
 
 /// The regular [`DISC_POINTS`]-gon inscribed in the circle of `radius` about `(0, 0, z)`,
@@ -187,6 +251,26 @@ impl ContactFeatures for Capsule {
         core_point + v * s
     }
 
+    fn has_columns(&self) -> bool {
+        true
+    }
+
+    fn column_top(&self, p: DVec3, v: DVec3) -> Option<f64> {
+        // The union of the cylinder part and the two end balls (an interval: the capsule
+        // is convex): the largest upper end.
+        let (r, hh) = (self.radius, self.half_height);
+        let tube = radial_interval(p, v, r).and_then(|t| meet(t, slab_interval(p.z, v.z, hh)));
+        [
+            ball_interval(p - DVec3::Z * hh, v, r),
+            ball_interval(p + DVec3::Z * hh, v, r),
+            tube,
+        ]
+        .into_iter()
+        .flatten()
+        .map(|(_, hi)| hi)
+        .reduce(f64::max)
+    }
+
     fn feature_towards(&self, _v: DVec3, out: &mut Polygon) {
         // The whole segment: an end that is not a support point is dropped by the
         // manifold's depth test.
@@ -241,6 +325,24 @@ impl ContactFeatures for Cuboid {
 }
 
 impl ContactFeatures for Cylinder {
+    fn has_columns(&self) -> bool {
+        true
+    }
+
+    fn column_top(&self, p: DVec3, v: DVec3) -> Option<f64> {
+        let (h, r) = (self.half_height, self.radius);
+        let tube = radial_interval(p, v, r)?;
+        // NOTE: a column through the rim of a cap, nearly in the cap's plane (a line
+        // contact's end on this cylinder's end), meets the side and the cap at the same
+        // point to rounding: the side's exit is taken when within rounding of the slab, or
+        // the slab's rounding would decide between the side and a zero-length chord.
+        let rounding = RIM_RELATIVE * (h + r + p.abs().max_element());
+        if (p.z + tube.1 * v.z).abs() <= h + rounding {
+            return Some(tube.1);
+        }
+        meet(tube, slab_interval(p.z, v.z, h)).map(|(_, hi)| hi)
+    }
+
     fn face_towards(&self, n: DVec3, out: &mut Polygon) -> Option<DVec3> {
         out.clear();
         if self.radius == 0.0 {
@@ -359,6 +461,26 @@ mod tests {
         assert_eq!(p.len(), DISC_POINTS);
         c.feature_towards(DVec3::new(1.0, 0.0, 0.2).normalize(), &mut p);
         assert_eq!(p.points(), &[DVec3::Z, DVec3::new(1.0, 0.0, -1.0)]);
+    }
+
+    #[test]
+    fn columns_leave_cylinders_and_capsules_at_their_surfaces() {
+        // The extreme along +X in the column through a point at x = 2: behind it.
+        let c = Cylinder::new(1.0, 0.5);
+        let s = c.column_top(DVec3::new(2.0, 0.0, 0.3), DVec3::X).unwrap();
+        assert!((s + 1.5).abs() < 1e-15, "{s}");
+        // Off the side line by 0.3: the circle at x = 0.4.
+        let s = c.column_top(DVec3::new(2.0, 0.3, 0.0), DVec3::X).unwrap();
+        assert!((s + 1.6).abs() < 1e-15, "{s}");
+        assert!(c.column_top(DVec3::new(2.0, 0.6, 0.0), DVec3::X).is_none());
+        assert!(c.column_top(DVec3::new(2.0, 0.0, 1.1), DVec3::X).is_none());
+        let k = Capsule::new(1.0, 0.5);
+        // Beyond the segment's end, the end ball answers.
+        let s = k.column_top(DVec3::new(2.0, 0.0, 1.3), DVec3::X).unwrap();
+        assert!((s + 1.6).abs() < 1e-15, "{s}");
+        let s = k.column_top(DVec3::new(2.0, 0.0, 0.2), DVec3::X).unwrap();
+        assert!((s + 1.5).abs() < 1e-15, "{s}");
+        assert!(k.column_top(DVec3::new(2.0, 0.0, 1.6), DVec3::X).is_none());
     }
 
     #[test]
