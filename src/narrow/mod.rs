@@ -17,6 +17,9 @@
 //! penetration depth, and [`signed_distance_convex`] combining both under the
 //! [`contact`] contract.
 //!
+//! [`convex_manifold`] builds multi-point manifolds for the GJK pairs from their signed
+//! distance (reference-face clipping over each shape's contact features).
+//!
 //! [`convex_mesh`] walks a mesh's BVH for a convex shape; [`toi`] finds the time of impact
 //! over a frame's motion by conservative advancement, on any of these distance queries.
 //!
@@ -25,6 +28,7 @@
 
 mod closest_points;
 pub mod contact;
+pub mod convex_manifold;
 pub mod convex_mesh;
 pub mod gjk;
 pub mod mesh_mesh;
@@ -34,6 +38,7 @@ mod triangle_overlap;
 pub mod triangle_triangle;
 
 pub use contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+pub use convex_manifold::{ContactFeatures, manifold_convex_convex};
 pub use gjk::{
     GjkCache, GjkOutcome, GjkParams, GjkResult, Rounded, gjk_distance, signed_distance_convex,
 };

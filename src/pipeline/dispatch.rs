@@ -5,7 +5,7 @@
 //! | pair | distance | manifold |
 //! |---|---|---|
 //! | sphere, capsule, cuboid among themselves | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
-//! | a cylinder, cone or convex hull with any convex shape | GJK on the cores, EPA when they overlap ([`crate::narrow::gjk`]) | one point: the signed-distance witnesses |
+//! | a cylinder, cone or convex hull with any convex shape | GJK on the cores, EPA when they overlap ([`crate::narrow::gjk`]) | reference-face clipping of the shapes' contact features from the distance's normal, ≤ 4 points ([`crate::narrow::convex_manifold`]) |
 //! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`super::mesh_contacts`]) |
 //! | mesh–mesh | [`Route::MeshMesh`]: the BVH tandem queries with warm starts and the worker pool | intersection segments, reduced |
 //!
@@ -22,6 +22,7 @@ use super::mesh_contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_m
 use crate::geometry::{Segment, SupportMap};
 use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
+use crate::narrow::convex_manifold::{ContactFeatures, manifold_convex_convex};
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
 use crate::narrow::gjk::{
     EpaWorkspace, GjkCache, GjkOutcome, GjkParams, POINT, Rounded, gjk_distance,
@@ -164,11 +165,13 @@ pub(super) fn manifold(
             flip_manifold(out, &iso);
         }
         // One point: sphere pairs (their closed-form manifolds are the distance's
-        // witnesses), GJK pairs, and mesh–mesh off the pipeline's route.
-        (S(_), S(_) | C(_) | B(_))
-        | (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
-        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!())
-        | (M(_), M(_)) => out.set_from_distance(d),
+        // witnesses) and mesh–mesh off the pipeline's route.
+        (S(_), S(_) | C(_) | B(_)) | (M(_), M(_)) => out.set_from_distance(d),
+        // GJK pairs: reference-face clipping from the distance's normal.
+        (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
+            manifold_convex_convex(features_of(a), features_of(b), &iso, d, out);
+        }
         (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, d, scratch, out),
     }
 }
@@ -255,6 +258,19 @@ pub(super) fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
         Shape::Convex(c) => (Core::Support(c.as_ref()), 0.0),
         Shape::Mesh(_) => return None,
     })
+}
+
+/// The contact features of a convex shape (the caller's arm guarantees it is not a mesh).
+fn features_of(shape: &Shape) -> &dyn ContactFeatures {
+    match shape {
+        Shape::Sphere(s) => s,
+        Shape::Capsule(c) => c,
+        Shape::Cuboid(b) => b,
+        Shape::Cylinder(c) => c,
+        Shape::Cone(c) => c,
+        Shape::Convex(c) => c.as_ref(),
+        Shape::Mesh(_) => unreachable!("the dispatcher sends only convex pairs here"),
+    }
 }
 
 /// GJK/EPA between two convex shapes (the caller's arm guarantees neither is a mesh).

@@ -1,0 +1,507 @@
+//! Multi-point contact manifolds of any two convex shapes, from their signed distance.
+//!
+//! The pairs answered by GJK/EPA (cylinders, cones, convex hulls, against any convex shape)
+//! get one normal and one deepest point from [`crate::narrow::gjk`]; a resting contact needs
+//! the whole contact patch. [`manifold_convex_convex`] builds it from the pair's
+//! [`ShapeDistance`] `d` (normal `n`, A→B), never running the distance query again.
+//!
+//! # Algorithm (Ericson, *Real-Time Collision Detection*, §8.3.4 (clipping);
+//! Gregorius, *Robust Contact Creation for Physics Simulations*, GDC 2015)
+//! 1. **Reference face**: A's face whose outward normal is closest to `n` and B's closest to
+//!    `−n` ([`ContactFeatures::face_towards`]); one counts when its cosine with the normal is
+//!    at least [`FACE_ALIGNMENT`] (about 0.8°, as the closed-form pairs); the better aligned
+//!    is the reference (A on ties). None: see *Parallel lines* below, else the single
+//!    point of `d` (edge–edge, point contacts).
+//! 2. **Incident feature**: the other shape's feature out of which the reference normal
+//!    points back ([`ContactFeatures::feature_towards`]): a polytope's best face, a
+//!    cylinder's cap or side line, a cone's base or slant line, a capsule's segment, a
+//!    sphere's centre. It is clipped (Sutherland–Hodgman) against the reference face's side
+//!    planes, which contain the contact direction, so that moving a point along `n` never
+//!    leaves the face.
+//! 3. **Depth test**: each clipped core point is moved along `n` onto the incident surface
+//!    (by the radius for a sphere; for a capsule's segment point, exactly where the ray
+//!    leaves the capsule, which is the radius only when the segment is ⟂ `n`), then along
+//!    `n` onto the reference face's plane; it is kept when it is at most
+//!    [`CONTACT_SLACK_RELATIVE`] × the scale above that plane. Both points lie on the segment along `n`, so every kept point meets
+//!    the contract of [`crate::narrow::contact`] (`point_b − point_a = distance · n`).
+//! 4. **Deepest point**: when `d`'s witnesses are deeper than every kept point by more than
+//!    the slack (a curved reference face's rim, a polytope vertex off the best incident
+//!    face), they are added, so the deepest reported depth is `d.distance`. Nothing kept: the
+//!    single point of `d`.
+//! 5. **Reduction** to [`MANIFOLD_POINTS`]: the deepest, the farthest from it, the one
+//!    spanning the largest triangle with those, the one adding the most area outside it.
+//!
+//! The manifold's normal is `d.normal`, unchanged; apart shapes (`d.distance > 0`) get an
+//! empty manifold with it.
+//!
+//! # Parallel lines
+//! Without a reference face, two line features (a cylinder's side, a capsule's segment, a
+//! cone's slant) ⟂ `n` and parallel within [`LINE_PARALLEL`] (a pipe lying on a pipe)
+//! touch along a segment: the overlap of the two lines, its ends pulled in by the drift of
+//! a depth-long column along lines not exactly ⟂ `n` (so no column slips past a line's
+//! end), gives up to two points. Each is the pair on one column along `n`: one shape's
+//! surface point, and the other's extreme towards it on that column
+//! ([`ContactFeatures::column_top`], answered by cylinders and capsules; two cones' slants
+//! get the single point).
+//!
+//! # Tolerances
+//! - [`FACE_ALIGNMENT`]: the closed forms' value, so a box given as a hull gets the same
+//!   manifold as the box.
+//! - [`CONTACT_SLACK_RELATIVE`] = 1e-9: EPA's normal is accurate to its relative tolerance
+//!   (1e-10), so points of a face lying flat on another are at the same depth to about
+//!   1e-10 × size; ten times that keeps them all without keeping points measurably above.
+//! - [`LINE_PARALLEL`] = 1e-2, as the closed forms' parallel edges; the columns make the
+//!   points exact whatever the angle, and the depth test drops the ends that do not touch.
+
+mod features;
+
+pub use features::{ContactFeatures, DISC_POINTS, FEATURE_POINTS, Polygon};
+
+use crate::math::{DVec3, Isometry};
+use crate::narrow::contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+
+/// Cosine between a face's normal and the contact normal above which the face is a
+/// reference face (about 0.8°), as in the closed-form pairs.
+pub const FACE_ALIGNMENT: f64 = 0.9999;
+
+/// How far above the reference plane (times the scale of the coordinates) a clipped point
+/// may lie and still be a contact point (module docs).
+pub const CONTACT_SLACK_RELATIVE: f64 = 1e-9;
+
+/// Sine of the angle under which two line features count as parallel, and a line as ⟂
+/// the normal (about 0.6°, as the closed-form pairs' edges).
+pub const LINE_PARALLEL: f64 = 1e-2;
+
+/// Candidate points: every clipped vertex plus the witness.
+const CANDIDATES: usize = 2 * FEATURE_POINTS + 1;
+
+/// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab` (B's frame in
+/// A's), A's frame, from their signed distance `d` (the [`crate::narrow::contact`]
+/// contract, A's frame): at most [`MANIFOLD_POINTS`] points with normal `d.normal`, each
+/// `≤ 0` deep to the slack, the deepest at `d.distance`; empty when `d.distance > 0`.
+///
+/// # Allocation
+/// None (fixed-capacity buffers on the stack).
+pub fn manifold_convex_convex<A: ContactFeatures + ?Sized, B: ContactFeatures + ?Sized>(
+    a: &A,
+    b: &B,
+    pose_ab: &Isometry,
+    d: &ShapeDistance,
+    out: &mut Manifold,
+) {
+    let n = d.normal;
+    out.reset(n);
+    if d.distance > 0.0 {
+        return;
+    }
+    let (mut face_a, mut face_b) = (Polygon::new(), Polygon::new());
+    let fa = a.face_towards(n, &mut face_a);
+    let fb = b
+        .face_towards(pose_ab.inverse_transform_vector(-n), &mut face_b)
+        .map(|f| pose_ab.transform_vector(f));
+    for p in face_b.points_mut() {
+        *p = pose_ab.transform_point(*p);
+    }
+    let scale = [d.point_a, d.point_b]
+        .iter()
+        .chain(face_a.points())
+        .chain(face_b.points())
+        .fold(d.distance.abs(), |s, p| s.max(p.abs().max_element()));
+    let slack = CONTACT_SLACK_RELATIVE * scale;
+    let cos_a = fa.filter(|_| has_area(&face_a, scale)).map(|f| f.dot(n));
+    let cos_b = fb.filter(|_| has_area(&face_b, scale)).map(|f| -f.dot(n));
+    let use_a = match (cos_a, cos_b) {
+        (Some(ca), Some(cb)) if ca >= FACE_ALIGNMENT || cb >= FACE_ALIGNMENT => Some(ca >= cb),
+        (Some(ca), None) if ca >= FACE_ALIGNMENT => Some(true),
+        (None, Some(cb)) if cb >= FACE_ALIGNMENT => Some(false),
+        _ => None,
+    };
+    let mut cands = Candidates::new();
+    let mut incident = Polygon::new();
+    match use_a {
+        Some(true) => {
+            let f = fa.unwrap_or(n);
+            b.feature_towards(pose_ab.inverse_transform_vector(-f), &mut incident);
+            for p in incident.points_mut() {
+                *p = pose_ab.transform_point(*p);
+            }
+            let reference = Reference {
+                outline: &face_a,
+                normal: f,
+                towards: n,
+            };
+            let to_surface = |c: DVec3| {
+                let local = pose_ab.inverse_transform_point(c);
+                let v = pose_ab.inverse_transform_vector(-n);
+                pose_ab.transform_point(b.surface_along(local, v))
+            };
+            reference.clip(&incident, &to_surface, true, slack, &mut cands);
+        }
+        Some(false) => {
+            let f = fb.unwrap_or(-n);
+            a.feature_towards(-f, &mut incident);
+            let reference = Reference {
+                outline: &face_b,
+                normal: f,
+                towards: -n,
+            };
+            reference.clip(
+                &incident,
+                &|c| a.surface_along(c, n),
+                false,
+                slack,
+                &mut cands,
+            );
+        }
+        None => parallel_lines(a, b, pose_ab, d, slack, &mut cands),
+    }
+    let deepest = cands
+        .points()
+        .iter()
+        .map(|p| p.distance)
+        .fold(f64::INFINITY, f64::min);
+    if d.distance < deepest - slack {
+        cands.push(ManifoldPoint {
+            point_a: d.point_a,
+            point_b: d.point_b,
+            distance: d.distance,
+        });
+    }
+    reduce(cands.points(), n, out);
+}
+
+/// Two line features (a cylinder's side, a capsule's segment, a cone's slant) ⟂ `n` and
+/// parallel within [`LINE_PARALLEL`]: B's line clipped to A's extent along it, each end
+/// giving the two surface points on the column through it along `n`; one of the shapes must
+/// answer [`ContactFeatures::column_top`] (a cylinder or a capsule). Else nothing.
+fn parallel_lines<A: ContactFeatures + ?Sized, B: ContactFeatures + ?Sized>(
+    a: &A,
+    b: &B,
+    pose_ab: &Isometry,
+    d: &ShapeDistance,
+    slack: f64,
+    out: &mut Candidates,
+) {
+    let n = d.normal;
+    let (mut la, mut lb) = (Polygon::new(), Polygon::new());
+    a.feature_towards(n, &mut la);
+    b.feature_towards(pose_ab.inverse_transform_vector(-n), &mut lb);
+    for p in lb.points_mut() {
+        *p = pose_ab.transform_point(*p);
+    }
+    let ([a0, a1], [b0, b1]) = (la.points(), lb.points()) else {
+        return;
+    };
+    let (da, db) = (*a1 - *a0, *b1 - *b0);
+    let (len_a, len_b) = (da.length(), db.length());
+    if len_a == 0.0
+        || len_b == 0.0
+        || da.dot(n).abs() > LINE_PARALLEL * len_a
+        || db.dot(n).abs() > LINE_PARALLEL * len_b
+        || da.cross(db).length() > LINE_PARALLEL * len_a * len_b
+    {
+        return;
+    }
+    let u = da / len_a;
+    // The overlap of both lines along u. A column (along n, at most the depth long)
+    // drifts along a line not exactly ⟂ n or not exactly parallel to the other: the
+    // overlap's ends are pulled in by that drift (and rounding), so no column leaves a
+    // line's end, where the side surface stops.
+    let tilt =
+        da.dot(n).abs() / len_a + db.dot(n).abs() / len_b + da.cross(db).length() / (len_a * len_b);
+    let drift = (d.distance.abs() + slack) * tilt + slack;
+    let (lo, hi) = (
+        a0.dot(u).min(a1.dot(u)).max(b0.dot(u).min(b1.dot(u))) + drift,
+        a0.dot(u).max(a1.dot(u)).min(b0.dot(u).max(b1.dot(u))) - drift,
+    );
+    if lo > hi {
+        return;
+    }
+    let (mut seg, mut next) = (lb, Polygon::new());
+    clip_plane(&seg, u, hi, &mut next);
+    clip_plane(&next, -u, -lo, &mut seg);
+    // Either B's surface point at q and A's extreme towards B in its column, or (when A
+    // answers no column) A's surface point at q's place along A's line and B's extreme
+    // towards A in its column.
+    let b_local = |p: DVec3| pose_ab.inverse_transform_point(p);
+    let towards_a = pose_ab.inverse_transform_vector(-n);
+    for q in seg.points() {
+        let pair = if a.has_columns() {
+            let pb = pose_ab.transform_point(b.surface_along(b_local(*q), towards_a));
+            a.column_top(pb, n).map(|s| (pb + n * s, pb))
+        } else if b.has_columns() {
+            let pa = a.surface_along(*a0 + u * (*q - *a0).dot(u), n);
+            b.column_top(b_local(pa), towards_a)
+                .map(|s| (pa, pa - n * s))
+        } else {
+            None
+        };
+        let Some((point_a, point_b)) = pair else {
+            continue;
+        };
+        let distance = (point_b - point_a).dot(n);
+        if distance <= slack {
+            out.push(ManifoldPoint {
+                point_a,
+                point_b,
+                distance,
+            });
+        }
+    }
+}
+
+/// Whether a face outline has an area above rounding (a zero-size box's face, a cap of
+/// radius 0 does not, and cannot bound a clip).
+fn has_area(outline: &Polygon, scale: f64) -> bool {
+    let pts = outline.points();
+    if pts.len() < 3 {
+        return false;
+    }
+    let twice: DVec3 = (0..pts.len())
+        .map(|i| (pts[i] - pts[0]).cross(pts[(i + 1) % pts.len()] - pts[0]))
+        .sum();
+    twice.length() > CONTACT_SLACK_RELATIVE * scale * scale
+}
+
+/// A reference face in A's frame.
+struct Reference<'p> {
+    /// Its outline.
+    outline: &'p Polygon,
+    /// Its outward unit normal.
+    normal: DVec3,
+    /// The contact direction from the reference shape to the incident one (`n` when the
+    /// reference is A's, `−n` when B's), within [`FACE_ALIGNMENT`] of `normal`.
+    towards: DVec3,
+}
+
+impl Reference<'_> {
+    /// Clips the incident core feature against the side planes and adds the points at most
+    /// `slack` above the face (module docs, steps 2–3); `to_surface` takes a core point to
+    /// the incident surface along `−towards`.
+    fn clip(
+        &self,
+        incident: &Polygon,
+        to_surface: &dyn Fn(DVec3) -> DVec3,
+        reference_is_a: bool,
+        slack: f64,
+        out: &mut Candidates,
+    ) {
+        let (f, m) = (self.normal, self.towards);
+        let ref_pts = self.outline.points();
+        let centroid = ref_pts.iter().copied().sum::<DVec3>() / ref_pts.len() as f64;
+        let offset = ref_pts
+            .iter()
+            .map(|p| f.dot(*p))
+            .fold(f64::NEG_INFINITY, f64::max);
+        let (mut inc, mut next) = (*incident, Polygon::new());
+        for i in 0..ref_pts.len() {
+            let (p, q) = (ref_pts[i], ref_pts[(i + 1) % ref_pts.len()]);
+            let mut side = (q - p).cross(m);
+            if side.dot(centroid - p) > 0.0 {
+                side = -side;
+            }
+            if side.length_squared() > 0.0 {
+                clip_plane(&inc, side, side.dot(p), &mut next);
+                std::mem::swap(&mut inc, &mut next);
+            }
+        }
+        let along = f.dot(m);
+        for core in inc.points() {
+            let on_incident = to_surface(*core);
+            let t = (f.dot(on_incident) - offset) / along;
+            if t > slack || t.is_nan() {
+                continue;
+            }
+            let on_reference = on_incident - m * t;
+            let (point_a, point_b) = if reference_is_a {
+                (on_reference, on_incident)
+            } else {
+                (on_incident, on_reference)
+            };
+            out.push(ManifoldPoint {
+                point_a,
+                point_b,
+                distance: t,
+            });
+        }
+    }
+}
+
+/// Sutherland–Hodgman: the part of `poly` with `side · x ≤ offset`, into `out`. A point
+/// stays a point and a segment a segment.
+fn clip_plane(poly: &Polygon, side: DVec3, offset: f64, out: &mut Polygon) {
+    out.clear();
+    let pts = poly.points();
+    let inside = |p: DVec3| side.dot(p) - offset;
+    match pts.len() {
+        0 => {}
+        1 => {
+            if inside(pts[0]) <= 0.0 {
+                out.push(pts[0]);
+            }
+        }
+        2 => {
+            let (p, q) = (pts[0], pts[1]);
+            let (dp, dq) = (inside(p), inside(q));
+            let cut = || p + (q - p) * (dp / (dp - dq));
+            match (dp <= 0.0, dq <= 0.0) {
+                (true, true) => {
+                    out.push(p);
+                    out.push(q);
+                }
+                (true, false) => {
+                    out.push(p);
+                    out.push(cut());
+                }
+                (false, true) => {
+                    out.push(cut());
+                    out.push(q);
+                }
+                (false, false) => {}
+            }
+        }
+        len => {
+            for i in 0..len {
+                let (p, q) = (pts[i], pts[(i + 1) % len]);
+                let (dp, dq) = (inside(p), inside(q));
+                if dp <= 0.0 {
+                    out.push(p);
+                }
+                if (dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0) {
+                    out.push(p + (q - p) * (dp / (dp - dq)));
+                }
+            }
+        }
+    }
+}
+
+/// Candidate contact points before reduction (fixed capacity).
+struct Candidates {
+    pts: [ManifoldPoint; CANDIDATES],
+    len: usize,
+}
+
+impl Candidates {
+    fn new() -> Self {
+        Self {
+            pts: [ManifoldPoint {
+                point_a: DVec3::ZERO,
+                point_b: DVec3::ZERO,
+                distance: 0.0,
+            }; CANDIDATES],
+            len: 0,
+        }
+    }
+
+    fn push(&mut self, p: ManifoldPoint) {
+        if self.len < CANDIDATES {
+            self.pts[self.len] = p;
+            self.len += 1;
+        }
+    }
+
+    fn points(&self) -> &[ManifoldPoint] {
+        &self.pts[..self.len]
+    }
+}
+
+/// At most [`MANIFOLD_POINTS`] of `pts` into `out` (module docs, step 5), positions taken
+/// on A's surface, areas about `normal`.
+fn reduce(pts: &[ManifoldPoint], normal: DVec3, out: &mut Manifold) {
+    if pts.len() <= MANIFOLD_POINTS {
+        for p in pts {
+            out.push(*p);
+        }
+        return;
+    }
+    let pos = |i: usize| pts[i].point_a;
+    let mut chosen = [usize::MAX; MANIFOLD_POINTS];
+    let best = |score: &dyn Fn(usize) -> f64, chosen: &[usize]| {
+        (0..pts.len())
+            .filter(|i| !chosen.contains(i))
+            .max_by(|&i, &j| score(i).total_cmp(&score(j)))
+            .unwrap_or(0)
+    };
+    chosen[0] = best(&|i| -pts[i].distance, &chosen);
+    let p0 = pos(chosen[0]);
+    chosen[1] = best(&|i| pos(i).distance_squared(p0), &chosen);
+    let p1 = pos(chosen[1]);
+    let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(normal);
+    let third = best(&|i| area(p0, p1, pos(i)).abs(), &chosen);
+    if area(p0, p1, pos(third)) == 0.0 {
+        // All on one line: its two ends.
+        out.push(pts[chosen[0]]);
+        out.push(pts[chosen[1]]);
+        return;
+    }
+    chosen[2] = third;
+    let p2 = pos(chosen[2]);
+    // Counter-clockwise about the normal; the fourth point is the farthest outside an edge.
+    let (p1, p2) = if area(p0, p1, p2) >= 0.0 {
+        (p1, p2)
+    } else {
+        (p2, p1)
+    };
+    let outside = |i: usize| {
+        let q = pos(i);
+        (-area(p0, p1, q))
+            .max(-area(p1, p2, q))
+            .max(-area(p2, p0, q))
+    };
+    let fourth = best(&outside, &chosen);
+    if outside(fourth) > 0.0 {
+        chosen[3] = fourth;
+    }
+    for i in chosen.into_iter().filter(|&i| i != usize::MAX) {
+        out.push(pts[i]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clipping_a_square_by_a_plane_keeps_the_inner_half() {
+        let mut sq = Polygon::new();
+        for p in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            sq.push(DVec3::new(p.0, p.1, 0.0));
+        }
+        let mut out = Polygon::new();
+        clip_plane(&sq, DVec3::X, 0.0, &mut out);
+        assert_eq!(out.len(), 4);
+        assert!(out.points().iter().all(|p| p.x <= 0.0));
+        clip_plane(&sq, DVec3::X, -2.0, &mut out);
+        assert!(out.is_empty());
+    }
+
+    #[test]
+    fn reduction_keeps_the_deepest_point_first_and_drops_interior_points() {
+        let mut pts = Vec::new();
+        for i in 0..8u8 {
+            let angle = f64::from(i) * std::f64::consts::FRAC_PI_4;
+            let p = DVec3::new(angle.cos(), angle.sin(), 0.0);
+            pts.push(ManifoldPoint {
+                point_a: p,
+                point_b: p,
+                distance: if i == 5 { -0.3 } else { -0.1 },
+            });
+        }
+        let mut m = Manifold::new();
+        reduce(&pts, DVec3::Z, &mut m);
+        assert_eq!(m.len(), 4);
+        assert_eq!(m.points()[0].distance, -0.3);
+        // A triangle with a point on an edge and one inside: no fourth point adds area.
+        let line: Vec<ManifoldPoint> = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (0.0, 1.0), (0.5, 0.2)]
+            .iter()
+            .map(|&(x, y)| ManifoldPoint {
+                point_a: DVec3::new(x, y, 0.0),
+                point_b: DVec3::new(x, y, 0.0),
+                distance: if x == 0.0 && y == 0.0 { -0.1 } else { 0.0 },
+            })
+            .collect();
+        let mut m = Manifold::new();
+        reduce(&line, DVec3::Z, &mut m);
+        assert_eq!(m.len(), 3);
+    }
+}
