@@ -367,11 +367,25 @@ fn convex_hulls(c: &mut Criterion, rng: &mut TestRng) {
                 })
                 .fold(0.0, f64::max)
         };
+        let mean_iterations = |accelerated: bool| {
+            let params = GjkParams {
+                accelerated,
+                ..GjkParams::default()
+            };
+            let total: u32 = separated
+                .proxima
+                .iter()
+                .map(|p| gjk_distance(a, b, p, &params, &mut GjkCache::default()).iterations)
+                .sum();
+            f64::from(total) / separated.proxima.len() as f64
+        };
         eprintln!(
             "narrow_phase/convex_distance/{name}: largest |proxima − parry| distance: plain \
-             {:e} m, accelerated {:e} m",
+             {:e} m, accelerated {:e} m; mean GJK iterations: plain {:.2}, accelerated {:.2}",
             worst(false),
-            worst(true)
+            worst(true),
+            mean_iterations(false),
+            mean_iterations(true)
         );
         for (engine, accelerated, warm) in VARIANTS {
             let params = GjkParams {

@@ -67,4 +67,15 @@ pub trait SupportMap {
     /// The farthest point of the shape along `direction` (local frame).
     #[must_use]
     fn support(&self, direction: DVec3) -> DVec3;
+
+    /// [`support`](Self::support) with a search hint kept by the caller between calls
+    /// along nearby directions (GJK's iterations, one pair across frames): shapes that
+    /// search (a convex hull climbing its vertex graph) start from `*hint` and store where
+    /// they ended. Any `hint` value is valid; the answer meets the same contract.
+    #[must_use]
+    #[inline]
+    fn support_from(&self, direction: DVec3, hint: &mut u32) -> DVec3 {
+        let _ = hint;
+        self.support(direction)
+    }
 }

@@ -39,22 +39,24 @@ fn argmax(local: &[DVec3], score: impl Fn(DVec3) -> f64) -> (usize, f64) {
     best
 }
 
-/// [`build`], then again on the corners alone when some vertices are not corners.
+/// [`build`], then again on the corners alone when some vertices are not corners; fills
+/// the support search's centred vertices.
 pub(super) fn build_with_corners(
     world: &[DVec3],
     local: &[DVec3],
     origin: DVec3,
     eps: f64,
 ) -> ConvexPolyhedron {
-    let hull = build(world, local, origin, eps);
+    let mut hull = build(world, local, origin, eps);
     if hull.dimension == 3 {
         let corners = hull.corners();
         if corners.len() < hull.vertices.len() {
             let world: Vec<DVec3> = corners.iter().map(|&i| hull.vertices[i]).collect();
             let local: Vec<DVec3> = world.iter().map(|p| *p - origin).collect();
-            return build(&world, &local, origin, eps);
+            hull = build(&world, &local, origin, eps);
         }
     }
+    hull.centred = hull.vertices.iter().map(|v| *v - origin).collect();
     hull
 }
 
@@ -68,6 +70,7 @@ fn build(world: &[DVec3], local: &[DVec3], origin: DVec3, eps: f64) -> ConvexPol
         origin,
         planes: Vec::new(),
         eps,
+        centred: Vec::new(),
         neighbour_start: Vec::new(),
         neighbours: Vec::new(),
     };

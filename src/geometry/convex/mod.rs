@@ -115,6 +115,8 @@ pub struct ConvexPolyhedron {
     planes: Vec<(DVec3, f64)>,
     /// Construction tolerance, metres.
     eps: f64,
+    /// `vertices − origin`, the support search's copy (as the hull was built on it).
+    centred: Vec<DVec3>,
     /// Vertex adjacency in compressed rows: the neighbours of vertex `i` are
     /// `neighbours[neighbour_start[i]..neighbour_start[i + 1]]`. Empty below dimension 2.
     neighbour_start: Vec<u32>,
@@ -326,10 +328,18 @@ impl SupportMap for ConvexPolyhedron {
     /// to tolerance, the result's `p · d` is within `tolerance() · |d|` of the maximum.
     #[inline]
     fn support(&self, direction: DVec3) -> DVec3 {
-        let score = |i: usize| (self.vertices[i] - self.origin).dot(direction);
-        let mut best = (score(0), 0);
-        if self.vertices.len() < HILL_CLIMB_MIN_VERTICES || self.neighbours.is_empty() {
-            for i in 1..self.vertices.len() {
+        self.support_from(direction, &mut 0)
+    }
+
+    /// The climb starts at vertex `*hint` (any out-of-range value: vertex 0) and stores the
+    /// vertex it ends at: successive GJK directions move little, so the climb is short.
+    #[inline]
+    fn support_from(&self, direction: DVec3, hint: &mut u32) -> DVec3 {
+        let centred = &self.centred;
+        let score = |i: usize| centred[i].dot(direction);
+        if centred.len() < HILL_CLIMB_MIN_VERTICES || self.neighbours.is_empty() {
+            let mut best = (score(0), 0);
+            for i in 1..centred.len() {
                 let s = score(i);
                 if s > best.0 {
                     best = (s, i);
@@ -337,6 +347,12 @@ impl SupportMap for ConvexPolyhedron {
             }
             return self.vertices[best.1];
         }
+        let start = if (*hint as usize) < centred.len() {
+            *hint as usize
+        } else {
+            0
+        };
+        let mut best = (score(start), start);
         loop {
             let (from, to) = (
                 self.neighbour_start[best.1] as usize,
@@ -350,6 +366,7 @@ impl SupportMap for ConvexPolyhedron {
                 }
             }
             if best.1 == before {
+                *hint = best.1 as u32;
                 return self.vertices[best.1];
             }
         }

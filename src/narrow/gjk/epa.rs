@@ -162,7 +162,8 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     params: &GjkParams,
     ws: &mut EpaWorkspace,
 ) -> EpaResult {
-    let sup = |d: DVec3| support(a, b, pose_ab, d);
+    let mut hints = [0; 2];
+    let mut sup = |d: DVec3| support(a, b, pose_ab, d, &mut hints);
     let mut fallback = Fallback::new();
     ws.vertices.clear();
     ws.faces.clear();

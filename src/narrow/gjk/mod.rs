@@ -68,11 +68,14 @@ impl Default for GjkParams {
     }
 }
 
-/// Warm start kept between frames for one pair: the last separating direction (A's frame).
+/// Warm start kept between frames for one pair: the last separating direction (A's frame)
+/// and where the shapes' support searches ended.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct GjkCache {
     /// The last `v` (closest point of `A − B` to the origin), or zero for none.
     pub direction: DVec3,
+    /// The support search hints of A and B ([`SupportMap::support_from`]).
+    pub support_hints: [u32; 2],
 }
 
 /// How GJK stopped.
@@ -114,16 +117,19 @@ pub struct GjkResult {
     pub simplex: Simplex,
 }
 
-/// The support point of `A − B` along `d` (A's frame).
+/// The support point of `A − B` along `d` (A's frame); `hints` are A's and B's support
+/// search hints.
 #[inline]
 fn support<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     a: &A,
     b: &B,
     pose_ab: &Isometry,
     d: DVec3,
+    hints: &mut [u32; 2],
 ) -> SupportPoint {
-    let pa = a.support(d);
-    let pb = pose_ab.transform_point(b.support(pose_ab.inverse_transform_vector(-d)));
+    let pa = a.support_from(d, &mut hints[0]);
+    let pb = pose_ab
+        .transform_point(b.support_from(pose_ab.inverse_transform_vector(-d), &mut hints[1]));
     SupportPoint {
         w: pa - pb,
         a: pa,
@@ -164,7 +170,8 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     } else {
         DVec3::X
     };
-    let first = support(a, b, pose_ab, -guess);
+    let mut hints = cache.support_hints;
+    let first = support(a, b, pose_ab, -guess, &mut hints);
     let mut simplex = Simplex::single(first);
     let mut v = first.w;
     let mut scale = magnitude(&first);
@@ -197,7 +204,7 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             dir = v;
         }
         iterations += 1;
-        let p = support(a, b, pose_ab, -dir);
+        let p = support(a, b, pose_ab, -dir, &mut hints);
         if !p.w.is_finite() {
             break;
         }
@@ -215,19 +222,16 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             break;
         }
         last_w = p.w;
-        let before = simplex;
         simplex.push(p);
-        let v_new = simplex.reduce();
-        if v_new.length_squared() >= dist2 {
-            // No progress: rounding limit. Keep the previous (better) simplex.
-            simplex = before;
+        let Some(v_new) = simplex.reduce_if_closer(dist2) else {
+            // No progress: rounding limit. The previous (better) simplex is kept.
             if accelerated {
                 accelerated = false;
                 continue;
             }
             outcome = settled(dist, floor);
             break;
-        }
+        };
         v = v_new;
     }
     if v.length_squared() == 0.0 {
@@ -237,6 +241,7 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     if v != DVec3::ZERO {
         cache.direction = v;
     }
+    cache.support_hints = hints;
     GjkResult {
         outcome,
         distance: if outcome == GjkOutcome::Penetrating {
@@ -303,7 +308,7 @@ fn certifies_touching<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     params: &GjkParams,
     n: DVec3,
 ) -> bool {
-    let p = support(a, b, pose_ab, n);
+    let p = support(a, b, pose_ab, n, &mut [0; 2]);
     let floor = params.abs_tol + ROUNDING_ULPS * f64::EPSILON * magnitude(&p);
     p.w.dot(n) <= floor
 }

@@ -126,27 +126,57 @@ impl Simplex {
         r
     }
 
+    /// Removes the last point [`push`](Self::push)ed, giving back the simplex as it was
+    /// (weights included) when [`reduce_if_closer`](Self::reduce_if_closer) refused it.
+    fn pop(&mut self) {
+        debug_assert!(self.len > 1);
+        self.len -= 1;
+    }
+
+    /// [`reduce`](Self::reduce) when the new closest point is closer to the origin than
+    /// `dist2` (squared metres); otherwise drops the last pushed point and keeps the simplex
+    /// as it was. Returns the new closest point, or `None` when there was no progress.
+    pub fn reduce_if_closer(&mut self, dist2: f64) -> Option<DVec3> {
+        let r = self.sub_distance();
+        if r.v.length_squared() >= dist2 {
+            self.pop();
+            return None;
+        }
+        self.apply(&r);
+        Some(r.v)
+    }
+
     /// Replaces the simplex by the smallest sub-simplex containing its point closest to the
     /// origin, stores that point's weights and returns it (`w` part). A full tetrahedron is
     /// kept only when it contains the origin; the result is then exactly zero.
     pub fn reduce(&mut self) -> DVec3 {
+        let r = self.sub_distance();
+        self.apply(&r);
+        r.v
+    }
+
+    /// The sub-distance of the current points (Montanari's signed volumes).
+    fn sub_distance(&self) -> Reduced {
         let mut p = [DVec3::ZERO; 4];
         for (q, s) in p.iter_mut().zip(self.points()) {
             *q = s.w;
         }
-        let r = match self.len {
+        match self.len {
             1 => Reduced::point(0, &p),
             2 => segment(&p, 0, 1),
             3 => triangle(&p, [0, 1, 2]),
             _ => tetrahedron(&p),
-        };
+        }
+    }
+
+    /// Keeps the points and weights `r` selects.
+    fn apply(&mut self, r: &Reduced) {
         let old = self.points;
         for k in 0..r.len {
             self.points[k] = old[r.idx[k]];
             self.lambda[k] = r.lambda[k];
         }
         self.len = r.len;
-        r.v
     }
 }
 
@@ -236,7 +266,8 @@ fn tetrahedron(p: &[DVec3; 4]) -> Reduced {
         vol(a, b, c, o),
     ];
     let total = c_.iter().sum::<f64>();
-    let size = (b - a).length() * (c - a).length() * (d - a).length();
+    // Squared, to spare three square roots: `|total| ≤ FLAT · |e1| |e2| |e3|`.
+    let size2 = (b - a).length_squared() * (c - a).length_squared() * (d - a).length_squared();
     let faces = |skip: [bool; 4]| {
         let mut best: Option<Reduced> = None;
         for (k, &s) in skip.iter().enumerate() {
@@ -248,7 +279,7 @@ fn tetrahedron(p: &[DVec3; 4]) -> Reduced {
         }
         best.expect("a skipped vertex names a face")
     };
-    if total.abs() <= FLAT_TETRAHEDRON * size || total.is_nan() {
+    if total * total <= FLAT_TETRAHEDRON * FLAT_TETRAHEDRON * size2 || total.is_nan() {
         return faces([true; 4]);
     }
     let wrong = c_.map(|x| !same_sign(x, total));
