@@ -11,7 +11,7 @@
 //! overlap on the sweep axis keeps it robust to "dice on a table" (all boxes sharing one
 //! z range), where every small vertical motion of the three-axis
 //! [`IncrementalSap`](super::IncrementalSap) swaps endpoints among all the boxes on the shared
-//! axis; the widest-spread axis is never the shared one in that layout.
+//! axis; the widest-spread axis is not the shared one in that layout.
 //!
 //! TODO(#6): the hierarchical hash grid and the automatic choice between the broad phases.
 
@@ -65,9 +65,11 @@ impl SortAndSweep {
     }
 
     /// Brings `order` up to date with `proxies` on `axis`: rebuilt and fully sorted when the
-    /// axis changed; otherwise the entries are refreshed in place (entries of proxies that
-    /// no longer exist dropped, new proxies appended) and insertion-sorted, which is linear
-    /// when the bodies moved coherently and few were added.
+    /// axis changed; otherwise entries past the new proxy count are dropped, new indices
+    /// appended, every entry's key refreshed (entries are indices, so a proxy that changed
+    /// place, e.g. by a caller's `swap_remove`, is simply re-keyed) and the order
+    /// insertion-sorted, which is linear when the bodies moved coherently and few changed
+    /// place.
     fn refresh_order(&mut self, proxies: &[Proxy], axis: usize) {
         if axis != self.axis || self.order.is_empty() {
             self.order.clear();
