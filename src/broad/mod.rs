@@ -8,15 +8,26 @@
 //! boxes, so the narrow phase never misses a close pair.
 //!
 //! [`brute_force`] tests every pair: the reference the faster broad phases are checked
-//! against. [`sort_sweep`] sorts the boxes on one axis and tests only overlapping intervals.
+//! against. [`sort_sweep`] sorts the boxes on one axis and tests only overlapping intervals;
+//! it takes the whole proxy list every frame. [`incremental_sap`] is stateful: bodies are
+//! inserted, updated and removed one by one, and it keeps sorted endpoint lists on all three
+//! axes and the overlapping-pair set between frames, so a body that did not move costs
+//! nothing.
+//!
+//! Every broad phase follows the same tie rule as [`Aabb::intersects`]: closed boxes, so
+//! boxes touching at a face, edge or corner pair, and zero-size boxes are points.
 
 pub mod brute_force;
+pub mod incremental_sap;
 pub mod sort_sweep;
 
 pub use brute_force::pairs_brute_force;
+pub use incremental_sap::IncrementalSap;
 pub use sort_sweep::SortAndSweep;
 
 use crate::bounding::Aabb;
+#[cfg(doc)]
+use crate::bounding::BoundingVolume;
 
 /// Which bodies may pair: `a` and `b` do when each one's group meets the other's mask.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -4,11 +4,16 @@
 //! against brute force's `n²/2`.
 //!
 //! The order is kept between frames and re-sorted by insertion sort, which is linear when
-//! bodies move coherently (the order barely changes). The axis is chosen again every frame
-//! from the centres' variance; changing it costs one full re-sort.
+//! bodies move coherently (the order barely changes); proxies added or removed since the
+//! last frame are appended or dropped before it, so insertions and removals do not force a
+//! full sort either. The axis is chosen again every frame from the centres' variance;
+//! changing it costs one full re-sort. Testing the other two axes only for the pairs that
+//! overlap on the sweep axis keeps it robust to "dice on a table" (all boxes sharing one
+//! z range), where every small vertical motion of the three-axis
+//! [`IncrementalSap`](super::IncrementalSap) swaps endpoints among all the boxes on the shared
+//! axis; the widest-spread axis is not the shared one in that layout.
 //!
-//! TODO(#6): incremental sweep-and-prune with persistent overlap status, the hierarchical
-//! hash grid, and the automatic choice between them.
+//! TODO(#6): the hierarchical hash grid and the automatic choice between the broad phases.
 
 use super::{CandidatePair, Proxy};
 use crate::bounding::BoundingVolume;
@@ -59,10 +64,14 @@ impl SortAndSweep {
         out.sort_unstable();
     }
 
-    /// Brings `order` up to date with `proxies` on `axis`: rebuilt when the proxy count or
-    /// the axis changed, otherwise refreshed in place and insertion-sorted.
+    /// Brings `order` up to date with `proxies` on `axis`: rebuilt and fully sorted when the
+    /// axis changed; otherwise entries past the new proxy count are dropped, new indices
+    /// appended, every entry's key refreshed (entries are indices, so a proxy that changed
+    /// place, e.g. by a caller's `swap_remove`, is simply re-keyed) and the order
+    /// insertion-sorted, which is linear when the bodies moved coherently and few changed
+    /// place.
     fn refresh_order(&mut self, proxies: &[Proxy], axis: usize) {
-        if self.order.len() != proxies.len() || axis != self.axis {
+        if axis != self.axis || self.order.is_empty() {
             self.order.clear();
             self.order.extend(
                 proxies
@@ -74,10 +83,54 @@ impl SortAndSweep {
             self.axis = axis;
             return;
         }
+        let (old, n) = (self.order.len(), proxies.len());
+        if n < old {
+            self.order.retain(|&(_, i)| (i as usize) < n);
+        }
         for entry in &mut self.order {
             entry.0 = proxies[entry.1 as usize].bounds.min[axis];
         }
+        self.order.extend(
+            proxies
+                .iter()
+                .enumerate()
+                .skip(old)
+                .map(|(i, p)| (p.bounds.min[axis], i as u32)),
+        );
         insertion_sort(&mut self.order);
+    }
+
+    /// Checks the kept order against `proxies`, which must be the slice of the last
+    /// [`Self::pairs`] call: one entry per proxy, each holding that proxy's low end on the
+    /// sweep axis, ascending. The pairs themselves are checked by comparing with
+    /// [`pairs_brute_force`](super::pairs_brute_force).
+    ///
+    /// # Errors
+    /// A description of the first violated invariant.
+    pub fn validate(&self, proxies: &[Proxy]) -> Result<(), String> {
+        if self.order.len() != proxies.len() {
+            return Err(format!(
+                "{} entries for {} proxies",
+                self.order.len(),
+                proxies.len()
+            ));
+        }
+        let mut seen = vec![false; proxies.len()];
+        for (k, &(low, i)) in self.order.iter().enumerate() {
+            let i = i as usize;
+            if i >= proxies.len() || std::mem::replace(&mut seen[i], true) {
+                return Err(format!(
+                    "entry {k}: proxy index {i} out of range or repeated"
+                ));
+            }
+            if low.to_bits() != proxies[i].bounds.min[self.axis].to_bits() {
+                return Err(format!("entry {k}: stale low end {low} for proxy {i}"));
+            }
+            if k > 0 && self.order[k - 1].0.total_cmp(&low).is_gt() {
+                return Err(format!("entries {} and {k} out of order", k - 1));
+            }
+        }
+        Ok(())
     }
 }
 

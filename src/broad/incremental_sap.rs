@@ -1,0 +1,658 @@
+//! Incremental sweep and prune on three axes (I-COLLIDE: Cohen, Lin, Manocha, Ponamgi 1995;
+//! Ericson, *Real-Time Collision Detection*, §7.5.2): a stateful broad phase that keeps, per
+//! axis, the sorted list of every body's box endpoints and the set of overlapping pairs
+//! between frames, so that a frame costs only the endpoint swaps its motion causes.
+//!
+//! # How it works
+//! Each axis holds `2n` endpoints (a min and a max per body) sorted by coordinate. On one
+//! axis, the intervals of bodies `a` and `b` overlap exactly when `a`'s min lies before `b`'s
+//! max and `b`'s min before `a`'s max. [`IncrementalSap::update`] moves a body's endpoints
+//! one at a time to their new coordinates by insertion sort (adjacent swaps); a min passing a
+//! max of another body (or back) is the only swap that changes an overlap, and:
+//!
+//! - when it may *start* one, the pair's full boxes are tested (all three axes, from the
+//!   stored bounds, which the endpoint lists agree with) and the pair enters the set if they
+//!   overlap and may pair;
+//! - when it *ends* one, the pair leaves the set.
+//!
+//! This is the "test on demand" form of the per-axis overlap count (the set holds only the
+//! pairs overlapping on all three axes, never the `O(n²)` pairs that overlap on one axis,
+//! which is what a count would store for "dice on a table", all sharing one z range). It is
+//! exact: during one endpoint's move, each other endpoint is passed at most once, and every
+//! pair whose relation changed ends with an event that leaves it in the set exactly when the
+//! boxes now overlap. A body's min is moved before its max when the min decreases, after it
+//! otherwise, so a stored box is never inverted, not even between the two moves.
+//!
+//! # Ties: touching boxes overlap
+//! [`Aabb::intersects`] uses closed intervals: boxes touching at a face, an edge or a corner
+//! overlap, and zero-size boxes are points. The endpoint order agrees exactly: endpoints
+//! sort by coordinate and, at equal coordinates, every min sorts before every max, so `a.min
+//! == b.max` puts `a`'s min before `b`'s max ("overlapping"). Coordinates are compared with
+//! `<` and `==`, not `total_cmp`, so `-0.0` and `0.0` tie as they do in `intersects`. Equal
+//! endpoints of the same kind keep their relative order; their order changes no overlap.
+//!
+//! # Costs (`n` bodies, `k` pairs in the set)
+//! - [`update`](IncrementalSap::update): `O(1 + s log k)` for `s` swaps, linear in how far
+//!   the body moved through the lists. A body that is not updated costs nothing.
+//! - [`insert`](IncrementalSap::insert) and [`remove`](IncrementalSap::remove): `O(n)`:
+//!   binary search of the endpoint positions, a `Vec` insert or remove (memmove) and
+//!   renumbering of the shifted endpoints on each axis, and the body's pairs found by one
+//!   direct scan of the axis where the fewest endpoints precede its max.
+//! - [`pairs`](IncrementalSap::pairs): `O(k)`: the set is a `BTreeSet` of
+//!   [`CandidatePair`]s, already in `(a, b)` order; each insertion or removal in it is
+//!   `O(log k)`.
+//!
+//! # Teleports
+//! A body that jumps far is moved by the same insertion sort, paying one swap per endpoint
+//! passed (up to `O(n)` per axis). Treating it as remove plus insert would not be cheaper:
+//! both of those are `O(n)` too (memmove and renumbering), so there is one path for all
+//! motion and no threshold to tune. Nothing was measured for this choice.
+//!
+//! # Input
+//! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant; the daemon
+//! validates poses before they reach the broad phase), checked by `debug_assert!`. A NaN
+//! would break the sort order and is never allowed in.
+
+use std::collections::{BTreeSet, HashMap};
+
+use super::{CandidatePair, CollisionFilter, Proxy, pairs_brute_force};
+use crate::bounding::{Aabb, BoundingVolume};
+
+/// Index of a body's min endpoint in [`IncrementalSap::positions`].
+const MIN: usize = 0;
+/// Index of a body's max endpoint in [`IncrementalSap::positions`].
+const MAX: usize = 1;
+
+/// One end of one body's interval on one axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Endpoint {
+    /// The coordinate, metres.
+    value: f64,
+    /// `slot << 1 | kind`, where `kind` is [`MIN`] or [`MAX`].
+    tag: u32,
+}
+
+impl Endpoint {
+    #[inline]
+    fn new(value: f64, slot: usize, kind: usize) -> Self {
+        debug_assert!(slot < (1 << 31), "too many bodies");
+        Self {
+            value,
+            tag: (slot as u32) << 1 | kind as u32,
+        }
+    }
+
+    #[inline]
+    fn slot(self) -> usize {
+        (self.tag >> 1) as usize
+    }
+
+    #[inline]
+    fn kind(self) -> usize {
+        (self.tag & 1) as usize
+    }
+
+    #[inline]
+    fn is_max(self) -> bool {
+        self.kind() == MAX
+    }
+
+    /// Whether `self` sorts strictly after `other`: a larger coordinate, or the same
+    /// coordinate with `self` a max and `other` a min (mins first, so touching overlaps).
+    #[inline]
+    fn after(self, other: Self) -> bool {
+        self.value > other.value || (self.value == other.value && self.kind() > other.kind())
+    }
+}
+
+/// Incremental three-axis sweep and prune over bodies identified by `u32` ids; see the
+/// module docs for the algorithm, the tie rule and the costs.
+#[derive(Debug, Clone, Default)]
+pub struct IncrementalSap {
+    /// The bodies, densely by slot; `proxies[s].bounds` is what the endpoint lists hold.
+    proxies: Vec<Proxy>,
+    /// `positions[s][axis][MIN | MAX]`: where slot `s`'s endpoints are in `axes[axis]`.
+    positions: Vec<[[u32; 2]; 3]>,
+    /// Per axis, all endpoints sorted by [`Endpoint::after`].
+    axes: [Vec<Endpoint>; 3],
+    /// Slot of each body id.
+    slot_of: HashMap<u32, u32>,
+    /// The pairs whose boxes overlap and that may pair, `a < b`.
+    pairs: BTreeSet<CandidatePair>,
+}
+
+impl IncrementalSap {
+    /// An empty broad phase.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Number of bodies.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.proxies.len()
+    }
+
+    /// Whether there are no bodies.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.proxies.is_empty()
+    }
+
+    /// Whether `body` is in the broad phase.
+    #[must_use]
+    pub fn contains(&self, body: u32) -> bool {
+        self.slot_of.contains_key(&body)
+    }
+
+    /// The bodies as proxies, in no particular order.
+    #[must_use]
+    pub fn proxies(&self) -> &[Proxy] {
+        &self.proxies
+    }
+
+    /// Adds `body` with its margin-grown world box `bounds` (metres; finite, `min <= max`).
+    /// Its pairs are found directly, without re-sorting the other bodies. Inserting an id
+    /// that is already present replaces that body (remove, then insert).
+    ///
+    /// Static bodies never pair with each other; `filter` decides the rest
+    /// ([`Proxy::may_pair`]).
+    pub fn insert(&mut self, body: u32, bounds: Aabb, is_static: bool, filter: CollisionFilter) {
+        debug_assert_valid_bounds(&bounds);
+        if self.contains(body) {
+            self.remove(body);
+        }
+        let slot = self.proxies.len();
+        let proxy = Proxy {
+            body,
+            bounds,
+            is_static,
+            filter,
+        };
+        self.proxies.push(proxy);
+        self.positions.push([[0; 2]; 3]);
+        self.slot_of.insert(body, slot as u32);
+        for axis in 0..3 {
+            let endpoints = &mut self.axes[axis];
+            // After every endpoint that does not sort after it (stable among ties); the max
+            // sorts strictly after the min, so it lands after it.
+            let min = Endpoint::new(bounds.min[axis], slot, MIN);
+            let min_at = endpoints.partition_point(|x| !x.after(min));
+            endpoints.insert(min_at, min);
+            let max = Endpoint::new(bounds.max[axis], slot, MAX);
+            let max_at = endpoints.partition_point(|x| !x.after(max));
+            endpoints.insert(max_at, max);
+            self.renumber_from(axis, min_at);
+        }
+        // Every body overlapping it has its min before its max on every axis: scan the axis
+        // where the fewest endpoints precede that max.
+        let axis = self.axis_with_fewest_before_max(slot);
+        let end = self.positions[slot][axis][MAX] as usize;
+        for e in &self.axes[axis][..end] {
+            if e.is_max() || e.slot() == slot {
+                continue;
+            }
+            let other = &self.proxies[e.slot()];
+            if proxy.may_pair(other) && proxy.bounds.intersects(&other.bounds) {
+                self.pairs.insert(pair_of(body, other.body));
+            }
+        }
+    }
+
+    /// Removes `body` and its pairs; `false` when it was not present.
+    pub fn remove(&mut self, body: u32) -> bool {
+        let Some(slot) = self.slot_of.remove(&body) else {
+            return false;
+        };
+        let slot = slot as usize;
+        // Its pairs all have their min before its max on every axis.
+        let axis = self.axis_with_fewest_before_max(slot);
+        let end = self.positions[slot][axis][MAX] as usize;
+        for e in &self.axes[axis][..end] {
+            if !e.is_max() && e.slot() != slot {
+                self.pairs
+                    .remove(&pair_of(body, self.proxies[e.slot()].body));
+            }
+        }
+        for axis in 0..3 {
+            let [min_at, max_at] = self.positions[slot][axis];
+            self.axes[axis].remove(max_at as usize);
+            self.axes[axis].remove(min_at as usize);
+            self.renumber_from(axis, min_at as usize);
+        }
+        // The last slot moves into the freed one.
+        let last = self.proxies.len() - 1;
+        self.proxies.swap_remove(slot);
+        self.positions.swap_remove(slot);
+        if slot != last {
+            for axis in 0..3 {
+                for kind in [MIN, MAX] {
+                    let at = self.positions[slot][axis][kind] as usize;
+                    self.axes[axis][at] = Endpoint::new(self.axes[axis][at].value, slot, kind);
+                }
+            }
+            self.slot_of.insert(self.proxies[slot].body, slot as u32);
+        }
+        true
+    }
+
+    /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`), updating the pair set
+    /// by the endpoint swaps the move causes. A body that did not move need not be updated.
+    /// Updating a body that is not present is a contract violation (`debug_assert!`; ignored
+    /// in release builds).
+    pub fn update(&mut self, body: u32, bounds: Aabb) {
+        debug_assert_valid_bounds(&bounds);
+        let Some(&slot) = self.slot_of.get(&body) else {
+            debug_assert!(false, "update of absent body {body}");
+            return;
+        };
+        let slot = slot as usize;
+        for axis in 0..3 {
+            let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
+            // Order the two moves so the stored interval is never inverted.
+            if lo < self.proxies[slot].bounds.min[axis] {
+                self.move_endpoint(slot, axis, MIN, lo);
+                self.move_endpoint(slot, axis, MAX, hi);
+            } else {
+                self.move_endpoint(slot, axis, MAX, hi);
+                self.move_endpoint(slot, axis, MIN, lo);
+            }
+        }
+    }
+
+    /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
+    /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
+    /// exactly the pairs of [`pairs_brute_force`] over [`proxies`](Self::proxies).
+    ///
+    /// # Cost
+    /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
+    pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
+        out.clear();
+        out.extend(self.pairs.iter().copied());
+    }
+
+    /// Checks every invariant: the slot table and id map agree; each axis holds exactly the
+    /// two endpoints of every body, at the positions recorded, with the body's stored
+    /// coordinates, sorted (mins first at ties); stored boxes are finite and not inverted;
+    /// and the pair set equals [`pairs_brute_force`] over the stored boxes. `O(n²)`: for
+    /// tests.
+    ///
+    /// # Errors
+    /// A description of the first violated invariant.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.proxies.len();
+        if self.positions.len() != n || self.slot_of.len() != n {
+            return Err(format!(
+                "{n} proxies, {} position rows, {} ids",
+                self.positions.len(),
+                self.slot_of.len()
+            ));
+        }
+        for (slot, p) in self.proxies.iter().enumerate() {
+            if self.slot_of.get(&p.body) != Some(&(slot as u32)) {
+                return Err(format!("body {} at slot {slot} not mapped to it", p.body));
+            }
+            let b = &p.bounds;
+            if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
+                return Err(format!("body {} has invalid bounds {b:?}", p.body));
+            }
+        }
+        for (axis, endpoints) in self.axes.iter().enumerate() {
+            if endpoints.len() != 2 * n {
+                return Err(format!(
+                    "axis {axis}: {} endpoints, {n} bodies",
+                    endpoints.len()
+                ));
+            }
+            for (i, e) in endpoints.iter().enumerate() {
+                let slot = e.slot();
+                if slot >= n || self.positions[slot][axis][e.kind()] as usize != i {
+                    return Err(format!(
+                        "axis {axis}: endpoint {i} ({e:?}) not where recorded"
+                    ));
+                }
+                let b = &self.proxies[slot].bounds;
+                let stored = if e.is_max() { b.max[axis] } else { b.min[axis] };
+                if stored.to_bits() != e.value.to_bits() {
+                    return Err(format!(
+                        "axis {axis}: endpoint {i} {} != stored {stored}",
+                        e.value
+                    ));
+                }
+                if i > 0 && endpoints[i - 1].after(*e) {
+                    return Err(format!(
+                        "axis {axis}: endpoints {} and {i} out of order",
+                        i - 1
+                    ));
+                }
+            }
+        }
+        let mut expected = Vec::new();
+        pairs_brute_force(&self.proxies, &mut expected);
+        if !self.pairs.iter().eq(expected.iter()) {
+            let have: BTreeSet<_> = self.pairs.iter().copied().collect();
+            let want: BTreeSet<_> = expected.into_iter().collect();
+            return Err(format!(
+                "pair set differs from brute force: extra {:?}, missing {:?}",
+                have.difference(&want).collect::<Vec<_>>(),
+                want.difference(&have).collect::<Vec<_>>()
+            ));
+        }
+        Ok(())
+    }
+
+    /// Sets one coordinate of slot `slot`'s box and moves that endpoint to its sorted place
+    /// by adjacent swaps, updating the pair set at each min/max swap with another body.
+    fn move_endpoint(&mut self, slot: usize, axis: usize, kind: usize, value: f64) {
+        let bounds = &mut self.proxies[slot].bounds;
+        if kind == MIN {
+            bounds.min[axis] = value;
+        } else {
+            bounds.max[axis] = value;
+        }
+        let endpoints = &mut self.axes[axis];
+        let mut i = self.positions[slot][axis][kind] as usize;
+        let moving = Endpoint::new(value, slot, kind);
+        // Down: a min passing a max may start an overlap; a max passing a min ends one.
+        while i > 0 && endpoints[i - 1].after(moving) {
+            let other = endpoints[i - 1];
+            endpoints[i] = other;
+            self.positions[other.slot()][axis][other.kind()] = i as u32;
+            if other.kind() != kind {
+                crossed(
+                    &self.proxies,
+                    &mut self.pairs,
+                    slot,
+                    other.slot(),
+                    kind == MIN,
+                );
+            }
+            i -= 1;
+        }
+        // Up: a max passing a min may start an overlap; a min passing a max ends one.
+        while i + 1 < endpoints.len() && moving.after(endpoints[i + 1]) {
+            let other = endpoints[i + 1];
+            endpoints[i] = other;
+            self.positions[other.slot()][axis][other.kind()] = i as u32;
+            if other.kind() != kind {
+                crossed(
+                    &self.proxies,
+                    &mut self.pairs,
+                    slot,
+                    other.slot(),
+                    kind == MAX,
+                );
+            }
+            i += 1;
+        }
+        endpoints[i] = moving;
+        self.positions[slot][axis][kind] = i as u32;
+    }
+
+    /// Records the positions of `axes[axis][from..]` (after an insert or remove shifted them).
+    fn renumber_from(&mut self, axis: usize, from: usize) {
+        for (i, e) in self.axes[axis].iter().enumerate().skip(from) {
+            self.positions[e.slot()][axis][e.kind()] = i as u32;
+        }
+    }
+
+    /// The axis on which the fewest endpoints precede slot `slot`'s max.
+    fn axis_with_fewest_before_max(&self, slot: usize) -> usize {
+        let at = self.positions[slot];
+        (0..3).min_by_key(|&axis| at[axis][MAX]).unwrap_or(0)
+    }
+}
+
+/// The pair set's response to slot `s`'s endpoint passing one of slot `t`'s of the other
+/// kind: when the swap may start an overlap, test the boxes (all axes) and the filters;
+/// when it ends one, drop the pair.
+#[inline]
+fn crossed(
+    proxies: &[Proxy],
+    pairs: &mut BTreeSet<CandidatePair>,
+    s: usize,
+    t: usize,
+    starts: bool,
+) {
+    debug_assert_ne!(s, t, "a body's min and max never swap");
+    let (p, q) = (&proxies[s], &proxies[t]);
+    let key = pair_of(p.body, q.body);
+    if starts {
+        if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
+            pairs.insert(key);
+        }
+    } else {
+        pairs.remove(&key);
+    }
+}
+
+/// The pair of two distinct ids, smaller first.
+#[inline]
+fn pair_of(a: u32, b: u32) -> CandidatePair {
+    CandidatePair {
+        a: a.min(b),
+        b: a.max(b),
+    }
+}
+
+#[inline]
+fn debug_assert_valid_bounds(bounds: &Aabb) {
+    debug_assert!(
+        bounds.min.is_finite() && bounds.max.is_finite() && bounds.min.cmple(bounds.max).all(),
+        "broad-phase bounds must be finite and not inverted: {bounds:?}"
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::DVec3;
+    use crate::test_support::{point_in_cube, rng};
+    use rand::Rng;
+
+    fn unit_at(x: f64, y: f64, z: f64) -> Aabb {
+        Aabb::new(DVec3::new(x, y, z), DVec3::new(x + 1.0, y + 1.0, z + 1.0))
+    }
+
+    fn pairs_of(sap: &mut IncrementalSap) -> Vec<(u32, u32)> {
+        let mut out = Vec::new();
+        sap.pairs(&mut out);
+        sap.validate().unwrap();
+        out.into_iter().map(|p| (p.a, p.b)).collect()
+    }
+
+    #[test]
+    fn boxes_touching_at_a_face_edge_or_corner_pair_and_a_gap_of_one_ulp_does_not() {
+        let mut sap = IncrementalSap::new();
+        sap.insert(0, unit_at(0.0, 0.0, 0.0), false, CollisionFilter::ALL);
+        sap.insert(1, unit_at(1.0, 0.0, 0.0), false, CollisionFilter::ALL); // face
+        sap.insert(2, unit_at(1.0, 1.0, 0.0), false, CollisionFilter::ALL); // edge with 0
+        sap.insert(3, unit_at(-1.0, -1.0, -1.0), false, CollisionFilter::ALL); // corner with 0
+        let gap = f64::from_bits(1.0f64.to_bits() + 1);
+        // Face with 0 and 3, edge with 1, corner with 2.
+        sap.insert(4, unit_at(0.0, 0.0, -1.0), false, CollisionFilter::ALL);
+        let all = [
+            (0, 1),
+            (0, 2),
+            (0, 3),
+            (0, 4),
+            (1, 2),
+            (1, 4),
+            (2, 4),
+            (3, 4),
+        ];
+        assert_eq!(pairs_of(&mut sap), all);
+        // One ulp apart: 1 no longer touches 0 and 4; back: touching again (both by swaps).
+        sap.update(1, unit_at(gap, 0.0, 0.0));
+        assert_eq!(
+            pairs_of(&mut sap),
+            [(0, 2), (0, 3), (0, 4), (1, 2), (2, 4), (3, 4)]
+        );
+        sap.update(1, unit_at(1.0, 0.0, 0.0));
+        assert_eq!(pairs_of(&mut sap), all);
+    }
+
+    #[test]
+    fn zero_size_boxes_pair_when_they_coincide_or_lie_on_a_face() {
+        let mut sap = IncrementalSap::new();
+        let point = |x: f64| Aabb::new(DVec3::splat(x), DVec3::splat(x));
+        sap.insert(7, point(0.5), false, CollisionFilter::ALL);
+        sap.insert(8, point(0.5), false, CollisionFilter::ALL);
+        sap.insert(9, point(1.0), false, CollisionFilter::ALL); // corner of the unit box
+        sap.insert(10, point(1.5), false, CollisionFilter::ALL);
+        sap.insert(3, unit_at(0.0, 0.0, 0.0), false, CollisionFilter::ALL);
+        assert_eq!(pairs_of(&mut sap), [(3, 7), (3, 8), (3, 9), (7, 8)]);
+        // Points walking across each other and the box's faces, in exact steps.
+        for step in 0..=12 {
+            let x = f64::from(step) * 0.125;
+            sap.update(10, point(1.5 - x));
+            sap.update(7, point(x));
+            let mut expected = Vec::new();
+            pairs_brute_force(sap.proxies(), &mut expected);
+            let mut found = Vec::new();
+            sap.pairs(&mut found);
+            assert_eq!(found, expected, "step {step}");
+            sap.validate().unwrap();
+        }
+    }
+
+    #[test]
+    fn negative_zero_and_zero_tie_as_in_aabb_intersects() {
+        let mut sap = IncrementalSap::new();
+        let a = Aabb::new(DVec3::splat(-1.0), DVec3::splat(-0.0));
+        let b = Aabb::new(DVec3::splat(0.0), DVec3::splat(1.0));
+        assert!(a.intersects(&b));
+        sap.insert(0, a, false, CollisionFilter::ALL);
+        sap.insert(1, b, false, CollisionFilter::ALL);
+        assert_eq!(pairs_of(&mut sap), [(0, 1)]);
+        // Arriving at the tie by motion rather than by insertion.
+        sap.update(1, Aabb::new(DVec3::splat(3.0), DVec3::splat(4.0)));
+        assert_eq!(pairs_of(&mut sap), []);
+        sap.update(1, b);
+        assert_eq!(pairs_of(&mut sap), [(0, 1)]);
+    }
+
+    #[test]
+    fn a_removed_id_can_be_reinserted_with_new_bounds_kind_and_filter() {
+        let mut sap = IncrementalSap::new();
+        for id in 0..5 {
+            sap.insert(
+                id,
+                unit_at(f64::from(id) * 0.5, 0.0, 0.0),
+                false,
+                CollisionFilter::ALL,
+            );
+        }
+        assert_eq!(
+            pairs_of(&mut sap),
+            [(0, 1), (0, 2), (1, 2), (1, 3), (2, 3), (2, 4), (3, 4)]
+        );
+        assert!(sap.remove(2));
+        assert!(!sap.remove(2));
+        assert!(!sap.contains(2));
+        assert_eq!(pairs_of(&mut sap), [(0, 1), (1, 3), (3, 4)]);
+        // Same id, now far away, then back, static and filtered against body 3.
+        sap.insert(2, unit_at(50.0, 0.0, 0.0), false, CollisionFilter::ALL);
+        assert_eq!(pairs_of(&mut sap), [(0, 1), (1, 3), (3, 4)]);
+        assert!(sap.remove(2));
+        let only_group_1 = CollisionFilter { group: 1, mask: 1 };
+        sap.insert(
+            3,
+            unit_at(1.5, 0.0, 0.0),
+            false,
+            CollisionFilter { group: 2, mask: 2 },
+        );
+        sap.insert(2, unit_at(1.0, 0.0, 0.0), true, only_group_1);
+        assert_eq!(
+            pairs_of(&mut sap),
+            [(0, 1), (0, 2), (1, 2), (1, 3), (2, 4), (3, 4)]
+        );
+        // Inserting a present id replaces it.
+        sap.insert(2, unit_at(-9.0, 0.0, 0.0), false, CollisionFilter::ALL);
+        assert_eq!(sap.len(), 5);
+        assert_eq!(pairs_of(&mut sap), [(0, 1), (1, 3), (3, 4)]);
+        for id in [0, 4, 1, 3, 2] {
+            assert!(sap.remove(id));
+            sap.validate().unwrap();
+        }
+        assert!(sap.is_empty());
+    }
+
+    #[test]
+    fn static_bodies_never_pair_with_each_other_however_they_overlap() {
+        let mut sap = IncrementalSap::new();
+        let mut rng = rng(606);
+        let mut dynamic_static = 0;
+        for id in 0..40u32 {
+            let c = point_in_cube(&mut rng, 1.0);
+            let bounds = Aabb::new(c - DVec3::splat(1.0), c + DVec3::splat(1.0));
+            sap.insert(id, bounds, id % 4 != 0, CollisionFilter::ALL);
+        }
+        for frame in 0..50 {
+            for id in 0..40u32 {
+                let c = point_in_cube(&mut rng, 1.0);
+                sap.update(id, Aabb::new(c - DVec3::splat(1.0), c + DVec3::splat(1.0)));
+            }
+            for (a, b) in pairs_of(&mut sap) {
+                assert!(
+                    a % 4 == 0 || b % 4 == 0,
+                    "frame {frame}: static pair ({a}, {b})"
+                );
+                dynamic_static += usize::from(a % 4 != 0 || b % 4 != 0);
+            }
+        }
+        assert!(dynamic_static > 1_000, "{dynamic_static}");
+    }
+
+    /// Random boxes on an exact grid of 1/4 m (many equal coordinates), moved, teleported,
+    /// removed and inserted one at a time; the invariants hold after every operation.
+    #[test]
+    fn validate_holds_after_every_single_operation_on_a_tie_heavy_grid() {
+        let mut rng = rng(707);
+        let mut sap = IncrementalSap::new();
+        let grid_box = |rng: &mut crate::test_support::TestRng| {
+            let lo = DVec3::new(
+                f64::from(rng.random_range(-8..8)),
+                f64::from(rng.random_range(-8..8)),
+                f64::from(rng.random_range(-8..8)),
+            ) * 0.25;
+            let size = DVec3::new(
+                f64::from(rng.random_range(0..5)),
+                f64::from(rng.random_range(0..5)),
+                f64::from(rng.random_range(0..5)),
+            ) * 0.25;
+            Aabb::new(lo, lo + size)
+        };
+        let mut present: Vec<u32> = Vec::new();
+        let mut total_pairs = 0;
+        for op in 0..3_000 {
+            let filter = CollisionFilter {
+                group: 1 << rng.random_range(0..2),
+                mask: rng.random_range(1..4),
+            };
+            match rng.random_range(0..10) {
+                0 | 1 if present.len() < 40 => {
+                    let id = rng.random_range(0..60);
+                    let is_static = rng.random_range(0..3) == 0;
+                    sap.insert(id, grid_box(&mut rng), is_static, filter);
+                    if !present.contains(&id) {
+                        present.push(id);
+                    }
+                }
+                2 if !present.is_empty() => {
+                    let i = rng.random_range(0..present.len());
+                    assert!(sap.remove(present.swap_remove(i)));
+                }
+                _ if !present.is_empty() => {
+                    let id = present[rng.random_range(0..present.len())];
+                    sap.update(id, grid_box(&mut rng));
+                }
+                _ => {}
+            }
+            sap.validate().unwrap_or_else(|e| panic!("op {op}: {e}"));
+            total_pairs += sap.pairs.len();
+        }
+        assert!(total_pairs > 5_000, "{total_pairs}");
+    }
+}
