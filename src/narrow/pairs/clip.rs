@@ -51,17 +51,36 @@ pub(super) fn manifold(a: &Core, b: &Core, out: &mut Manifold) {
         out.reset(axis.normal);
         return;
     }
-    manifold_from_distance(a, b, &distance_with_axis(a, b, &axis), out);
+    if axis.separation <= 0.0 {
+        // Overlapping cores: the distance's normal is the axis (query, step 3).
+        manifold_along(a, b, axis.normal, || distance_with_axis(a, b, &axis), out);
+    } else {
+        manifold_from_distance(a, b, &distance_with_axis(a, b, &axis), out);
+    }
 }
 
 /// [`manifold`] given the cores' signed distance `d` (from [`super::query`], or from a
 /// pair's own faster path with the same contract).
 pub(super) fn manifold_from_distance(a: &Core, b: &Core, d: &ShapeDistance, out: &mut Manifold) {
-    let slack = FEATURE_RELATIVE * a.scale().max(b.scale());
     out.reset(d.normal);
     if d.distance > 0.0 {
         return;
     }
+    manifold_along(a, b, d.normal, || *d, out);
+}
+
+/// The manifold of cores touching or overlapping with contact normal `n` (A→B): the
+/// signed distance `distance()` (whose normal is `n`) is computed only when no face or
+/// parallel-edge contact gives points and its witnesses are the one point left.
+pub(super) fn manifold_along(
+    a: &Core,
+    b: &Core,
+    n: DVec3,
+    distance: impl FnOnce() -> ShapeDistance,
+    out: &mut Manifold,
+) {
+    let slack = FEATURE_RELATIVE * a.scale().max(b.scale());
+    out.reset(n);
     let mut cands = Candidates {
         pts: [ManifoldPoint {
             point_a: DVec3::ZERO,
@@ -70,29 +89,32 @@ pub(super) fn manifold_from_distance(a: &Core, b: &Core, d: &ShapeDistance, out:
         }; 8],
         len: 0,
     };
-    let n = d.normal;
-    let face_a = a.best_face(n).filter(|f| f.2 >= FACE_ALIGNMENT);
-    let face_b = b.best_face(-n).filter(|f| f.2 >= FACE_ALIGNMENT);
-    let use_a = match (&face_a, &face_b) {
-        (Some(fa), Some(fb)) => Some(fa.2 >= fb.2),
+    // The better aligned reference face; only that one is built.
+    let aligned = |c: Option<f64>| c.filter(|&c| c >= FACE_ALIGNMENT);
+    let use_a = match (
+        aligned(a.best_face_alignment(n)),
+        aligned(b.best_face_alignment(-n)),
+    ) {
+        (Some(ca), Some(cb)) => Some(ca >= cb),
         (Some(_), None) => Some(true),
         (None, Some(_)) => Some(false),
         (None, None) => None,
     };
     match use_a {
         Some(true) => {
-            let (poly, f, _) = face_a.unwrap_or_default();
+            let (poly, f, _) = a.best_face(n).unwrap_or_default();
             out.normal = f;
             clip_face(&poly, f, a.radius, b, true, slack, &mut cands);
         }
         Some(false) => {
-            let (poly, f, _) = face_b.unwrap_or_default();
+            let (poly, f, _) = b.best_face(-n).unwrap_or_default();
             out.normal = -f;
             clip_face(&poly, f, b.radius, a, false, slack, &mut cands);
         }
         None => parallel_edges(a, b, n, slack, &mut cands),
     }
     if cands.len == 0 {
+        let d = distance();
         out.normal = n;
         out.push(ManifoldPoint {
             point_a: d.point_a,

@@ -263,6 +263,22 @@ impl Core {
         out
     }
 
+    /// The cosine between `n` (unit) and the outward normal of [`best_face`](Self::best_face),
+    /// without building the face; `None` when it has none.
+    #[must_use]
+    pub fn best_face_alignment(&self, n: DVec3) -> Option<f64> {
+        match self.kind {
+            Kind::Box { axes, half, .. } => {
+                let local = axes.transpose() * n;
+                let i = local.abs().max_position();
+                let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+                (half[j] * half[k] > 0.0).then(|| local[i].abs())
+            }
+            Kind::Triangle if self.nf == 1 => Some(self.faces[0].dot(n).abs()),
+            _ => None,
+        }
+    }
+
     /// The face of the core whose outward normal is closest to `n`, with that normal and
     /// its cosine to `n`; `None` for cores without faces of non-zero area.
     #[must_use]
