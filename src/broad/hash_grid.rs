@@ -10,7 +10,10 @@
 //! `ratio ≥ 2` ([`HashGrid::with_levels`]; [`DEFAULT_RATIO`] is 2). A body lives at the
 //! smallest level whose cell edge is at least its box's largest extent, so its box covers at
 //! most 2 cells per axis there (3 when rounding puts an end a hair across a boundary), at
-//! most 8 cells in all. Cell `(i, j, l)` of level `k` holds the bodies of that level whose
+//! most 8 cells in all (never more than 27, even far from the origin: on an axis where the
+//! box has positive extent, that extent is at least one ulp of its coordinates and at most
+//! the cell edge, so `coordinate / edge` stays below 2⁵³, where the cell index is exact to
+//! within the rounding of one product). Cell `(i, j, l)` of level `k` holds the bodies of that level whose
 //! box meets it; only occupied cells exist, in a per-level hash map keyed by the three cell
 //! coordinates, hashed by a multiply–rotate absorb of each coordinate from a seed that is
 //! the level, then the SplitMix64 finaliser (every input bit reaches the high bits the map's
@@ -58,12 +61,16 @@
 //! touching boxes share a cell at every level. `-0.0` and `0.0` fall in the same cell. Cells
 //! only prune; the pair rule is [`Aabb::intersects`] (closed boxes), as in every broad phase.
 //!
-//! # Costs (`n` bodies, `k` pairs in the set, `c` bodies in a body's cells)
-//! - [`update`](HashGrid::update): `O(c + log k)` per candidate plus up to 8 hash look-ups per
-//!   populated level (the finer ones at most one per body of that level); no cell-list change
-//!   when the body stayed in its cells. A body that is not updated costs nothing.
-//! - [`insert`](HashGrid::insert), [`remove`](HashGrid::remove): the same query plus up to 8
-//!   cell-list edits; `O(n)` for an oversized body.
+//! # Costs (`n` bodies, `k` pairs in the set, `c` candidates a body gathers)
+//! - [`update`](HashGrid::update): `O(c log k)` (one box test and one set edit per
+//!   candidate, each tested once) plus, per populated level, up to 8 hash look-ups (27 at
+//!   worst; at a finer level, at most as many as that level has bodies), twice when the body
+//!   left or entered a cell at one of them; the cell lists change only when it left or
+//!   entered a cell of its own level, or changed level. A body that is not updated costs
+//!   nothing. `O(n)` for an oversized body, and every body also gathers every oversized one.
+//! - [`insert`](HashGrid::insert), [`remove`](HashGrid::remove): one such query plus up to
+//!   8 cell-list edits and an `O(1)` slot move; the [`AUTO_SAMPLE`]-th insertion of
+//!   [`HashGrid::new`] also places every body once.
 //! - [`pairs`](HashGrid::pairs): `O(k)`: the set is a `BTreeSet` already in `(a, b)` order.
 //!
 //! # Input
@@ -593,7 +600,9 @@ impl HashGrid {
         self.member_at[slot] = at;
         if level != OVERSIZED {
             let grid = &mut self.levels[usize::from(level)];
-            CellRange::of(&self.proxies[slot].bounds, grid.inv).for_each(|cell| {
+            let range = CellRange::of(&self.proxies[slot].bounds, grid.inv);
+            debug_assert!(range.count() <= 27, "a box spans {range:?} at its level");
+            range.for_each(|cell| {
                 grid.cells.entry(cell).or_default().push(slot as u32);
             });
         }
@@ -1103,6 +1112,47 @@ mod tests {
         assert_eq!(grid.level(64), Some(None));
         assert_eq!(grid.cell_sizes().len(), 7);
         assert_eq!(pairs_of(&mut grid).len(), grid.pairs.len());
+    }
+
+    /// Bodies a trillion metres out (where one ulp is about a millimetre, the level-0 cell)
+    /// and at ±1e300 m (cell indices saturate at the ends of `i64`) still pair exactly.
+    #[test]
+    fn far_from_the_origin_boxes_span_few_cells_and_pair_exactly() {
+        let mut grid = HashGrid::with_levels(1e-3, 2.0, 8);
+        let mut rng = rng(1_010);
+        let base = DVec3::new(1e12, -1e12, 3e11);
+        let ulp = 1e12f64.to_bits();
+        let far_box = |rng: &mut TestRng| {
+            let lo = DVec3::new(
+                f64::from_bits(ulp + rng.random_range(0..40)),
+                -f64::from_bits(ulp + rng.random_range(0..40)),
+                base.z + f64::from(rng.random_range(0..40)) * 2f64.powi(-14),
+            );
+            let ulps = f64::from(rng.random_range(0..6)) * 2f64.powi(-13);
+            Aabb::new(lo, lo + DVec3::splat(ulps))
+        };
+        for id in 0..60u32 {
+            grid.insert(id, far_box(&mut rng), false, CollisionFilter::ALL);
+        }
+        let edge = Aabb::new(DVec3::splat(1e300), DVec3::splat(1e300));
+        grid.insert(60, edge, false, CollisionFilter::ALL);
+        grid.insert(61, edge, false, CollisionFilter::ALL);
+        grid.insert(
+            62,
+            Aabb::new(DVec3::splat(-1e300), DVec3::splat(-1e300)),
+            false,
+            CollisionFilter::ALL,
+        );
+        let mut pairs = 0;
+        for op in 0..1_000 {
+            let id = rng.random_range(0..60u32);
+            grid.update(id, far_box(&mut rng));
+            grid.validate().unwrap_or_else(|e| panic!("op {op}: {e}"));
+            pairs += grid.pairs.len();
+        }
+        assert!(grid.pairs.contains(&pair_of(60, 61)));
+        assert!(!grid.pairs.contains(&pair_of(60, 62)));
+        assert!(pairs > 5_000, "{pairs}");
     }
 
     #[test]
