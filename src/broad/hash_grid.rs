@@ -8,12 +8,13 @@
 //! # Levels
 //! Level `k` has cubic cells of edge `min_cell · ratioᵏ` metres, `k = 0 .. count`, with
 //! `ratio ≥ 2` ([`HashGrid::with_levels`]; [`DEFAULT_RATIO`] is 2). A body lives at the
-//! smallest level whose cell edge is at least its box's largest extent, so its box covers at
-//! most 2 cells per axis there (3 when rounding puts an end a hair across a boundary), at
-//! most 8 cells in all (never more than 27, even far from the origin: on an axis where the
-//! box has positive extent, that extent is at least one ulp of its coordinates and at most
-//! the cell edge, so `coordinate / edge` stays below 2⁵³, where the cell index is exact to
-//! within the rounding of one product). Cell `(i, j, l)` of level `k` holds the bodies of that level whose
+//! smallest level whose cell edge is at least its box's largest extent, so its box covers 1
+//! or 2 cells per axis there (3 when rounding puts an end a hair across a boundary): at most
+//! 8 cells, 27 at worst. That holds even far from the origin: on an axis where the box has
+//! positive extent, the extent is at least one ulp of its coordinates and at most the cell
+//! edge, so `coordinate / edge` stays below 2⁵⁴, where products are spaced at most 2 apart
+//! and the two ends' cell indices still differ by at most 2 (checked by `debug_assert!` on
+//! every registration). Cell `(i, j, l)` of level `k` holds the bodies of that level whose
 //! box meets it; only occupied cells exist, in a per-level hash map keyed by the three cell
 //! coordinates, hashed by a multiply–rotate absorb of each coordinate from a seed that is
 //! the level, then the SplitMix64 finaliser (every input bit reaches the high bits the map's
@@ -1149,6 +1150,26 @@ mod tests {
             grid.update(id, far_box(&mut rng));
             grid.validate().unwrap_or_else(|e| panic!("op {op}: {e}"));
             pairs += grid.pairs.len();
+        }
+        // Cells of one ulp (level 0) to four: `coordinate / edge` near 2⁵³, boxes of 0 to 4
+        // ulps; the registration check (at most 3 cells per axis) holds throughout.
+        let ulp = 2f64.powi(-13);
+        let mut tiny = HashGrid::with_levels(ulp, 2.0, 3);
+        for op in 0..2_000u32 {
+            let lo = DVec3::new(
+                f64::from_bits(1e12f64.to_bits() + rng.random_range(0..16)),
+                -f64::from_bits(1e12f64.to_bits() + rng.random_range(0..16)),
+                f64::from_bits(2f64.powi(40).to_bits() - rng.random_range(0..16)),
+            );
+            let size = ulp * f64::from(rng.random_range(0..5));
+            tiny.insert(
+                op % 40,
+                Aabb::new(lo, lo + DVec3::splat(size)),
+                false,
+                CollisionFilter::ALL,
+            );
+            tiny.validate()
+                .unwrap_or_else(|e| panic!("tiny op {op}: {e}"));
         }
         assert!(grid.pairs.contains(&pair_of(60, 61)));
         assert!(!grid.pairs.contains(&pair_of(60, 62)));
