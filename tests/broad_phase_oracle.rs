@@ -34,7 +34,8 @@ use std::time::Instant;
 
 use proxima::bounding::{Aabb, BoundingVolume};
 use proxima::broad::{
-    CandidatePair, CollisionFilter, IncrementalSap, Proxy, SortAndSweep, pairs_brute_force,
+    CandidatePair, CollisionFilter, HashGrid, IncrementalSap, Proxy, SortAndSweep,
+    pairs_brute_force,
 };
 use proxima::math::DVec3;
 use rand::Rng;
@@ -81,6 +82,31 @@ impl BroadPhase for IncrementalSap {
             ));
         }
         IncrementalSap::validate(self)
+    }
+}
+
+impl BroadPhase for HashGrid {
+    fn insert(&mut self, p: &Proxy) {
+        HashGrid::insert(self, p.body, p.bounds, p.is_static, p.filter);
+    }
+    fn remove(&mut self, body: u32) {
+        assert!(HashGrid::remove(self, body), "{body} was present");
+    }
+    fn update(&mut self, body: u32, bounds: Aabb) {
+        HashGrid::update(self, body, bounds);
+    }
+    fn pairs(&mut self, _: &[Proxy], out: &mut Vec<CandidatePair>) {
+        HashGrid::pairs(self, out);
+    }
+    fn validate(&self, proxies: &[Proxy]) -> Result<(), String> {
+        if self.len() != proxies.len() {
+            return Err(format!(
+                "{} bodies, world has {}",
+                self.len(),
+                proxies.len()
+            ));
+        }
+        HashGrid::validate(self)
     }
 }
 
@@ -462,5 +488,13 @@ fn sort_and_sweep_equals_brute_force_after_every_one_of_ten_thousand_frames() {
     let start = Instant::now();
     let counts = run(|| Box::new(SortAndSweep::new()), 6_100);
     eprintln!("sort and sweep: {counts:?} in {:?}", start.elapsed());
+    assert_scenarios_happened(&counts);
+}
+
+#[test]
+fn hash_grid_equals_brute_force_after_every_one_of_ten_thousand_frames() {
+    let start = Instant::now();
+    let counts = run(|| Box::new(HashGrid::new()), 6_200);
+    eprintln!("hash grid: {counts:?} in {:?}", start.elapsed());
     assert_scenarios_happened(&counts);
 }

@@ -12,16 +12,23 @@
 //! it takes the whole proxy list every frame. [`incremental_sap`] is stateful: bodies are
 //! inserted, updated and removed one by one, and it keeps sorted endpoint lists on all three
 //! axes and the overlapping-pair set between frames, so a body that did not move costs
-//! nothing.
+//! nothing. [`hash_grid`] has the same stateful API: a hierarchy of hashed uniform grids
+//! whose cell sizes grow geometrically, each body stored in the few cells of the one level
+//! that fits its size (bodies larger than the coarsest cell in an oversized list tested
+//! against all), and the overlapping-pair set kept between frames, so a moved body re-tests
+//! only the bodies in its cells; it does not degrade when boxes share a coordinate range
+//! ("dice on a table"), which costs the three-axis sweep endpoint swaps.
 //!
 //! Every broad phase follows the same tie rule as [`Aabb::intersects`]: closed boxes, so
 //! boxes touching at a face, edge or corner pair, and zero-size boxes are points.
 
 pub mod brute_force;
+pub mod hash_grid;
 pub mod incremental_sap;
 pub mod sort_sweep;
 
 pub use brute_force::pairs_brute_force;
+pub use hash_grid::HashGrid;
 pub use incremental_sap::IncrementalSap;
 pub use sort_sweep::SortAndSweep;
 
