@@ -13,7 +13,7 @@
 //! [`IncrementalSap`](super::IncrementalSap) swaps endpoints among all the boxes on the shared
 //! axis; the widest-spread axis is not the shared one in that layout.
 //!
-//! TODO(#6): the hierarchical hash grid and the automatic choice between the broad phases.
+//! TODO(#6): the automatic choice between this, [`super::IncrementalSap`] and [`super::HashGrid`].
 
 use super::{CandidatePair, Proxy};
 use crate::bounding::BoundingVolume;
