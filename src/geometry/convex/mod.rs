@@ -333,7 +333,9 @@ impl SupportMap for ConvexPolyhedron {
 
     /// The climb starts at vertex `*hint` (any out-of-range value: vertex 0) and stores the
     /// vertex it ends at: successive GJK directions move little, so the climb is short.
-    #[inline]
+    // PERF: inlined into GJK, the direction stays in registers (through a call its (y, z)
+    // half was reloaded across two stores, stalling store forwarding).
+    #[inline(always)]
     fn support_from(&self, direction: DVec3, hint: &mut u32) -> DVec3 {
         let centred = &self.centred;
         let score = |i: usize| centred[i].dot(direction);

@@ -28,6 +28,8 @@ pub struct SupportPoint {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Simplex {
     points: [SupportPoint; 4],
+    /// `points[k].w`, contiguous for the sub-distance.
+    ws: [DVec3; 4],
     lambda: [f64; 4],
     len: usize,
 }
@@ -72,6 +74,7 @@ impl Simplex {
     pub fn single(p: SupportPoint) -> Self {
         let mut s = Self::default();
         s.points[0] = p;
+        s.ws[0] = p.w;
         s.lambda[0] = 1.0;
         s.len = 1;
         s
@@ -104,13 +107,14 @@ impl Simplex {
     /// Whether `w` is already one of the points (exactly).
     #[must_use]
     pub fn contains(&self, w: DVec3) -> bool {
-        self.points().iter().any(|p| p.w == w)
+        self.ws[..self.len].contains(&w)
     }
 
     /// Adds a point (the simplex must hold fewer than 4).
     pub fn push(&mut self, p: SupportPoint) {
         debug_assert!(self.len < 4);
         self.points[self.len] = p;
+        self.ws[self.len] = p.w;
         self.len += 1;
     }
 
@@ -157,24 +161,27 @@ impl Simplex {
 
     /// The sub-distance of the current points (Montanari's signed volumes).
     fn sub_distance(&self) -> Reduced {
-        let mut p = [DVec3::ZERO; 4];
-        for (q, s) in p.iter_mut().zip(self.points()) {
-            *q = s.w;
-        }
+        let p = &self.ws;
         match self.len {
-            1 => Reduced::point(0, &p),
-            2 => segment(&p, 0, 1),
-            3 => triangle(&p, [0, 1, 2]),
-            _ => tetrahedron(&p),
+            1 => Reduced::point(0, p),
+            2 => segment(p, 0, 1),
+            3 => triangle(p, [0, 1, 2]),
+            _ => tetrahedron(p),
         }
     }
 
     /// Keeps the points and weights `r` selects.
     fn apply(&mut self, r: &Reduced) {
-        let old = self.points;
-        for k in 0..r.len {
-            self.points[k] = old[r.idx[k]];
-            self.lambda[k] = r.lambda[k];
+        // Kept in increasing index order, so moving them down in place never overwrites a
+        // point still to be moved (PERF: no copy of the whole simplex).
+        let mut order = [0, 1, 2, 3];
+        let order = &mut order[..r.len];
+        order.sort_unstable_by_key(|&k| r.idx[k]);
+        for (slot, &k) in order.iter().enumerate() {
+            let from = r.idx[k];
+            self.points[slot] = self.points[from];
+            self.ws[slot] = self.ws[from];
+            self.lambda[slot] = r.lambda[k];
         }
         self.len = r.len;
     }
