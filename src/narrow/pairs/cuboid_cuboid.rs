@@ -29,7 +29,10 @@ pub fn distance_cuboid_cuboid(a: &Cuboid, b: &Cuboid, pose_ab: &Isometry) -> Sha
     let boxes = Boxes::new(a, b, pose_ab);
     // Apart along any axis is enough to go to the closest pair; overlapping needs the best.
     let axis = boxes.best_axis_or_first_above(0.0);
-    boxes.distance(&axis, || cores(a, b, pose_ab))
+    boxes.distance(&axis, |axis| {
+        let (core_a, core_b) = cores(a, b, pose_ab);
+        query::distance_with_axis(&core_a, &core_b, axis)
+    })
 }
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4
@@ -45,10 +48,13 @@ pub fn manifold_cuboid_cuboid(a: &Cuboid, b: &Cuboid, pose_ab: &Isometry, out: &
     let (core_a, core_b) = cores(a, b, pose_ab);
     if axis.separation <= 0.0 {
         // Overlapping: the normal is the axis; the witnesses only if clipping finds nothing.
-        let distance = || boxes.distance(&axis, || (core_a, core_b));
+        let shared = |axis: &Axis| query::distance_with_axis(&core_a, &core_b, axis);
+        let distance = || boxes.distance(&axis, shared);
         clip::manifold_along(&core_a, &core_b, axis.normal, distance, out);
     } else {
-        let d = boxes.distance(&axis, || (core_a, core_b));
+        let d = boxes.distance(&axis, |axis| {
+            query::distance_with_axis(&core_a, &core_b, axis)
+        });
         clip::manifold_from_distance(&core_a, &core_b, &d, out);
     }
 }
@@ -178,16 +184,16 @@ impl Boxes {
         best
     }
 
-    /// The signed distance given the best axis, or any axis the boxes are apart on; `cores` gives the boxes to the shared engine
-    /// (penetration, and the rare apart case [`Self::closest_pair_apart`] leaves to it).
-    fn distance(&self, axis: &Axis, cores: impl FnOnce() -> (Core, Core)) -> ShapeDistance {
+    /// The signed distance given the best axis, or any axis the boxes are apart on; `shared`
+    /// is the shared engine's answer on the boxes' cores with that axis (penetration, and the
+    /// rare apart case [`Self::closest_pair_apart`] leaves to it).
+    fn distance(&self, axis: &Axis, shared: impl FnOnce(&Axis) -> ShapeDistance) -> ShapeDistance {
         if axis.separation > 0.0
             && let Some((on_a, on_b)) = self.closest_pair_apart()
         {
             return query::apart(0.0, 0.0, on_a, on_b, axis, self.tiny);
         }
-        let (core_a, core_b) = cores();
-        query::distance_with_axis(&core_a, &core_b, axis)
+        shared(axis)
     }
 
     /// The closest pair of boxes known to be apart ([`super::query`], step 2), or `None` when

@@ -324,7 +324,13 @@ pub(super) fn distance_with_axis(a: &Core, b: &Core, axis: &Axis) -> ShapeDistan
         for p in &mut fb.pts[..fb.len] {
             *p += shift;
         }
-        let (on_a, on_b) = closest_pair(&a.support_feature(n, tiny), &fb);
+        let fa = a.support_feature(n, tiny);
+        let (on_a, on_b) = if fa.len == 2 && fb.len == 2 {
+            // PERF: edge against edge, the common overlapping case: one segment pair.
+            closest_points_segment_segment(fa.pts[0], fa.pts[1], fb.pts[0], fb.pts[1])
+        } else {
+            closest_pair(&fa, &fb)
+        };
         rounded(a.radius, b.radius, -depth, on_a, on_b - shift, n)
     }
 }
