@@ -107,6 +107,62 @@ impl Manifold {
         }
     }
 
+    /// Adds the most informative [`MANIFOLD_POINTS`] of `pts` (all of them when they are
+    /// few): the deepest, the farthest from it, the one spanning the largest triangle with
+    /// those, then the one farthest outside that triangle — positions on A's surface, areas
+    /// about the manifold's normal. Points on one line give its two ends; a fourth inside the
+    /// triangle is left out.
+    pub fn push_reduced(&mut self, pts: &[ManifoldPoint]) {
+        let (normal, out) = (self.normal, self);
+        if pts.len() <= MANIFOLD_POINTS {
+            for p in pts {
+                out.push(*p);
+            }
+            return;
+        }
+        let pos = |i: usize| pts[i].point_a;
+        let mut chosen = [usize::MAX; MANIFOLD_POINTS];
+        let best = |score: &dyn Fn(usize) -> f64, chosen: &[usize]| {
+            (0..pts.len())
+                .filter(|i| !chosen.contains(i))
+                .max_by(|&i, &j| score(i).total_cmp(&score(j)))
+                .unwrap_or(0)
+        };
+        chosen[0] = best(&|i| -pts[i].distance, &chosen);
+        let p0 = pos(chosen[0]);
+        chosen[1] = best(&|i| pos(i).distance_squared(p0), &chosen);
+        let p1 = pos(chosen[1]);
+        let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(normal);
+        let third = best(&|i| area(p0, p1, pos(i)).abs(), &chosen);
+        if area(p0, p1, pos(third)) == 0.0 {
+            // All on one line: its two ends.
+            out.push(pts[chosen[0]]);
+            out.push(pts[chosen[1]]);
+            return;
+        }
+        chosen[2] = third;
+        let p2 = pos(chosen[2]);
+        // Counter-clockwise about the normal; the fourth point is the farthest outside an edge.
+        let (p1, p2) = if area(p0, p1, p2) >= 0.0 {
+            (p1, p2)
+        } else {
+            (p2, p1)
+        };
+        let outside = |i: usize| {
+            let q = pos(i);
+            (-area(p0, p1, q))
+                .max(-area(p1, p2, q))
+                .max(-area(p2, p0, q))
+        };
+        let fourth = best(&outside, &chosen);
+        if outside(fourth) > 0.0 {
+            chosen[3] = fourth;
+        }
+        for i in chosen.into_iter().filter(|&i| i != usize::MAX) {
+            out.push(pts[i]);
+        }
+    }
+
     /// Empties the manifold and sets its normal.
     pub fn reset(&mut self, normal: DVec3) {
         self.normal = normal;

@@ -28,8 +28,9 @@
 //!    the slack (a curved reference face's rim, a polytope vertex off the best incident
 //!    face), they are added, so the deepest reported depth is `d.distance`. Nothing kept: the
 //!    single point of `d`.
-//! 5. **Reduction** to [`MANIFOLD_POINTS`]: the deepest, the farthest from it, the one
-//!    spanning the largest triangle with those, the one adding the most area outside it.
+//! 5. **Reduction** to [`MANIFOLD_POINTS`](crate::narrow::contact::MANIFOLD_POINTS) by
+//!    [`Manifold::push_reduced`]: the deepest, the farthest from it, the one spanning the
+//!    largest triangle with those, the one adding the most area outside it.
 //!
 //! The manifold's normal is `d.normal`, unchanged; apart shapes (`d.distance > 0`) get an
 //! empty manifold with it.
@@ -58,7 +59,7 @@ mod features;
 pub use features::{ContactFeatures, DISC_POINTS, FEATURE_POINTS, Polygon};
 
 use crate::math::{DVec3, Isometry};
-use crate::narrow::contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
 
 /// Cosine between a face's normal and the contact normal above which the face is a
 /// reference face (about 0.8°), as in the closed-form pairs.
@@ -77,7 +78,7 @@ const CANDIDATES: usize = 2 * FEATURE_POINTS + 1;
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab` (B's frame in
 /// A's), A's frame, from their signed distance `d` (the [`crate::narrow::contact`]
-/// contract, A's frame): at most [`MANIFOLD_POINTS`] points with normal `d.normal`, each
+/// contract, A's frame): at most [`MANIFOLD_POINTS`](crate::narrow::contact::MANIFOLD_POINTS) points with normal `d.normal`, each
 /// `≤ 0` deep to the slack, the deepest at `d.distance`; empty when `d.distance > 0`.
 ///
 /// # Allocation
@@ -167,7 +168,7 @@ pub fn manifold_convex_convex<A: ContactFeatures + ?Sized, B: ContactFeatures + 
             distance: d.distance,
         });
     }
-    reduce(cands.points(), n, out);
+    out.push_reduced(cands.points());
 }
 
 /// Two line features (a cylinder's side, a capsule's segment, a cone's slant) ⟂ `n` and
@@ -405,58 +406,6 @@ impl Candidates {
     }
 }
 
-/// At most [`MANIFOLD_POINTS`] of `pts` into `out` (module docs, step 5), positions taken
-/// on A's surface, areas about `normal`.
-fn reduce(pts: &[ManifoldPoint], normal: DVec3, out: &mut Manifold) {
-    if pts.len() <= MANIFOLD_POINTS {
-        for p in pts {
-            out.push(*p);
-        }
-        return;
-    }
-    let pos = |i: usize| pts[i].point_a;
-    let mut chosen = [usize::MAX; MANIFOLD_POINTS];
-    let best = |score: &dyn Fn(usize) -> f64, chosen: &[usize]| {
-        (0..pts.len())
-            .filter(|i| !chosen.contains(i))
-            .max_by(|&i, &j| score(i).total_cmp(&score(j)))
-            .unwrap_or(0)
-    };
-    chosen[0] = best(&|i| -pts[i].distance, &chosen);
-    let p0 = pos(chosen[0]);
-    chosen[1] = best(&|i| pos(i).distance_squared(p0), &chosen);
-    let p1 = pos(chosen[1]);
-    let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(normal);
-    let third = best(&|i| area(p0, p1, pos(i)).abs(), &chosen);
-    if area(p0, p1, pos(third)) == 0.0 {
-        // All on one line: its two ends.
-        out.push(pts[chosen[0]]);
-        out.push(pts[chosen[1]]);
-        return;
-    }
-    chosen[2] = third;
-    let p2 = pos(chosen[2]);
-    // Counter-clockwise about the normal; the fourth point is the farthest outside an edge.
-    let (p1, p2) = if area(p0, p1, p2) >= 0.0 {
-        (p1, p2)
-    } else {
-        (p2, p1)
-    };
-    let outside = |i: usize| {
-        let q = pos(i);
-        (-area(p0, p1, q))
-            .max(-area(p1, p2, q))
-            .max(-area(p2, p0, q))
-    };
-    let fourth = best(&outside, &chosen);
-    if outside(fourth) > 0.0 {
-        chosen[3] = fourth;
-    }
-    for i in chosen.into_iter().filter(|&i| i != usize::MAX) {
-        out.push(pts[i]);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -488,7 +437,8 @@ mod tests {
             });
         }
         let mut m = Manifold::new();
-        reduce(&pts, DVec3::Z, &mut m);
+        m.reset(DVec3::Z);
+        m.push_reduced(&pts);
         assert_eq!(m.len(), 4);
         assert_eq!(m.points()[0].distance, -0.3);
         // A triangle with a point on an edge and one inside: no fourth point adds area.
@@ -501,7 +451,8 @@ mod tests {
             })
             .collect();
         let mut m = Manifold::new();
-        reduce(&line, DVec3::Z, &mut m);
+        m.reset(DVec3::Z);
+        m.push_reduced(&line);
         assert_eq!(m.len(), 3);
     }
 }

@@ -17,13 +17,14 @@
 //!   line through it along the normal: up to 2 points.
 //! - Otherwise (edge–edge, anything against a point): 1 point, the distance witnesses.
 //!
-//! More than [`MANIFOLD_POINTS`] candidates are reduced to the deepest, the farthest from
-//! it, then the two that span the largest area.
+//! More than [`MANIFOLD_POINTS`](crate::narrow::contact::MANIFOLD_POINTS) candidates are
+//! reduced by [`Manifold::push_reduced`] (the deepest, the farthest from it, then the two
+//! that span the largest area).
 
 use super::core::{Core, Kind, Polygon, line_interval};
 use super::query::{FEATURE_RELATIVE, best_axis, distance_with_axis};
 use crate::math::DVec3;
-use crate::narrow::contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
 
 /// Cosine between a face normal and the contact normal above which the face is a
 /// reference face (about 0.8°).
@@ -123,9 +124,7 @@ pub(super) fn manifold_along(
         });
         return;
     }
-    for p in reduce(&cands, out.normal) {
-        out.push(p);
-    }
+    out.push_reduced(&cands.pts[..cands.len]);
 }
 
 /// The incident feature of `core` against a reference face of outward normal `f`.
@@ -341,54 +340,6 @@ fn column_point(core: &Core, q: DVec3, n: DVec3, end: Column) -> Option<DVec3> {
     Some(a + d * t)
 }
 
-/// At most [`MANIFOLD_POINTS`] of the candidates: the deepest, the farthest from it, the
-/// one spanning the largest triangle with those, then the one adding the most area.
-fn reduce(c: &Candidates, normal: DVec3) -> impl Iterator<Item = ManifoldPoint> {
-    let pts = &c.pts[..c.len];
-    let mut chosen = [usize::MAX; MANIFOLD_POINTS];
-    if pts.len() <= MANIFOLD_POINTS {
-        for (i, slot) in chosen.iter_mut().enumerate().take(pts.len()) {
-            *slot = i;
-        }
-    } else {
-        let pos = |i: usize| pts[i].point_a;
-        let argmax = |score: &dyn Fn(usize) -> f64, chosen: &[usize]| {
-            (0..pts.len())
-                .filter(|i| !chosen.contains(i))
-                .max_by(|&i, &j| score(i).total_cmp(&score(j)))
-                .unwrap_or(0)
-        };
-        chosen[0] = argmax(&|i| -pts[i].distance, &chosen);
-        let p0 = pos(chosen[0]);
-        chosen[1] = argmax(&|i| pos(i).distance_squared(p0), &chosen);
-        let p1 = pos(chosen[1]);
-        let area = |x: DVec3, y: DVec3, z: DVec3| (y - x).cross(z - x).dot(normal);
-        chosen[2] = argmax(&|i| area(p0, p1, pos(i)).abs(), &chosen);
-        let p2 = pos(chosen[2]);
-        // Orient the triangle counter-clockwise about the normal, then the fourth point is
-        // the one farthest outside one of its edges.
-        let (p1, p2) = if area(p0, p1, p2) >= 0.0 {
-            (p1, p2)
-        } else {
-            (p2, p1)
-        };
-        chosen[3] = argmax(
-            &|i| {
-                let q = pos(i);
-                (-area(p0, p1, q))
-                    .max(-area(p1, p2, q))
-                    .max(-area(p2, p0, q))
-            },
-            &chosen,
-        );
-    }
-    let pts = c.pts;
-    chosen
-        .into_iter()
-        .filter(|&i| i != usize::MAX)
-        .map(move |i| pts[i])
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -415,7 +366,10 @@ mod tests {
                 point(angle.cos(), angle.sin(), if i == 3 { -0.2 } else { -0.1 });
         }
         c.len = 8;
-        let kept: Vec<ManifoldPoint> = reduce(&c, DVec3::Z).collect();
+        let mut m = Manifold::new();
+        m.reset(DVec3::Z);
+        m.push_reduced(&c.pts[..c.len]);
+        let kept = m.points();
         assert_eq!(kept.len(), 4);
         assert_eq!(kept[0].distance, -0.2);
         // Opposite vertices, then the widest: the quad is the inscribed square.
@@ -428,7 +382,7 @@ mod tests {
             }
             0.5 * sum
         };
-        assert!((area(&kept) - 2.0).abs() < 1e-12, "{kept:?}");
+        assert!((area(kept) - 2.0).abs() < 1e-12, "{kept:?}");
     }
 
     #[test]
