@@ -60,55 +60,38 @@ trait BroadPhase {
     fn validate(&self, proxies: &[Proxy]) -> Result<(), String>;
 }
 
-impl BroadPhase for IncrementalSap {
-    fn insert(&mut self, p: &Proxy) {
-        IncrementalSap::insert(self, p.body, p.bounds, p.is_static, p.filter);
-    }
-    fn remove(&mut self, body: u32) {
-        assert!(IncrementalSap::remove(self, body), "{body} was present");
-    }
-    fn update(&mut self, body: u32, bounds: Aabb) {
-        IncrementalSap::update(self, body, bounds);
-    }
-    fn pairs(&mut self, _: &[Proxy], out: &mut Vec<CandidatePair>) {
-        IncrementalSap::pairs(self, out);
-    }
-    fn validate(&self, proxies: &[Proxy]) -> Result<(), String> {
-        if self.len() != proxies.len() {
-            return Err(format!(
-                "{} bodies, world has {}",
-                self.len(),
-                proxies.len()
-            ));
+/// The stateful broad phases share one body-level API (`insert`, `remove`, `update`,
+/// `pairs`, `validate`, `len`); one adapter serves them all.
+macro_rules! stateful_broad_phase {
+    ($($phase:ident),+) => {$(
+        impl BroadPhase for $phase {
+            fn insert(&mut self, p: &Proxy) {
+                $phase::insert(self, p.body, p.bounds, p.is_static, p.filter);
+            }
+            fn remove(&mut self, body: u32) {
+                assert!($phase::remove(self, body), "{body} was present");
+            }
+            fn update(&mut self, body: u32, bounds: Aabb) {
+                $phase::update(self, body, bounds);
+            }
+            fn pairs(&mut self, _: &[Proxy], out: &mut Vec<CandidatePair>) {
+                $phase::pairs(self, out);
+            }
+            fn validate(&self, proxies: &[Proxy]) -> Result<(), String> {
+                if self.len() != proxies.len() {
+                    return Err(format!(
+                        "{} bodies, world has {}",
+                        self.len(),
+                        proxies.len()
+                    ));
+                }
+                $phase::validate(self)
+            }
         }
-        IncrementalSap::validate(self)
-    }
+    )+};
 }
 
-impl BroadPhase for HashGrid {
-    fn insert(&mut self, p: &Proxy) {
-        HashGrid::insert(self, p.body, p.bounds, p.is_static, p.filter);
-    }
-    fn remove(&mut self, body: u32) {
-        assert!(HashGrid::remove(self, body), "{body} was present");
-    }
-    fn update(&mut self, body: u32, bounds: Aabb) {
-        HashGrid::update(self, body, bounds);
-    }
-    fn pairs(&mut self, _: &[Proxy], out: &mut Vec<CandidatePair>) {
-        HashGrid::pairs(self, out);
-    }
-    fn validate(&self, proxies: &[Proxy]) -> Result<(), String> {
-        if self.len() != proxies.len() {
-            return Err(format!(
-                "{} bodies, world has {}",
-                self.len(),
-                proxies.len()
-            ));
-        }
-        HashGrid::validate(self)
-    }
-}
+stateful_broad_phase!(IncrementalSap, HashGrid);
 
 impl BroadPhase for SortAndSweep {
     fn insert(&mut self, _: &Proxy) {}
