@@ -219,8 +219,8 @@ fn parallel_lines<A: ContactFeatures + ?Sized, B: ContactFeatures + ?Sized>(
         return;
     }
     let (mut seg, mut next) = (lb, Polygon::new());
-    clip_plane(&seg, u, hi, &mut next);
-    clip_plane(&next, -u, -lo, &mut seg);
+    seg.clip_plane_into(u, hi, &mut next);
+    next.clip_plane_into(-u, -lo, &mut seg);
     // Either B's surface point at q and A's extreme towards B in its column, or (when A
     // answers no column) A's surface point at q's place along A's line and B's extreme
     // towards A in its column.
@@ -302,7 +302,7 @@ impl Reference<'_> {
                 side = -side;
             }
             if side.length_squared() > 0.0 {
-                clip_plane(&inc, side, side.dot(p), &mut next);
+                inc.clip_plane_into(side, side.dot(p), &mut next);
                 std::mem::swap(&mut inc, &mut next);
             }
         }
@@ -324,54 +324,6 @@ impl Reference<'_> {
                 point_b,
                 distance: t,
             });
-        }
-    }
-}
-
-/// Sutherland–Hodgman: the part of `poly` with `side · x ≤ offset`, into `out`. A point
-/// stays a point and a segment a segment.
-fn clip_plane(poly: &Polygon, side: DVec3, offset: f64, out: &mut Polygon) {
-    out.clear();
-    let pts = poly.points();
-    let inside = |p: DVec3| side.dot(p) - offset;
-    match pts.len() {
-        0 => {}
-        1 => {
-            if inside(pts[0]) <= 0.0 {
-                out.push(pts[0]);
-            }
-        }
-        2 => {
-            let (p, q) = (pts[0], pts[1]);
-            let (dp, dq) = (inside(p), inside(q));
-            let cut = || p + (q - p) * (dp / (dp - dq));
-            match (dp <= 0.0, dq <= 0.0) {
-                (true, true) => {
-                    out.push(p);
-                    out.push(q);
-                }
-                (true, false) => {
-                    out.push(p);
-                    out.push(cut());
-                }
-                (false, true) => {
-                    out.push(cut());
-                    out.push(q);
-                }
-                (false, false) => {}
-            }
-        }
-        len => {
-            for i in 0..len {
-                let (p, q) = (pts[i], pts[(i + 1) % len]);
-                let (dp, dq) = (inside(p), inside(q));
-                if dp <= 0.0 {
-                    out.push(p);
-                }
-                if (dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0) {
-                    out.push(p + (q - p) * (dp / (dp - dq)));
-                }
-            }
         }
     }
 }
@@ -417,10 +369,10 @@ mod tests {
             sq.push(DVec3::new(p.0, p.1, 0.0));
         }
         let mut out = Polygon::new();
-        clip_plane(&sq, DVec3::X, 0.0, &mut out);
+        sq.clip_plane_into(DVec3::X, 0.0, &mut out);
         assert_eq!(out.len(), 4);
         assert!(out.points().iter().all(|p| p.x <= 0.0));
-        clip_plane(&sq, DVec3::X, -2.0, &mut out);
+        sq.clip_plane_into(DVec3::X, -2.0, &mut out);
         assert!(out.is_empty());
     }
 

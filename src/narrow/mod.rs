@@ -33,6 +33,7 @@ pub mod convex_mesh;
 pub mod gjk;
 pub mod mesh_mesh;
 pub mod pairs;
+pub mod polygon;
 pub mod toi;
 mod triangle_overlap;
 pub mod triangle_triangle;

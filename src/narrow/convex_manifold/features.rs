@@ -25,66 +25,7 @@ const POLYGON_CAPACITY: usize = 2 * FEATURE_POINTS;
 
 /// A point, segment or convex polygon of at most [`FEATURE_POINTS`] + [`FEATURE_POINTS`]
 /// vertices (room for clipping), in order around its outline. Never allocates.
-#[derive(Debug, Clone, Copy)]
-pub struct Polygon {
-    pts: [DVec3; POLYGON_CAPACITY],
-    len: usize,
-}
-
-impl Default for Polygon {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Polygon {
-    /// An empty polygon.
-    #[must_use]
-    pub const fn new() -> Self {
-        Self {
-            pts: [DVec3::ZERO; POLYGON_CAPACITY],
-            len: 0,
-        }
-    }
-
-    /// Empties it.
-    pub fn clear(&mut self) {
-        self.len = 0;
-    }
-
-    /// Adds a vertex; returns `false` (and drops it) when full.
-    pub fn push(&mut self, p: DVec3) -> bool {
-        if self.len == POLYGON_CAPACITY {
-            return false;
-        }
-        self.pts[self.len] = p;
-        self.len += 1;
-        true
-    }
-
-    /// The vertices.
-    #[must_use]
-    pub fn points(&self) -> &[DVec3] {
-        &self.pts[..self.len]
-    }
-
-    /// The vertices, mutable (to move the polygon into another frame).
-    pub fn points_mut(&mut self) -> &mut [DVec3] {
-        &mut self.pts[..self.len]
-    }
-
-    /// Number of vertices.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// Whether it has no vertex.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-}
+pub type Polygon = crate::narrow::polygon::Polygon<POLYGON_CAPACITY>;
 
 /// What a convex shape shows another shape it touches: a core (its points, local frame)
 /// swept by a ball of [`core_radius`](Self::core_radius).

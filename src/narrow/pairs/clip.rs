@@ -166,7 +166,7 @@ fn clip_face(
             side = -side;
         }
         if side.length_squared() > 0.0 {
-            inc = clip_plane(&inc, side, side.dot(p));
+            inc = inc.clipped(side, side.dot(p));
         }
     }
     for q in inc.points() {
@@ -201,50 +201,6 @@ fn clip_face(
     }
 }
 
-/// Sutherland–Hodgman: the part of `poly` with `side · x ≤ offset`. A segment stays a
-/// segment and a point a point.
-fn clip_plane(poly: &Polygon, side: DVec3, offset: f64) -> Polygon {
-    let mut out = Polygon::default();
-    let pts = poly.points();
-    let inside = |p: DVec3| side.dot(p) - offset;
-    match pts.len() {
-        0 => {}
-        1 => {
-            if inside(pts[0]) <= 0.0 {
-                out.push(pts[0]);
-            }
-        }
-        2 => {
-            let (da, db) = (inside(pts[0]), inside(pts[1]));
-            if da <= 0.0 && db <= 0.0 {
-                out = *poly;
-            } else if da <= 0.0 || db <= 0.0 {
-                let cut = pts[0] + (pts[1] - pts[0]) * (da / (da - db));
-                if da <= 0.0 {
-                    out.push(pts[0]);
-                    out.push(cut);
-                } else {
-                    out.push(cut);
-                    out.push(pts[1]);
-                }
-            }
-        }
-        n => {
-            for i in 0..n {
-                let (p, q) = (pts[i], pts[(i + 1) % n]);
-                let (dp, dq) = (inside(p), inside(q));
-                if dp <= 0.0 {
-                    out.push(p);
-                }
-                if (dp < 0.0 && dq > 0.0) || (dp > 0.0 && dq < 0.0) {
-                    out.push(p + (q - p) * (dp / (dp - dq)));
-                }
-            }
-        }
-    }
-    out
-}
-
 /// Two parallel edge features (both ⟂ the normal) give up to two points; else none.
 fn parallel_edges(a: &Core, b: &Core, n: DVec3, slack: f64, out: &mut Candidates) {
     let fa = a.support_feature(n, EDGE_PARALLEL * a.extent());
@@ -264,8 +220,8 @@ fn parallel_edges(a: &Core, b: &Core, n: DVec3, slack: f64, out: &mut Candidates
     let u = da / la;
     let (t0, t1) = (fa.pts[0].dot(u), fa.pts[1].dot(u));
     let mut seg = fb;
-    seg = clip_plane(&seg, u, t1);
-    seg = clip_plane(&seg, -u, -t0);
+    seg = seg.clipped(u, t1);
+    seg = seg.clipped(-u, -t0);
     for q in seg.points() {
         // Both surface points on the line through `q` along `n`: B's where the line leaves
         // B towards A, A's where it enters A from B's side.
@@ -390,11 +346,11 @@ mod tests {
         let mut seg = Polygon::default();
         seg.push(DVec3::new(-2.0, 0.0, 0.0));
         seg.push(DVec3::new(2.0, 0.0, 0.0));
-        let out = clip_plane(&seg, DVec3::X, 1.0);
+        let out = seg.clipped(DVec3::X, 1.0);
         assert_eq!(
             out.points(),
             &[DVec3::new(-2.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0)]
         );
-        assert_eq!(clip_plane(&seg, DVec3::X, -3.0).len, 0);
+        assert_eq!(seg.clipped(DVec3::X, -3.0).len, 0);
     }
 }

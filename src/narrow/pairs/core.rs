@@ -319,57 +319,7 @@ impl Core {
 
 /// A convex polygon of at most 8 points (a point, a segment, a triangle, a quad, or a quad
 /// clipped by a quad), cyclic order.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Polygon {
-    pub pts: [DVec3; 8],
-    pub len: usize,
-}
-
-impl Polygon {
-    /// Appends a point (ignored when full).
-    pub fn push(&mut self, p: DVec3) {
-        if self.len < self.pts.len() {
-            self.pts[self.len] = p;
-            self.len += 1;
-        }
-    }
-
-    /// The points.
-    pub fn points(&self) -> &[DVec3] {
-        &self.pts[..self.len]
-    }
-
-    /// The point of the (closed, convex, planar) polygon closest to `p`.
-    #[must_use]
-    pub fn closest_point(&self, p: DVec3) -> DVec3 {
-        let v = self.points();
-        match v.len() {
-            1 => v[0],
-            2 => closest_point_segment(p, v[0], v[1]),
-            _ => {
-                let mut best = closest_point_triangle(p, v[0], v[1], v[2]);
-                for i in 3..v.len() {
-                    let q = closest_point_triangle(p, v[0], v[i - 1], v[i]);
-                    if q.distance_squared(p) < best.distance_squared(p) {
-                        best = q;
-                    }
-                }
-                best
-            }
-        }
-    }
-
-    /// The polygon's edges (none for a point, one for a segment).
-    pub fn edges(&self) -> impl Iterator<Item = (DVec3, DVec3)> + '_ {
-        let n = self.len;
-        let count = match n {
-            0 | 1 => 0,
-            2 => 1,
-            _ => n,
-        };
-        (0..count).map(move |i| (self.pts[i], self.pts[(i + 1) % n]))
-    }
-}
+pub(super) type Polygon = crate::narrow::polygon::Polygon<8>;
 
 /// The interval `[enter, exit]` of parameters `s` for which `o + v s` (unit `v`) lies in
 /// the rounded core (`None` when the line misses it). Only for point and segment cores
