@@ -761,16 +761,7 @@ mod tests {
         Aabb::new(lo, lo + DVec3::splat(size))
     }
 
-    fn unit_at(x: f64, y: f64, z: f64) -> Aabb {
-        cube(DVec3::new(x, y, z), 1.0)
-    }
-
-    fn pairs_of(grid: &mut HashGrid) -> Vec<(u32, u32)> {
-        let mut out = Vec::new();
-        grid.pairs(&mut out);
-        grid.validate().unwrap();
-        out.into_iter().map(|p| (p.a, p.b)).collect()
-    }
+    use crate::broad::conformance::{self, pairs_of, unit_at};
 
     /// The cells of `level` that list `body`.
     fn cells_of(grid: &HashGrid, body: u32, level: usize) -> Vec<[i64; 3]> {
@@ -944,52 +935,13 @@ mod tests {
     #[test]
     fn a_removed_id_can_be_reinserted_with_new_bounds_kind_and_filter() {
         let mut grid = HashGrid::with_levels(0.5, 2.0, 4);
-        for id in 0..5 {
-            grid.insert(
-                id,
-                unit_at(f64::from(id) * 0.5, 0.0, 0.0),
-                false,
-                CollisionFilter::ALL,
-            );
-        }
-        assert_eq!(
-            pairs_of(&mut grid),
-            [(0, 1), (0, 2), (1, 2), (1, 3), (2, 3), (2, 4), (3, 4)]
-        );
-        assert!(grid.remove(2));
-        assert!(!grid.remove(2));
-        assert!(!grid.contains(2));
-        assert_eq!(pairs_of(&mut grid), [(0, 1), (1, 3), (3, 4)]);
-        grid.insert(2, unit_at(50.0, 0.0, 0.0), false, CollisionFilter::ALL);
-        assert_eq!(pairs_of(&mut grid), [(0, 1), (1, 3), (3, 4)]);
-        assert!(grid.remove(2));
-        let only_group_1 = CollisionFilter { group: 1, mask: 1 };
-        grid.insert(
-            3,
-            unit_at(1.5, 0.0, 0.0),
-            false,
-            CollisionFilter { group: 2, mask: 2 },
-        );
-        grid.insert(2, unit_at(1.0, 0.0, 0.0), true, only_group_1);
-        assert_eq!(
-            pairs_of(&mut grid),
-            [(0, 1), (0, 2), (1, 2), (1, 3), (2, 4), (3, 4)]
-        );
-        // Inserting a present id replaces it, here with a body of another level.
-        grid.insert(
-            2,
+        // The replacement is a body of another level.
+        conformance::removed_ids_come_back_with_new_bounds_kind_and_filter(
+            &mut grid,
             cube(DVec3::splat(-9.0), 3.0),
-            false,
-            CollisionFilter::ALL,
         );
-        assert_eq!(grid.len(), 5);
         assert_eq!(grid.level(2), Some(Some(3)));
-        assert_eq!(pairs_of(&mut grid), [(0, 1), (1, 3), (3, 4)]);
-        for id in [0, 4, 1, 3, 2] {
-            assert!(grid.remove(id));
-            grid.validate().unwrap();
-        }
-        assert!(grid.is_empty());
+        conformance::removing_every_body_empties_it(&mut grid);
         assert!(
             grid.levels
                 .iter()
@@ -999,31 +951,20 @@ mod tests {
 
     #[test]
     fn static_bodies_never_pair_with_each_other_however_they_overlap() {
-        let mut grid = HashGrid::new();
-        let mut rng = rng(606);
-        let mut dynamic_static = 0;
         let boxed = |rng: &mut TestRng| {
             let c = point_in_cube(rng, 1.0);
             let h = DVec3::splat(rng.random_range(0.0..1.0));
             Aabb::new(c - h, c + h)
         };
-        for id in 0..100u32 {
-            grid.insert(id, boxed(&mut rng), id % 4 != 0, CollisionFilter::ALL);
-        }
+        let mut grid = HashGrid::new();
+        conformance::static_bodies_never_pair_with_each_other(
+            &mut grid,
+            &mut rng(606),
+            100,
+            boxed,
+            10_000,
+        );
         assert!(grid.cell_sizes().len() > 1);
-        for frame in 0..50 {
-            for id in 0..100u32 {
-                grid.update(id, boxed(&mut rng));
-            }
-            for (a, b) in pairs_of(&mut grid) {
-                assert!(
-                    a % 4 == 0 || b % 4 == 0,
-                    "frame {frame}: static pair ({a}, {b})"
-                );
-                dynamic_static += usize::from(a % 4 != 0 || b % 4 != 0);
-            }
-        }
-        assert!(dynamic_static > 10_000, "{dynamic_static}");
     }
 
     /// Sizes spanning seven orders of magnitude over 24 levels (and beyond: oversized), with

@@ -451,16 +451,7 @@ mod tests {
     use crate::test_support::{point_in_cube, rng};
     use rand::Rng;
 
-    fn unit_at(x: f64, y: f64, z: f64) -> Aabb {
-        Aabb::new(DVec3::new(x, y, z), DVec3::new(x + 1.0, y + 1.0, z + 1.0))
-    }
-
-    fn pairs_of(sap: &mut IncrementalSap) -> Vec<(u32, u32)> {
-        let mut out = Vec::new();
-        sap.pairs(&mut out);
-        sap.validate().unwrap();
-        out.into_iter().map(|p| (p.a, p.b)).collect()
-    }
+    use crate::broad::conformance::{self, pairs_of, unit_at};
 
     #[test]
     fn boxes_touching_at_a_face_edge_or_corner_pair_and_a_gap_of_one_ulp_does_not() {
@@ -536,73 +527,27 @@ mod tests {
     #[test]
     fn a_removed_id_can_be_reinserted_with_new_bounds_kind_and_filter() {
         let mut sap = IncrementalSap::new();
-        for id in 0..5 {
-            sap.insert(
-                id,
-                unit_at(f64::from(id) * 0.5, 0.0, 0.0),
-                false,
-                CollisionFilter::ALL,
-            );
-        }
-        assert_eq!(
-            pairs_of(&mut sap),
-            [(0, 1), (0, 2), (1, 2), (1, 3), (2, 3), (2, 4), (3, 4)]
+        conformance::removed_ids_come_back_with_new_bounds_kind_and_filter(
+            &mut sap,
+            unit_at(-9.0, 0.0, 0.0),
         );
-        assert!(sap.remove(2));
-        assert!(!sap.remove(2));
-        assert!(!sap.contains(2));
-        assert_eq!(pairs_of(&mut sap), [(0, 1), (1, 3), (3, 4)]);
-        // Same id, now far away, then back, static and filtered against body 3.
-        sap.insert(2, unit_at(50.0, 0.0, 0.0), false, CollisionFilter::ALL);
-        assert_eq!(pairs_of(&mut sap), [(0, 1), (1, 3), (3, 4)]);
-        assert!(sap.remove(2));
-        let only_group_1 = CollisionFilter { group: 1, mask: 1 };
-        sap.insert(
-            3,
-            unit_at(1.5, 0.0, 0.0),
-            false,
-            CollisionFilter { group: 2, mask: 2 },
-        );
-        sap.insert(2, unit_at(1.0, 0.0, 0.0), true, only_group_1);
-        assert_eq!(
-            pairs_of(&mut sap),
-            [(0, 1), (0, 2), (1, 2), (1, 3), (2, 4), (3, 4)]
-        );
-        // Inserting a present id replaces it.
-        sap.insert(2, unit_at(-9.0, 0.0, 0.0), false, CollisionFilter::ALL);
-        assert_eq!(sap.len(), 5);
-        assert_eq!(pairs_of(&mut sap), [(0, 1), (1, 3), (3, 4)]);
-        for id in [0, 4, 1, 3, 2] {
-            assert!(sap.remove(id));
-            sap.validate().unwrap();
-        }
-        assert!(sap.is_empty());
+        conformance::removing_every_body_empties_it(&mut sap);
     }
 
     #[test]
     fn static_bodies_never_pair_with_each_other_however_they_overlap() {
+        let boxed = |rng: &mut crate::test_support::TestRng| {
+            let c = point_in_cube(rng, 1.0);
+            Aabb::new(c - DVec3::splat(1.0), c + DVec3::splat(1.0))
+        };
         let mut sap = IncrementalSap::new();
-        let mut rng = rng(606);
-        let mut dynamic_static = 0;
-        for id in 0..40u32 {
-            let c = point_in_cube(&mut rng, 1.0);
-            let bounds = Aabb::new(c - DVec3::splat(1.0), c + DVec3::splat(1.0));
-            sap.insert(id, bounds, id % 4 != 0, CollisionFilter::ALL);
-        }
-        for frame in 0..50 {
-            for id in 0..40u32 {
-                let c = point_in_cube(&mut rng, 1.0);
-                sap.update(id, Aabb::new(c - DVec3::splat(1.0), c + DVec3::splat(1.0)));
-            }
-            for (a, b) in pairs_of(&mut sap) {
-                assert!(
-                    a % 4 == 0 || b % 4 == 0,
-                    "frame {frame}: static pair ({a}, {b})"
-                );
-                dynamic_static += usize::from(a % 4 != 0 || b % 4 != 0);
-            }
-        }
-        assert!(dynamic_static > 1_000, "{dynamic_static}");
+        conformance::static_bodies_never_pair_with_each_other(
+            &mut sap,
+            &mut rng(606),
+            40,
+            boxed,
+            1_000,
+        );
     }
 
     /// Random boxes on an exact grid of 1/4 m (many equal coordinates), moved, teleported,

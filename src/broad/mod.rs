@@ -23,6 +23,8 @@
 //! boxes touching at a face, edge or corner pair, and zero-size boxes are points.
 
 pub mod brute_force;
+#[cfg(test)]
+mod conformance;
 pub mod hash_grid;
 pub mod incremental_sap;
 pub mod sort_sweep;
