@@ -32,15 +32,14 @@
 //! endpoints of the same kind keep their relative order; their order changes no overlap.
 //!
 //! # Costs (`n` bodies, `k` pairs in the set)
-//! - [`update`](IncrementalSap::update): `O(1 + s log k)` for `s` swaps, linear in how far
+//! - [`update`](IncrementalSap::update): `O(1 + s)` for `s` swaps, linear in how far
 //!   the body moved through the lists. A body that is not updated costs nothing.
 //! - [`insert`](IncrementalSap::insert) and [`remove`](IncrementalSap::remove): `O(n)`:
 //!   binary search of the endpoint positions, a `Vec` insert or remove (memmove) and
 //!   renumbering of the shifted endpoints on each axis, and the body's pairs found by one
 //!   direct scan of the axis where the fewest endpoints precede its max.
-//! - [`pairs`](IncrementalSap::pairs): `O(k)`: the set is a `BTreeSet` of
-//!   [`CandidatePair`]s, already in `(a, b)` order; each insertion or removal in it is
-//!   `O(log k)`.
+//! - [`pairs`](IncrementalSap::pairs): `O(k + e log e)` for `e` pair changes since the
+//!   last call: the set is a [`PairSet`], whose edits are logged in `O(1)` and merged here.
 //!
 //! # Teleports
 //! A body that jumps far is moved by the same insertion sort, paying one swap per endpoint
@@ -53,8 +52,10 @@
 //! validates poses before they reach the broad phase), checked by `debug_assert!`. A NaN
 //! would break the sort order and is never allowed in.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::BTreeSet;
 
+use super::body_map::BodyMap;
+use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, pairs_brute_force};
 use crate::bounding::{Aabb, BoundingVolume};
 
@@ -116,9 +117,9 @@ pub struct IncrementalSap {
     /// Per axis, all endpoints sorted by [`Endpoint::after`].
     axes: [Vec<Endpoint>; 3],
     /// Slot of each body id.
-    slot_of: HashMap<u32, u32>,
+    slot_of: BodyMap,
     /// The pairs whose boxes overlap and that may pair, `a < b`.
-    pairs: BTreeSet<CandidatePair>,
+    pairs: PairSet,
 }
 
 impl IncrementalSap {
@@ -211,8 +212,10 @@ impl IncrementalSap {
         let end = self.positions[slot][axis][MAX] as usize;
         for e in &self.axes[axis][..end] {
             if !e.is_max() && e.slot() != slot {
-                self.pairs
-                    .remove(&pair_of(body, self.proxies[e.slot()].body));
+                let (p, q) = (&self.proxies[slot], &self.proxies[e.slot()]);
+                if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
+                    self.pairs.remove(pair_of(body, q.body));
+                }
             }
         }
         for axis in 0..3 {
@@ -269,7 +272,7 @@ impl IncrementalSap {
     /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
     pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
         out.clear();
-        out.extend(self.pairs.iter().copied());
+        out.extend_from_slice(self.pairs.commit());
     }
 
     /// Checks every invariant: the slot table and id map agree; each axis holds exactly the
@@ -330,8 +333,9 @@ impl IncrementalSap {
         }
         let mut expected = Vec::new();
         pairs_brute_force(&self.proxies, &mut expected);
-        if !self.pairs.iter().eq(expected.iter()) {
-            let have: BTreeSet<_> = self.pairs.iter().copied().collect();
+        let have = self.pairs.snapshot();
+        if have != expected {
+            let have: BTreeSet<_> = have.into_iter().collect();
             let want: BTreeSet<_> = expected.into_iter().collect();
             return Err(format!(
                 "pair set differs from brute force: extra {:?}, missing {:?}",
@@ -363,8 +367,8 @@ impl IncrementalSap {
                 crossed(
                     &self.proxies,
                     &mut self.pairs,
-                    slot,
-                    other.slot(),
+                    (slot, other.slot()),
+                    axis,
                     kind == MIN,
                 );
             }
@@ -379,8 +383,8 @@ impl IncrementalSap {
                 crossed(
                     &self.proxies,
                     &mut self.pairs,
-                    slot,
-                    other.slot(),
+                    (slot, other.slot()),
+                    axis,
                     kind == MAX,
                 );
             }
@@ -405,25 +409,33 @@ impl IncrementalSap {
 }
 
 /// The pair set's response to slot `s`'s endpoint passing one of slot `t`'s of the other
-/// kind: when the swap may start an overlap, test the boxes (all axes) and the filters;
-/// when it ends one, drop the pair.
+/// kind on `axis`: when the swap may start an overlap, test the boxes (all axes) and the
+/// filters; when it ends one, drop the pair if it was in the set, that is when the two
+/// intervals were overlapping on the other two axes too (they were on `axis` until this
+/// swap) and the bodies may pair. Only real changes are logged.
 #[inline]
 fn crossed(
     proxies: &[Proxy],
-    pairs: &mut BTreeSet<CandidatePair>,
-    s: usize,
-    t: usize,
+    pairs: &mut PairSet,
+    (s, t): (usize, usize),
+    axis: usize,
     starts: bool,
 ) {
     debug_assert_ne!(s, t, "a body's min and max never swap");
     let (p, q) = (&proxies[s], &proxies[t]);
-    let key = pair_of(p.body, q.body);
+    if !p.may_pair(q) {
+        return;
+    }
     if starts {
-        if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
-            pairs.insert(key);
+        if p.bounds.intersects(&q.bounds) {
+            pairs.insert(pair_of(p.body, q.body));
         }
     } else {
-        pairs.remove(&key);
+        let (a, b) = (&p.bounds, &q.bounds);
+        let overlaps_on = |k: usize| a.min[k] <= b.max[k] && b.min[k] <= a.max[k];
+        if overlaps_on((axis + 1) % 3) && overlaps_on((axis + 2) % 3) {
+            pairs.remove(pair_of(p.body, q.body));
+        }
     }
 }
 

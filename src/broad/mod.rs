@@ -22,11 +22,13 @@
 //! Every broad phase follows the same tie rule as [`Aabb::intersects`]: closed boxes, so
 //! boxes touching at a face, edge or corner pair, and zero-size boxes are points.
 
+mod body_map;
 pub mod brute_force;
 #[cfg(test)]
 mod conformance;
 pub mod hash_grid;
 pub mod incremental_sap;
+mod pair_set;
 pub mod sort_sweep;
 
 pub use brute_force::pairs_brute_force;
