@@ -83,7 +83,9 @@
 //!
 //! # Allocation
 //! None once the workspace and the output have grown to the largest frame, except one
-//! warm-start cache entry when a mesh–mesh pair becomes a candidate.
+//! warm-start cache entry when a mesh–mesh pair becomes a candidate, and the kept broad
+//! phase's own: a rebuild (or an `Auto` measurement) allocates it anew, and the stateful
+//! kinds' pair sets and hash cells allocate as pairs and occupied cells appear.
 
 mod answer;
 mod contacts;
