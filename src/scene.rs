@@ -959,6 +959,55 @@ mod tests {
         }
     }
 
+    /// The log covers the gap from a sync point only when nothing it cannot see happened:
+    /// same frame (the whole log), the next frame with no edit after the point, never a
+    /// frame later, another scene or a clone.
+    #[test]
+    fn changes_since_a_sync_point_are_given_only_when_the_log_covers_them() {
+        let mut s = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let sphere = s.register_shape(Shape::Sphere(Sphere::new(1.0))).unwrap();
+        let a = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        let b = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        let at = |x: f64| Pose::from_translation(DVec3::X * x);
+        let point = s.sync_point();
+        assert_eq!(s.changes_since(point), Some(&[a.0, b.0][..]));
+        s.set_pose(a, at(1.0)).unwrap(); // logged already: once
+        assert_eq!(s.changes_since(point), Some(&[a.0, b.0][..]));
+        let synced = s.sync_point();
+        s.end_frame();
+        // Nothing after `synced`: the new frame's log is all there is to read; `point`
+        // missed the move.
+        assert_eq!(s.changes_since(synced), Some(&[][..]));
+        assert_eq!(s.changes_since(point), None);
+        let point = s.sync_point();
+        s.set_pose(b, at(2.0)).unwrap();
+        s.set_pose(a, at(1.0)).unwrap(); // unchanged pose: not a change
+        s.update_body(a, Motion::Static, CollisionFilter::ALL, None)
+            .unwrap();
+        s.set_pose(b, at(3.0)).unwrap();
+        assert_eq!(s.changes_since(point), Some(&[b.0, a.0][..]));
+        let synced = s.sync_point();
+        s.remove_body(a).unwrap(); // after the step of this frame
+        s.end_frame();
+        assert_eq!(
+            s.changes_since(synced),
+            None,
+            "an edit after the point is lost"
+        );
+        let point = s.sync_point();
+        s.end_frame();
+        s.end_frame();
+        assert_eq!(s.changes_since(point), None, "a skipped frame");
+        let point = s.sync_point();
+        let copy = s.clone();
+        assert_ne!(copy.uid(), s.uid());
+        assert_eq!(copy.changes_since(point), None);
+        assert_eq!(s.changes_since(point), Some(&[][..]));
+        let other = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        assert_eq!(other.changes_since(point), None);
+        assert_eq!(s.validate(), Ok(()));
+    }
+
     #[test]
     fn filters_pair_only_when_both_groups_meet_the_other_mask() {
         let (a, b) = (
