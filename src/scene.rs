@@ -17,6 +17,15 @@
 //! first pose is not a pose any frame saw, so no sweep is invented from it). Time of impact
 //! and swept boxes ([`Scene::swept_proxies`]) read it.
 //!
+//! # Change log
+//! A scene lists the bodies that changed in the current frame ([`Scene::changes`]): added,
+//! removed, moved by [`Scene::set_pose`] to a different pose, or changed by
+//! [`Scene::update_body`], each id once, cleared by [`Scene::end_frame`]. With the scene's
+//! process-unique id ([`Scene::uid`]; a clone gets a new one) and an edit counter, a reader
+//! that kept its own state of the bodies (the pipeline's broad phase) learns from
+//! [`Scene::changes_since`] which bodies to re-read, or that it must rebuild. The scene also
+//! carries which broad phase its frames run ([`Scene::set_broad_phase`]).
+//!
 //! # Invariants
 //! Checked by [`Scene::validate`]: every live body names a registered shape; its world box
 //! is its shape's local box moved by its pose; no body's frame stamps are ahead of the
@@ -24,7 +33,7 @@
 
 use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
 pub use crate::broad::CollisionFilter;
-use crate::broad::Proxy;
+use crate::broad::{BroadPhaseChoice, Proxy};
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::mesh::MeshEdges;
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
@@ -32,6 +41,7 @@ use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::toi::{FrameMotion, swept_bounds};
 use std::fmt;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A shape's id within its scene.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -157,6 +167,8 @@ pub struct Body {
     moved_in: u64,
     /// The frame in which the body was added (it is at rest during that frame).
     added_in: u64,
+    /// The frame in which the body's id was last put in the change log.
+    logged_in: u64,
 }
 
 /// Limits that keep one client from exhausting the daemon.
@@ -210,8 +222,24 @@ impl fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
+/// Where a reader of a scene's bodies stood: which scene, which frame, how many edits had
+/// been made ([`Scene::sync_point`], [`Scene::changes_since`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SyncPoint {
+    uid: u64,
+    frame: u64,
+    edits: u64,
+}
+
+/// Source of [`Scene::uid`]s.
+static NEXT_SCENE_UID: AtomicU64 = AtomicU64::new(1);
+
+fn next_uid() -> u64 {
+    NEXT_SCENE_UID.fetch_add(1, Ordering::Relaxed)
+}
+
 /// Shapes and bodies of one scene (see the [module docs](self)).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct Scene {
     shapes: Vec<Shape>,
     /// `shape_boxes[i]` is shape `i`'s local box, computed once at registration.
@@ -224,6 +252,36 @@ pub struct Scene {
     frame: u64,
     default_margin: f64,
     limits: SceneLimits,
+    /// Unique among the scenes of this process (clones included).
+    uid: u64,
+    /// Ids of the bodies changed in the current frame, each once (see the module docs).
+    changes: Vec<u32>,
+    /// Changes of bodies ever made (every add, remove, update, and move to a new pose).
+    edits: u64,
+    /// `edits` when the current frame began.
+    edits_at_frame_start: u64,
+    /// Which broad phase frames over this scene run.
+    broad_phase: BroadPhaseChoice,
+}
+
+impl Clone for Scene {
+    /// A copy with its own [`Scene::uid`]: readers synced to `self` rebuild for the copy.
+    fn clone(&self) -> Self {
+        Self {
+            shapes: self.shapes.clone(),
+            shape_boxes: self.shape_boxes.clone(),
+            bodies: self.bodies.clone(),
+            live: self.live,
+            frame: self.frame,
+            default_margin: self.default_margin,
+            limits: self.limits,
+            uid: next_uid(),
+            changes: self.changes.clone(),
+            edits: self.edits,
+            edits_at_frame_start: self.edits_at_frame_start,
+            broad_phase: self.broad_phase,
+        }
+    }
 }
 
 impl Scene {
@@ -241,6 +299,11 @@ impl Scene {
             frame: 0,
             default_margin,
             limits,
+            uid: next_uid(),
+            changes: Vec::new(),
+            edits: 0,
+            edits_at_frame_start: 0,
+            broad_phase: BroadPhaseChoice::Auto,
         })
     }
 
@@ -289,9 +352,13 @@ impl Scene {
             frame_start: desc.pose,
             moved_in: self.frame,
             added_in: self.frame,
+            logged_in: self.frame,
         }));
         self.live += 1;
-        Ok(BodyId(self.bodies.len() as u32 - 1))
+        let id = self.bodies.len() as u32 - 1;
+        self.changes.push(id);
+        self.edits += 1;
+        Ok(BodyId(id))
     }
 
     /// Removes a body; its id is not reused.
@@ -305,6 +372,10 @@ impl Scene {
             .and_then(Option::take)
             .ok_or(SceneError::UnknownBody(id))?;
         self.live -= 1;
+        if body.logged_in != self.frame {
+            self.changes.push(id.0);
+        }
+        self.edits += 1;
         Ok(body)
     }
 
@@ -322,10 +393,18 @@ impl Scene {
     ) -> Result<(), SceneError> {
         let margin = margin.unwrap_or(self.default_margin);
         check_margin(margin)?;
-        let body = self.body_mut(id)?;
+        let frame = self.frame;
+        let Some(Some(body)) = self.bodies.get_mut(id.0 as usize) else {
+            return Err(SceneError::UnknownBody(id));
+        };
         body.motion = motion;
         body.filter = filter;
         body.margin = margin;
+        if body.logged_in != frame {
+            body.logged_in = frame;
+            self.changes.push(id.0);
+        }
+        self.edits += 1;
         Ok(())
     }
 
@@ -336,7 +415,7 @@ impl Scene {
     /// # Errors
     /// [`SceneError::UnknownBody`].
     pub fn set_pose(&mut self, id: BodyId, pose: Pose) -> Result<(), SceneError> {
-        // Field borrows (not `body_mut`), so the local box is read in place: a copy of it
+        // Field borrows (not a helper returning `&mut Body`), so the local box is read in place: a copy of it
         // on the stack read back whole stalled store forwarding (20 → 2 ns per body).
         let Some(Some(body)) = self.bodies.get_mut(id.0 as usize) else {
             return Err(SceneError::UnknownBody(id));
@@ -351,14 +430,88 @@ impl Scene {
             }
             body.world_bounds = self.shape_boxes[body.shape.0 as usize].world(&pose);
             body.pose = pose;
+            if body.logged_in != self.frame {
+                body.logged_in = self.frame;
+                self.changes.push(id.0);
+            }
+            self.edits += 1;
         }
         Ok(())
     }
 
     /// Ends the current frame: every body's pose now is where its motion over the next
-    /// frame starts. The daemon calls it once a frame's results are published; O(1).
+    /// frame starts, and the change log starts empty. The daemon calls it once a frame's
+    /// results are published; O(1).
     pub fn end_frame(&mut self) {
         self.frame += 1;
+        self.changes.clear();
+        self.edits_at_frame_start = self.edits;
+    }
+
+    /// The current frame's number: frames answered so far ([`Scene::end_frame`]).
+    #[must_use]
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// This scene's id, unique among the scenes (and clones) of this process.
+    #[must_use]
+    pub fn uid(&self) -> u64 {
+        self.uid
+    }
+
+    /// Ids of the bodies changed in the current frame (added, removed, moved to another
+    /// pose, updated), each once, in the order of their first change. Removed bodies stay
+    /// listed; a body added and removed in the same frame is listed once.
+    #[must_use]
+    pub fn changes(&self) -> &[u32] {
+        &self.changes
+    }
+
+    /// Where a reader that has just read every body stands.
+    #[must_use]
+    pub fn sync_point(&self) -> SyncPoint {
+        SyncPoint {
+            uid: self.uid,
+            frame: self.frame,
+            edits: self.edits,
+        }
+    }
+
+    /// The bodies to re-read to catch up from `point` (taken with [`Scene::sync_point`]),
+    /// or `None` when the log cannot tell and the reader must read every body: another
+    /// scene, an older frame than the previous one, or the previous frame changed after
+    /// `point` (the log of that frame is gone).
+    ///
+    /// In the same frame as `point` it is the whole current log: a superset of what changed
+    /// since (a body moved twice in one frame is logged once), so re-reading the listed
+    /// bodies must be idempotent. Each listed id is a live body (re-read it) or a removed
+    /// one (forget it).
+    #[must_use]
+    pub fn changes_since(&self, point: SyncPoint) -> Option<&[u32]> {
+        let current = point.uid == self.uid
+            && (point.frame == self.frame
+                || (point.frame + 1 == self.frame && point.edits == self.edits_at_frame_start));
+        current.then_some(self.changes.as_slice())
+    }
+
+    /// Which broad phase frames over this scene run: [`BroadPhaseChoice::Auto`] (the
+    /// default) or a fixed one.
+    #[must_use]
+    pub fn broad_phase(&self) -> BroadPhaseChoice {
+        self.broad_phase
+    }
+
+    /// Sets which broad phase frames over this scene run (from the next frame on; results
+    /// do not depend on it, only their cost).
+    pub fn set_broad_phase(&mut self, choice: BroadPhaseChoice) {
+        self.broad_phase = choice;
+    }
+
+    /// The broad-phase view of one live body: what [`Scene::proxies`] lists for it.
+    #[must_use]
+    pub fn proxy(&self, id: BodyId) -> Option<Proxy> {
+        self.body(id).map(|body| proxy_of(id, body))
     }
 
     /// The motion of `body` (a live body of this scene) over the current frame: from its
@@ -434,12 +587,7 @@ impl Scene {
     /// None once `out` holds as many proxies as there are bodies.
     pub fn proxies(&self, out: &mut Vec<Proxy>) {
         out.clear();
-        out.extend(self.bodies().map(|(id, body)| Proxy {
-            body: id.0,
-            bounds: body.world_bounds.grown(body.margin),
-            is_static: body.motion == Motion::Static,
-            filter: body.filter,
-        }));
+        out.extend(self.bodies().map(|(id, body)| proxy_of(id, body)));
     }
 
     /// Number of live bodies.
@@ -462,25 +610,45 @@ impl Scene {
             if body.world_bounds != LocalBox::of(shape).world(&body.pose) {
                 return Err(format!("body {} has a stale world box", id.0));
             }
-            if body.moved_in > self.frame || body.added_in > body.moved_in {
+            if body.moved_in > self.frame
+                || body.added_in > body.moved_in
+                || body.logged_in > self.frame
+                || body.added_in > body.logged_in
+            {
                 return Err(format!("body {} has frame stamps out of order", id.0));
+            }
+            let logged = self.changes.contains(&id.0);
+            if logged != (body.logged_in == self.frame) {
+                return Err(format!("body {} logged {logged}, stamp disagrees", id.0));
             }
         }
         if live != self.live {
             return Err(format!("{live} live bodies, {} counted", self.live));
         }
+        let mut ids = self.changes.clone();
+        ids.sort_unstable();
+        if ids.windows(2).any(|w| w[0] == w[1])
+            || ids.last().is_some_and(|&i| i as usize >= self.bodies.len())
+        {
+            return Err("the change log repeats an id or names an unknown body".into());
+        }
+        if self.edits < self.edits_at_frame_start {
+            return Err("edit count went backwards".into());
+        }
         Ok(())
-    }
-
-    fn body_mut(&mut self, id: BodyId) -> Result<&mut Body, SceneError> {
-        self.bodies
-            .get_mut(id.0 as usize)
-            .and_then(Option::as_mut)
-            .ok_or(SceneError::UnknownBody(id))
     }
 }
 
-/// The world box of `shape` at `pose` (conservative: the local box moved and re-boxed).
+/// The broad-phase view of body `id`: its world box grown by its margin.
+fn proxy_of(id: BodyId, body: &Body) -> Proxy {
+    Proxy {
+        body: id.0,
+        bounds: body.world_bounds.grown(body.margin),
+        is_static: body.motion == Motion::Static,
+        filter: body.filter,
+    }
+}
+
 /// A shape's local box (centre and half extents, computed once at registration), and
 /// whether every rotation leaves it unchanged (a sphere's), so a new pose only moves it.
 #[derive(Debug, Clone, Copy)]
@@ -789,6 +957,55 @@ mod tests {
             assert_eq!(s.validate(), Ok(()));
             s.remove_body(id).unwrap();
         }
+    }
+
+    /// The log covers the gap from a sync point only when nothing it cannot see happened:
+    /// same frame (the whole log), the next frame with no edit after the point, never a
+    /// frame later, another scene or a clone.
+    #[test]
+    fn changes_since_a_sync_point_are_given_only_when_the_log_covers_them() {
+        let mut s = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let sphere = s.register_shape(Shape::Sphere(Sphere::new(1.0))).unwrap();
+        let a = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        let b = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        let at = |x: f64| Pose::from_translation(DVec3::X * x);
+        let point = s.sync_point();
+        assert_eq!(s.changes_since(point), Some(&[a.0, b.0][..]));
+        s.set_pose(a, at(1.0)).unwrap(); // logged already: once
+        assert_eq!(s.changes_since(point), Some(&[a.0, b.0][..]));
+        let synced = s.sync_point();
+        s.end_frame();
+        // Nothing after `synced`: the new frame's log is all there is to read; `point`
+        // missed the move.
+        assert_eq!(s.changes_since(synced), Some(&[][..]));
+        assert_eq!(s.changes_since(point), None);
+        let point = s.sync_point();
+        s.set_pose(b, at(2.0)).unwrap();
+        s.set_pose(a, at(1.0)).unwrap(); // unchanged pose: not a change
+        s.update_body(a, Motion::Static, CollisionFilter::ALL, None)
+            .unwrap();
+        s.set_pose(b, at(3.0)).unwrap();
+        assert_eq!(s.changes_since(point), Some(&[b.0, a.0][..]));
+        let synced = s.sync_point();
+        s.remove_body(a).unwrap(); // after the step of this frame
+        s.end_frame();
+        assert_eq!(
+            s.changes_since(synced),
+            None,
+            "an edit after the point is lost"
+        );
+        let point = s.sync_point();
+        s.end_frame();
+        s.end_frame();
+        assert_eq!(s.changes_since(point), None, "a skipped frame");
+        let point = s.sync_point();
+        let copy = s.clone();
+        assert_ne!(copy.uid(), s.uid());
+        assert_eq!(copy.changes_since(point), None);
+        assert_eq!(s.changes_since(point), Some(&[][..]));
+        let other = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        assert_eq!(other.changes_since(point), None);
+        assert_eq!(s.validate(), Ok(()));
     }
 
     #[test]

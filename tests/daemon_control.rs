@@ -216,3 +216,82 @@ fn bad_requests_get_their_codes_and_another_client_keeps_being_served() {
     assert_eq!(rejected(bad.create_scene()), ErrorCode::LimitExceeded);
     good_client_still_served();
 }
+
+/// `SetSceneParams` with every broad-phase code is accepted; an undefined code and an
+/// unknown scene are refused with their codes, and the scene keeps being served: bodies are
+/// added and its frames answered after.
+#[test]
+fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keeps_serving() {
+    use proxima_ipc::wire::{BroadPhaseCode, Command};
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let scene = client.create_scene().unwrap();
+    let sphere = client
+        .register_primitive(scene, Primitive::Sphere { radius: 0.5 })
+        .unwrap();
+    for (i, code) in [
+        BroadPhaseCode::IncrementalSap,
+        BroadPhaseCode::HashGrid,
+        BroadPhaseCode::SortAndSweep,
+        BroadPhaseCode::Auto,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        client.set_broad_phase(scene, code).unwrap();
+        client
+            .add_body(scene, &body(sphere, i as f64 * 0.75))
+            .unwrap();
+    }
+    let bad = ControlRequest {
+        protocol_version: proxima_ipc::PROTOCOL_VERSION,
+        command: Command::SetSceneParams as u32,
+        scene,
+        broad_phase: 4,
+        ..ControlRequest::default()
+    };
+    let reply = client.request(&bad, &[]).unwrap();
+    assert_eq!(
+        ErrorCode::from_u32(reply.status),
+        Some(ErrorCode::MalformedMessage)
+    );
+    assert!(
+        reply.reason().contains("broad phase 4"),
+        "{}",
+        reply.reason()
+    );
+    let reply = client
+        .request(
+            &ControlRequest {
+                broad_phase: u32::MAX,
+                ..bad
+            },
+            &[],
+        )
+        .unwrap();
+    assert_eq!(
+        ErrorCode::from_u32(reply.status),
+        Some(ErrorCode::MalformedMessage)
+    );
+    assert_eq!(
+        rejected(client.set_broad_phase(scene + 9, BroadPhaseCode::HashGrid)),
+        ErrorCode::UnknownScene
+    );
+    // Still served: control, and frames (four spheres 0.75 m apart, radius 0.5: three
+    // touching pairs).
+    client.add_body(scene, &body(sphere, 10.0)).unwrap();
+    let link = client.open_scene(scene).unwrap();
+    for frame in 1..=3u64 {
+        link.publish_poses(frame, 0, proxima_ipc::wire::query::OVERLAP, &[])
+            .unwrap();
+        let result = link
+            .receive_results_for(frame, std::time::Duration::from_secs(10))
+            .unwrap()
+            .expect("a result frame");
+        assert_eq!(
+            ErrorCode::from_u32(result.header().status),
+            Some(ErrorCode::Ok)
+        );
+        assert_eq!(result.header().pair_count, 3, "frame {frame}");
+    }
+}

@@ -527,3 +527,149 @@ fn toi_frames_over_shared_memory_match_the_in_process_pipeline_record_for_record
         "TOI frames {toi_frames}, at the start {at_start}, during the motion {during}"
     );
 }
+
+/// The scene's broad phase fixed over the wire (`SetSceneParams`): incremental sweep and
+/// prune for 20 frames, then the hash grid, then back to automatic, while a third of the
+/// bodies move each frame (the rest rest, unlisted) and bodies are removed and added between
+/// frames. The daemon's result frames hold record for record what the in-process pipeline
+/// gives on the same scene with the same choice.
+#[test]
+fn frames_with_a_fixed_incremental_sap_or_hash_grid_match_the_in_process_pipeline() {
+    use proxima::broad::{BroadPhaseChoice, BroadPhaseKind};
+    use proxima_ipc::wire::BroadPhaseCode;
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let TwinScenes {
+        scene_id,
+        mut oracle,
+    } = twin_scenes(&client);
+    // twin_scenes registers the torus, then the box: shape 1 is the box on both sides.
+    assert!(matches!(
+        oracle.shape(proxima::scene::ShapeId(1)),
+        Some(Shape::Cuboid(_))
+    ));
+    let link = client.open_scene(scene_id).unwrap();
+    let mut rng = support::rng(89);
+    let mut workspace = PipelineWorkspace::default();
+    let mut expected = FrameResults::default();
+    let queries = [
+        Query::CLOSE.union(Query::CONTACTS),
+        Query::DISTANCE,
+        Query::OVERLAP.union(Query::TOI),
+    ];
+    let mut poses: Vec<Option<Pose>> = (0..oracle.body_count())
+        .map(|_| {
+            Some(Pose::from_translation(support::point_in_cube(
+                &mut rng, 1.6,
+            )))
+        })
+        .collect();
+    let mut pairs_seen = 0;
+    for frame in 1..=60u64 {
+        if frame % 20 == 1 {
+            let (code, choice) = match frame / 20 {
+                0 => (
+                    BroadPhaseCode::IncrementalSap,
+                    BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap),
+                ),
+                1 => (
+                    BroadPhaseCode::HashGrid,
+                    BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid),
+                ),
+                _ => (BroadPhaseCode::Auto, BroadPhaseChoice::Auto),
+            };
+            client.set_broad_phase(scene_id, code).unwrap();
+            oracle.set_broad_phase(choice);
+        }
+        if frame % 5 == 0 {
+            let live: Vec<usize> = (0..poses.len()).filter(|&i| poses[i].is_some()).collect();
+            let gone = live[rng.random_range(0..live.len())];
+            client.remove_body(scene_id, gone as u32).unwrap();
+            oracle.remove_body(BodyId(gone as u32)).unwrap();
+            poses[gone] = None;
+            let at = support::point_in_cube(&mut rng, 1.6);
+            let spec = BodySpec {
+                margin: Some(MARGIN),
+                ..body(1, 0.0)
+            };
+            let id = client
+                .add_body(
+                    scene_id,
+                    &BodySpec {
+                        position: at.to_array(),
+                        ..spec
+                    },
+                )
+                .unwrap();
+            let desc = BodyDesc {
+                shape: proxima::scene::ShapeId(1),
+                pose: Pose::from_translation(at),
+                motion: SceneMotion::Dynamic,
+                filter: CollisionFilter::ALL,
+                margin: Some(MARGIN),
+            };
+            assert_eq!(oracle.add_body(&desc).unwrap(), BodyId(id));
+            assert_eq!(id as usize, poses.len());
+            poses.push(Some(desc.pose));
+        }
+        let q = queries[frame as usize % queries.len()];
+        let mut records = Vec::new();
+        for (i, pose) in poses.iter_mut().enumerate() {
+            let Some(pose) = pose else { continue };
+            if frame > 1 && !(i + frame as usize).is_multiple_of(3) {
+                continue;
+            }
+            let turn = DQuat::from_scaled_axis(support::point_in_cube(&mut rng, 0.2));
+            *pose = Pose::new(
+                pose.position + support::point_in_cube(&mut rng, 0.2),
+                (turn * pose.rotation).normalize(),
+            );
+            let r = pose.rotation;
+            records.push(PoseRecord {
+                orientation: [r.x, r.y, r.z, r.w],
+                ..pose_record(i as u32, pose.position)
+            });
+        }
+        link.publish_poses(frame, 0, flags(q), &records).unwrap();
+        for r in &records {
+            let [x, y, z, w] = r.orientation;
+            let pose =
+                Pose::try_new(DVec3::from(r.position), DQuat::from_xyzw(x, y, z, w)).unwrap();
+            oracle.set_pose(BodyId(r.body), pose).unwrap();
+        }
+        let report = step(&oracle, q, &mut workspace, &mut expected);
+        oracle.end_frame();
+        let result = link
+            .receive_results_for(frame, TIMEOUT)
+            .unwrap()
+            .expect("a result frame");
+        let header = result.header();
+        assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
+        assert_eq!(
+            (
+                header.candidate_count,
+                header.pair_count,
+                header.contact_count,
+                header.toi_count
+            ),
+            (
+                report.candidates.max(report.toi_candidates),
+                report.pairs,
+                report.contacts,
+                report.tois
+            ),
+            "frame {frame} {q:?}"
+        );
+        if let BroadPhaseChoice::Fixed(kind) = oracle.broad_phase() {
+            assert_eq!(report.broad_kind, Some(kind));
+        }
+        assert_eq!(
+            result.records().len(),
+            expected.pairs.len() + expected.contacts.len() + expected.tois.len()
+        );
+        assert_same_records(result.records(), &expected, frame);
+        assert_linked(&result);
+        pairs_seen += expected.pairs.len();
+    }
+    assert!(pairs_seen > 100, "pairs {pairs_seen}");
+}

@@ -60,7 +60,9 @@ use iceoryx2::service::port_factory::request_response::PortFactory;
 
 use crate::error::{ClientConnectError, ControlError, SceneOpenError};
 use crate::scene_link::SceneLink;
-use crate::wire::{Command, ControlReply, ControlRequest, ErrorCode, MotionCode, ShapeKindCode};
+use crate::wire::{
+    BroadPhaseCode, Command, ControlReply, ControlRequest, ErrorCode, MotionCode, ShapeKindCode,
+};
 use crate::{CONTROL_INITIAL_MAX_SLICE_LEN, DEFAULT_ROOT, EVENT_CONTROL_SENT, PROTOCOL_VERSION};
 
 /// How long a reply is awaited by spinning before the wait starts sleeping.
@@ -476,6 +478,24 @@ impl<S: Service> Client<S> {
             mask,
             margin: margin_to_wire(margin),
             ..self.header(Command::UpdateBody, scene)
+        })
+        .map(drop)
+    }
+
+    /// Sets which broad phase scene `scene`'s frames run, from its next frame on
+    /// ([`BroadPhaseCode::Auto`], the default, lets the daemon choose). Results do not
+    /// depend on it, only their cost.
+    ///
+    /// # Errors
+    /// See [`ControlError`].
+    pub fn set_broad_phase(
+        &self,
+        scene: u32,
+        broad_phase: BroadPhaseCode,
+    ) -> Result<(), ControlError> {
+        self.call(&ControlRequest {
+            broad_phase: broad_phase as u32,
+            ..self.header(Command::SetSceneParams, scene)
         })
         .map(drop)
     }
@@ -922,6 +942,21 @@ mod tests {
             .update_body(4, 9, Motion::Dynamic, 0, 0, None)
             .unwrap();
         assert_eq!(responder.next().0.margin, -1.0);
+
+        for code in [
+            BroadPhaseCode::Auto,
+            BroadPhaseCode::SortAndSweep,
+            BroadPhaseCode::IncrementalSap,
+            BroadPhaseCode::HashGrid,
+        ] {
+            client.set_broad_phase(6, code).unwrap();
+            let (header, payload) = responder.next();
+            let expected = ControlRequest {
+                broad_phase: code as u32,
+                ..base(Command::SetSceneParams, 6)
+            };
+            assert_eq!((header, payload.len()), (expected, 0));
+        }
     }
 
     #[test]

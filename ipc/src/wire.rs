@@ -14,6 +14,10 @@
 //! | `<root>/<scene>/poses` (publish–subscribe) | `[PoseRecord]` | [`PoseFrameHeader`] |
 //! | `<root>/<scene>/results` (publish–subscribe) | `[ResultRecord]`: pairs, then contacts, then times of impact | [`ResultFrameHeader`] |
 //! | `<root>/control` (request–response) | request `[u8]` (geometry, see [`ControlRequest`]), response [`ControlReply`] | request: [`ControlRequest`] |
+//!
+//! Control commands ([`Command`]): `Hello`, `CreateScene`, `DropScene`, `RegisterShape`,
+//! `AddBody`, `RemoveBody`, `UpdateBody`, `SetSceneParams` (the scene's broad phase,
+//! [`BroadPhaseCode`]).
 
 use iceoryx2::prelude::ZeroCopySend;
 
@@ -354,6 +358,10 @@ pub enum Command {
     RemoveBody = 5,
     /// Change body `target`'s motion, group, mask and margin.
     UpdateBody = 6,
+    /// Set scene `scene`'s parameters: which broad phase its frames run
+    /// ([`ControlRequest::broad_phase`], a [`BroadPhaseCode`]); from the next frame on.
+    /// Results do not depend on it, only their cost. The reply's `id` is the scene id.
+    SetSceneParams = 7,
 }
 
 /// Shape kinds of [`ControlRequest::shape_kind`], with the meaning of `dimensions` (metres)
@@ -392,6 +400,7 @@ impl Command {
             4 => Self::AddBody,
             5 => Self::RemoveBody,
             6 => Self::UpdateBody,
+            7 => Self::SetSceneParams,
             _ => return None,
         })
     }
@@ -439,6 +448,38 @@ impl MotionCode {
     }
 }
 
+/// Broad phases of [`ControlRequest::broad_phase`] ([`Command::SetSceneParams`]). Every one
+/// reports the same candidate pairs; they differ in cost per scene class.
+///
+/// Versioned with the protocol like [`Command`], so matched exhaustively.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum BroadPhaseCode {
+    /// The daemon chooses from the scene's measured statistics (body count, size spread,
+    /// clustering, fraction moving), re-measured as the scene runs. The default.
+    Auto = 0,
+    /// One-axis sort and sweep over every body each frame.
+    SortAndSweep = 1,
+    /// Incremental three-axis sweep and prune: a body that did not move costs nothing.
+    IncrementalSap = 2,
+    /// Hierarchical hash grid: a body that did not move costs nothing.
+    HashGrid = 3,
+}
+
+impl BroadPhaseCode {
+    /// The broad phase for a wire value, `None` for values this version does not define.
+    #[must_use]
+    pub const fn from_u32(value: u32) -> Option<Self> {
+        Some(match value {
+            0 => Self::Auto,
+            1 => Self::SortAndSweep,
+            2 => Self::IncrementalSap,
+            3 => Self::HashGrid,
+            _ => return None,
+        })
+    }
+}
+
 /// A control request (the user header of a `[u8]` request on `<root>/control`).
 ///
 /// The byte payload carries geometry for [`Command::RegisterShape`] of a convex or mesh
@@ -469,6 +510,11 @@ pub struct ControlRequest {
     pub vertex_count: u32,
     /// Number of `u32` indices in the geometry payload (a multiple of 3).
     pub index_count: u32,
+    /// [`BroadPhaseCode`] as `u32` (`SetSceneParams`); an undefined value is refused with
+    /// [`ErrorCode::MalformedMessage`] and changes nothing.
+    pub broad_phase: u32,
+    /// Always 0 (keeps `margin` 8-byte aligned without hidden padding).
+    pub reserved: u32,
     /// Close-pair margin of the body, metres, `≥ 0`; negative = the scene's default.
     pub margin: f64,
     /// Primitive dimensions, metres (see [`ShapeKindCode`]).
@@ -541,7 +587,7 @@ impl ControlReply {
     }
 }
 
-const _: () = assert!(size_of::<ControlRequest>() == 136);
+const _: () = assert!(size_of::<ControlRequest>() == 144);
 const _: () = assert!(size_of::<ControlReply>() == 128);
 const _: () = assert!(size_of::<PoseFrameHeader>() == 32);
 const _: () = assert!(size_of::<PoseRecord>() == 64);

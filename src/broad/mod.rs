@@ -19,6 +19,11 @@
 //! only the bodies in its cells; it does not degrade when boxes share a coordinate range
 //! ("dice on a table"), which costs the three-axis sweep endpoint swaps.
 //!
+//! [`select`] puts the three behind one stateful API ([`BroadPhase`]: insert, update, remove,
+//! pairs) and chooses among them from measured scene statistics ([`BroadPhaseStats`],
+//! [`choose`]); the pipeline keeps one per scene in sync with the scene's change log, so a
+//! body that did not change is never touched.
+//!
 //! Every broad phase follows the same tie rule as [`Aabb::intersects`]: closed boxes, so
 //! boxes touching at a face, edge or corner pair, and zero-size boxes are points.
 
@@ -29,11 +34,13 @@ mod conformance;
 pub mod hash_grid;
 pub mod incremental_sap;
 mod pair_set;
+pub mod select;
 pub mod sort_sweep;
 
 pub use brute_force::pairs_brute_force;
 pub use hash_grid::HashGrid;
 pub use incremental_sap::IncrementalSap;
+pub use select::{BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, choose};
 pub use sort_sweep::SortAndSweep;
 
 use crate::bounding::Aabb;

@@ -6,9 +6,10 @@
 
 use super::config::DaemonConfig;
 use super::convert::{self, Rejection};
+use crate::broad::{BroadPhaseChoice, BroadPhaseKind};
 use crate::scene::{BodyDesc, BodyId, Scene, ShapeId};
 use proxima_ipc::PROTOCOL_VERSION;
-use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
+use proxima_ipc::wire::{BroadPhaseCode, Command, ControlReply, ControlRequest, ErrorCode};
 
 /// The scenes a daemon serves, by id (ids are not reused while the daemon runs).
 #[derive(Debug)]
@@ -111,6 +112,11 @@ impl ControlState {
                     .map_err(scene_rejection)?;
                 Ok(request.target)
             }
+            Command::SetSceneParams => {
+                let choice = broad_phase(request.broad_phase)?;
+                self.live_scene(request.scene)?.set_broad_phase(choice);
+                Ok(request.scene)
+            }
         }
     }
 
@@ -146,6 +152,22 @@ impl ControlState {
         self.scene_mut(id)
             .ok_or_else(|| Rejection::new(ErrorCode::UnknownScene, format!("no scene {id}")))
     }
+}
+
+/// The broad-phase choice of a wire code.
+fn broad_phase(code: u32) -> Result<BroadPhaseChoice, Rejection> {
+    let code = BroadPhaseCode::from_u32(code).ok_or_else(|| {
+        Rejection::new(
+            ErrorCode::MalformedMessage,
+            format!("unknown broad phase {code} (0 auto, 1 sort and sweep, 2 incremental SAP, 3 hash grid)"),
+        )
+    })?;
+    Ok(match code {
+        BroadPhaseCode::Auto => BroadPhaseChoice::Auto,
+        BroadPhaseCode::SortAndSweep => BroadPhaseChoice::Fixed(BroadPhaseKind::SortAndSweep),
+        BroadPhaseCode::IncrementalSap => BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap),
+        BroadPhaseCode::HashGrid => BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid),
+    })
 }
 
 fn scene_rejection(e: crate::scene::SceneError) -> Rejection {
@@ -271,6 +293,21 @@ mod tests {
         };
         assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::Ok);
         assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::UnknownBody);
+        for (wire_code, choice) in [
+            (3, BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid)),
+            (2, BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap)),
+            (1, BroadPhaseChoice::Fixed(BroadPhaseKind::SortAndSweep)),
+            (0, BroadPhaseChoice::Auto),
+        ] {
+            let params = ControlRequest {
+                scene,
+                broad_phase: wire_code,
+                ..request(Command::SetSceneParams)
+            };
+            let reply = state.handle(&params, &[]);
+            assert_eq!((code(&reply), reply.id), (ErrorCode::Ok, scene));
+            assert_eq!(state.scene(scene).unwrap().broad_phase(), choice);
+        }
         let drop = ControlRequest {
             scene,
             ..request(Command::DropScene)
@@ -433,6 +470,33 @@ mod tests {
                     ..request(Command::AddBody)
                 },
                 vec![],
+                ErrorCode::MalformedMessage,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    broad_phase: 4,
+                    ..request(Command::SetSceneParams)
+                },
+                vec![],
+                ErrorCode::MalformedMessage,
+            ),
+            (
+                ControlRequest {
+                    scene: 5,
+                    broad_phase: 2,
+                    ..request(Command::SetSceneParams)
+                },
+                vec![],
+                ErrorCode::UnknownScene,
+            ),
+            (
+                ControlRequest {
+                    scene,
+                    broad_phase: 2,
+                    ..request(Command::SetSceneParams)
+                },
+                vec![1],
                 ErrorCode::MalformedMessage,
             ),
             (

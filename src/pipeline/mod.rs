@@ -51,6 +51,21 @@
 //! records are separate from the pair records: a frame asking `CLOSE | TOI` gets both,
 //! each by its own rule.
 //!
+//! # Broad phase kept between frames
+//! The workspace keeps one stateful [`BroadPhase`] of the scene's bodies, of the kind the
+//! scene asks for ([`Scene::broad_phase`]): a fixed one, or with
+//! [`BroadPhaseChoice::Auto`] the kind [`choose`] picks from [`BroadPhaseStats`] measured on
+//! the scene at its first frame and again every [`AUTO_REMEASURE_FRAMES`] frames (a
+//! different pick rebuilds the broad phase). Each frame it re-reads only the bodies in the
+//! scene's change log ([`Scene::changes_since`]): a body that did not change is never
+//! touched, static bodies included. It rebuilds from every body instead on a scene it was
+//! not synced to, after a skipped frame (or a frame asking only `TOI`, which does not
+//! sync), after changes made between its last frame's step and [`Scene::end_frame`], and
+//! when the kind changes. Stepping twice in one frame re-reads the same log and answers the
+//! same. [`StepReport::broad_kind`] and [`StepReport::broad_updates`] say which kind ran and
+//! how many bodies it re-read. Results never depend on the kind, only their cost. The swept
+//! boxes of `TOI` still go through a [`SortAndSweep`] over every body each frame.
+//!
 //! # Design note: determinism and ordering
 //! The same scene and query give the same results: the broad phase yields pairs sorted by
 //! `(a, b)`, each pair is answered independently in that order, and nothing depends on
@@ -68,7 +83,9 @@
 //!
 //! # Allocation
 //! None once the workspace and the output have grown to the largest frame, except one
-//! warm-start cache entry when a mesh–mesh pair becomes a candidate.
+//! warm-start cache entry when a mesh–mesh pair becomes a candidate, and the kept broad
+//! phase's own: a rebuild (or an `Auto` measurement) allocates it anew, and the stateful
+//! kinds' pair sets and hash cells allocate as pairs and occupied cells appear.
 
 mod answer;
 mod contacts;
@@ -80,12 +97,15 @@ pub mod workers;
 pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
 pub use toi::{PairToi, TOI_TOLERANCE};
 
-use crate::broad::{CandidatePair, Proxy, SortAndSweep};
+use crate::broad::{
+    BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, Proxy,
+    SortAndSweep, choose,
+};
 use crate::math::DVec3;
 use crate::narrow::contact::Manifold;
 use crate::narrow::mesh_mesh::DistanceCache;
 use crate::scene::MeshShape;
-use crate::scene::{Body, BodyId, Scene, Shape};
+use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
 use answer::{Answer, MeshScratch};
 use dispatch::{NarrowScratch, Route};
 use std::collections::HashMap;
@@ -262,6 +282,25 @@ pub struct StepReport {
     pub pairs: u32,
     /// Contact points (`results.contacts.len()`).
     pub contacts: u32,
+    /// The broad phase that found `candidates`; `None` when only `toi` was asked (the kept
+    /// broad phase did not run).
+    pub broad_kind: Option<BroadPhaseKind>,
+    /// Bodies the kept broad phase re-read this frame: those in the scene's change log, or
+    /// every body when it was rebuilt (see the [module docs](self)); 0 when it did not run.
+    pub broad_updates: u32,
+}
+
+/// Frames between two measurements of a [`BroadPhaseChoice::Auto`] scene's statistics.
+pub const AUTO_REMEASURE_FRAMES: u64 = 256;
+
+/// The automatic choice made for one scene.
+#[derive(Debug, Clone, Copy)]
+struct AutoChoice {
+    /// [`Scene::uid`] of the scene measured.
+    scene: u64,
+    kind: BroadPhaseKind,
+    /// The frame of the measurement.
+    measured_at: u64,
 }
 
 /// State of [`step`] kept across frames: scratch space (no allocation once grown), the
@@ -269,9 +308,14 @@ pub struct StepReport {
 /// last frame, and the worker pool when there is one.
 #[derive(Debug, Default)]
 pub struct PipelineWorkspace {
+    /// Every body's proxy, when the broad phase is rebuilt or the scene measured.
     proxies: Vec<Proxy>,
-    /// The broad phase's order, kept between frames (coherent motion re-sorts in linear time).
-    sweep: SortAndSweep,
+    /// The broad phase over the current boxes, kept in sync with the scene (module docs).
+    broad: Option<BroadPhase>,
+    /// Where `broad` was last synced to its scene.
+    synced: Option<SyncPoint>,
+    /// The last automatic choice, when the scene's choice is `Auto`.
+    auto: Option<AutoChoice>,
     candidates: Vec<CandidatePair>,
     /// This thread's mesh–mesh scratch.
     mesh: MeshScratch,
@@ -320,14 +364,15 @@ pub fn step(
     results.pairs.clear();
     results.contacts.clear();
     results.tois.clear();
-    if query.at_current_poses() {
-        scene.proxies(&mut workspace.proxies);
-        workspace
-            .sweep
-            .pairs(&workspace.proxies, &mut workspace.candidates);
+    let (broad_kind, broad_updates) = if query.at_current_poses() {
+        let updates = sync_broad_phase(scene, workspace);
+        let broad = workspace.broad.as_mut().expect("synced");
+        broad.pairs(&mut workspace.candidates);
+        (Some(broad.kind()), updates)
     } else {
         workspace.candidates.clear();
-    }
+        (None, 0)
+    };
     if query.toi {
         scene.swept_proxies(&mut workspace.swept);
         workspace
@@ -438,7 +483,68 @@ pub fn step(
         pairs: index(results.pairs.len()),
         contacts: index(results.contacts.len()),
         tois: index(results.tois.len()),
+        broad_kind,
+        broad_updates: index(broad_updates),
     }
+}
+
+/// Brings the workspace's broad phase up to date with `scene` (see the [module
+/// docs](self)); returns how many bodies it re-read.
+fn sync_broad_phase(scene: &Scene, workspace: &mut PipelineWorkspace) -> usize {
+    let changes = workspace
+        .synced
+        .and_then(|point| scene.changes_since(point));
+    let mut listed = false;
+    let kind = match scene.broad_phase() {
+        BroadPhaseChoice::Fixed(kind) => {
+            workspace.auto = None;
+            kind
+        }
+        BroadPhaseChoice::Auto => match workspace.auto {
+            Some(auto)
+                if auto.scene == scene.uid()
+                    && (auto.measured_at..auto.measured_at + AUTO_REMEASURE_FRAMES)
+                        .contains(&scene.frame()) =>
+            {
+                auto.kind
+            }
+            _ => {
+                scene.proxies(&mut workspace.proxies);
+                listed = true;
+                let moved = changes.map_or(workspace.proxies.len(), <[u32]>::len);
+                let kind = choose(&BroadPhaseStats::measure(&workspace.proxies, moved));
+                workspace.auto = Some(AutoChoice {
+                    scene: scene.uid(),
+                    kind,
+                    measured_at: scene.frame(),
+                });
+                kind
+            }
+        },
+    };
+    workspace.synced = Some(scene.sync_point());
+    let PipelineWorkspace { broad, proxies, .. } = workspace;
+    if let (Some(broad), Some(changes)) = (broad.as_mut(), changes)
+        && broad.kind() == kind
+    {
+        for &id in changes {
+            match scene.proxy(BodyId(id)) {
+                Some(proxy) => broad.set(&proxy),
+                None => {
+                    broad.remove(id);
+                }
+            }
+        }
+        return changes.len();
+    }
+    if !listed {
+        scene.proxies(proxies);
+    }
+    let broad = broad.insert(BroadPhase::new(kind));
+    for p in proxies.iter() {
+        broad.insert(p.body, p.bounds, p.is_static, p.filter);
+    }
+    proxies.len()
 }
 
 fn index(n: usize) -> u32 {

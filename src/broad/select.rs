@@ -1,0 +1,649 @@
+//! One stateful broad phase behind one API, and the choice of which one a scene uses.
+//!
+//! [`BroadPhase`] holds one of the three broad phases ([`BroadPhaseKind`]) and gives them the
+//! same body-level API: [`insert`](BroadPhase::insert), [`update`](BroadPhase::update),
+//! [`remove`](BroadPhase::remove), [`pairs`](BroadPhase::pairs). The stateful
+//! [`IncrementalSap`] and [`HashGrid`] take it as is; for the stateless [`SortAndSweep`] it
+//! keeps the proxy list itself (a dense list with an id → slot map; removal swaps the last
+//! proxy into the freed slot, which the sweep's kept order re-keys for free) and sweeps it in
+//! [`pairs`](BroadPhase::pairs). Every kind reports exactly the pairs of
+//! [`pairs_brute_force`](super::pairs_brute_force) over its bodies, in `(a, b)` order.
+//!
+//! [`BroadPhaseStats::measure`] summarises a scene's proxies (body count, fraction moving,
+//! spread of sizes, clustering along the sweep axis) and [`choose`] maps the summary to a
+//! kind: what a scene with [`BroadPhaseChoice::Auto`] runs.
+
+use std::collections::HashMap;
+
+use super::{CandidatePair, CollisionFilter, HashGrid, IncrementalSap, Proxy, SortAndSweep};
+use crate::bounding::Aabb;
+
+/// Which broad-phase algorithm.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum BroadPhaseKind {
+    /// One-axis sort and sweep over the whole proxy list each frame ([`SortAndSweep`]).
+    SortAndSweep,
+    /// Incremental three-axis sweep and prune ([`IncrementalSap`]).
+    IncrementalSap,
+    /// Hierarchical hash grid ([`HashGrid`]).
+    HashGrid,
+}
+
+impl BroadPhaseKind {
+    /// Every kind.
+    pub const ALL: [Self; 3] = [Self::SortAndSweep, Self::IncrementalSap, Self::HashGrid];
+}
+
+/// Which broad phase a scene runs: chosen from measured statistics, or fixed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
+pub enum BroadPhaseChoice {
+    /// [`choose`] from [`BroadPhaseStats`] measured on the scene.
+    #[default]
+    Auto,
+    /// Always this one.
+    Fixed(BroadPhaseKind),
+}
+
+/// Per-body record of [`BroadPhase`]: what `update` must not change, and the body's slot in
+/// the sort-and-sweep proxy list.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    is_static: bool,
+    filter: CollisionFilter,
+    /// Index into [`Sweep::proxies`] (sort and sweep only; 0 otherwise).
+    slot: u32,
+}
+
+/// Sort and sweep with its proxy list.
+#[derive(Debug, Clone, Default)]
+struct Sweep {
+    proxies: Vec<Proxy>,
+    sweep: SortAndSweep,
+    /// Whether `sweep`'s kept order matches `proxies` (no change since the last `pairs`).
+    swept: bool,
+}
+
+#[derive(Debug, Clone)]
+enum Inner {
+    Sweep(Sweep),
+    Sap(IncrementalSap),
+    Grid(HashGrid),
+}
+
+/// One broad phase of any [`BroadPhaseKind`] behind one stateful API over bodies identified
+/// by `u32` ids (see the [module docs](self)).
+#[derive(Debug, Clone)]
+pub struct BroadPhase {
+    inner: Inner,
+    entries: HashMap<u32, Entry>,
+}
+
+impl BroadPhase {
+    /// An empty broad phase of kind `kind`.
+    #[must_use]
+    pub fn new(kind: BroadPhaseKind) -> Self {
+        let inner = match kind {
+            BroadPhaseKind::SortAndSweep => Inner::Sweep(Sweep::default()),
+            BroadPhaseKind::IncrementalSap => Inner::Sap(IncrementalSap::new()),
+            BroadPhaseKind::HashGrid => Inner::Grid(HashGrid::new()),
+        };
+        Self {
+            inner,
+            entries: HashMap::new(),
+        }
+    }
+
+    /// Its algorithm.
+    #[must_use]
+    pub fn kind(&self) -> BroadPhaseKind {
+        match self.inner {
+            Inner::Sweep(_) => BroadPhaseKind::SortAndSweep,
+            Inner::Sap(_) => BroadPhaseKind::IncrementalSap,
+            Inner::Grid(_) => BroadPhaseKind::HashGrid,
+        }
+    }
+
+    /// Number of bodies.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Whether there are no bodies.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// Whether `body` is in the broad phase.
+    #[must_use]
+    pub fn contains(&self, body: u32) -> bool {
+        self.entries.contains_key(&body)
+    }
+
+    /// The bodies as proxies, in no particular order.
+    #[must_use]
+    pub fn proxies(&self) -> &[Proxy] {
+        match &self.inner {
+            Inner::Sweep(s) => &s.proxies,
+            Inner::Sap(s) => s.proxies(),
+            Inner::Grid(g) => g.proxies(),
+        }
+    }
+
+    /// Adds `body` with its margin-grown world box `bounds` (metres; finite, `min <= max`).
+    /// Inserting an id that is already present replaces that body.
+    pub fn insert(&mut self, body: u32, bounds: Aabb, is_static: bool, filter: CollisionFilter) {
+        if self.contains(body) {
+            self.remove(body);
+        }
+        let mut slot = 0;
+        match &mut self.inner {
+            Inner::Sweep(s) => {
+                debug_assert!(
+                    bounds.min.is_finite() && bounds.max.is_finite(),
+                    "non-finite bounds {bounds:?}"
+                );
+                debug_assert!(bounds.min.cmple(bounds.max).all(), "inverted bounds");
+                slot = s.proxies.len() as u32;
+                s.proxies.push(Proxy {
+                    body,
+                    bounds,
+                    is_static,
+                    filter,
+                });
+                s.swept = false;
+            }
+            Inner::Sap(s) => s.insert(body, bounds, is_static, filter),
+            Inner::Grid(g) => g.insert(body, bounds, is_static, filter),
+        }
+        self.entries.insert(
+            body,
+            Entry {
+                is_static,
+                filter,
+                slot,
+            },
+        );
+    }
+
+    /// Removes `body` and its pairs; `false` when it was not present.
+    pub fn remove(&mut self, body: u32) -> bool {
+        let Some(entry) = self.entries.remove(&body) else {
+            return false;
+        };
+        match &mut self.inner {
+            Inner::Sweep(s) => {
+                let slot = entry.slot as usize;
+                s.proxies.swap_remove(slot);
+                if let Some(moved) = s.proxies.get(slot) {
+                    self.entries
+                        .get_mut(&moved.body)
+                        .expect("every listed proxy has an entry")
+                        .slot = slot as u32;
+                }
+                s.swept = false;
+            }
+            Inner::Sap(s) => {
+                s.remove(body);
+            }
+            Inner::Grid(g) => {
+                g.remove(body);
+            }
+        }
+        true
+    }
+
+    /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`). Updating a body that is
+    /// not present is a contract violation (`debug_assert!`; ignored in release builds).
+    pub fn update(&mut self, body: u32, bounds: Aabb) {
+        match &mut self.inner {
+            Inner::Sweep(s) => {
+                let Some(entry) = self.entries.get(&body) else {
+                    debug_assert!(false, "update of absent body {body}");
+                    return;
+                };
+                debug_assert!(
+                    bounds.min.is_finite()
+                        && bounds.max.is_finite()
+                        && bounds.min.cmple(bounds.max).all(),
+                    "invalid bounds {bounds:?}"
+                );
+                s.proxies[entry.slot as usize].bounds = bounds;
+                s.swept = false;
+            }
+            Inner::Sap(s) => s.update(body, bounds),
+            Inner::Grid(g) => g.update(body, bounds),
+        }
+    }
+
+    /// Brings `proxy.body` in line with `proxy`, whatever its state: inserted when absent,
+    /// updated when present with the same static flag and filter, replaced (removed and
+    /// inserted) when either changed. Applying it twice is the same as once.
+    pub fn set(&mut self, proxy: &Proxy) {
+        match self.entries.get(&proxy.body) {
+            Some(e) if e.is_static == proxy.is_static && e.filter == proxy.filter => {
+                self.update(proxy.body, proxy.bounds);
+            }
+            _ => self.insert(proxy.body, proxy.bounds, proxy.is_static, proxy.filter),
+        }
+    }
+
+    /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
+    /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
+    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over
+    /// [`proxies`](Self::proxies).
+    pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
+        match &mut self.inner {
+            Inner::Sweep(s) => {
+                s.sweep.pairs(&s.proxies, out);
+                s.swept = true;
+            }
+            Inner::Sap(s) => s.pairs(out),
+            Inner::Grid(g) => g.pairs(out),
+        }
+    }
+
+    /// Checks every invariant: the id map agrees with the wrapped broad phase's bodies (ids,
+    /// static flags, filters, slots) and the wrapped broad phase's own `validate` (for sort
+    /// and sweep: the kept order, when no body changed since the last [`Self::pairs`]).
+    /// `O(n²)` for the stateful kinds: for tests.
+    ///
+    /// # Errors
+    /// A description of the first violated invariant.
+    pub fn validate(&self) -> Result<(), String> {
+        let proxies = self.proxies();
+        if proxies.len() != self.entries.len() {
+            return Err(format!(
+                "{} proxies, {} entries",
+                proxies.len(),
+                self.entries.len()
+            ));
+        }
+        let sweep = matches!(self.inner, Inner::Sweep(_));
+        for (slot, p) in proxies.iter().enumerate() {
+            let Some(e) = self.entries.get(&p.body) else {
+                return Err(format!("body {} has no entry", p.body));
+            };
+            if e.is_static != p.is_static || e.filter != p.filter {
+                return Err(format!("body {}: entry disagrees with its proxy", p.body));
+            }
+            if sweep && e.slot as usize != slot {
+                return Err(format!(
+                    "body {} at slot {slot}, entry says {}",
+                    p.body, e.slot
+                ));
+            }
+        }
+        match &self.inner {
+            Inner::Sweep(s) if s.swept => s.sweep.validate(&s.proxies),
+            Inner::Sweep(_) => Ok(()),
+            Inner::Sap(s) => s.validate(),
+            Inner::Grid(g) => g.validate(),
+        }
+    }
+}
+
+/// What the automatic choice looks at, measured on a scene's proxies
+/// ([`BroadPhaseStats::measure`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BroadPhaseStats {
+    /// Number of bodies.
+    pub bodies: usize,
+    /// Fraction of the bodies that changed (moved, added, re-filtered) in the measured
+    /// frame, in `[0, 1]`; 0 with no bodies.
+    pub moving_fraction: f64,
+    /// `p90 / p10` of the boxes' largest edge lengths: 1 when all are alike; infinite when
+    /// at least 10 % of the boxes are points and some are not; 1 with no bodies or when
+    /// both percentiles are 0.
+    pub size_spread: f64,
+    /// Pairs of boxes whose intervals overlap (touching counts) on the axis where the box
+    /// centres spread most, divided by the number of bodies: about the mean number of
+    /// neighbours a body's interval meets there, a clustering measure (0 with no bodies).
+    pub sweep_overlap_ratio: f64,
+}
+
+impl BroadPhaseStats {
+    /// Measures `proxies`, of which `moved` changed this frame (clamped to the count).
+    /// `O(n log n)`; allocates two scratch lists.
+    ///
+    /// Percentiles are nearest-rank on the sorted values: `p_q = v[round(q · (n − 1))]`.
+    #[must_use]
+    pub fn measure(proxies: &[Proxy], moved: usize) -> Self {
+        let n = proxies.len();
+        if n == 0 {
+            return Self {
+                bodies: 0,
+                moving_fraction: 0.0,
+                size_spread: 1.0,
+                sweep_overlap_ratio: 0.0,
+            };
+        }
+        let mut sizes: Vec<f64> = proxies
+            .iter()
+            .map(|p| (p.bounds.max - p.bounds.min).max_element())
+            .collect();
+        sizes.sort_unstable_by(f64::total_cmp);
+        let percentile = |q: f64| sizes[(q * (n - 1) as f64).round() as usize];
+        let (p10, p90) = (percentile(0.1), percentile(0.9));
+        let size_spread = if p90 == 0.0 { 1.0 } else { p90 / p10 };
+        Self {
+            bodies: n,
+            moving_fraction: moved.min(n) as f64 / n as f64,
+            size_spread,
+            sweep_overlap_ratio: interval_overlaps(proxies, widest_spread_axis(proxies)) as f64
+                / n as f64,
+        }
+    }
+}
+
+/// The broad phase a scene with [`BroadPhaseChoice::Auto`] runs, given its statistics.
+#[must_use]
+pub fn choose(stats: &BroadPhaseStats) -> BroadPhaseKind {
+    // PLACEHOLDER(#6): a stand-in rule until the measured one (the three algorithms timed
+    // per scene class, with the table that justifies it) replaces it. Only the body count
+    // is looked at here; nothing below was measured.
+    if stats.bodies >= 5_000 {
+        BroadPhaseKind::HashGrid
+    } else {
+        BroadPhaseKind::SortAndSweep
+    }
+}
+
+/// Pairs `i < j` whose closed intervals on `axis` overlap, counted without enumerating
+/// them: interval `i` meets every `j` whose min is `≤ max_i`, except those whose max is
+/// `< min_i` (which also have their min `≤ max_i`).
+fn interval_overlaps(proxies: &[Proxy], axis: usize) -> u64 {
+    let mut mins: Vec<f64> = proxies.iter().map(|p| p.bounds.min[axis]).collect();
+    let mut maxs: Vec<f64> = proxies.iter().map(|p| p.bounds.max[axis]).collect();
+    mins.sort_unstable_by(f64::total_cmp);
+    maxs.sort_unstable_by(f64::total_cmp);
+    let twice: u64 = proxies
+        .iter()
+        .map(|p| {
+            let (lo, hi) = (p.bounds.min[axis], p.bounds.max[axis]);
+            let starts_before_end = mins.partition_point(|&m| m <= hi);
+            let ends_before_start = maxs.partition_point(|&m| m < lo);
+            // Minus itself.
+            (starts_before_end - ends_before_start - 1) as u64
+        })
+        .sum();
+    twice / 2
+}
+
+/// The axis (0, 1, 2) along which the box centres have the largest variance (the one
+/// [`SortAndSweep`] sweeps; ties go to the lower axis).
+fn widest_spread_axis(proxies: &[Proxy]) -> usize {
+    let n = proxies.len().max(1) as f64;
+    let mean = proxies
+        .iter()
+        .fold(crate::math::DVec3::ZERO, |s, p| s + p.bounds.center())
+        / n;
+    let variance = proxies.iter().fold(crate::math::DVec3::ZERO, |s, p| {
+        let d = p.bounds.center() - mean;
+        s + d * d
+    });
+    if variance.x >= variance.y && variance.x >= variance.z {
+        0
+    } else if variance.y >= variance.z {
+        1
+    } else {
+        2
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::broad::pairs_brute_force;
+    use crate::math::DVec3;
+    use crate::test_support::{TestRng, point_in_cube, rng};
+    use rand::Rng;
+
+    fn random_bounds(rng: &mut TestRng, spread: f64) -> Aabb {
+        let c = point_in_cube(rng, spread);
+        // Zero-size, huge and ordinary boxes.
+        let h = match rng.random_range(0..12) {
+            0 => DVec3::ZERO,
+            1 => DVec3::splat(rng.random_range(2.0..20.0)),
+            _ => DVec3::new(
+                rng.random_range(0.0..1.0),
+                rng.random_range(0.0..1.0),
+                rng.random_range(0.0..1.0),
+            ),
+        };
+        Aabb::new(c - h, c + h)
+    }
+
+    fn random_filter(rng: &mut TestRng) -> CollisionFilter {
+        CollisionFilter {
+            group: 1 << rng.random_range(0..3),
+            mask: rng.random_range(1..8),
+        }
+    }
+
+    fn shifted(b: &Aabb, d: DVec3) -> Aabb {
+        Aabb::new(b.min + d, b.max + d)
+    }
+
+    /// Seeded frames of coherent motion with teleports, insertions, removals, re-filtered
+    /// and re-flagged bodies (through `set`) and repeated `set`s: every kind reports exactly
+    /// brute force's pairs over the bodies it was given, and validates, every frame.
+    #[test]
+    fn every_kind_reports_brute_force_pairs_over_random_insert_update_remove_frames() {
+        for (k, kind) in BroadPhaseKind::ALL.into_iter().enumerate() {
+            let mut rng = rng(600 + k as u64);
+            let mut ops = [0usize; 5]; // update, insert, remove, set, absent remove
+            let (mut total_pairs, mut empty_frames, mut frames) = (0usize, 0usize, 0usize);
+            let (mut expected, mut found) = (Vec::new(), Vec::new());
+            for scene in 0..6 {
+                let spread = [3.0, 12.0, 40.0][scene % 3];
+                let mut phase = BroadPhase::new(kind);
+                assert_eq!(phase.kind(), kind);
+                let mut truth: Vec<Proxy> = Vec::new();
+                let mut next_id = 7u32;
+                for _ in 0..rng.random_range(0..120) {
+                    let p = Proxy {
+                        body: next_id,
+                        bounds: random_bounds(&mut rng, spread),
+                        is_static: rng.random_range(0..4) == 0,
+                        filter: random_filter(&mut rng),
+                    };
+                    phase.insert(p.body, p.bounds, p.is_static, p.filter);
+                    truth.push(p);
+                    next_id += 3;
+                }
+                for _ in 0..60 {
+                    for p in &mut truth {
+                        if p.is_static || rng.random_range(0..3) == 0 {
+                            continue; // static or resting: not updated
+                        }
+                        p.bounds = if rng.random_range(0..60) == 0 {
+                            random_bounds(&mut rng, spread) // teleport and resize
+                        } else {
+                            shifted(&p.bounds, point_in_cube(&mut rng, 0.1))
+                        };
+                        phase.update(p.body, p.bounds);
+                        ops[0] += 1;
+                    }
+                    if rng.random_range(0..4) == 0 {
+                        let p = Proxy {
+                            body: next_id,
+                            bounds: random_bounds(&mut rng, spread),
+                            is_static: rng.random_range(0..4) == 0,
+                            filter: random_filter(&mut rng),
+                        };
+                        next_id += 3;
+                        phase.insert(p.body, p.bounds, p.is_static, p.filter);
+                        truth.push(p);
+                        ops[1] += 1;
+                    }
+                    if rng.random_range(0..4) == 0 && !truth.is_empty() {
+                        let p = truth.swap_remove(rng.random_range(0..truth.len()));
+                        assert!(phase.remove(p.body));
+                        ops[2] += 1;
+                    }
+                    if rng.random_range(0..3) == 0 && !truth.is_empty() {
+                        let i = rng.random_range(0..truth.len());
+                        let p = &mut truth[i];
+                        match rng.random_range(0..3) {
+                            0 => p.filter = random_filter(&mut rng),
+                            1 => p.is_static = !p.is_static,
+                            _ => p.bounds = shifted(&p.bounds, point_in_cube(&mut rng, 1.0)),
+                        }
+                        phase.set(p);
+                        phase.set(p); // idempotent
+                        ops[3] += 1;
+                    }
+                    if rng.random_range(0..10) == 0 {
+                        assert!(!phase.remove(1)); // ids are 7 + 3k: never present
+                        ops[4] += 1;
+                    }
+                    pairs_brute_force(&truth, &mut expected);
+                    phase.pairs(&mut found);
+                    assert_eq!(found, expected, "{kind:?} scene {scene} frame {frames}");
+                    assert_eq!(phase.len(), truth.len());
+                    phase.validate().unwrap();
+                    total_pairs += expected.len();
+                    empty_frames += usize::from(expected.is_empty());
+                    frames += 1;
+                }
+            }
+            assert!(
+                total_pairs > 5_000 && empty_frames > 0 && ops.iter().all(|&n| n > 5),
+                "{kind:?}: pairs {total_pairs}, empty frames {empty_frames}, ops {ops:?}"
+            );
+        }
+    }
+
+    fn cube(body: u32, low: DVec3, edge: f64) -> Proxy {
+        Proxy {
+            body,
+            bounds: Aabb::new(low, low + DVec3::splat(edge)),
+            is_static: false,
+            filter: CollisionFilter::ALL,
+        }
+    }
+
+    #[test]
+    fn stats_of_an_empty_scene_are_neutral() {
+        let stats = BroadPhaseStats::measure(&[], 5);
+        assert_eq!(
+            stats,
+            BroadPhaseStats {
+                bodies: 0,
+                moving_fraction: 0.0,
+                size_spread: 1.0,
+                sweep_overlap_ratio: 0.0
+            }
+        );
+    }
+
+    /// A row of unit cubes along y: apart (no overlaps), touching face to face (each meets
+    /// its neighbour: 9 pairs), all in one place (45 pairs); measured on y, where the centres
+    /// spread, not on x or z, where every interval is the same.
+    #[test]
+    fn sweep_overlaps_are_counted_on_the_widest_spread_axis_touching_included() {
+        let row = |gap: f64| -> Vec<Proxy> {
+            (0..10)
+                .map(|i| cube(i, DVec3::new(0.0, f64::from(i) * (1.0 + gap), 0.0), 1.0))
+                .collect()
+        };
+        assert_eq!(
+            BroadPhaseStats::measure(&row(1.0), 0).sweep_overlap_ratio,
+            0.0
+        );
+        assert_eq!(
+            BroadPhaseStats::measure(&row(0.0), 0).sweep_overlap_ratio,
+            0.9
+        );
+        let heap: Vec<Proxy> = (0..10).map(|i| cube(i, DVec3::ZERO, 1.0)).collect();
+        assert_eq!(BroadPhaseStats::measure(&heap, 0).sweep_overlap_ratio, 4.5);
+        // Dice on a table: a 10 × 10 grid on x, y, all sharing one z range. On z every pair
+        // overlaps (4,950); on x (tie with y, the lower axis) each die meets the 9 others of
+        // its column and nothing else: 10 · 45 pairs.
+        let dice: Vec<Proxy> = (0..100)
+            .map(|i| {
+                cube(
+                    i,
+                    DVec3::new(f64::from(i % 10) * 3.0, f64::from(i / 10) * 3.0, 0.0),
+                    1.0,
+                )
+            })
+            .collect();
+        assert_eq!(BroadPhaseStats::measure(&dice, 0).sweep_overlap_ratio, 4.5);
+        assert_eq!(widest_spread_axis(&dice), 0);
+        assert_eq!(widest_spread_axis(&row(0.0)), 1);
+        // Against a direct count over random boxes.
+        let mut rng = rng(611);
+        for case in 0..200 {
+            let proxies: Vec<Proxy> = (0..rng.random_range(1..60))
+                .map(|i| Proxy {
+                    body: i,
+                    bounds: random_bounds(&mut rng, 5.0),
+                    is_static: false,
+                    filter: CollisionFilter::ALL,
+                })
+                .collect();
+            let axis = widest_spread_axis(&proxies);
+            let mut direct = 0u64;
+            for (i, p) in proxies.iter().enumerate() {
+                for q in &proxies[i + 1..] {
+                    direct += u64::from(
+                        p.bounds.min[axis] <= q.bounds.max[axis]
+                            && q.bounds.min[axis] <= p.bounds.max[axis],
+                    );
+                }
+            }
+            assert_eq!(interval_overlaps(&proxies, axis), direct, "case {case}");
+        }
+    }
+
+    #[test]
+    fn size_spread_is_p90_over_p10_of_the_largest_edges_and_moving_fraction_is_clamped() {
+        // Edges 1..=10: p10 = v[round(0.9)] = 2, p90 = v[round(8.1)] = 9.
+        let sizes: Vec<Proxy> = (0..10u32)
+            .map(|i| cube(i, DVec3::splat(f64::from(i) * 100.0), f64::from(10 - i)))
+            .collect();
+        let stats = BroadPhaseStats::measure(&sizes, 3);
+        assert_eq!(stats.size_spread, 4.5);
+        assert_eq!(stats.moving_fraction, 0.3);
+        assert_eq!(stats.bodies, 10);
+        assert_eq!(BroadPhaseStats::measure(&sizes, 25).moving_fraction, 1.0);
+        // The largest edge, not the smallest: flat boxes 4 × 1 × 1 and 1 × 8 × 1 alike.
+        let flat = [
+            Proxy {
+                bounds: Aabb::new(DVec3::ZERO, DVec3::new(4.0, 1.0, 1.0)),
+                ..cube(0, DVec3::ZERO, 1.0)
+            },
+            Proxy {
+                bounds: Aabb::new(DVec3::ZERO, DVec3::new(1.0, 8.0, 1.0)),
+                ..cube(1, DVec3::ZERO, 1.0)
+            },
+        ];
+        assert_eq!(BroadPhaseStats::measure(&flat, 0).size_spread, 2.0);
+        // Points: all points is "alike" (1); mostly points with some boxes is unbounded.
+        let points: Vec<Proxy> = (0..10).map(|i| cube(i, DVec3::ZERO, 0.0)).collect();
+        assert_eq!(BroadPhaseStats::measure(&points, 0).size_spread, 1.0);
+        let mut mixed = points;
+        mixed.extend((10..12).map(|i| cube(i, DVec3::ZERO, 1.0)));
+        assert_eq!(
+            BroadPhaseStats::measure(&mixed, 0).size_spread,
+            f64::INFINITY
+        );
+    }
+
+    #[test]
+    fn the_choice_is_one_of_the_kinds_for_any_statistics() {
+        // The rule itself is a placeholder (see `choose`); only that it answers.
+        for bodies in [0, 1, 100, 10_000, 1_000_000] {
+            let stats = BroadPhaseStats {
+                bodies,
+                moving_fraction: 0.1,
+                size_spread: 3.0,
+                sweep_overlap_ratio: 2.0,
+            };
+            assert!(BroadPhaseKind::ALL.contains(&choose(&stats)));
+        }
+    }
+}
