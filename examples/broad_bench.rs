@@ -66,7 +66,10 @@ struct Args {
     frames: usize,
     /// Broad phases to run, comma-separated (sort_sweep, incremental_sap, hash_grid,
     /// parry_bvh, rapier_bvh).
-    #[arg(long, default_value = "sort_sweep,incremental_sap,hash_grid,parry_bvh,rapier_bvh")]
+    #[arg(
+        long,
+        default_value = "sort_sweep,incremental_sap,hash_grid,parry_bvh,rapier_bvh"
+    )]
     algos: String,
     /// Check every broad phase's pair set against the others every this many frames
     /// (0: never).

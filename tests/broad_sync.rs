@@ -255,7 +255,14 @@ fn kept_broad_phases_answer_like_a_fresh_workspace_and_reread_only_changed_bodie
                 // the scene as it is then (bodies changed: all of them when the log cannot
                 // tell); kept in between.
                 BroadPhaseChoice::Auto if i == 0 => {
-                    if auto_kind.is_none() || frame - auto_measured_at >= AUTO_REMEASURE_FRAMES {
+                    // Measured at the first frame and every AUTO_REMEASURE_FRAMES after it
+                    // (the report carries the statistics), on the scene as it is then
+                    // (bodies changed: all of them when the log cannot tell); kept in
+                    // between, and the pick is `choose` of what was measured.
+                    let due =
+                        auto_kind.is_none() || frame - auto_measured_at >= AUTO_REMEASURE_FRAMES;
+                    assert_eq!(got.1.broad_stats.is_some(), due, "{what}");
+                    if let Some(stats) = got.1.broad_stats {
                         let mut proxies = Vec::new();
                         world.scene.proxies(&mut proxies);
                         let moved = if must_rebuild[0] {
@@ -263,7 +270,11 @@ fn kept_broad_phases_answer_like_a_fresh_workspace_and_reread_only_changed_bodie
                         } else {
                             world.scene.changes().len()
                         };
-                        auto_kind = Some(choose(&BroadPhaseStats::measure(&proxies, moved)));
+                        let mut expected = BroadPhaseStats::measure(&proxies, moved);
+                        expected.far_move_fraction = stats.far_move_fraction;
+                        assert_eq!(stats, expected, "{what}");
+                        assert!((0.0..=1.0).contains(&stats.far_move_fraction), "{what}");
+                        auto_kind = Some(choose(&stats));
                         auto_measured_at = frame;
                     }
                     assert_eq!(Some(kind), auto_kind, "{what}");

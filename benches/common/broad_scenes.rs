@@ -129,14 +129,16 @@ impl BroadScene {
                 let side = (8.0 * bodies as f64).cbrt();
                 let (low, high) = (DVec3::ZERO, DVec3::splat(side));
                 for _ in 0..bodies {
-                    let half = DVec3::from_array(std::array::from_fn(|_| rng.random_range(0.25..0.75)));
+                    let half =
+                        DVec3::from_array(std::array::from_fn(|_| rng.random_range(0.25..0.75)));
                     boxes.push((uniform_in(&mut rng, low, high), half, low, high));
                 }
             }
             Layout::Clustered => {
                 let side = 2.0 * (8.0 * bodies as f64).cbrt();
                 let (low, high) = (DVec3::ZERO, DVec3::splat(side));
-                let clusters: Vec<DVec3> = (0..64).map(|_| uniform_in(&mut rng, low, high)).collect();
+                let clusters: Vec<DVec3> =
+                    (0..64).map(|_| uniform_in(&mut rng, low, high)).collect();
                 let sigma = 0.5 * (bodies as f64 / 64.0).cbrt();
                 for i in 0..bodies {
                     let centre = clusters[i % clusters.len()] + sigma * gaussian3(&mut rng);
@@ -151,7 +153,8 @@ impl BroadScene {
                 for c in 0..columns {
                     let (x, y) = ((c % per_row) as f64, (c / per_row) as f64);
                     for level in 0..STACK_HEIGHT {
-                        let centre = DVec3::new(x * STACK_SPACING, y * STACK_SPACING, 0.5 + level as f64);
+                        let centre =
+                            DVec3::new(x * STACK_SPACING, y * STACK_SPACING, 0.5 + level as f64);
                         let roam = DVec3::splat(0.05);
                         boxes.push((centre, half, centre - roam, centre + roam));
                     }

@@ -1,4 +1,4 @@
-//! Body id → slot maps of the stateful broad phases, with a hash fit for `u32` ids.
+//! Body id maps of the stateful broad phases, with a hash fit for `u32` ids.
 //!
 //! The standard library's SipHash guards against adversarial keys and costs about 20 ns a
 //! look-up; body ids are chosen by the scene, not by an adversary, and every moved body is
@@ -8,8 +8,8 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
-/// Body id → slot.
-pub(crate) type BodyMap = HashMap<u32, u32, BuildHasherDefault<IdHasher>>;
+/// Body id → a value (by default its slot).
+pub(crate) type BodyMap<V = u32> = HashMap<u32, V, BuildHasherDefault<IdHasher>>;
 
 /// Multiplicative hash of one `u32` id.
 #[derive(Debug, Clone, Copy, Default)]

@@ -582,7 +582,9 @@ impl HashGrid {
                 CellRange::of(b, grid.inv).for_each(|cell| {
                     entries[k] += 1;
                     let here = grid.cells.get(&cell).map_or(0, |list| {
-                        list.iter().filter(|&&e| e & !FROM_FINER == slot as u32).count()
+                        list.iter()
+                            .filter(|&&e| e & !FROM_FINER == slot as u32)
+                            .count()
                     });
                     let flagged = grid.cells.get(&cell).is_some_and(|l| l.contains(&entry));
                     if (here != 1 || !flagged) && bad.is_none() {
@@ -736,7 +738,10 @@ impl HashGrid {
     fn list_at(&mut self, slot: usize, k: usize, bounds: &Aabb, own: usize) {
         let grid = &mut self.levels[k];
         let range = CellRange::of(bounds, grid.inv);
-        debug_assert!(range.count() <= 27, "a box spans {range:?} at level {k} ≥ its own");
+        debug_assert!(
+            range.count() <= 27,
+            "a box spans {range:?} at level {k} ≥ its own"
+        );
         let entry = slot as u32 | if k > own { FROM_FINER } else { 0 };
         range.for_each(|cell| grid.cells.entry(cell).or_default().push(entry));
     }
@@ -784,7 +789,10 @@ impl HashGrid {
             for grid in &mut self.levels[usize::from(level)..] {
                 CellRange::of(&bounds, grid.inv).for_each(|cell| {
                     let list = grid.cells.get_mut(&cell).expect("registered cell exists");
-                    for e in list.iter_mut().filter(|e| (**e & !FROM_FINER) as usize == from) {
+                    for e in list
+                        .iter_mut()
+                        .filter(|e| (**e & !FROM_FINER) as usize == from)
+                    {
                         *e = to as u32 | (*e & FROM_FINER);
                     }
                 });
@@ -852,10 +860,15 @@ impl HashGrid {
     /// Whether boxes `a` and `b` at `level` would gather from the same cells.
     fn same_query_cells(&self, a: &Aabb, b: &Aabb, level: u8) -> bool {
         level == OVERSIZED
-            || self.levels.iter().enumerate().skip(usize::from(level)).all(|(k, grid)| {
-                (grid.members.is_empty() && k != usize::from(level))
-                    || CellRange::of(a, grid.inv) == CellRange::of(b, grid.inv)
-            })
+            || self
+                .levels
+                .iter()
+                .enumerate()
+                .skip(usize::from(level))
+                .all(|(k, grid)| {
+                    (grid.members.is_empty() && k != usize::from(level))
+                        || CellRange::of(a, grid.inv) == CellRange::of(b, grid.inv)
+                })
     }
 
     /// Sets each gathered candidate's pair with `slot` from the current boxes, logging only
@@ -1176,7 +1189,10 @@ mod tests {
         assert!(levels_used.len() >= 20, "{levels_used:?}");
         assert!(levels_used.contains(&OVERSIZED), "{levels_used:?}");
         assert!(level_changes > 500, "{level_changes}");
-        assert!(finer_pairs > 5_000 && pairs > 10_000, "{finer_pairs} {pairs}");
+        assert!(
+            finer_pairs > 5_000 && pairs > 10_000,
+            "{finer_pairs} {pairs}"
+        );
     }
 
     #[test]
@@ -1303,9 +1319,24 @@ mod tests {
     fn the_fast_floor_equals_the_library_floor_everywhere_including_huge_and_signed_zero() {
         let mut rng = rng(0xf1);
         let specials = [
-            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 1.0 - f64::EPSILON, -1.0 + f64::EPSILON,
-            2f64.powi(52) + 0.5, -(2f64.powi(52)) - 1.0, 2f64.powi(62), -(2f64.powi(63)),
-            2f64.powi(63), -(2f64.powi(64)), 1e300, -1e300, f64::MIN_POSITIVE, -f64::MIN_POSITIVE,
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.0 - f64::EPSILON,
+            -1.0 + f64::EPSILON,
+            2f64.powi(52) + 0.5,
+            -(2f64.powi(52)) - 1.0,
+            2f64.powi(62),
+            -(2f64.powi(63)),
+            2f64.powi(63),
+            -(2f64.powi(64)),
+            1e300,
+            -1e300,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
         ];
         let randoms = (0..100_000).map(|_| {
             let x: f64 = rng.random_range(-1.0..1.0);

@@ -56,7 +56,9 @@
 //! scene asks for ([`Scene::broad_phase`]): a fixed one, or with
 //! [`BroadPhaseChoice::Auto`] the kind [`choose`] picks from [`BroadPhaseStats`] measured on
 //! the scene at its first frame and again every [`AUTO_REMEASURE_FRAMES`] frames (a
-//! different pick rebuilds the broad phase). Each frame it re-reads only the bodies in the
+//! different pick rebuilds the broad phase; the share of far moves comes from the kept broad
+//! phase's counts since the last measurement, [`BroadPhase::take_move_counts`]; the
+//! statistics are in [`StepReport::broad_stats`] on the frames that measured). Each frame it re-reads only the bodies in the
 //! scene's change log ([`Scene::changes_since`]): a body that did not change is never
 //! touched, static bodies included. It rebuilds from every body instead on a scene it was
 //! not synced to, after a skipped frame (or a frame asking only `TOI`, which does not
@@ -260,7 +262,7 @@ pub enum Completeness {
 }
 
 /// What [`step`] did: completeness, stage timings, counts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepReport {
     /// Whether every answer is exact.
     pub completeness: Completeness,
@@ -288,6 +290,9 @@ pub struct StepReport {
     /// Bodies the kept broad phase re-read this frame: those in the scene's change log, or
     /// every body when it was rebuilt (see the [module docs](self)); 0 when it did not run.
     pub broad_updates: u32,
+    /// With [`BroadPhaseChoice::Auto`], the statistics measured this frame, from which
+    /// [`choose`] picked `broad_kind`; `None` on frames that kept the last pick.
+    pub broad_stats: Option<BroadPhaseStats>,
 }
 
 /// Frames between two measurements of a [`BroadPhaseChoice::Auto`] scene's statistics.
@@ -364,8 +369,9 @@ pub fn step(
     results.pairs.clear();
     results.contacts.clear();
     results.tois.clear();
+    let mut broad_stats = None;
     let (broad_kind, broad_updates) = if query.at_current_poses() {
-        let updates = sync_broad_phase(scene, workspace);
+        let updates = sync_broad_phase(scene, workspace, &mut broad_stats);
         let broad = workspace.broad.as_mut().expect("synced");
         broad.pairs(&mut workspace.candidates);
         (Some(broad.kind()), updates)
@@ -485,12 +491,18 @@ pub fn step(
         tois: index(results.tois.len()),
         broad_kind,
         broad_updates: index(broad_updates),
+        broad_stats,
     }
 }
 
 /// Brings the workspace's broad phase up to date with `scene` (see the [module
-/// docs](self)); returns how many bodies it re-read.
-fn sync_broad_phase(scene: &Scene, workspace: &mut PipelineWorkspace) -> usize {
+/// docs](self)); returns how many bodies it re-read, and sets `measured` when it measured
+/// the scene for the automatic choice.
+fn sync_broad_phase(
+    scene: &Scene,
+    workspace: &mut PipelineWorkspace,
+    measured: &mut Option<BroadPhaseStats>,
+) -> usize {
     let changes = workspace
         .synced
         .and_then(|point| scene.changes_since(point));
@@ -512,7 +524,17 @@ fn sync_broad_phase(scene: &Scene, workspace: &mut PipelineWorkspace) -> usize {
                 scene.proxies(&mut workspace.proxies);
                 listed = true;
                 let moved = changes.map_or(workspace.proxies.len(), <[u32]>::len);
-                let kind = choose(&BroadPhaseStats::measure(&workspace.proxies, moved));
+                let mut stats = BroadPhaseStats::measure(&workspace.proxies, moved);
+                if let Some(broad) = workspace.broad.as_mut() {
+                    let (moves, far) = broad.take_move_counts();
+                    stats.far_move_fraction = if moves == 0 {
+                        0.0
+                    } else {
+                        far as f64 / moves as f64
+                    };
+                }
+                *measured = Some(stats);
+                let kind = choose(&stats);
                 workspace.auto = Some(AutoChoice {
                     scene: scene.uid(),
                     kind,
