@@ -44,9 +44,37 @@ pub(super) const GJK: GjkParams = GjkParams {
     accelerated: false,
 };
 
+/// How many narrow-phase distance queries took each path (counted by the dispatcher, and
+/// by the pipeline for mesh–mesh pairs on their own route): which stages a frame really
+/// entered. Time-of-impact searches count each of their distance steps.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PathCounts {
+    /// Closed forms: sphere, capsule and cuboid among themselves.
+    pub closed_form: u32,
+    /// GJK runs: convex pairs without a closed form, and the early-out of capsule and
+    /// cuboid pairs that proves them beyond the reporting limit.
+    pub gjk: u32,
+    /// EPA runs: GJK found the cores overlapping.
+    pub epa: u32,
+    /// Walks of a mesh's BVH for a convex shape against the mesh.
+    pub convex_mesh: u32,
+    /// Mesh–mesh BVH tandem queries.
+    pub mesh_mesh: u32,
+}
+
+impl PathCounts {
+    /// Queries that entered BVH code (convex–mesh walks and mesh–mesh traversals).
+    #[must_use]
+    pub fn bvh(&self) -> u32 {
+        self.convex_mesh + self.mesh_mesh
+    }
+}
+
 /// Scratch of the dispatcher for one thread (no allocation once grown).
 #[derive(Debug, Default)]
 pub(super) struct NarrowScratch {
+    /// Paths taken since the pipeline last reset it (once per frame).
+    pub(super) paths: PathCounts,
     pub(super) epa: EpaWorkspace,
     pub(super) convex_mesh: ConvexMeshWorkspace,
     mesh_mesh: MeshMeshWorkspace,
@@ -97,19 +125,32 @@ pub(super) fn distance(
 ) -> ShapeDistance {
     use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
     let iso = pose_ab.to_isometry();
+    let paths = &mut scratch.paths;
     match (a, b) {
-        (S(x), S(y)) => pairs::distance_sphere_sphere(x, y, &iso),
-        (S(x), C(y)) => pairs::distance_sphere_capsule(x, y, &iso),
-        (S(x), B(y)) => pairs::distance_sphere_cuboid(x, y, &iso),
-        (C(x), C(y)) => {
-            beyond(a, b, &iso, limit).unwrap_or_else(|| pairs::distance_capsule_capsule(x, y, &iso))
+        (S(x), S(y)) => {
+            paths.closed_form += 1;
+            pairs::distance_sphere_sphere(x, y, &iso)
         }
-        (C(x), B(y)) => {
-            beyond(a, b, &iso, limit).unwrap_or_else(|| pairs::distance_capsule_cuboid(x, y, &iso))
+        (S(x), C(y)) => {
+            paths.closed_form += 1;
+            pairs::distance_sphere_capsule(x, y, &iso)
         }
-        (B(x), B(y)) => {
-            beyond(a, b, &iso, limit).unwrap_or_else(|| pairs::distance_cuboid_cuboid(x, y, &iso))
+        (S(x), B(y)) => {
+            paths.closed_form += 1;
+            pairs::distance_sphere_cuboid(x, y, &iso)
         }
+        (C(x), C(y)) => beyond(a, b, &iso, limit, paths).unwrap_or_else(|| {
+            paths.closed_form += 1;
+            pairs::distance_capsule_capsule(x, y, &iso)
+        }),
+        (C(x), B(y)) => beyond(a, b, &iso, limit, paths).unwrap_or_else(|| {
+            paths.closed_form += 1;
+            pairs::distance_capsule_cuboid(x, y, &iso)
+        }),
+        (B(x), B(y)) => beyond(a, b, &iso, limit, paths).unwrap_or_else(|| {
+            paths.closed_form += 1;
+            pairs::distance_cuboid_cuboid(x, y, &iso)
+        }),
         (C(_), S(_)) | (B(_), S(_) | C(_)) => {
             flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso)
         }
@@ -117,9 +158,13 @@ pub(super) fn distance(
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
             convex_distance(a, b, &iso, scratch)
         }
-        (convex!(), M(mesh)) => shape_mesh_distance(a, mesh, pose_ab, limit, scratch),
+        (convex!(), M(mesh)) => {
+            paths.convex_mesh += 1;
+            shape_mesh_distance(a, mesh, pose_ab, limit, scratch)
+        }
         (M(_), convex!()) => flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso),
         (M(x), M(y)) => {
+            paths.mesh_mesh += 1;
             let d = distance_mesh_mesh(
                 &x.distance_tree,
                 &y.distance_tree,
@@ -184,13 +229,20 @@ const GJK_RELATIVE_ERROR: f64 = 1e-9;
 /// be reported, so the exact closed form need not run: GJK costs a fraction of the
 /// closed forms' feature search when they are apart); `None` when they may be within it.
 /// Its distance is then exact to GJK's tolerance, above the limit as [`distance`] allows.
-fn beyond(a: &Shape, b: &Shape, pose_ab: &Isometry, limit: f64) -> Option<ShapeDistance> {
+fn beyond(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    limit: f64,
+    paths: &mut PathCounts,
+) -> Option<ShapeDistance> {
     if !limit.is_finite() {
         return None;
     }
     let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_of(a), core_of(b)) else {
         return None;
     };
+    paths.gjk += 1;
     let g = gjk_distance(
         core_a.support_map(),
         core_b.support_map(),
@@ -287,13 +339,15 @@ fn convex_distance(
         Rounded::new(core_a.support_map(), radius_a),
         Rounded::new(core_b.support_map(), radius_b),
     );
-    signed_distance_convex(
+    let (distance, outcome) = signed_distance_convex(
         &ra,
         &rb,
         pose_ab,
         &GJK,
         &mut GjkCache::default(),
         &mut scratch.epa,
-    )
-    .0
+    );
+    scratch.paths.gjk += 1;
+    scratch.paths.epa += u32::from(outcome.epa.is_some());
+    distance
 }

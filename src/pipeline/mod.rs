@@ -97,6 +97,7 @@ mod toi;
 pub mod workers;
 
 pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
+pub use dispatch::PathCounts;
 pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{
@@ -293,6 +294,9 @@ pub struct StepReport {
     /// With [`BroadPhaseChoice::Auto`], the statistics measured this frame, from which
     /// [`choose`] picked `broad_kind`; `None` on frames that kept the last pick.
     pub broad_stats: Option<BroadPhaseStats>,
+    /// Narrow-phase queries by path: which stages the frame entered (a scene of spheres
+    /// and capsules never enters BVH or EPA code: `paths.bvh() == 0`, `paths.epa == 0`).
+    pub paths: PathCounts,
 }
 
 /// Frames between two measurements of a [`BroadPhaseChoice::Auto`] scene's statistics.
@@ -369,6 +373,7 @@ pub fn step(
     results.pairs.clear();
     results.contacts.clear();
     results.tois.clear();
+    workspace.narrow.paths = PathCounts::default();
     let mut broad_stats = None;
     let (broad_kind, broad_updates) = if query.at_current_poses() {
         let updates = sync_broad_phase(scene, workspace, &mut broad_stats);
@@ -439,21 +444,25 @@ pub fn step(
                 answer::direct(pair, (a, sa), (b, sb), query, narrow, manifold, contacts)
             }
             (Route::MeshMesh(..), Some(_)) => {
+                narrow.paths.mesh_mesh += 1;
                 let outcome = pooled.next().expect("one pool outcome per mesh pair");
                 debug_assert_eq!(outcome.slot as usize, slot);
                 contacts.extend_from_slice(outcome.contacts());
                 mesh_caches.insert(*pair, outcome.cache);
                 outcome.answer
             }
-            (Route::MeshMesh(ma, mb), None) => answer::mesh_mesh(
-                pair,
-                (a, ma),
-                (b, mb),
-                query,
-                mesh_caches.entry(*pair).or_default(),
-                mesh,
-                contacts,
-            ),
+            (Route::MeshMesh(ma, mb), None) => {
+                narrow.paths.mesh_mesh += 1;
+                answer::mesh_mesh(
+                    pair,
+                    (a, ma),
+                    (b, mb),
+                    query,
+                    mesh_caches.entry(*pair).or_default(),
+                    mesh,
+                    contacts,
+                )
+            }
         };
         if !answer.result.exact {
             completeness = Completeness::Truncated { level: 0 };
@@ -492,6 +501,7 @@ pub fn step(
         broad_kind,
         broad_updates: index(broad_updates),
         broad_stats,
+        paths: narrow.paths,
     }
 }
 
