@@ -169,6 +169,19 @@ pub struct Body {
     added_in: u64,
     /// The frame in which the body's id was last put in the change log.
     logged_in: u64,
+    /// The scene's edit count right after this body's last change ([`Body::version`]).
+    version: u64,
+}
+
+impl Body {
+    /// Changes whenever the body does (added, moved to another pose, motion, filter or
+    /// margin updated) and never repeats within its scene: two reads of a body with the
+    /// same version saw the same body. Answers that depend only on two bodies can be kept
+    /// while both versions stay.
+    #[must_use]
+    pub fn version(&self) -> u64 {
+        self.version
+    }
 }
 
 /// Limits that keep one client from exhausting the daemon.
@@ -353,6 +366,7 @@ impl Scene {
             moved_in: self.frame,
             added_in: self.frame,
             logged_in: self.frame,
+            version: self.edits + 1,
         }));
         self.live += 1;
         let id = self.bodies.len() as u32 - 1;
@@ -405,6 +419,7 @@ impl Scene {
             self.changes.push(id.0);
         }
         self.edits += 1;
+        body.version = self.edits;
         Ok(())
     }
 
@@ -435,6 +450,7 @@ impl Scene {
                 self.changes.push(id.0);
             }
             self.edits += 1;
+            body.version = self.edits;
         }
         Ok(())
     }

@@ -68,6 +68,14 @@
 //! how many bodies it re-read. Results never depend on the kind, only their cost. The swept
 //! boxes of `TOI` still go through a [`SortAndSweep`] over every body each frame.
 //!
+//! # Answers kept between frames
+//! A candidate pair whose two bodies did not change since it was last answered (same
+//! [`Body::version`](crate::scene::Body::version)s, same scene, same query) gets that
+//! answer again, contacts included, without running any query: resting bodies cost only
+//! the broad phase. Answers depend on nothing else, so the frame is identical to one that
+//! answers them afresh (tested). A pair that stops being a candidate forgets its answer.
+//! [`StepReport::reused_pairs`] counts them.
+//!
 //! # Design note: determinism and ordering
 //! The same scene and query give the same results: the broad phase yields pairs sorted by
 //! `(a, b)`, each pair is answered independently in that order, and nothing depends on
@@ -296,11 +304,40 @@ pub struct StepReport {
     pub broad_stats: Option<BroadPhaseStats>,
     /// Narrow-phase queries by path: which stages the frame entered (a scene of spheres
     /// and capsules never enters BVH or EPA code: `paths.bvh() == 0`, `paths.epa == 0`).
+    /// Reused answers (`reused_pairs`) take no path.
     pub paths: PathCounts,
+    /// Candidate pairs answered by last frame's answer, neither body having changed (see
+    /// the [module docs](self)).
+    pub reused_pairs: u32,
 }
 
 /// Frames between two measurements of a [`BroadPhaseChoice::Auto`] scene's statistics.
 pub const AUTO_REMEASURE_FRAMES: u64 = 256;
+
+/// A candidate pair's answer kept from the frame that computed it ("pairs whose relative
+/// pose did not change reuse last frame's answer", DESIGN §6): valid while the scene, the
+/// query and both bodies' [`versions`](crate::scene::Body::version) are the same, since an
+/// answer depends on nothing else (shapes never change). Both bodies unchanged is stricter
+/// than an unchanged relative pose: the answer is in world frame, so a pair moved rigidly
+/// together is answered again.
+#[derive(Debug, Clone)]
+struct KeptAnswer {
+    scene: u64,
+    versions: [u64; 2],
+    query: Query,
+    answer: Answer,
+    /// Its contacts, world frame (`pair` rewritten when reused).
+    contacts: Vec<ContactPoint>,
+}
+
+impl KeptAnswer {
+    /// Whether it answers `pair` of `scene` under `query` now.
+    fn fits(&self, scene: &Scene, pair: &CandidatePair, query: Query) -> bool {
+        self.scene == scene.uid()
+            && self.query == query
+            && self.versions == [body(scene, pair.a).version(), body(scene, pair.b).version()]
+    }
+}
 
 /// The automatic choice made for one scene.
 #[derive(Debug, Clone, Copy)]
@@ -331,6 +368,8 @@ pub struct PipelineWorkspace {
     /// Closest triangle pair of each mesh–mesh candidate, for the next frame's first bound.
     /// Pairs that stop being candidates are forgotten; a pair that appears inserts once.
     mesh_caches: HashMap<CandidatePair, DistanceCache>,
+    /// Last answer of each candidate pair, reused while neither body changes.
+    kept: HashMap<CandidatePair, KeptAnswer>,
     /// Answers a frame's mesh–mesh pairs in parallel (see [`workers`]).
     workers: Option<Arc<WorkerPool>>,
     /// The pool's answers of this frame, by candidate slot.
@@ -399,6 +438,7 @@ pub fn step(
         candidates,
         mesh,
         mesh_caches,
+        kept,
         workers,
         outcomes,
         job_contacts,
@@ -408,17 +448,22 @@ pub fn step(
         ..
     } = workspace;
     mesh_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
+    kept.retain(|pair, _| candidates.binary_search(pair).is_ok());
+    let is_kept = |pair: &CandidatePair| kept.get(pair).is_some_and(|k| k.fits(scene, pair, query));
     outcomes.clear();
     let parallel = workers.as_ref().filter(|_| {
         candidates
             .iter()
-            .filter(|pair| mesh_pair(scene, pair).is_some())
+            .filter(|pair| mesh_pair(scene, pair).is_some() && !is_kept(pair))
             .take(MIN_PARALLEL_MESH_PAIRS)
             .count()
             == MIN_PARALLEL_MESH_PAIRS
     });
     if let Some(pool) = parallel {
         let jobs = candidates.iter().enumerate().filter_map(|(slot, pair)| {
+            if is_kept(pair) {
+                return None;
+            }
             let (mesh_a, mesh_b) = mesh_pair(scene, pair)?;
             Some(MeshJob {
                 slot: index(slot),
@@ -434,12 +479,23 @@ pub fn step(
         pool.answer_all(jobs, outcomes, mesh, job_contacts);
     }
     let mut pooled = outcomes.iter();
+    let mut reused = 0;
     for (slot, pair) in candidates.iter().enumerate() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let first_contact = results.contacts.len();
         let contacts = &mut results.contacts;
+        if let Some(k) = kept.get(pair).filter(|k| k.fits(scene, pair, query)) {
+            reused += 1;
+            contacts.extend_from_slice(&k.contacts);
+            let answer = k.answer;
+            if !answer.result.exact {
+                completeness = Completeness::Truncated { level: 0 };
+            }
+            report(query, answer, (a, b), first_contact, results);
+            continue;
+        }
         let (sa, sb) = (shape(scene, a), shape(scene, b));
-        let mut answer = match (dispatch::route(sa, sb), parallel) {
+        let answer = match (dispatch::route(sa, sb), parallel) {
             (Route::Direct, _) => {
                 answer::direct(pair, (a, sa), (b, sb), query, narrow, manifold, contacts)
             }
@@ -467,20 +523,22 @@ pub fn step(
         if !answer.result.exact {
             completeness = Completeness::Truncated { level: 0 };
         }
-        if query.reports(&answer, a.margin + b.margin) {
-            let count = results.contacts.len() - first_contact;
-            if count > 0 {
-                answer.result.first_contact = index(first_contact);
-                answer.result.contact_count = index(count);
-                let pair = index(results.pairs.len());
-                for c in &mut results.contacts[first_contact..] {
-                    c.pair = pair;
-                }
-            }
-            results.pairs.push(answer.result);
-        } else {
-            results.contacts.truncate(first_contact);
-        }
+        let entry = kept.entry(*pair).or_insert_with(|| KeptAnswer {
+            scene: 0,
+            versions: [0; 2],
+            query,
+            answer,
+            contacts: Vec::new(),
+        });
+        entry.scene = scene.uid();
+        entry.versions = [a.version(), b.version()];
+        entry.query = query;
+        entry.answer = answer;
+        entry.contacts.clear();
+        entry
+            .contacts
+            .extend_from_slice(&results.contacts[first_contact..]);
+        report(query, answer, (a, b), first_contact, results);
     }
     for pair in toi_candidates.iter() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
@@ -502,6 +560,7 @@ pub fn step(
         broad_updates: index(broad_updates),
         broad_stats,
         paths: narrow.paths,
+        reused_pairs: reused,
     }
 }
 
@@ -577,6 +636,31 @@ fn sync_broad_phase(
         broad.insert(p.body, p.bounds, p.is_static, p.filter);
     }
     proxies.len()
+}
+
+/// Adds `answer` (its contacts already at `results.contacts[first_contact..]`) to the
+/// frame's records when `query` reports it, linking its contacts; else drops the contacts.
+fn report(
+    query: Query,
+    mut answer: Answer,
+    (a, b): (&Body, &Body),
+    first_contact: usize,
+    results: &mut FrameResults,
+) {
+    if query.reports(&answer, a.margin + b.margin) {
+        let count = results.contacts.len() - first_contact;
+        if count > 0 {
+            answer.result.first_contact = index(first_contact);
+            answer.result.contact_count = index(count);
+            let pair = index(results.pairs.len());
+            for c in &mut results.contacts[first_contact..] {
+                c.pair = pair;
+            }
+        }
+        results.pairs.push(answer.result);
+    } else {
+        results.contacts.truncate(first_contact);
+    }
 }
 
 fn index(n: usize) -> u32 {
