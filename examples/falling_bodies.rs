@@ -13,8 +13,11 @@
 //! publishes every body's pose straight into shared memory with `CLOSE | CONTACTS`, waits
 //! for the result frame, and for each touching pair applies an impulse along the contact
 //! normal at its deepest point (restitution 0.4, bodies as point masses: no spin response),
-//! then pushes the bodies apart by the depth. Once a second it prints the frame's pairs,
-//! contacts, round trip and how many bodies have come to rest.
+//! then pushes the bodies apart by the depth. A body slow for half a second falls asleep,
+//! as in any rigid-body engine: it stops moving until a hard hit wakes it, so its pose, and
+//! with it the daemon's answers for its pairs with other sleepers, stay the same (the
+//! daemon reuses them). Once a second it prints the frame's pairs, contacts, round trip and
+//! how many bodies have come to rest.
 //!
 //! Every pair is answered exactly (closed forms for spheres, capsules and boxes, the tori's
 //! BVHs against everything else), so the frames say `exact`.
@@ -43,6 +46,13 @@ const MARGIN: f64 = 0.02;
 /// A body whose speed stays under this for 30 frames counts as resting, m/s (a body at
 /// rest on the floor still gains g·dt ≈ 0.08 m/s each frame before its contact stops it).
 const REST_SPEED: f64 = 0.15;
+/// A body resting this many frames falls asleep: it is no longer integrated, so its pose
+/// stays bit for bit the same and the daemon reuses the answers of its pairs with other
+/// sleepers. An awake body hitting it faster than [`WAKE_SPEED`] wakes it; slower contact
+/// (a body settling on it) treats it as immovable.
+const SLEEP_FRAMES: u32 = 60;
+/// Approach speed along the contact normal that wakes a sleeper, m/s.
+const WAKE_SPEED: f64 = 0.3;
 
 #[derive(Debug, Parser)]
 #[command(about = "Bodies falling into a bin, bounced with proximad's contacts")]
@@ -195,6 +205,8 @@ struct Body {
     spin: DVec3,
     inverse_mass: f64,
     slow_frames: u32,
+    /// Not integrated until an awake body pushes it.
+    asleep: bool,
 }
 
 /// The bodies, and which daemon id is which body (`None`: a bin wall).
@@ -293,6 +305,7 @@ impl World {
                 spin: DVec3::new(0.3, -0.2, 0.5) * ((i % 3) as f64 - 1.0),
                 inverse_mass: 1.0,
                 slow_frames: 0,
+                asleep: false,
             });
         }
         Ok(world)
@@ -318,7 +331,7 @@ impl World {
 
     /// Gravity, then velocities (semi-implicit Euler); spin decays.
     fn integrate(&mut self, dt: f64) {
-        for b in &mut self.bodies {
+        for b in self.bodies.iter_mut().filter(|b| !b.asleep) {
             b.velocity.z -= GRAVITY * dt;
             b.position += b.velocity * dt;
             let turn = b.spin * dt;
@@ -328,6 +341,9 @@ impl World {
             b.spin *= 0.995;
             let slow = b.velocity.length() < REST_SPEED;
             b.slow_frames = if slow { b.slow_frames + 1 } else { 0 };
+            if b.slow_frames > SLEEP_FRAMES {
+                (b.asleep, b.velocity, b.spin) = (true, DVec3::ZERO, DVec3::ZERO);
+            }
         }
     }
 
@@ -356,14 +372,29 @@ impl World {
             ia.map_or(0.0, |i| self.bodies[i].inverse_mass),
             ib.map_or(0.0, |i| self.bodies[i].inverse_mass),
         );
-        let total = inv_a + inv_b;
-        if total == 0.0 {
+        let asleep = |i: Option<usize>| i.is_none_or(|i| self.bodies[i].asleep);
+        if asleep(ia) && asleep(ib) {
+            // Sleepers (and walls) stay put against each other.
             return false;
         }
         let n = DVec3::from_array(contact.normal);
         let depth = (-contact.distance).max(0.0);
         let velocity = |i: Option<usize>| i.map_or(DVec3::ZERO, |i| self.bodies[i].velocity);
         let approach = (velocity(ib) - velocity(ia)).dot(n);
+        // A hard hit wakes a sleeper; a soft one leaves it asleep and immovable.
+        let mut immovable = |i: Option<usize>, inv: f64| match i {
+            Some(i) if self.bodies[i].asleep && -approach > WAKE_SPEED => {
+                (self.bodies[i].asleep, self.bodies[i].slow_frames) = (false, 0);
+                inv
+            }
+            Some(i) if self.bodies[i].asleep => 0.0,
+            _ => inv,
+        };
+        let (inv_a, inv_b) = (immovable(ia, inv_a), immovable(ib, inv_b));
+        let total = inv_a + inv_b;
+        if total == 0.0 {
+            return false;
+        }
         let impulse = if approach < 0.0 {
             -(1.0 + RESTITUTION) * approach / total
         } else {
@@ -382,7 +413,10 @@ impl World {
     }
 
     fn resting(&self) -> usize {
-        self.bodies.iter().filter(|b| b.slow_frames > 30).count()
+        self.bodies
+            .iter()
+            .filter(|b| b.asleep || b.slow_frames > 30)
+            .count()
     }
 }
 
