@@ -201,8 +201,11 @@ impl FrontierAnswer {
     #[must_use]
     #[inline]
     pub fn clamped_error_bound(&self) -> f64 {
-        let upper = self.distance_lower + self.error_bound;
-        (upper.min(self.threshold) - self.distance_lower.min(self.threshold)).max(0.0)
+        if self.distance_lower >= self.threshold {
+            0.0
+        } else {
+            self.error_bound.min(self.threshold - self.distance_lower)
+        }
     }
 }
 
