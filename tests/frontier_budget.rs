@@ -10,13 +10,14 @@
 //! a radius that doubles until some pair is found for the large ones. No BVH is involved.
 //! The two oracles are checked against each other on the small scenes.
 //!
-//! Scenes: piles of six tori at seeded random poses (about ten candidate pairs each, some
+//! Scenes: degenerate pairs (coplanar faces touching or 1e-9 apart, a mesh against itself,
+//! zero-area triangles, an open grid, triangle soup, zero thresholds), piles of six tori at seeded random poses (about ten candidate pairs each, some
 //! touching, some within their threshold, some beyond it), and the Stanford bunny, fandisk
 //! and a torus at placed poses (from `../shared/data`, skipped when absent).
 //!
-//! At every interruption point (every budget `0 ..= unlimited visits` on the small scenes,
-//! a dense sample on the large one), reached by resuming one traversal with a growing
-//! [`VisitBudget`], each pair's answer must be conservative (close pairs are `maybe_close`,
+//! At every interruption point (every budget `0 ..= unlimited visits`, the budget polled
+//! after every entry or every few visits), reached by resuming one traversal with a
+//! growing [`VisitBudget`], each pair's answer must be conservative (close pairs are `maybe_close`,
 //! `distance_lower ≤ true ≤ distance_upper`, `true − distance_lower ≤ error_bound`) and
 //! no worse than at the previous point (`distance_lower` never decreases; Exact answers
 //! never change). Sampled budgets are re-run from scratch, twice: bit-identical to the
@@ -25,7 +26,7 @@
 //! touching, near and apart pairs, are all asserted to occur.
 mod support;
 
-use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Obb, Rss};
+use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, Rss};
 use proxima::bvh::frontier::{
     Completeness, FrontierAnswer, FrontierPair, FrontierWorkspace, Unlimited, VisitBudget,
     query_frontier,
@@ -238,6 +239,61 @@ fn tori_pile(seed: u64) -> Scene {
         .collect();
     Scene {
         name: format!("tori pile {seed}"),
+        meshes,
+        pairs,
+        truth,
+    }
+}
+
+/// Degenerate pairs: coplanar faces touching and a hair apart, a mesh against itself,
+/// zero-area triangles, an open grid, random triangle soup, thresholds of zero.
+fn degenerate_scene(seed: u64) -> Scene {
+    let mut r = rng(seed);
+    let half = DVec3::splat(0.5);
+    let meshes = vec![
+        meshes::cuboid(half),
+        meshes::subdivided_cuboid(half, 3),
+        meshes::grid(0.6, 6),
+        meshes::zero_area_triangles(&mut r, 40, 0.5),
+        meshes::with_zero_area_triangles(&mut r, DVec3::new(0.3, 0.4, 0.5), 12),
+        meshes::torus(0.4, 0.1, 12, 6),
+        meshes::triangle_soup(&mut r, 60, 0.5, 0.1),
+    ];
+    let up = |z: f64| Pose::from_translation(DVec3::new(0.0, 0.0, z));
+    let mut pairs = vec![
+        // Stacked boxes, faces coplanar: touching, then 1e-9 apart.
+        (0, 1, up(1.0), 0.0),
+        (0, 1, up(1.0 + 1e-9), 0.0),
+        (0, 1, up(1.0 + 1e-9), 2e-9),
+        (1, 0, up(-1.0 - 1e-3), 1e-3),
+        // A mesh against itself at the same pose.
+        (5, 5, Pose::IDENTITY, 0.01),
+        (3, 3, Pose::IDENTITY, 0.0),
+        // A torus lying on the open grid, a hair above it.
+        (2, 5, up(0.1 + 1e-4), 1e-4),
+        (2, 5, up(0.1 + 1e-4), 0.0),
+        (5, 2, up(-0.3), 0.05),
+    ];
+    for _ in 0..6 {
+        let (a, b) = ([3, 4, 6][r.random_range(0..3)], r.random_range(0..7));
+        let pose = Pose::new(support::point_in_cube(&mut r, 0.8), rotation(&mut r));
+        pairs.push((a, b, pose, r.random_range(0.0..0.1)));
+    }
+    let pairs: Vec<PairSpec> = pairs
+        .into_iter()
+        .map(|(a, b, pose_ab, threshold)| PairSpec {
+            a,
+            b,
+            pose_ab,
+            threshold,
+        })
+        .collect();
+    let truth = pairs
+        .iter()
+        .map(|p| Oracle::new(&meshes[p.a], &meshes[p.b], &p.pose_ab).brute_force())
+        .collect();
+    Scene {
+        name: format!("degenerate {seed}"),
         meshes,
         pairs,
         truth,
@@ -664,7 +720,49 @@ fn every_interruption_point_of_the_tori_piles_is_conservative_and_monotone() {
 }
 
 #[test]
-fn every_sampled_interruption_point_of_bunny_and_fandisk_is_conservative_and_monotone() {
+fn every_interruption_point_of_degenerate_pairs_is_conservative_and_monotone() {
+    let mut tally = Tally::default();
+    for seed in [21, 22, 23] {
+        let scene = degenerate_scene(seed);
+        let plan = Plan {
+            poll_every: 1,
+            step: 1,
+            fresh: 20,
+            build: BuildParams::BINNED_SAH.with_leaf_size(2),
+        };
+        check_scene::<Obb>(&scene, plan, &mut tally);
+        check_scene::<Rss>(&scene, plan, &mut tally);
+        check_scene::<Lss>(
+            &scene,
+            Plan {
+                poll_every: 5,
+                ..plan
+            },
+            &mut tally,
+        );
+        check_scene::<Aabb>(
+            &scene,
+            Plan {
+                build: BuildParams::MEDIAN,
+                ..plan
+            },
+            &mut tally,
+        );
+        check_scene::<Kdop18>(
+            &scene,
+            Plan {
+                build: BuildParams::AGGLOMERATIVE,
+                ..plan
+            },
+            &mut tally,
+        );
+    }
+    eprintln!("{tally:?}");
+    tally.assert_every_outcome("degenerate pairs");
+}
+
+#[test]
+fn every_interruption_point_of_bunny_fandisk_and_a_torus_is_conservative_and_monotone() {
     let Some(scene) = bunny_fandisk() else {
         eprintln!("skipped: ../shared/data/meshes not found");
         return;

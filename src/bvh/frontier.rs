@@ -24,6 +24,11 @@
 //!   child's bound is the larger of its own and its parent's (both bound the child's
 //!   triangles), so bounds never decrease along a descent.
 //!
+//! So an entry carries its own tested bound (a child's is computed when it is created, not
+//! when its round comes): the frontier holds only node pairs not yet proven apart, and a
+//! truncated answer's lower bound is the tightest the visits made so far give. A root entry
+//! stands at bound `0` until it is processed.
+//!
 //! The [`Budget`] is polled between entries once at least `poll_every` visits (default
 //! [`DEFAULT_POLL_EVERY`]) were made since the last poll, never inside an entry (so never
 //! inside a triangle test). When it refuses, [`FrontierWorkspace::run`] returns and the
@@ -63,6 +68,37 @@
 //! larger ones or by exact distances not below it (volume bounds are padded below the true
 //! distance by more than the rounding of a triangle distance), so `distance_lower` never
 //! decreases, and an Exact pair has nothing left to change.
+//!
+//! # Cost outside visits
+//! Each round is sorted when it begins (`O(n log n)` for its `n` entries, created by at
+//! most `n` visits of the round before; not polled), and [`FrontierWorkspace::answers`]
+//! reads every waiting entry once.
+//!
+//! # Example
+//! ```
+//! use proxima::bounding::Obb;
+//! use proxima::bvh::frontier::{FrontierPair, FrontierWorkspace, VisitBudget, query_frontier};
+//! use proxima::bvh::{BuildParams, Bvh};
+//! use proxima::geometry::TriMesh;
+//! use proxima::math::{DVec3, Isometry};
+//!
+//! let torus = Bvh::<Obb>::from_mesh(&TriMesh::torus(1.0, 0.3, 16, 8), &BuildParams::BINNED_SAH);
+//! let pairs = [FrontierPair {
+//!     a: &torus,
+//!     b: &torus,
+//!     pose_ab: Isometry::from_translation(DVec3::new(2.65, 0.0, 0.0)),
+//!     threshold: 0.1,
+//! }];
+//! let (mut workspace, mut answers) = (FrontierWorkspace::new(), Vec::new());
+//! // A small budget: a truncated, conservative answer.
+//! query_frontier(&pairs, &mut VisitBudget(40), &mut workspace, &mut answers);
+//! assert!(answers[0].maybe_close && !answers[0].is_exact());
+//! // Resume without limit: the exact answer (the tori are 0.05 m apart).
+//! assert!(workspace.run(&pairs, &mut VisitBudget(u64::MAX)));
+//! workspace.answers(&pairs, &mut answers);
+//! assert!(answers[0].is_exact() && answers[0].maybe_close);
+//! assert!((answers[0].distance() - 0.05).abs() < 1e-2);
+//! ```
 //!
 //! # Allocation
 //! The workspace owns the two entry vectors (swapped every round), the per-pair state and
@@ -800,5 +836,46 @@ mod tests {
             assert_eq!(resumed.entries_per_round(), fresh.entries_per_round());
             assert_eq!(resumed_out, fresh_out, "{limit}");
         }
+    }
+
+    #[test]
+    fn an_empty_frame_finishes_at_once() {
+        let pairs: [FrontierPair<'_, Obb>; 0] = [];
+        let (mut ws, mut out) = (FrontierWorkspace::new(), vec![]);
+        assert!(query_frontier(
+            &pairs,
+            &mut VisitBudget(0),
+            &mut ws,
+            &mut out
+        ));
+        assert!(out.is_empty() && ws.is_finished());
+        assert_eq!(ws.stats().visits, 0);
+    }
+
+    #[test]
+    fn single_triangle_meshes_are_answered_from_their_root_pair() {
+        use crate::geometry::Triangle;
+        let tri = Triangle::new(DVec3::ZERO, DVec3::X, DVec3::Y);
+        let t = Bvh::<Obb>::from_triangles(&[tri], &BuildParams::MEDIAN);
+        let pairs = [0.5, 2.0].map(|z| FrontierPair {
+            a: &t,
+            b: &t,
+            pose_ab: Isometry::from_translation(DVec3::new(0.0, 0.0, z)),
+            threshold: 1.0,
+        });
+        let (mut ws, mut out) = (FrontierWorkspace::new(), vec![]);
+        assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut out));
+        // One bound per root, then one triangle test for the pair within threshold.
+        assert_eq!(ws.stats().bv_tests, 2);
+        assert_eq!(ws.stats().triangle_tests, 1);
+        assert_eq!(ws.stats().rounds, 1);
+        assert!(out[0].maybe_close && out[0].is_exact());
+        let exact = distance_triangle_triangle(&tri, &tri.transformed(&pairs[0].pose_ab));
+        assert_eq!(out[0].distance_lower, exact.distance);
+        assert!((exact.distance - 0.5).abs() <= out[0].error_bound);
+        assert!(!out[1].maybe_close && out[1].is_exact());
+        assert!(out[1].distance_lower > 1.0 && out[1].distance_lower <= 2.0);
+        assert_eq!(out[1].distance_upper, None);
+        assert!(2.0 <= out[1].distance_lower + out[1].error_bound);
     }
 }
