@@ -19,7 +19,7 @@
 //! - an entry of two leaves runs [`distance_triangle_triangle`] on each triangle pair (one
 //!   visit each), updating the pair's best exact distance and its witnesses;
 //! - any other entry is replaced by its children on the side chosen by
-//!   [`descend_a`](super::tandem::descend_a): each child's bound is computed (one visit)
+//!   [`descend_a`]: each child's bound is computed (one visit)
 //!   and the child joins the *next* round unless it is dropped by the rules above. A
 //!   child's bound is the larger of its own and its parent's (both bound the child's
 //!   triangles), so bounds never decrease along a descent.
