@@ -1,0 +1,881 @@
+//! The budgeted breadth-first frontier: one global list of `(pair, node of A, node of B)`
+//! entries over *all* mesh pairs of a frame, refined round by round under a budget, so that
+//! every pair degrades together when time runs out (DESIGN.md §5).
+//!
+//! # The question
+//! Each [`FrontierPair`] asks: *is the distance between the triangles of `a` and of `b`
+//! (placed at `pose_ab`) at most `threshold`, and if so, what is it?* The threshold is the
+//! pair's margin sum, metres.
+//!
+//! # The traversal
+//! [`FrontierWorkspace::start`] puts one root entry per pair on the frontier (round 1).
+//! A round takes the entries of the frontier in increasing order of their distance lower
+//! bound (ties by pair index, then node of A, then node of B: deterministic), and for each:
+//! - a root entry first gets its own bound ([`BoundingVolume::distance_lower_bound_within`],
+//!   one *visit*);
+//! - an entry whose bound exceeds `threshold` is dropped (that part is proven apart); one
+//!   whose bound is not below the pair's best exact distance so far is dropped too (it
+//!   cannot improve the minimum; no visit);
+//! - an entry of two leaves runs [`distance_triangle_triangle`] on each triangle pair (one
+//!   visit each), updating the pair's best exact distance and its witnesses;
+//! - any other entry is replaced by its children on the side chosen by
+//!   [`descend_a`]: each child's bound is computed (one visit)
+//!   and the child joins the *next* round unless it is dropped by the rules above. A
+//!   child's bound is the larger of its own and its parent's (both bound the child's
+//!   triangles), so bounds never decrease along a descent.
+//!
+//! So an entry carries its own tested bound (a child's is computed when it is created, not
+//! when its round comes): the frontier holds only node pairs not yet proven apart, and a
+//! truncated answer's lower bound is the tightest the visits made so far give. A root entry
+//! stands at bound `0` until it is processed.
+//!
+//! The [`Budget`] is polled between entries once at least `poll_every` visits (default
+//! [`DEFAULT_POLL_EVERY`]) were made since the last poll, never inside an entry (so never
+//! inside a triangle test). When it refuses, [`FrontierWorkspace::run`] returns and the
+//! entries left stand in for the unfinished work; calling `run` again resumes exactly where
+//! it stopped, so a resumed run and a fresh run with the larger budget reach the same state
+//! (for budgets, like [`VisitBudget`], that refuse from some visit count on).
+//!
+//! # The answers ([`FrontierAnswer`])
+//! A pair's *live* entries are its entries still waiting whose bound is at most `threshold`
+//! and below its best exact distance. Write `best` for the smallest triangle-pair distance
+//! computed so far (`+∞` when none), `floor` for the smallest bound of its entries dropped
+//! for exceeding `threshold`, `live` for the smallest bound of its live entries.
+//! - **Exact** when it has no live entry. If `best ≤ threshold`, `best` *is* the minimum
+//!   over all triangle pairs (every triangle pair lies under a dropped entry, a tested leaf
+//!   pair or an entry that could not beat `best`): `maybe_close`, `distance_lower =
+//!   distance_upper = best`, witnesses of that pair, `error_bound` = rounding. Otherwise
+//!   the pair is proven apart: `!maybe_close`, `distance_lower = min(floor, best) >
+//!   threshold`.
+//! - **Truncated { level }** while it has live entries, `level` the shallowest depth
+//!   (descents from the root pair) among them: `maybe_close = true` (a pair is never
+//!   reported apart before it is proven apart, so there is no false negative),
+//!   `distance_lower = min(live, floor, best)`, a lower bound of the true distance because
+//!   every triangle pair lies under one of those three.
+//!
+//! The *reported* distance is always `distance_lower` ([`FrontierAnswer::distance`]): never
+//! more than the true distance (a truncated answer errs on the side of "closer"). The error
+//! bound states how much closer at most: `error_bound = upper − distance_lower + rounding`,
+//! with `upper` the smallest of `best` and, for the root pair and every live entry `(X, Y)`,
+//! `|centre(X) − centre(Y)| + stand_off(X) + stand_off(Y)` — some point of each mesh lies
+//! within its volume's stand-off of the volume's centre, so the true distance is at most
+//! that. Hence `distance_lower ≤ true ≤ distance_lower + error_bound`, and
+//! `true ≤ distance_upper` whenever a leaf pair was tested. For the thresholded question
+//! alone, [`FrontierAnswer::clamped_error_bound`] bounds the error of `min(distance,
+//! threshold)`.
+//!
+//! More budget never makes an answer worse: processing an entry replaces its bound by
+//! larger ones or by exact distances not below it (volume bounds are padded below the true
+//! distance by more than the rounding of a triangle distance), so `distance_lower` never
+//! decreases, and an Exact pair has nothing left to change.
+//!
+//! # Cost outside visits
+//! Each round is sorted when it begins (`O(n log n)` for its `n` entries, created by at
+//! most `n` visits of the round before; not polled), and [`FrontierWorkspace::answers`]
+//! reads every waiting entry once.
+//!
+//! # Example
+//! ```
+//! use proxima::bounding::Obb;
+//! use proxima::bvh::frontier::{FrontierPair, FrontierWorkspace, VisitBudget, query_frontier};
+//! use proxima::bvh::{BuildParams, Bvh};
+//! use proxima::geometry::TriMesh;
+//! use proxima::math::{DVec3, Isometry};
+//!
+//! let torus = Bvh::<Obb>::from_mesh(&TriMesh::torus(1.0, 0.3, 16, 8), &BuildParams::BINNED_SAH);
+//! let pairs = [FrontierPair {
+//!     a: &torus,
+//!     b: &torus,
+//!     pose_ab: Isometry::from_translation(DVec3::new(2.65, 0.0, 0.0)),
+//!     threshold: 0.1,
+//! }];
+//! let (mut workspace, mut answers) = (FrontierWorkspace::new(), Vec::new());
+//! // A small budget: a truncated, conservative answer.
+//! query_frontier(&pairs, &mut VisitBudget(40), &mut workspace, &mut answers);
+//! assert!(answers[0].maybe_close && !answers[0].is_exact());
+//! // Resume without limit: the exact answer (the tori are 0.05 m apart).
+//! assert!(workspace.run(&pairs, &mut VisitBudget(u64::MAX)));
+//! workspace.answers(&pairs, &mut answers);
+//! assert!(answers[0].is_exact() && answers[0].maybe_close);
+//! assert!((answers[0].distance() - 0.05).abs() < 1e-2);
+//! ```
+//!
+//! # Allocation
+//! The workspace owns the two entry vectors (swapped every round), the per-pair state and
+//! the per-round counters; none of them allocates once grown to the largest frame seen.
+
+use super::Bvh;
+use super::tandem::descend_a;
+use crate::bounding::BoundingVolume;
+use crate::math::{DVec3, Isometry, conservative_slack};
+use crate::narrow::distance_triangle_triangle;
+use std::cmp::Ordering;
+use std::time::Instant;
+
+/// Visits between two budget polls unless set with [`FrontierWorkspace::with_poll_every`].
+pub const DEFAULT_POLL_EVERY: u64 = 32;
+
+/// How much work the frontier may still do, polled between bounded batches of visits.
+pub trait Budget {
+    /// Whether work may go on after `visits` visits (bounding-volume tests plus triangle
+    /// tests) since [`FrontierWorkspace::start`].
+    fn allows(&mut self, visits: u64) -> bool;
+}
+
+/// A counted budget: allows work while fewer than `0` visits were made (so `VisitBudget(0)`
+/// does nothing). A batch started below the limit is finished, so a run may end up to one
+/// batch (`poll_every` visits plus one entry) beyond it. Deterministic: tests use only this.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct VisitBudget(pub u64);
+
+impl Budget for VisitBudget {
+    #[inline]
+    fn allows(&mut self, visits: u64) -> bool {
+        visits < self.0
+    }
+}
+
+/// A wall-clock budget: allows work until the instant is reached (for the frame pipeline).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Deadline(pub Instant);
+
+impl Budget for Deadline {
+    #[inline]
+    fn allows(&mut self, _visits: u64) -> bool {
+        Instant::now() < self.0
+    }
+}
+
+/// No limit: the traversal runs to the exact answers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Unlimited;
+
+impl Budget for Unlimited {
+    #[inline]
+    fn allows(&mut self, _visits: u64) -> bool {
+        true
+    }
+}
+
+/// One mesh pair of the frame.
+#[derive(Debug, Clone, Copy)]
+pub struct FrontierPair<'a, B> {
+    /// Tree of mesh A (A's frame).
+    pub a: &'a Bvh<B>,
+    /// Tree of mesh B (B's frame).
+    pub b: &'a Bvh<B>,
+    /// B's frame expressed in A's frame.
+    pub pose_ab: Isometry,
+    /// The distance that counts as close (the pair's margin sum), metres, finite, `≥ 0`.
+    pub threshold: f64,
+}
+
+/// Whether an answer is final.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Completeness {
+    /// The traversal of this pair finished: the answer is the exact one.
+    Exact,
+    /// The budget ran out with work of this pair left; `level` is the shallowest depth
+    /// (descents from the root pair) of its waiting node pairs.
+    Truncated {
+        /// Shallowest depth of the pair's waiting entries.
+        level: u32,
+    },
+}
+
+/// The closest triangle pair computed so far, A's frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrontierWitnesses {
+    /// Point of A's triangle closest to B's.
+    pub point_a: DVec3,
+    /// Point of B's triangle closest to A's (equal to `point_a` when they intersect).
+    pub point_b: DVec3,
+    /// The two triangles, as indices into each mesh's own triangle list.
+    pub triangles: [u32; 2],
+}
+
+/// The frontier's answer for one pair; see the [module docs](self) for exactly what each
+/// field holds and why it is conservative.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FrontierAnswer {
+    /// Exact, or truncated at some level.
+    pub completeness: Completeness,
+    /// `false` only when the pair is proven farther apart than its threshold.
+    pub maybe_close: bool,
+    /// A lower bound of the true distance, metres; the reported distance. Equal to the
+    /// true distance for an Exact close pair.
+    pub distance_lower: f64,
+    /// The smallest exact triangle-pair distance computed (an upper bound of the true
+    /// distance), when some leaf pair was tested.
+    pub distance_upper: Option<f64>,
+    /// The triangle pair realising `distance_upper` (the closest pair when the answer is
+    /// Exact and close).
+    pub witnesses: Option<FrontierWitnesses>,
+    /// `distance_lower ≤ true ≤ distance_lower + error_bound`, metres.
+    pub error_bound: f64,
+    /// The pair's threshold, copied for [`clamped_error_bound`](Self::clamped_error_bound).
+    pub threshold: f64,
+}
+
+impl FrontierAnswer {
+    /// The reported distance: [`distance_lower`](Self::distance_lower).
+    #[must_use]
+    #[inline]
+    pub fn distance(&self) -> f64 {
+        self.distance_lower
+    }
+
+    /// Whether the traversal of this pair finished.
+    #[must_use]
+    #[inline]
+    pub fn is_exact(&self) -> bool {
+        self.completeness == Completeness::Exact
+    }
+
+    /// A bound of `|min(distance, threshold) − min(true, threshold)|`: the error that
+    /// matters to the question "how close, if within threshold".
+    #[must_use]
+    #[inline]
+    pub fn clamped_error_bound(&self) -> f64 {
+        if self.distance_lower >= self.threshold {
+            0.0
+        } else {
+            self.error_bound.min(self.threshold - self.distance_lower)
+        }
+    }
+}
+
+/// Counters of one traversal since [`FrontierWorkspace::start`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FrontierStats {
+    /// Visits: bounding-volume tests plus triangle tests.
+    pub visits: u64,
+    /// Node-pair bound computations.
+    pub bv_tests: u64,
+    /// Triangle-pair distance computations.
+    pub triangle_tests: u64,
+    /// Rounds begun (the roots' round counts).
+    pub rounds: u64,
+    /// Budget polls.
+    pub polls: u64,
+}
+
+/// A node pair waiting on the frontier.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Entry {
+    /// Lower bound of the distance between the triangles under the two nodes, metres
+    /// (`0` for a root entry, whose bound is computed when it is processed).
+    bound: f64,
+    /// Index of the pair in the caller's slice.
+    pair: u32,
+    /// Node of A.
+    a: u32,
+    /// Node of B.
+    b: u32,
+    /// Descents from the root pair; `0` marks a root entry.
+    depth: u32,
+}
+
+/// The processing order within a round: smallest bound first, then pair, node of A, node
+/// of B (a total order: no two entries share all four).
+#[inline]
+fn entry_order(x: &Entry, y: &Entry) -> Ordering {
+    x.bound
+        .total_cmp(&y.bound)
+        .then_with(|| (x.pair, x.a, x.b).cmp(&(y.pair, y.a, y.b)))
+}
+
+/// What the frontier knows about one pair besides its waiting entries.
+#[derive(Debug, Clone, Copy)]
+struct PairState {
+    threshold: f64,
+    /// Smallest triangle-pair distance computed, `+∞` when none.
+    best: f64,
+    witnesses: Option<FrontierWitnesses>,
+    /// Smallest bound of the entries dropped for exceeding the threshold, `+∞` when none.
+    floor: f64,
+    /// Upper bound of the true distance from the two root volumes.
+    root_upper: f64,
+    /// Rounding of a triangle distance at this pair's scale.
+    rounding: f64,
+}
+
+/// Scratch space and state of the frontier; keep one per thread and reuse it every frame.
+#[derive(Debug, Clone)]
+pub struct FrontierWorkspace {
+    /// The round being processed, sorted; `current[cursor..]` waits.
+    current: Vec<Entry>,
+    cursor: usize,
+    /// Entries for the next round.
+    next: Vec<Entry>,
+    pairs: Vec<PairState>,
+    stats: FrontierStats,
+    /// Entries at the start of each round begun.
+    entries_per_round: Vec<u64>,
+    /// The budget is polled before the next entry once `visits` reaches this.
+    next_poll: u64,
+    poll_every: u64,
+}
+
+impl Default for FrontierWorkspace {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl FrontierWorkspace {
+    /// An empty workspace polling every [`DEFAULT_POLL_EVERY`] visits.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::with_poll_every(DEFAULT_POLL_EVERY)
+    }
+
+    /// An empty workspace polling the budget once at least `visits` (`≥ 1`) visits were
+    /// made since the last poll.
+    #[must_use]
+    pub fn with_poll_every(visits: u64) -> Self {
+        assert!(visits >= 1, "poll interval must be at least one visit");
+        Self {
+            current: Vec::new(),
+            cursor: 0,
+            next: Vec::new(),
+            pairs: Vec::new(),
+            stats: FrontierStats::default(),
+            entries_per_round: Vec::new(),
+            next_poll: 0,
+            poll_every: visits,
+        }
+    }
+
+    /// Resets the frontier to one root entry per pair of `pairs` (round 1, no visit yet).
+    /// Thresholds must be finite and `≥ 0`.
+    pub fn start<B: BoundingVolume>(&mut self, pairs: &[FrontierPair<'_, B>]) {
+        assert!(
+            u32::try_from(pairs.len()).is_ok(),
+            "too many pairs for one frontier"
+        );
+        self.current.clear();
+        self.next.clear();
+        self.cursor = 0;
+        self.pairs.clear();
+        self.stats = FrontierStats::default();
+        self.entries_per_round.clear();
+        self.next_poll = 0;
+        for (i, p) in pairs.iter().enumerate() {
+            debug_assert!(
+                p.threshold.is_finite() && p.threshold >= 0.0,
+                "threshold {} of pair {i}",
+                p.threshold
+            );
+            let (ra, rb) = (p.a.root_bv(), p.b.root_bv());
+            self.pairs.push(PairState {
+                threshold: p.threshold,
+                best: f64::INFINITY,
+                witnesses: None,
+                floor: f64::INFINITY,
+                root_upper: centre_upper_bound(ra, rb, &p.pose_ab),
+                rounding: rounding_bound(ra, rb, &p.pose_ab),
+            });
+            self.current.push(Entry {
+                bound: 0.0,
+                pair: i as u32,
+                a: 0,
+                b: 0,
+                depth: 0,
+            });
+        }
+        self.begin_round();
+    }
+
+    /// Refines the frontier until it is empty (returns `true`) or `budget` refuses at a
+    /// poll (returns `false`); calling again resumes. `pairs` must be the slice given to
+    /// [`start`](Self::start).
+    pub fn run<B: BoundingVolume, T: Budget + ?Sized>(
+        &mut self,
+        pairs: &[FrontierPair<'_, B>],
+        budget: &mut T,
+    ) -> bool {
+        debug_assert_eq!(pairs.len(), self.pairs.len(), "pairs differ from start");
+        loop {
+            if self.cursor == self.current.len() {
+                if self.next.is_empty() {
+                    return true;
+                }
+                std::mem::swap(&mut self.current, &mut self.next);
+                self.next.clear();
+                self.begin_round();
+            }
+            if self.stats.visits >= self.next_poll {
+                self.stats.polls += 1;
+                if !budget.allows(self.stats.visits) {
+                    return false;
+                }
+                self.next_poll = self.stats.visits + self.poll_every;
+            }
+            let entry = self.current[self.cursor];
+            self.cursor += 1;
+            self.process(&pairs[entry.pair as usize], entry);
+        }
+    }
+
+    /// Whether nothing is left on the frontier (every answer is Exact).
+    #[must_use]
+    pub fn is_finished(&self) -> bool {
+        self.cursor == self.current.len() && self.next.is_empty()
+    }
+
+    /// Counters since [`start`](Self::start).
+    #[must_use]
+    pub fn stats(&self) -> &FrontierStats {
+        &self.stats
+    }
+
+    /// Entries on the frontier at the start of each round begun.
+    #[must_use]
+    pub fn entries_per_round(&self) -> &[u64] {
+        &self.entries_per_round
+    }
+
+    /// Entries still waiting (live or not).
+    #[must_use]
+    pub fn waiting(&self) -> usize {
+        self.current.len() - self.cursor + self.next.len()
+    }
+
+    /// The answer for every pair, in order, into `out` (cleared first); see the
+    /// [module docs](self). `pairs` must be the slice given to [`start`](Self::start).
+    pub fn answers<B: BoundingVolume>(
+        &self,
+        pairs: &[FrontierPair<'_, B>],
+        out: &mut Vec<FrontierAnswer>,
+    ) {
+        debug_assert_eq!(pairs.len(), self.pairs.len(), "pairs differ from start");
+        out.clear();
+        // First pass: `out` holds, per pair, the live minimum bound (`distance_lower`),
+        // shallowest depth (`Truncated`) and smallest centre bound (`error_bound`).
+        out.extend(self.pairs.iter().map(|s| FrontierAnswer {
+            completeness: Completeness::Exact,
+            maybe_close: false,
+            distance_lower: f64::INFINITY,
+            distance_upper: None,
+            witnesses: s.witnesses,
+            error_bound: s.root_upper,
+            threshold: s.threshold,
+        }));
+        for e in self.current[self.cursor..].iter().chain(&self.next) {
+            let state = &self.pairs[e.pair as usize];
+            if !is_live(e.bound, state) {
+                continue;
+            }
+            let p = &pairs[e.pair as usize];
+            let (x, y) = (&p.a.nodes()[e.a as usize].bv, &p.b.nodes()[e.b as usize].bv);
+            let answer = &mut out[e.pair as usize];
+            answer.distance_lower = answer.distance_lower.min(e.bound);
+            answer.error_bound = answer.error_bound.min(centre_upper_bound(x, y, &p.pose_ab));
+            answer.completeness = match answer.completeness {
+                Completeness::Truncated { level } if level <= e.depth => answer.completeness,
+                _ => Completeness::Truncated { level: e.depth },
+            };
+        }
+        for (answer, state) in out.iter_mut().zip(&self.pairs) {
+            let best = state.best;
+            answer.distance_upper = best.is_finite().then_some(best);
+            let upper = answer.error_bound.min(best);
+            if answer.completeness == Completeness::Exact && best <= state.threshold {
+                answer.maybe_close = true;
+                answer.distance_lower = best;
+                answer.error_bound = state.rounding;
+            } else {
+                answer.maybe_close = !answer.is_exact();
+                answer.distance_lower = answer.distance_lower.min(state.floor).min(best);
+                answer.error_bound = (upper - answer.distance_lower).max(0.0) + state.rounding;
+            }
+        }
+    }
+
+    /// Sorts the round just swapped in and counts it.
+    fn begin_round(&mut self) {
+        self.current.sort_unstable_by(entry_order);
+        self.cursor = 0;
+        self.stats.rounds += 1;
+        self.entries_per_round.push(self.current.len() as u64);
+    }
+
+    /// Processes one entry (see the module docs); bounded work: one bound, two child
+    /// bounds or one leaf pair's triangle tests.
+    fn process<B: BoundingVolume>(&mut self, pair: &FrontierPair<'_, B>, mut entry: Entry) {
+        let state = &mut self.pairs[entry.pair as usize];
+        let (na, nb) = (pair.a.nodes(), pair.b.nodes());
+        let iso = &pair.pose_ab;
+        let (x, y) = (&na[entry.a as usize], &nb[entry.b as usize]);
+        if entry.depth == 0 {
+            entry.bound =
+                x.bv.distance_lower_bound_within(&y.bv, iso, state.threshold);
+            self.stats.visits += 1;
+            self.stats.bv_tests += 1;
+            if entry.bound > state.threshold {
+                state.floor = state.floor.min(entry.bound);
+                return;
+            }
+        }
+        if !is_live(entry.bound, state) {
+            return;
+        }
+        if x.is_leaf() && y.is_leaf() {
+            let (ta, tb) = (pair.a.triangles(), pair.b.triangles());
+            for sb in y.slots() {
+                let tri_b = tb[sb].transformed(iso);
+                for sa in x.slots() {
+                    let d = distance_triangle_triangle(&ta[sa], &tri_b);
+                    self.stats.visits += 1;
+                    self.stats.triangle_tests += 1;
+                    if d.distance < state.best {
+                        state.best = d.distance;
+                        state.witnesses = Some(FrontierWitnesses {
+                            point_a: d.point_a,
+                            point_b: d.point_b,
+                            triangles: [pair.a.triangle_id(sa), pair.b.triangle_id(sb)],
+                        });
+                    }
+                }
+            }
+            return;
+        }
+        let children = if descend_a(x, y) {
+            x.children().map(|c| [c as u32, entry.b])
+        } else {
+            y.children().map(|c| [entry.a, c as u32])
+        };
+        for [ca, cb] in children {
+            let limit = state.threshold.min(state.best);
+            let own =
+                na[ca as usize]
+                    .bv
+                    .distance_lower_bound_within(&nb[cb as usize].bv, iso, limit);
+            self.stats.visits += 1;
+            self.stats.bv_tests += 1;
+            let bound = own.max(entry.bound);
+            if bound > state.threshold {
+                state.floor = state.floor.min(bound);
+            } else if bound < state.best {
+                self.next.push(Entry {
+                    bound,
+                    pair: entry.pair,
+                    a: ca,
+                    b: cb,
+                    depth: entry.depth + 1,
+                });
+            }
+        }
+    }
+}
+
+/// Runs a fresh frontier over `pairs` under `budget` and writes every pair's answer to
+/// `out`; returns whether every answer is Exact.
+pub fn query_frontier<B: BoundingVolume, T: Budget + ?Sized>(
+    pairs: &[FrontierPair<'_, B>],
+    budget: &mut T,
+    workspace: &mut FrontierWorkspace,
+    out: &mut Vec<FrontierAnswer>,
+) -> bool {
+    workspace.start(pairs);
+    let finished = workspace.run(pairs, budget);
+    workspace.answers(pairs, out);
+    finished
+}
+
+/// Whether an entry with this bound can still change the pair's answer.
+#[inline]
+fn is_live(bound: f64, state: &PairState) -> bool {
+    bound <= state.threshold && bound < state.best
+}
+
+/// An upper bound of the distance between the geometry bounded by `x` (frame A) and by `y`
+/// (frame B): each volume's centre lies inside it, hence within its stand-off of its
+/// geometry. Padded for the rounding of the centre's transform.
+#[must_use]
+fn centre_upper_bound<B: BoundingVolume>(x: &B, y: &B, pose_ab: &Isometry) -> f64 {
+    let (cx, cy) = (x.center(), pose_ab.transform_point(y.center()));
+    let slack =
+        conservative_slack(cx.abs().max_element() + cy.abs().max_element() + x.size() + y.size());
+    cx.distance(cy) + x.stand_off() + y.stand_off() + slack
+}
+
+/// Rounding error of a triangle–triangle distance between these meshes at this pose: a few
+/// ulps of the largest coordinate involved (as the exact mesh–mesh distance states it).
+#[must_use]
+fn rounding_bound<B: BoundingVolume>(a: &B, b: &B, pose_ab: &Isometry) -> f64 {
+    let reach = |bv: &B| bv.center().abs().max_element() + bv.size();
+    conservative_slack(reach(a) + reach(b) + pose_ab.translation.abs().max_element())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bounding::{Obb, Rss};
+    use crate::bvh::BuildParams;
+    use crate::geometry::TriMesh;
+    use crate::math::{DQuat, Pose};
+    use crate::narrow::mesh_mesh::{
+        DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh,
+    };
+
+    fn entry(bound: f64, pair: u32, a: u32, b: u32) -> Entry {
+        Entry {
+            bound,
+            pair,
+            a,
+            b,
+            depth: 1,
+        }
+    }
+
+    /// Two tori (leaf size 4) at three poses: touching, a little apart, far apart.
+    fn scene<B: BoundingVolume>() -> (Bvh<B>, Bvh<B>, Vec<Pose>) {
+        let params = BuildParams::BINNED_SAH.with_leaf_size(4);
+        let a = Bvh::from_mesh(&TriMesh::torus(1.0, 0.3, 16, 8), &params);
+        let b = Bvh::from_mesh(&TriMesh::torus(0.8, 0.25, 12, 6), &params);
+        let turn = DQuat::from_rotation_x(1.2);
+        let poses = [0.9, 2.5, 6.0]
+            .map(|x| Pose::new(DVec3::new(x, 0.1, 0.05), turn))
+            .to_vec();
+        (a, b, poses)
+    }
+
+    fn pairs<'a, B>(a: &'a Bvh<B>, b: &'a Bvh<B>, poses: &[Pose]) -> Vec<FrontierPair<'a, B>> {
+        poses
+            .iter()
+            .map(|pose| FrontierPair {
+                a,
+                b,
+                pose_ab: pose.to_isometry(),
+                threshold: 0.3,
+            })
+            .collect()
+    }
+
+    /// Records the visit counts it was polled at, and refuses from `limit` on.
+    struct Recorder {
+        limit: u64,
+        polled_at: Vec<u64>,
+    }
+
+    impl Budget for Recorder {
+        fn allows(&mut self, visits: u64) -> bool {
+            self.polled_at.push(visits);
+            visits < self.limit
+        }
+    }
+
+    #[test]
+    fn entries_are_ordered_by_smallest_bound_then_pair_then_nodes() {
+        let mut entries = [
+            entry(0.5, 0, 1, 1),
+            entry(0.1, 2, 3, 4),
+            entry(0.1, 1, 9, 9),
+            entry(0.1, 1, 2, 7),
+            entry(0.1, 1, 2, 5),
+            entry(0.0, 3, 0, 0),
+        ];
+        entries.sort_unstable_by(entry_order);
+        let keys: Vec<_> = entries.iter().map(|e| (e.pair, e.a, e.b)).collect();
+        assert_eq!(
+            keys,
+            [
+                (3, 0, 0),
+                (1, 2, 5),
+                (1, 2, 7),
+                (1, 9, 9),
+                (2, 3, 4),
+                (0, 1, 1)
+            ]
+        );
+    }
+
+    #[test]
+    fn every_round_is_processed_in_entry_order() {
+        let (a, b, poses) = scene::<Obb>();
+        let pairs = pairs(&a, &b, &poses);
+        let mut ws = FrontierWorkspace::with_poll_every(1);
+        ws.start(&pairs);
+        let mut rounds_seen = 0;
+        for limit in 1.. {
+            let done = ws.run(&pairs, &mut VisitBudget(limit));
+            if ws.cursor == 0 || done {
+                assert!(ws.current.is_sorted_by(|x, y| entry_order(x, y).is_le()));
+                rounds_seen += 1;
+            }
+            if done {
+                break;
+            }
+        }
+        assert!(rounds_seen >= 3, "{rounds_seen}");
+    }
+
+    #[test]
+    fn the_budget_is_polled_between_batches_and_never_inside_a_leaf_pair() {
+        let (a, b, poses) = scene::<Rss>();
+        let pairs = pairs(&a, &b, &poses);
+        let unlimited = {
+            let mut ws = FrontierWorkspace::new();
+            ws.start(&pairs);
+            assert!(ws.run(&pairs, &mut Unlimited));
+            ws.stats().visits
+        };
+        // The most one entry costs: a bound plus 4 × 4 triangle tests (leaf size 4).
+        let entry_cost = 17;
+        for poll_every in [1, 5, 32] {
+            for limit in (0..unlimited + 40).step_by(7) {
+                let mut ws = FrontierWorkspace::with_poll_every(poll_every);
+                let mut budget = Recorder {
+                    limit,
+                    polled_at: Vec::new(),
+                };
+                ws.start(&pairs);
+                let done = ws.run(&pairs, &mut budget);
+                let visits = ws.stats().visits;
+                assert_eq!(
+                    budget.polled_at[0], 0,
+                    "the first poll comes before any work"
+                );
+                for w in budget.polled_at.windows(2) {
+                    assert!(w[1] >= w[0] + poll_every, "{poll_every}: {w:?}");
+                    assert!(w[1] < w[0] + poll_every + entry_cost, "{poll_every}: {w:?}");
+                }
+                assert_eq!(ws.stats().polls, budget.polled_at.len() as u64);
+                if done {
+                    assert_eq!(visits, unlimited);
+                } else {
+                    assert!(visits >= limit, "stopped early: {visits} < {limit}");
+                    assert_eq!(*budget.polled_at.last().unwrap(), visits);
+                    assert!(visits < limit.max(1) + poll_every + entry_cost);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_zero_budget_or_a_past_deadline_does_no_work_and_answers_maybe_close() {
+        let (a, b, poses) = scene::<Obb>();
+        let pairs = pairs(&a, &b, &poses);
+        let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+        let past = Instant::now();
+        for finished in [
+            query_frontier(&pairs, &mut VisitBudget(0), &mut ws, &mut out),
+            query_frontier(&pairs, &mut Deadline(past), &mut ws, &mut out),
+        ] {
+            assert!(!finished);
+            assert_eq!(ws.stats().visits, 0);
+            assert_eq!(ws.entries_per_round(), [3]);
+            for answer in &out {
+                assert_eq!(answer.completeness, Completeness::Truncated { level: 0 });
+                assert!(answer.maybe_close);
+                assert_eq!(answer.distance_lower, 0.0);
+                assert_eq!(answer.distance_upper, None);
+                assert!(answer.error_bound.is_finite() && answer.error_bound > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn an_unlimited_run_gives_the_exact_distance_query_answers() {
+        let (a, b, poses) = scene::<Rss>();
+        let pairs = pairs(&a, &b, &poses);
+        let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+        assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut out));
+        assert!(ws.is_finished());
+        assert_eq!(ws.waiting(), 0);
+        let stats = *ws.stats();
+        assert_eq!(stats.visits, stats.bv_tests + stats.triangle_tests);
+        assert_eq!(stats.rounds, ws.entries_per_round().len() as u64);
+        let mut close = 0;
+        for ((p, pose), answer) in pairs.iter().zip(&poses).zip(&out) {
+            assert!(answer.is_exact());
+            let exact = distance_mesh_mesh(
+                &a,
+                &b,
+                pose,
+                &DistanceParams::EXACT,
+                &mut DistanceCache::new(),
+                &mut MeshMeshWorkspace::new(),
+            );
+            assert_eq!(answer.maybe_close, exact.distance <= p.threshold);
+            if answer.maybe_close {
+                close += 1;
+                assert_eq!(answer.distance_lower, exact.distance);
+                assert_eq!(answer.distance_upper, Some(exact.distance));
+                let w = answer.witnesses.unwrap();
+                assert_eq!(w.point_a.distance(w.point_b), exact.distance);
+            } else {
+                assert!(answer.distance_lower > p.threshold);
+                assert!(answer.distance_lower <= exact.distance);
+                assert!(exact.distance <= answer.distance_lower + answer.error_bound);
+            }
+        }
+        assert_eq!(
+            close, 2,
+            "touching and near pairs are close, the far one is not"
+        );
+    }
+
+    #[test]
+    fn a_resumed_run_reaches_the_state_of_a_fresh_run_with_the_larger_budget() {
+        let (a, b, poses) = scene::<Obb>();
+        let pairs = pairs(&a, &b, &poses);
+        let mut resumed = FrontierWorkspace::new();
+        resumed.start(&pairs);
+        let (mut fresh_out, mut resumed_out) = (Vec::new(), Vec::new());
+        let mut fresh = FrontierWorkspace::new();
+        for limit in (0..2000).step_by(13) {
+            resumed.run(&pairs, &mut VisitBudget(limit));
+            resumed.answers(&pairs, &mut resumed_out);
+            query_frontier(&pairs, &mut VisitBudget(limit), &mut fresh, &mut fresh_out);
+            // Polls differ (a refused poll is repeated on resuming); the work does not.
+            let work = |s: &FrontierStats| FrontierStats { polls: 0, ..*s };
+            assert_eq!(work(resumed.stats()), work(fresh.stats()), "{limit}");
+            assert_eq!(resumed.entries_per_round(), fresh.entries_per_round());
+            assert_eq!(resumed_out, fresh_out, "{limit}");
+        }
+    }
+
+    #[test]
+    fn an_empty_frame_finishes_at_once() {
+        let pairs: [FrontierPair<'_, Obb>; 0] = [];
+        let (mut ws, mut out) = (FrontierWorkspace::new(), vec![]);
+        assert!(query_frontier(
+            &pairs,
+            &mut VisitBudget(0),
+            &mut ws,
+            &mut out
+        ));
+        assert!(out.is_empty() && ws.is_finished());
+        assert_eq!(ws.stats().visits, 0);
+    }
+
+    #[test]
+    fn single_triangle_meshes_are_answered_from_their_root_pair() {
+        use crate::geometry::Triangle;
+        let tri = Triangle::new(DVec3::ZERO, DVec3::X, DVec3::Y);
+        let t = Bvh::<Obb>::from_triangles(&[tri], &BuildParams::MEDIAN);
+        let pairs = [0.5, 2.0].map(|z| FrontierPair {
+            a: &t,
+            b: &t,
+            pose_ab: Isometry::from_translation(DVec3::new(0.0, 0.0, z)),
+            threshold: 1.0,
+        });
+        let (mut ws, mut out) = (FrontierWorkspace::new(), vec![]);
+        assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut out));
+        // One bound per root, then one triangle test for the pair within threshold.
+        assert_eq!(ws.stats().bv_tests, 2);
+        assert_eq!(ws.stats().triangle_tests, 1);
+        assert_eq!(ws.stats().rounds, 1);
+        assert!(out[0].maybe_close && out[0].is_exact());
+        let exact = distance_triangle_triangle(&tri, &tri.transformed(&pairs[0].pose_ab));
+        assert_eq!(out[0].distance_lower, exact.distance);
+        assert!((exact.distance - 0.5).abs() <= out[0].error_bound);
+        assert!(!out[1].maybe_close && out[1].is_exact());
+        assert!(out[1].distance_lower > 1.0 && out[1].distance_lower <= 2.0);
+        assert_eq!(out[1].distance_upper, None);
+        assert!(2.0 <= out[1].distance_lower + out[1].error_bound);
+    }
+}
