@@ -14,6 +14,7 @@
 //! kind: what a scene with [`BroadPhaseChoice::Auto`] runs.
 
 use super::body_map::BodyMap;
+use super::sort_sweep::widest_spread_axis;
 use super::{CandidatePair, CollisionFilter, HashGrid, IncrementalSap, Proxy, SortAndSweep};
 use crate::bounding::Aabb;
 
@@ -446,27 +447,6 @@ fn interval_overlaps(proxies: &[Proxy], axis: usize) -> u64 {
         })
         .sum();
     twice / 2
-}
-
-/// The axis (0, 1, 2) along which the box centres have the largest variance (the one
-/// [`SortAndSweep`] sweeps; ties go to the lower axis).
-fn widest_spread_axis(proxies: &[Proxy]) -> usize {
-    let n = proxies.len().max(1) as f64;
-    let mean = proxies
-        .iter()
-        .fold(crate::math::DVec3::ZERO, |s, p| s + p.bounds.center())
-        / n;
-    let variance = proxies.iter().fold(crate::math::DVec3::ZERO, |s, p| {
-        let d = p.bounds.center() - mean;
-        s + d * d
-    });
-    if variance.x >= variance.y && variance.x >= variance.z {
-        0
-    } else if variance.y >= variance.z {
-        1
-    } else {
-        2
-    }
 }
 
 #[cfg(test)]
