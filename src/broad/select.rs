@@ -371,60 +371,62 @@ fn is_far_move(old: &Aabb, new: &Aabb) -> bool {
     shift.max_element() > (old.max - old.min).max_element()
 }
 
-/// Above this fraction of bodies changing per frame, a scene counts as "everything moves".
+/// Above this fraction of bodies changing per frame, the stateless sort and sweep (which
+/// costs the same whatever moved) beats per-body updates.
 pub const MOSTLY_MOVING: f64 = 0.5;
+/// Above this fraction of bodies changing per frame in a large scene, likewise.
+pub const LARGE_SCENE_MOVING: f64 = 0.15;
 /// Above this fraction of far moves among the updates, a scene counts as teleporting.
 pub const TELEPORTING: f64 = 0.01;
-/// Most bodies for [`IncrementalSap`] on a coherent scene.
+/// Most bodies for [`IncrementalSap`] on a coherent scene; more go to the [`HashGrid`].
 pub const SAP_MAX_BODIES: usize = 3_000;
-/// Most bodies for [`SortAndSweep`] when everything moves.
-pub const SWEEP_MAX_BODIES: usize = 2_000;
 
 /// The broad phase a scene with [`BroadPhaseChoice::Auto`] runs, given its statistics:
 ///
-/// 1. more than [`MOSTLY_MOVING`] of the bodies changing per frame: [`SortAndSweep`] up to
-///    [`SWEEP_MAX_BODIES`], else [`HashGrid`];
-/// 2. more than [`TELEPORTING`] of the updates far moves: [`HashGrid`];
-/// 3. up to [`SAP_MAX_BODIES`]: [`IncrementalSap`];
+/// 1. more than [`MOSTLY_MOVING`] of the bodies changing per frame, or more than
+///    [`TELEPORTING`] of the updates far moves: [`SortAndSweep`];
+/// 2. up to [`SAP_MAX_BODIES`] bodies: [`IncrementalSap`];
+/// 3. more than [`LARGE_SCENE_MOVING`] changing per frame: [`SortAndSweep`];
 /// 4. else [`HashGrid`].
 ///
 /// # The measurements behind it
-/// `examples/broad_bench` on this machine (2-core AMD EPYC, one core used), mean µs per
-/// frame, rapier's BVH broad phase (`parry_bvh`) in the same run; uniform, clustered and
-/// stacked layouts of `common/broad_scenes.rs`:
+/// `examples/broad_bench` on this machine (2-core AMD EPYC VM, one core used), mean µs per
+/// frame, the three broad phases and rapier's BVH broad phase (`parry_bvh`) in lockstep on
+/// the same frames, uniform / clustered / stacked layouts of `common/broad_scenes.rs`
+/// (taken while another build ran on the other core: ratios within a row are what count):
 ///
-/// | scene class | bodies | sort & sweep | incremental SAP | hash grid | parry BVH |
+/// | bodies | motion (share moving) | sort & sweep | incremental SAP | hash grid | parry BVH |
 /// |---|---|---|---|---|---|
-/// | 10 % moving, coherent (uniform / clustered / stack) | 1,000 | 334 / 135 / 182 | **32 / 21 / 17** | 48 / 49 / 46 | 82 / 48 / 49 |
-/// | same | 3,000 | – | **130 / 95 / 100** | 141 / 190 / 156 | 245 / 161 / 145 |
-/// | same | 10,000 | – | 805 / **619** / 731 | **656** / 968 / **583** | 1,020 / 923 / 513 |
-/// | 10 % teleporting | 1,000 | 384 / 204 / 210 | 4,418 / 3,463 / 128 | **181 / 184 / 58** | 447 / 207 / 55 |
-/// | same | 10,000 | – | 391,278 / 380,475 / 9,143 | **2,494 / 3,355 / 1,107** | 27,040 / 20,176 / 819 |
-/// | all moving, coherent | 1,000 | 355 / **166** / 319 | **256** / 181 / **234** | 418 / 471 / 600 | 134 / 83 / 79 |
-/// | all teleporting | 1,000 | **439 / 245 / 334** | 35,891 / 33,689 / 1,457 | 1,304 / 1,684 / 614 | 2,461 / 2,120 / 89 |
-/// | all moving, coherent | 10,000 | – | 7,168 / **5,390** / 11,426 | **5,585** / 10,396 / **6,258** | 1,718 / 1,878 / 1,102 |
+/// | 1,000 | coherent (10 %) | 60 / 46 / 68 | **32 / 21 / 17** | 40 / 44 / 39 | 64 / 43 / 46 |
+/// | 1,000 | coherent (25 %) | 75 / 95 / 134 | **68 / 51 / 86** | 99 / 187 / 180 | 90 / 55 / 84 |
+/// | 1,000 | coherent (all) | **158 / 87 / 146** | 375 / 250 / 275 | 549 / 635 / 741 | 193 / 108 / 90 |
+/// | 1,000 | teleporting (10 %) | **201 / 143** / 125 | 5,757 / 4,616 / 190 | 242 / 201 / **58** | 532 / 291 / 52 |
+/// | 1,000 | teleporting (all) | **120 / 106 / 194** | 39,534 / 40,733 / 1,892 | 1,514 / 2,080 / 726 | 2,650 / 2,573 / 155 |
+/// | 10,000 | coherent (5 %) | 1,661 / 1,654 / 840 | 478 / **411** / 827 | **770** / 582 / **416** | 1,044 / 1,129 / 691 |
+/// | 10,000 | coherent (10 %) | 1,288 / 1,064 / **983** | 1,454 / **714** / 1,319 | **930** / 1,112 / 1,478 | 1,017 / 963 / 733 |
+/// | 10,000 | coherent (25 %) | **1,118 / 1,125 / 1,354** | 1,936 / 1,629 / 2,509 | 1,577 / 2,902 / 1,870 | 1,379 / 1,384 / 1,237 |
+/// | 10,000 | coherent (all) | **1,158 / 1,265 / 1,665** | 7,942 / 5,521 / 14,073 | 5,546 / 10,702 / 7,023 | 1,660 / 2,120 / 1,546 |
+/// | 10,000 | teleporting (10 %) | **1,445 / 1,554** / 1,224 | 392,653 / 406,826 / 9,418 | 2,450 / 2,948 / **1,023** | 29,391 / 23,764 / 693 |
 ///
 /// The incremental sweep and prune is the fastest of the three on coherent scenes up to a
-/// few thousand bodies (its swaps are few and cheap), but a far move costs it a swap with
-/// every endpoint passed (about 100× slower when 10 % teleport) and its insertions are
-/// `O(n)` each; the hash grid costs about the same whatever the motion, and wins on
-/// coherent scenes from about 10,000 bodies; when every body moves, one full sweep beats
-/// per-body updates up to a couple of thousand bodies, and is as robust to teleports. Where
-/// the two stateful kinds are within 30 % of each other, the rule takes the one without a
-/// bad case (the grid). Everything-moves frames are where parry's BVH (refit and one
-/// self-traversal) beats all three: see issue #6's closing note.
+/// few thousand bodies, but a far move costs it a swap with every endpoint passed (20 to
+/// 300 times slower when bodies teleport) and its insertions are `O(n)` each. The hash
+/// grid's cost follows the bodies that moved, about the same whatever the motion, and it
+/// leads among large coherent scenes with few bodies moving. Sort and sweep in grid
+/// columns costs the same whatever moved: it wins once a quarter of a large scene moves,
+/// and whenever bodies teleport. Where two kinds are within about 30 % the rule takes the
+/// one without a bad case. Stacked dice are where parry's BVH (refit and one
+/// self-traversal) beats all three: see issue #6's notes.
 #[must_use]
 pub fn choose(stats: &BroadPhaseStats) -> BroadPhaseKind {
-    if stats.moving_fraction > MOSTLY_MOVING {
-        if stats.bodies <= SWEEP_MAX_BODIES {
-            BroadPhaseKind::SortAndSweep
-        } else {
-            BroadPhaseKind::HashGrid
-        }
-    } else if stats.far_move_fraction > TELEPORTING || stats.bodies > SAP_MAX_BODIES {
-        BroadPhaseKind::HashGrid
-    } else {
+    if stats.moving_fraction > MOSTLY_MOVING || stats.far_move_fraction > TELEPORTING {
+        BroadPhaseKind::SortAndSweep
+    } else if stats.bodies <= SAP_MAX_BODIES {
         BroadPhaseKind::IncrementalSap
+    } else if stats.moving_fraction > LARGE_SCENE_MOVING {
+        BroadPhaseKind::SortAndSweep
+    } else {
+        BroadPhaseKind::HashGrid
     }
 }
 
@@ -704,16 +706,17 @@ mod tests {
         let cases = [
             // (bodies, moving, far moves) → kind, as the table in `choose` measured.
             ((1_000, 0.1, 0.0), Sap),
+            ((1_000, 0.25, 0.0), Sap),
             ((3_000, 0.1, 0.0), Sap),
             ((3_001, 0.1, 0.0), Grid),
-            ((10_000, 0.1, 0.0), Grid),
-            ((1_000, 0.1, 1.0), Grid),
-            ((1_000, 0.1, 0.02), Grid),
+            ((10_000, 0.05, 0.0), Grid),
+            ((10_000, 0.25, 0.0), Sweep),
+            ((1_000, 0.1, 1.0), Sweep),
+            ((1_000, 0.1, 0.02), Sweep),
             ((1_000, 0.1, 0.005), Sap),
             ((1_000, 1.0, 0.0), Sweep),
-            ((1_000, 1.0, 1.0), Sweep),
-            ((2_001, 1.0, 1.0), Grid),
-            ((10_000, 1.0, 0.0), Grid),
+            ((100_000, 1.0, 1.0), Sweep),
+            ((10_000, 0.1, 0.5), Sweep),
             ((0, 0.0, 0.0), Sap),
         ];
         for ((bodies, moving, far), kind) in cases {
