@@ -10,9 +10,6 @@
 //! to date (timed, `iter_custom`). Proxima's broad phases also write the sorted pair list;
 //! rapier's keeps its pair map. 100,000 bodies take too long per sample for criterion: run
 //! `cargo run --release --example broad_bench -- --bodies 100000` for them.
-//!
-//! Sort and sweep is left out at 10,000 bodies: its one-axis sweep tests every pair whose
-//! intervals overlap on that axis, about 2 million a frame on the uniform layout (16 ms).
 
 // Shared with the other broad-phase target, which uses the items this one does not.
 #[allow(dead_code)]
@@ -47,9 +44,6 @@ fn broad_phase(c: &mut Criterion) {
         let mut group = c.benchmark_group(format!("broad/{}_{}", layout.name(), motion.name()));
         for bodies in [1_000, 10_000] {
             for name in NAMES {
-                if name == "sort_sweep" && bodies > 1_000 {
-                    continue;
-                }
                 let mut scene = BroadScene::new(layout, bodies, MOVING, motion, SEED);
                 let mut out = Vec::new();
                 let mut moved = Vec::new();
