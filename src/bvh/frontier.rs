@@ -839,6 +839,41 @@ mod tests {
     }
 
     #[test]
+    fn an_infinite_threshold_gives_every_pairs_exact_distance() {
+        let (a, b, poses) = scene::<Rss>();
+        let mut pairs = pairs(&a, &b, &poses);
+        for p in &mut pairs {
+            p.threshold = f64::INFINITY;
+        }
+        let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+        assert!(!query_frontier(
+            &pairs,
+            &mut VisitBudget(30),
+            &mut ws,
+            &mut out
+        ));
+        assert!(
+            out.iter()
+                .all(|x| x.maybe_close && x.error_bound.is_finite())
+        );
+        assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut out));
+        for (pose, answer) in poses.iter().zip(&out) {
+            let exact = distance_mesh_mesh(
+                &a,
+                &b,
+                pose,
+                &DistanceParams::EXACT,
+                &mut DistanceCache::new(),
+                &mut MeshMeshWorkspace::new(),
+            );
+            assert!(answer.is_exact() && answer.maybe_close);
+            assert_eq!(answer.distance_lower, exact.distance);
+            assert_eq!(answer.clamped_error_bound(), answer.error_bound);
+        }
+        assert!(out[2].distance_lower > 1.0, "the far pair is far");
+    }
+
+    #[test]
     fn a_resumed_run_reaches_the_state_of_a_fresh_run_with_the_larger_budget() {
         let (a, b, poses) = scene::<Obb>();
         let pairs = pairs(&a, &b, &poses);

@@ -266,7 +266,8 @@ fn mesh_mesh_tail(
 /// (the same minimum over all triangle pairs, with the same rounding bound; when several
 /// triangle pairs share the minimum, as intersecting meshes do at 0, the witnesses may name
 /// another of them). Contacts, overlap tests and everything else run as in [`mesh_mesh`].
-/// The frontier's threshold must have been the margin sum, or `+∞` with `DISTANCE`.
+/// The frontier's threshold must have been the margin sum, or with `DISTANCE` an upper
+/// bound of the pair's distance (so a finished pair is always `maybe_close` then).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn mesh_mesh_finished(
     pair: &CandidatePair,
@@ -289,12 +290,30 @@ pub(super) fn mesh_mesh_finished(
             point_a: w.point_a,
             point_b: w.point_b,
         });
-    if wants_distance && known.is_none() {
-        // Proven beyond the margins (never with `DISTANCE`, whose threshold is `+∞`): the
-        // case [`mesh_mesh`] settles with its tolerance query, settled the same way.
-        return mesh_mesh(pair, (a, ma), (b, mb), query, cache, scratch, contacts);
-    }
     let pose_ab = Pose::relative(&a.pose, &b.pose);
+    if wants_distance && known.is_none() {
+        // Proven beyond the margins: every triangle pair's distance exceeds them, which is
+        // what [`mesh_mesh`]'s tolerance query would find. It then answers "far" unless
+        // touching matters and the exact predicates find an intersection (a grazing
+        // contact the float distances miss, or an upper bound under `DISTANCE` that
+        // rounding undercut), where it computes the exact distance: so does this.
+        let grazing = (query.overlap || query.contacts)
+            && intersects_mesh_mesh(
+                &ma.overlap_tree,
+                &mb.overlap_tree,
+                &pose_ab,
+                &mut scratch.traversal,
+            );
+        if query.distance || grazing {
+            return mesh_mesh(pair, (a, ma), (b, mb), query, cache, scratch, contacts);
+        }
+        let mut result = empty_record(pair);
+        result.distance = f64::INFINITY;
+        return Answer {
+            result,
+            touching: false,
+        };
+    }
     mesh_mesh_tail(
         empty_record(pair),
         (a, ma),
