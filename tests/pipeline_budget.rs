@@ -554,3 +554,43 @@ fn truncated_answers_are_refined_frame_after_frame_until_the_frame_is_exact() {
     }
     assert!(tally.truncated_records > 10, "{tally:?}");
 }
+
+/// A deadline already past (or closer than the reserve) lets the frontier do nothing: every
+/// mesh pair is answered at level 0, exactly as a zero visit budget; a deadline an hour
+/// away lets it finish: the exact frame. (No timing is measured: both outcomes hold on any
+/// machine that answers a frame in less than an hour.)
+#[test]
+fn a_past_deadline_answers_at_level_0_and_a_distant_one_gives_the_exact_frame() {
+    use proxima::pipeline::{Deadline, FRONTIER_RESERVE};
+    use std::time::{Duration, Instant};
+    let scene = pile(2);
+    for (name, query) in QUERIES {
+        let zero = run(&scene, query, &mut VisitBudget(0));
+        assert_eq!(
+            zero.report.completeness,
+            Completeness::Truncated { level: 0 }
+        );
+        for deadline in [Instant::now(), Instant::now() + FRONTIER_RESERVE / 2] {
+            let past = run(&scene, query, &mut Deadline(deadline));
+            assert_eq!(
+                (&past.pairs, &past.contacts),
+                (&zero.pairs, &zero.contacts),
+                "{name}"
+            );
+            assert_eq!(past.report.frontier.visits, 0);
+            assert_eq!(past.report.completeness, zero.report.completeness);
+        }
+        let exact = run_exact(&scene, query);
+        let distant = run(
+            &scene,
+            query,
+            &mut Deadline(Instant::now() + Duration::from_secs(3600)),
+        );
+        assert_eq!(distant.report.completeness, Completeness::Exact, "{name}");
+        assert!(distant.report.frontier.visits > 0, "{name}: the frontier ran");
+        assert_eq!(distant.pairs.len(), exact.pairs.len());
+        for (g, w) in distant.pairs.iter().zip(&exact.pairs) {
+            same_record((&distant, g), (&exact, w), name);
+        }
+    }
+}

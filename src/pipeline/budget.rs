@@ -11,11 +11,14 @@ pub use crate::bvh::frontier::{Budget, Deadline, Unlimited, VisitBudget};
 /// exact contacts of finished touching mesh pairs, the records of truncated pairs, and
 /// the daemon's writing and publishing of the result frame. 100 µs.
 ///
-/// Why this much: the latency target is the budget plus 50 µs at p99.9, and
-/// publishing alone (loan, write, send, notify) is tens of microseconds on the 2-core VM
-/// (the daemon's `stage_ns[PUBLISH]`); the rest of the narrow phase for a few hundred
-/// primitive pairs is of the same order. It is an estimate to be replaced by a measured
-/// value from `examples/time_vs_error.rs` (release builds; tests here never measure time).
+/// Why this much: the latency target is the budget plus 50 µs at p99.9. Publishing
+/// (loan, write, send, notify) is part of a raw iceoryx2 round trip, measured at 78 µs p50
+/// and 128 µs p99 there and back on the 2-core VM (README, `ipc_latency`), so about half
+/// of that one way; the rest of the narrow phase for a few hundred primitive pairs is of
+/// the same order (closed forms 3–900 ns, GJK 0.5–7 µs per pair, README). Not measured
+/// on budgeted frames yet: to be replaced by the value `examples/time_vs_error.rs`
+/// measures from the daemon's `stage_ns[NARROW]` and `stage_ns[PUBLISH]` (release builds;
+/// tests here never measure time).
 pub const FRONTIER_RESERVE: Duration = Duration::from_micros(100);
 
 /// The deadline of the frontier inside a frame ending at `frame_deadline`:

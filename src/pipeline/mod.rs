@@ -746,6 +746,12 @@ fn run_frontier(
         mesh_pair(scene, pair).is_some()
             && !kept.get(pair).is_some_and(|k| k.fits(scene, pair, query))
     };
+    if !candidates.iter().any(|pair| needed(&pair)) {
+        // Nothing to answer: no run (and nothing left to resume later).
+        frontier_pairs.clear();
+        frontier_answers.clear();
+        return FrontierStats::default();
+    }
     let resume = frontier_run.resumes(scene, query, frontier_pairs, candidates)
         && candidates
             .iter()
