@@ -673,3 +673,150 @@ fn frames_with_a_fixed_incremental_sap_or_hash_grid_match_the_in_process_pipelin
     }
     assert!(pairs_seen > 100, "pairs {pairs_seen}");
 }
+
+/// Eight tori on a 4 × 2 grid, neighbours touching or near, registered in the daemon and
+/// in process body for body; returns the scene ids and the frame's pose records.
+fn twin_tori_pile(client: &Client<ipc::Service>) -> (TwinScenes, Vec<PoseRecord>) {
+    let scene_id = client.create_scene().unwrap();
+    let mut oracle = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let torus = support::meshes::torus(0.45, 0.12, 16, 8);
+    let vertices: Vec<[f64; 3]> = torus.vertices().iter().map(|v| v.to_array()).collect();
+    let remote = client
+        .register_mesh(scene_id, &vertices, torus.triangles())
+        .unwrap();
+    let local = oracle
+        .register_shape(Shape::Mesh(Arc::new(MeshShape::new(torus))))
+        .unwrap();
+    let mut rng = support::rng(97);
+    let mut records = Vec::new();
+    for k in 0..8u32 {
+        let spec = BodySpec {
+            margin: Some(0.03),
+            ..body(remote, 0.0)
+        };
+        let id = client.add_body(scene_id, &spec).unwrap();
+        let desc = BodyDesc {
+            shape: local,
+            pose: Pose::IDENTITY,
+            motion: SceneMotion::Dynamic,
+            filter: CollisionFilter::ALL,
+            margin: Some(0.03),
+        };
+        assert_eq!(oracle.add_body(&desc).unwrap(), BodyId(id));
+        let cell = DVec3::new(f64::from(k % 4) - 1.5, f64::from(k / 4) - 0.5, 0.0) * 0.85;
+        let r = support::rotation(&mut rng);
+        records.push(PoseRecord {
+            orientation: [r.x, r.y, r.z, r.w],
+            ..pose_record(id, cell + support::point_in_cube(&mut rng, 0.2))
+        });
+    }
+    for r in &records {
+        let [x, y, z, w] = r.orientation;
+        let pose = Pose::try_new(DVec3::from(r.position), DQuat::from_xyzw(x, y, z, w)).unwrap();
+        oracle.set_pose(BodyId(r.body), pose).unwrap();
+    }
+    (TwinScenes { scene_id, oracle }, records)
+}
+
+/// The frame budget over shared memory: a torus pile frame with a 1 ns budget (less than
+/// the pipeline's reserve, so the frontier does no work) comes back `Truncated` at level 0
+/// with every truly touching pair reported with a contact and every close pair reported,
+/// record for record what the in-process pipeline gives with a zero visit budget; the same
+/// frame with budget 0 (none) comes back `Exact`, equal to the in-process `step`.
+#[test]
+fn a_budgeted_torus_pile_frame_is_truncated_and_conservative_and_budget_zero_is_exact() {
+    use proxima::pipeline::{Completeness, VisitBudget, step_within};
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let (
+        TwinScenes {
+            scene_id,
+            mut oracle,
+        },
+        records,
+    ) = twin_tori_pile(&client);
+    let link = client.open_scene(scene_id).unwrap();
+    let q = Query::CLOSE.union(Query::CONTACTS);
+    // The truth: every candidate pair's exact distance.
+    let mut truth = FrameResults::default();
+    step(
+        &oracle,
+        Query::DISTANCE,
+        &mut PipelineWorkspace::default(),
+        &mut truth,
+    );
+    let touching: Vec<_> = truth.pairs.iter().filter(|p| p.distance <= 0.0).collect();
+    let close: Vec<_> = truth.pairs.iter().filter(|p| p.distance <= 0.06).collect();
+    assert!(
+        touching.len() >= 3 && close.len() > touching.len(),
+        "touching {}, close {}",
+        touching.len(),
+        close.len()
+    );
+    let mut workspace = PipelineWorkspace::default();
+    let mut expected = FrameResults::default();
+
+    link.publish_poses(1, 1, flags(q), &records).unwrap();
+    let report = step_within(
+        &oracle,
+        q,
+        &mut VisitBudget(0),
+        &mut workspace,
+        &mut expected,
+    );
+    oracle.end_frame();
+    assert_eq!(report.completeness, Completeness::Truncated { level: 0 });
+    let result = link
+        .receive_results_for(1, TIMEOUT)
+        .unwrap()
+        .expect("a result frame");
+    let header = result.header();
+    assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
+    assert_eq!(
+        header.completeness,
+        wire::Completeness::Truncated as u32,
+        "a 1 ns budget cannot be met"
+    );
+    assert_eq!(header.deepest_level, 0);
+    assert_eq!(header.budget_met, 0);
+    assert_same_records(result.records(), &expected, 1);
+    assert_linked(&result);
+    for t in &close {
+        let got = result
+            .pairs()
+            .iter()
+            .find(|p| (p.body_a, p.body_b) == (t.a, t.b))
+            .unwrap_or_else(|| panic!("close pair {}–{} missed", t.a, t.b));
+        assert!(got.distance <= t.distance + 1e-12);
+        assert!(t.distance - got.distance <= got.error_bound + 1e-12);
+        if t.distance <= 0.0 {
+            assert!(
+                got.count >= 1,
+                "touching pair {}–{} without contact",
+                t.a,
+                t.b
+            );
+        }
+    }
+
+    link.publish_poses(2, 0, flags(q), &records).unwrap();
+    for r in &records {
+        let [x, y, z, w] = r.orientation;
+        let pose = Pose::try_new(DVec3::from(r.position), DQuat::from_xyzw(x, y, z, w)).unwrap();
+        oracle.set_pose(BodyId(r.body), pose).unwrap();
+    }
+    let report = step(&oracle, q, &mut workspace, &mut expected);
+    oracle.end_frame();
+    assert_eq!(report.completeness, Completeness::Exact);
+    let result = link
+        .receive_results_for(2, TIMEOUT)
+        .unwrap()
+        .expect("a result frame");
+    let header = result.header();
+    assert_eq!(header.completeness, wire::Completeness::Exact as u32);
+    assert_eq!((header.deepest_level, header.budget_met), (0, 1));
+    assert_eq!(header.stage_ns[wire::stage::MID], 0);
+    assert_same_records(result.records(), &expected, 2);
+    assert_linked(&result);
+    assert_eq!(result.pairs().len(), close.len(), "exactly the close pairs");
+}

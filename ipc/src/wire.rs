@@ -210,8 +210,8 @@ impl std::fmt::Display for ErrorCode {
 pub enum Completeness {
     /// Every pair answered exactly.
     Exact = 0,
-    /// The deadline cut traversal short, or some candidate pair has no exact narrow phase
-    /// yet and got the conservative box answer (level 0); answers are conservative (see
+    /// The deadline cut traversal short, or answering some candidate pair failed (a bug)
+    /// and it got the conservative box answer (level 0); answers are conservative (see
     /// DESIGN §4) and [`ResultFrameHeader::deepest_level`] bounds their error.
     Truncated = 1,
 }
@@ -225,11 +225,12 @@ pub mod stage {
     pub const PLAN: usize = 1;
     /// Broad phase: margin-grown world boxes to candidate pairs.
     pub const BROAD: usize = 2;
-    /// Mid phase: BVH traversal (not separate yet: 0; counted in `NARROW`, since the mesh
-    /// queries traverse and test triangles in one pass).
+    /// Mid phase: the budgeted breadth-first frontier over every mesh–mesh pair's BVH
+    /// node pairs, in frames with a budget (`budget_ns > 0`). Without a budget 0: the exact
+    /// mesh queries traverse and test triangles in one pass, counted in `NARROW`.
     pub const MID: usize = 3;
     /// Narrow phase: every candidate pair's answer for the frame's query, BVH traversal
-    /// and manifold reduction included.
+    /// (outside `MID`) and manifold reduction included.
     pub const NARROW: usize = 4;
     /// Writing and publishing the result frame.
     pub const PUBLISH: usize = 5;

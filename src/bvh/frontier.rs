@@ -120,6 +120,20 @@ pub trait Budget {
     /// Whether work may go on after `visits` visits (bounding-volume tests plus triangle
     /// tests) since [`FrontierWorkspace::start`].
     fn allows(&mut self, visits: u64) -> bool;
+
+    /// The wall-clock instant this budget ends at, when it is one (so a caller can reserve
+    /// time for work after the traversal); `None` for counted and unlimited budgets.
+    #[must_use]
+    fn deadline(&self) -> Option<Instant> {
+        None
+    }
+
+    /// Whether this budget never refuses (callers may then take their exact, unbudgeted
+    /// paths, which give the same answers).
+    #[must_use]
+    fn is_unlimited(&self) -> bool {
+        false
+    }
 }
 
 /// A counted budget: allows work while fewer than `0` visits were made (so `VisitBudget(0)`
@@ -144,6 +158,10 @@ impl Budget for Deadline {
     fn allows(&mut self, _visits: u64) -> bool {
         Instant::now() < self.0
     }
+
+    fn deadline(&self) -> Option<Instant> {
+        Some(self.0)
+    }
 }
 
 /// No limit: the traversal runs to the exact answers.
@@ -153,6 +171,10 @@ pub struct Unlimited;
 impl Budget for Unlimited {
     #[inline]
     fn allows(&mut self, _visits: u64) -> bool {
+        true
+    }
+
+    fn is_unlimited(&self) -> bool {
         true
     }
 }
@@ -166,7 +188,9 @@ pub struct FrontierPair<'a, B> {
     pub b: &'a Bvh<B>,
     /// B's frame expressed in A's frame.
     pub pose_ab: Isometry,
-    /// The distance that counts as close (the pair's margin sum), metres, finite, `≥ 0`.
+    /// The distance that counts as close (the pair's margin sum), metres, `≥ 0`; `+∞`
+    /// asks for the exact distance of every pair (nothing is dropped for exceeding it,
+    /// only for not beating the pair's best distance so far).
     pub threshold: f64,
 }
 
@@ -348,7 +372,7 @@ impl FrontierWorkspace {
     }
 
     /// Resets the frontier to one root entry per pair of `pairs` (round 1, no visit yet).
-    /// Thresholds must be finite and `≥ 0`.
+    /// Thresholds must be `≥ 0` (`+∞` allowed, NaN not).
     pub fn start<B: BoundingVolume>(&mut self, pairs: &[FrontierPair<'_, B>]) {
         assert!(
             u32::try_from(pairs.len()).is_ok(),
@@ -362,11 +386,7 @@ impl FrontierWorkspace {
         self.entries_per_round.clear();
         self.next_poll = 0;
         for (i, p) in pairs.iter().enumerate() {
-            debug_assert!(
-                p.threshold.is_finite() && p.threshold >= 0.0,
-                "threshold {} of pair {i}",
-                p.threshold
-            );
+            debug_assert!(p.threshold >= 0.0, "threshold {} of pair {i}", p.threshold);
             let (ra, rb) = (p.a.root_bv(), p.b.root_bv());
             self.pairs.push(PairState {
                 threshold: p.threshold,
@@ -816,6 +836,41 @@ mod tests {
             close, 2,
             "touching and near pairs are close, the far one is not"
         );
+    }
+
+    #[test]
+    fn an_infinite_threshold_gives_every_pairs_exact_distance() {
+        let (a, b, poses) = scene::<Rss>();
+        let mut pairs = pairs(&a, &b, &poses);
+        for p in &mut pairs {
+            p.threshold = f64::INFINITY;
+        }
+        let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+        assert!(!query_frontier(
+            &pairs,
+            &mut VisitBudget(30),
+            &mut ws,
+            &mut out
+        ));
+        assert!(
+            out.iter()
+                .all(|x| x.maybe_close && x.error_bound.is_finite())
+        );
+        assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut out));
+        for (pose, answer) in poses.iter().zip(&out) {
+            let exact = distance_mesh_mesh(
+                &a,
+                &b,
+                pose,
+                &DistanceParams::EXACT,
+                &mut DistanceCache::new(),
+                &mut MeshMeshWorkspace::new(),
+            );
+            assert!(answer.is_exact() && answer.maybe_close);
+            assert_eq!(answer.distance_lower, exact.distance);
+            assert_eq!(answer.clamped_error_bound(), answer.error_bound);
+        }
+        assert!(out[2].distance_lower > 1.0, "the far pair is far");
     }
 
     #[test]

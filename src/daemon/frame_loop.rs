@@ -4,9 +4,16 @@
 //! notify. An answered frame ends the scene's frame ([`Scene::end_frame`]): its poses are
 //! where the next frame's motion starts (refused frames apply no pose and end nothing).
 //!
-//! The header carries the pipeline's own [`StepReport`]: broad and narrow timings
-//! (`stage_ns[BROAD]`, `stage_ns[NARROW]`), candidate, pair and contact counts; ingest and
-//! publish are timed here. Stages the pipeline does not have yet (plan, mid) stay 0.
+//! A frame with a budget (`budget_ns > 0`) runs [`pipeline::step_within`] with a
+//! [`Deadline`] at the frame's receipt plus its budget (the pipeline keeps
+//! [`FRONTIER_RESERVE`](pipeline::FRONTIER_RESERVE) of it for the narrow phase and this
+//! publishing); `budget_ns == 0` runs the exact [`pipeline::step`].
+//!
+//! The header carries the pipeline's own [`StepReport`]: its completeness (with
+//! `Truncated`, the shallowest level any pair stopped at in `deepest_level`), broad, mid
+//! (the budgeted frontier, 0 without a budget) and narrow timings (`stage_ns[BROAD]`,
+//! `stage_ns[MID]`, `stage_ns[NARROW]`), candidate, pair and contact counts; ingest and
+//! publish are timed here. The plan stage the pipeline does not have yet stays 0.
 //!
 //! # Allocation
 //! After a scene's first frames, none: the pipeline workspace and the result lists are
@@ -18,8 +25,8 @@ use super::ingest::{FrameRejection, apply_pose_frame};
 use super::log::{Cause, Level, Logger, Subject};
 use crate::math::Pose;
 use crate::pipeline::{
-    self, Completeness, ContactPoint, FrameResults, PairResult, PairToi, PipelineWorkspace,
-    StepReport, WorkerPool,
+    self, Completeness, ContactPoint, Deadline, FrameResults, PairResult, PairToi,
+    PipelineWorkspace, StepReport, WorkerPool,
 };
 use crate::scene::{BodyId, Scene};
 use iceoryx2::port::notifier::Notifier;
@@ -31,7 +38,7 @@ use proxima_ipc::wire::{
 };
 use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION};
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// Initial number of result records a result sample can hold (grows by powers of two).
 const INITIAL_RESULT_RECORDS: usize = 1024;
@@ -146,8 +153,18 @@ impl<S: Service> SceneFrames<S> {
                     result.error_body = body.unwrap_or(u32::MAX);
                 }
                 Ok(query) => {
-                    let report =
-                        pipeline::step(scene, query, &mut self.workspace, &mut self.output);
+                    let report = if header.budget_ns == 0 {
+                        pipeline::step(scene, query, &mut self.workspace, &mut self.output)
+                    } else {
+                        let deadline = received + Duration::from_nanos(header.budget_ns);
+                        pipeline::step_within(
+                            scene,
+                            query,
+                            &mut Deadline(deadline),
+                            &mut self.workspace,
+                            &mut self.output,
+                        )
+                    };
                     scene.end_frame();
                     fill_header(&mut result, &report);
                 }
@@ -207,6 +224,7 @@ fn fill_header(header: &mut ResultFrameHeader, report: &StepReport) {
         }
     };
     header.stage_ns[wire::stage::BROAD] = report.broad_ns;
+    header.stage_ns[wire::stage::MID] = report.mid_ns;
     header.stage_ns[wire::stage::NARROW] = report.narrow_ns;
     // With TOI the swept candidates, a superset of the others.
     header.candidate_count = report.candidates.max(report.toi_candidates);

@@ -12,6 +12,7 @@ use super::dispatch::{self, NarrowScratch};
 use super::{ContactPoint, PairResult, Query};
 use crate::bounding::Aabb;
 use crate::broad::CandidatePair;
+use crate::bvh::frontier::FrontierAnswer;
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::contact::Manifold;
 use crate::narrow::mesh_mesh::{
@@ -144,18 +145,7 @@ pub(super) fn mesh_mesh(
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     let pose_ab = Pose::relative(&a.pose, &b.pose);
-    let mut result = PairResult {
-        a: pair.a,
-        b: pair.b,
-        distance: 0.0,
-        error_bound: 0.0,
-        point_a: DVec3::ZERO,
-        point_b: DVec3::ZERO,
-        normal: DVec3::ZERO,
-        exact: true,
-        first_contact: 0,
-        contact_count: 0,
-    };
+    let mut result = empty_record(pair);
     // `CLOSE` without `DISTANCE` needs the distance only of pairs within their margins: a
     // tolerance query, which stops at the first triangle pair close enough, rules the
     // others out (its lower bounds prune far pairs near the roots). Its float distances
@@ -185,8 +175,7 @@ pub(super) fn mesh_mesh(
             touching: false,
         };
     }
-    let mut touching = None;
-    if query.close || query.distance {
+    let known = (query.close || query.distance).then(|| {
         let d = distance_mesh_mesh(
             &ma.distance_tree,
             &mb.distance_tree,
@@ -195,6 +184,50 @@ pub(super) fn mesh_mesh(
             cache,
             &mut scratch.traversal,
         );
+        KnownDistance {
+            distance: d.distance,
+            error_bound: d.error_bound,
+            point_a: d.point_a,
+            point_b: d.point_b,
+        }
+    });
+    mesh_mesh_tail(
+        result,
+        (a, ma),
+        mb,
+        &pose_ab,
+        query,
+        known,
+        scratch,
+        contacts,
+    )
+}
+
+/// The exact distance of a mesh pair, witnesses in A's frame.
+#[derive(Debug, Clone, Copy)]
+struct KnownDistance {
+    distance: f64,
+    error_bound: f64,
+    point_a: DVec3,
+    point_b: DVec3,
+}
+
+/// What [`mesh_mesh`] does once the distance is known (when the query needs it): the
+/// record's distance, witnesses and normal, the manifold when contacts are asked, and the
+/// touching decision.
+#[allow(clippy::too_many_arguments)]
+fn mesh_mesh_tail(
+    mut result: PairResult,
+    (a, ma): (&Body, &MeshShape),
+    mb: &MeshShape,
+    pose_ab: &Pose,
+    query: Query,
+    known: Option<KnownDistance>,
+    scratch: &mut MeshScratch,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    let mut touching = None;
+    if let Some(d) = known {
         result.distance = d.distance;
         result.error_bound = d.error_bound;
         result.point_a = a.pose.transform_point(d.point_a);
@@ -206,7 +239,7 @@ pub(super) fn mesh_mesh(
     }
     if query.contacts && touching != Some(false) {
         let first = contacts.len();
-        mesh_manifold(a, ma, mb, &pose_ab, scratch, contacts);
+        mesh_manifold(a, ma, mb, pose_ab, scratch, contacts);
         if let Some(c) = contacts.get(first) {
             touching = Some(true);
             if !(query.close || query.distance) {
@@ -220,11 +253,138 @@ pub(super) fn mesh_mesh(
         intersects_mesh_mesh(
             &ma.overlap_tree,
             &mb.overlap_tree,
-            &pose_ab,
+            pose_ab,
             &mut scratch.traversal,
         )
     });
     Answer { result, touching }
+}
+
+/// A mesh pair whose budgeted frontier traversal finished (`frontier` is
+/// [`Exact`](crate::bvh::frontier::Completeness::Exact)): the record [`mesh_mesh`] gives,
+/// with the distance and witnesses taken from the frontier instead of a second traversal
+/// (the same minimum over all triangle pairs, with the same rounding bound; when several
+/// triangle pairs share the minimum, as intersecting meshes do at 0, the witnesses may name
+/// another of them). Contacts, overlap tests and everything else run as in [`mesh_mesh`].
+/// The frontier's threshold must have been the margin sum, or with `DISTANCE` an upper
+/// bound of the pair's distance (so a finished pair is always `maybe_close` then).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn mesh_mesh_finished(
+    pair: &CandidatePair,
+    (a, ma): (&Body, &MeshShape),
+    (b, mb): (&Body, &MeshShape),
+    query: Query,
+    frontier: &FrontierAnswer,
+    cache: &mut DistanceCache,
+    scratch: &mut MeshScratch,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    debug_assert!(frontier.is_exact());
+    let wants_distance = query.close || query.distance;
+    let known = frontier
+        .witnesses
+        .filter(|_| frontier.maybe_close)
+        .map(|w| KnownDistance {
+            distance: frontier.distance_lower,
+            error_bound: frontier.error_bound,
+            point_a: w.point_a,
+            point_b: w.point_b,
+        });
+    let pose_ab = Pose::relative(&a.pose, &b.pose);
+    if wants_distance && known.is_none() {
+        // Proven beyond the margins: every triangle pair's distance exceeds them, which is
+        // what [`mesh_mesh`]'s tolerance query would find. It then answers "far" unless
+        // touching matters and the exact predicates find an intersection (a grazing
+        // contact the float distances miss, or an upper bound under `DISTANCE` that
+        // rounding undercut), where it computes the exact distance: so does this.
+        let grazing = (query.overlap || query.contacts)
+            && intersects_mesh_mesh(
+                &ma.overlap_tree,
+                &mb.overlap_tree,
+                &pose_ab,
+                &mut scratch.traversal,
+            );
+        if query.distance || grazing {
+            return mesh_mesh(pair, (a, ma), (b, mb), query, cache, scratch, contacts);
+        }
+        let mut result = empty_record(pair);
+        result.distance = f64::INFINITY;
+        return Answer {
+            result,
+            touching: false,
+        };
+    }
+    mesh_mesh_tail(
+        empty_record(pair),
+        (a, ma),
+        mb,
+        &pose_ab,
+        query,
+        known.filter(|_| wants_distance),
+        scratch,
+        contacts,
+    )
+}
+
+/// A mesh pair whose budgeted frontier traversal was cut short (`frontier` is
+/// [`Truncated`](crate::bvh::frontier::Completeness::Truncated), hence `maybe_close`): the
+/// conservative answer DESIGN §4 asks for. Distance: the frontier's lower bound (never
+/// above the truth) with its error bound (`true ≤ distance + error_bound`), `exact` false.
+/// The pair *may touch* when that bound is `≤ 0`; its contact (when asked) is then one
+/// point, as the box answer's: the record's witnesses and normal, distance 0 (meshes have
+/// no depth) with the record's error bound. Witnesses: the closest triangle pair the
+/// frontier found so far (`distance_upper` apart), else the points of the two world boxes
+/// nearest each other, with the box normal.
+pub(super) fn mesh_mesh_truncated(
+    pair: &CandidatePair,
+    (a, b): (&Body, &Body),
+    query: Query,
+    frontier: &FrontierAnswer,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    debug_assert!(!frontier.is_exact() && frontier.maybe_close);
+    let mut scratch = Vec::new();
+    let boxes = boxes(
+        pair,
+        &a.world_bounds,
+        &b.world_bounds,
+        Query::NONE,
+        &mut scratch,
+    );
+    let mut result = boxes.result;
+    if let Some(w) = frontier.witnesses {
+        let (point_a, point_b) = (
+            a.pose.transform_point(w.point_a),
+            a.pose.transform_point(w.point_b),
+        );
+        if let Some(normal) = (point_b - point_a).try_normalize() {
+            (result.point_a, result.point_b, result.normal) = (point_a, point_b, normal);
+        }
+    }
+    result.distance = frontier.distance_lower;
+    result.error_bound = frontier.error_bound;
+    result.exact = false;
+    let touching = result.distance <= 0.0;
+    if query.contacts && touching {
+        contacts.push(witness_contact(&result, 0.0));
+    }
+    Answer { result, touching }
+}
+
+/// A mesh pair's record before anything is known: distance 0, no witnesses, exact.
+fn empty_record(pair: &CandidatePair) -> PairResult {
+    PairResult {
+        a: pair.a,
+        b: pair.b,
+        distance: 0.0,
+        error_bound: 0.0,
+        point_a: DVec3::ZERO,
+        point_b: DVec3::ZERO,
+        normal: DVec3::ZERO,
+        exact: true,
+        first_contact: 0,
+        contact_count: 0,
+    }
 }
 
 /// Appends the manifold of two meshes (nothing when they do not intersect): the segment ends

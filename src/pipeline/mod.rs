@@ -74,13 +74,16 @@
 //! answer again, contacts included, without running any query: resting bodies cost only
 //! the broad phase. Answers depend on nothing else, so the frame is identical to one that
 //! answers them afresh (tested). A pair that stops being a candidate forgets its answer.
-//! [`StepReport::reused_pairs`] counts them.
+//! [`StepReport::reused_pairs`] counts them. Only exact answers are kept: a pair a
+//! budgeted frame left truncated ([`step_within`]) is answered again next frame.
 //!
 //! # Design note: determinism and ordering
 //! The same scene and query give the same results: the broad phase yields pairs sorted by
 //! `(a, b)`, each pair is answered independently in that order, and nothing depends on
-//! timing (only [`StepReport`]'s timings do). Budgeted (time-critical) traversal joins with
-//! issue #7 behind this same seam.
+//! timing (only [`StepReport`]'s timings do). Under a budget ([`step_within`]) the answers
+//! also depend on how much of it the frame had: the same for the same counted budget (and
+//! the same workspace history, since a resting scene's frontier resumes), never worse with
+//! more.
 //!
 //! # What is exact today
 //! Sphere–sphere (closed form) and mesh–mesh (exact BVH queries, meshes as surfaces:
@@ -98,22 +101,27 @@
 //! kinds' pair sets and hash cells allocate as pairs and occupied cells appear.
 
 mod answer;
+pub mod budget;
 mod contacts;
 mod dispatch;
 mod mesh_contacts;
 mod toi;
 pub mod workers;
 
+pub use budget::{Budget, Deadline, FRONTIER_RESERVE, Unlimited, VisitBudget, frontier_deadline};
 pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
 pub use dispatch::PathCounts;
 pub use toi::{PairToi, TOI_TOLERANCE};
 
+use crate::bounding::Rss;
 use crate::broad::{
     BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, Proxy,
     SortAndSweep, choose,
 };
-use crate::math::DVec3;
+use crate::bvh::frontier::{self, FrontierAnswer, FrontierPair, FrontierStats, FrontierWorkspace};
+use crate::math::{DVec3, Pose};
 use crate::narrow::contact::Manifold;
+use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::DistanceCache;
 use crate::scene::MeshShape;
 use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
@@ -309,6 +317,16 @@ pub struct StepReport {
     /// Candidate pairs answered by last frame's answer, neither body having changed (see
     /// the [module docs](self)).
     pub reused_pairs: u32,
+    /// The budgeted mesh–mesh frontier ([`step_within`] with a limited budget), nanoseconds;
+    /// 0 when it did not run. Not part of `narrow_ns`.
+    pub mid_ns: u64,
+    /// The frontier's counters of this frame (visits, rounds begun, bound and triangle
+    /// tests, polls; a resumed frontier counts only this frame's share); all 0 when it did
+    /// not run.
+    pub frontier: FrontierStats,
+    /// Mesh–mesh pairs the frontier left unfinished: answered conservatively (see
+    /// [`step_within`]); 0 when it did not run.
+    pub truncated_pairs: u32,
 }
 
 /// Frames between two measurements of a [`BroadPhaseChoice::Auto`] scene's statistics.
@@ -386,6 +404,17 @@ pub struct PipelineWorkspace {
     swept_sweep: SortAndSweep,
     /// Candidate pairs of the swept boxes.
     toi_candidates: Vec<CandidatePair>,
+    /// The budgeted frontier's state (frames with a limited budget).
+    frontier: FrontierWorkspace,
+    /// The frontier's answers of this frame, in candidate order of its pairs.
+    frontier_answers: Vec<FrontierAnswer>,
+    /// The candidate pairs the frontier answered this frame, in its order.
+    frontier_pairs: Vec<CandidatePair>,
+    /// Per mesh–mesh candidate, the triangle ids of the closest triangle pair a budgeted
+    /// frame's frontier found: next frame's first upper bound under `DISTANCE`.
+    frontier_seeds: HashMap<CandidatePair, [u32; 2]>,
+    /// What the frontier last ran over, to resume it next frame.
+    frontier_run: FrontierRun,
 }
 
 impl PipelineWorkspace {
@@ -398,13 +427,85 @@ impl PipelineWorkspace {
             ..Self::default()
         }
     }
+
+    /// This workspace with its budgeted frontier polling the budget once at least `visits`
+    /// (`≥ 1`) visits were made since the last poll (default
+    /// [`DEFAULT_POLL_EVERY`](crate::bvh::frontier::DEFAULT_POLL_EVERY)); 1 lets tests stop
+    /// it at every interruption point.
+    #[must_use]
+    pub fn with_frontier_poll_every(mut self, visits: u64) -> Self {
+        self.frontier = FrontierWorkspace::with_poll_every(visits);
+        self
+    }
 }
 
 /// Runs one frame over `scene`: the pairs `query` asks for (see the [module docs](self)),
-/// with their contacts, written to `results` (cleared first).
+/// with their contacts, written to `results` (cleared first). Every answer exact: this is
+/// [`step_within`] with an [`Unlimited`] budget.
 pub fn step(
     scene: &Scene,
     query: Query,
+    workspace: &mut PipelineWorkspace,
+    results: &mut FrameResults,
+) -> StepReport {
+    step_within(scene, query, &mut Unlimited, workspace, results)
+}
+
+/// [`step`] under a budget (DESIGN §5): the frame's mesh–mesh pairs are answered through
+/// one budgeted breadth-first frontier ([`frontier`]) over all of them, and those it could
+/// not finish get conservative answers.
+///
+/// # With an unlimited budget
+/// ([`Budget::is_unlimited`]): exactly [`step`]'s answers, by the same exact per-pair
+/// queries (warm-started, on the worker pool when there is one).
+///
+/// # With a limited budget
+/// Before the per-pair loop, every mesh–mesh candidate pair not answered by a kept answer
+/// joins one frontier run, with threshold the pair's margin sum (`CLOSE`, `OVERLAP`,
+/// `CONTACTS`) or, when `DISTANCE` is asked, an upper bound of the pair's distance: the
+/// distance of one triangle pair (the closest a previous budgeted frame found for it, else
+/// the first triangles; one triangle test outside the budget). The frontier then prunes
+/// with that bound and each pair's best distance so far, and gives the exact distance when
+/// it finishes. (With a threshold of `+∞` instead, breadth-first order finds no distance
+/// before the leaves and descends every node pair: about 1.5× the visits on the test
+/// piles, and still about 50× those of `CLOSE`: `DISTANCE` is the costly query under a
+/// budget.) The frontier runs on the calling thread under `budget`; a [`Deadline`] is
+/// moved [`FRONTIER_RESERVE`] earlier ([`frontier_deadline`]) to leave time for the rest
+/// of the frame.
+///
+/// When last frame's frontier was cut short and every one of its pairs is still a
+/// candidate with both bodies unchanged (same scene, same query), it *resumes* where it
+/// stopped instead of starting over: a pair too costly for one frame's budget is refined
+/// frame after frame while its bodies rest, and reaches its exact answer after as many
+/// visits as one unlimited run. Then, per pair:
+/// - a pair the frontier finished gets the exact record (distance, witnesses, normal from
+///   the witnesses, as [`step`] gives; only the witnesses may name another triangle pair
+///   at the same distance) and, when `CONTACTS` is asked and it touches, the exact
+///   mesh–mesh contacts;
+/// - a pair it left unfinished may qualify: it is reported by the usual rule with
+///   `distance` the frontier's lower bound (never above the true distance), its error
+///   bound (`true ≤ distance + error_bound`), `exact = false`, "may touch" when that
+///   bound is `≤ 0` (with one conservative contact point when `CONTACTS` is asked, as the
+///   box answers give), and the frame is [`Completeness::Truncated`] at the shallowest
+///   level of any such pair. No pair that qualifies is ever left out.
+///
+/// Only exact answers are kept for reuse ([`PipelineWorkspace`]): a truncated pair is
+/// refined again next frame. [`StepReport`] carries the frontier's counters
+/// ([`StepReport::frontier`], [`StepReport::truncated_pairs`]) and time
+/// ([`StepReport::mid_ns`]).
+///
+/// Not yet budgeted: the broad phase, the pairs outside the frontier (closed forms,
+/// GJK/EPA, convex–mesh walks), the exact contacts of finished touching mesh pairs and
+/// time of impact run to completion whatever the budget (the reserve is for them). The
+/// worker pool is not used for a budgeted frontier (one thread).
+///
+/// # Allocation
+/// As [`step`], plus, with a limited budget, one list of the frame's frontier pairs (it
+/// borrows the scene's trees) and one seed entry when a mesh pair first gets a witness.
+pub fn step_within(
+    scene: &Scene,
+    query: Query,
+    budget: &mut dyn Budget,
     workspace: &mut PipelineWorkspace,
     results: &mut FrameResults,
 ) -> StepReport {
@@ -433,7 +534,21 @@ pub fn step(
     }
     let broad_ns = elapsed_ns(started);
     let started = Instant::now();
+    let limited = !budget.is_unlimited() && query.at_current_poses();
+    let mut mid_ns = 0;
+    let mut frontier_stats = FrontierStats::default();
+    if limited {
+        let mut reserved = budget.deadline().map(frontier_deadline);
+        let frontier_budget: &mut dyn Budget = match reserved.as_mut() {
+            Some(deadline) => deadline,
+            None => &mut *budget,
+        };
+        frontier_stats = run_frontier(scene, query, frontier_budget, workspace);
+        mid_ns = elapsed_ns(started);
+    }
+    let started = Instant::now();
     let mut completeness = Completeness::Exact;
+    let mut truncated_pairs = 0;
     let PipelineWorkspace {
         candidates,
         mesh,
@@ -445,6 +560,8 @@ pub fn step(
         narrow,
         manifold,
         toi_candidates,
+        frontier_answers,
+        frontier_pairs,
         ..
     } = workspace;
     mesh_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
@@ -452,12 +569,13 @@ pub fn step(
     let is_kept = |pair: &CandidatePair| kept.get(pair).is_some_and(|k| k.fits(scene, pair, query));
     outcomes.clear();
     let parallel = workers.as_ref().filter(|_| {
-        candidates
-            .iter()
-            .filter(|pair| mesh_pair(scene, pair).is_some() && !is_kept(pair))
-            .take(MIN_PARALLEL_MESH_PAIRS)
-            .count()
-            == MIN_PARALLEL_MESH_PAIRS
+        !limited
+            && candidates
+                .iter()
+                .filter(|pair| mesh_pair(scene, pair).is_some() && !is_kept(pair))
+                .take(MIN_PARALLEL_MESH_PAIRS)
+                .count()
+                == MIN_PARALLEL_MESH_PAIRS
     });
     if let Some(pool) = parallel {
         let jobs = candidates.iter().enumerate().filter_map(|(slot, pair)| {
@@ -479,6 +597,7 @@ pub fn step(
         pool.answer_all(jobs, outcomes, mesh, job_contacts);
     }
     let mut pooled = outcomes.iter();
+    let mut from_frontier = frontier_pairs.iter().zip(frontier_answers.iter());
     let mut reused = 0;
     for (slot, pair) in candidates.iter().enumerate() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
@@ -487,17 +606,38 @@ pub fn step(
         if let Some(k) = kept.get(pair).filter(|k| k.fits(scene, pair, query)) {
             reused += 1;
             contacts.extend_from_slice(&k.contacts);
-            let answer = k.answer;
-            if !answer.result.exact {
-                completeness = Completeness::Truncated { level: 0 };
-            }
-            report(query, answer, (a, b), first_contact, results);
+            debug_assert!(k.answer.result.exact, "only exact answers are kept");
+            report(query, k.answer, (a, b), first_contact, results);
             continue;
         }
         let (sa, sb) = (shape(scene, a), shape(scene, b));
+        let mut truncated_level = None;
         let answer = match (dispatch::route(sa, sb), parallel) {
             (Route::Direct, _) => {
                 answer::direct(pair, (a, sa), (b, sb), query, narrow, manifold, contacts)
+            }
+            (Route::MeshMesh(ma, mb), _) if limited => {
+                narrow.paths.mesh_mesh += 1;
+                let (_, found) = from_frontier
+                    .find(|(p, _)| *p == pair)
+                    .expect("a frontier answer for every mesh pair not kept");
+                match found.completeness {
+                    frontier::Completeness::Exact => answer::mesh_mesh_finished(
+                        pair,
+                        (a, ma),
+                        (b, mb),
+                        query,
+                        found,
+                        mesh_caches.entry(*pair).or_default(),
+                        mesh,
+                        contacts,
+                    ),
+                    frontier::Completeness::Truncated { level } => {
+                        truncated_pairs += 1;
+                        truncated_level = Some(level);
+                        answer::mesh_mesh_truncated(pair, (a, b), query, found, contacts)
+                    }
+                }
             }
             (Route::MeshMesh(..), Some(_)) => {
                 narrow.paths.mesh_mesh += 1;
@@ -521,7 +661,12 @@ pub fn step(
             }
         };
         if !answer.result.exact {
-            completeness = Completeness::Truncated { level: 0 };
+            // A truncated frontier answer, or the worker pool's fallback box answer (level
+            // 0: world boxes).
+            completeness = shallower(completeness, truncated_level.unwrap_or(0));
+            report(query, answer, (a, b), first_contact, results);
+            kept.remove(pair);
+            continue;
         }
         let entry = kept.entry(*pair).or_insert_with(|| KeptAnswer {
             scene: 0,
@@ -561,7 +706,192 @@ pub fn step(
         broad_stats,
         paths: narrow.paths,
         reused_pairs: reused,
+        mid_ns,
+        frontier: frontier_stats,
+        truncated_pairs,
     }
+}
+
+/// The completeness of a frame with one more answer truncated at `level`: the shallowest.
+fn shallower(completeness: Completeness, level: u32) -> Completeness {
+    match completeness {
+        Completeness::Truncated { level: seen } if seen <= level => completeness,
+        _ => Completeness::Truncated { level },
+    }
+}
+
+/// Answers the frame's mesh–mesh candidates that no kept answer covers through the
+/// frontier, under `budget` (see [`step_within`]): resumes last frame's frontier when it
+/// can ([`FrontierRun::resumes`]), else runs a fresh one over those pairs in candidate
+/// order. Leaves the frontier's pairs in `workspace.frontier_pairs` and their answers in
+/// `workspace.frontier_answers` (a superset of the pairs asked when resuming, in candidate
+/// order); returns this frame's share of the frontier's counters.
+fn run_frontier(
+    scene: &Scene,
+    query: Query,
+    budget: &mut dyn Budget,
+    workspace: &mut PipelineWorkspace,
+) -> FrontierStats {
+    let PipelineWorkspace {
+        candidates,
+        kept,
+        frontier,
+        frontier_answers,
+        frontier_pairs,
+        frontier_seeds,
+        frontier_run,
+        ..
+    } = workspace;
+    let needed = |pair: &&CandidatePair| {
+        mesh_pair(scene, pair).is_some()
+            && !kept.get(pair).is_some_and(|k| k.fits(scene, pair, query))
+    };
+    if !candidates.iter().any(|pair| needed(&pair)) {
+        // Nothing to answer: no run (and nothing left to resume later).
+        frontier_pairs.clear();
+        frontier_answers.clear();
+        return FrontierStats::default();
+    }
+    let resume = frontier_run.resumes(scene, query, frontier_pairs, candidates)
+        && candidates
+            .iter()
+            .filter(needed)
+            .all(|pair| frontier_pairs.binary_search(pair).is_ok());
+    if !resume {
+        frontier_seeds.retain(|pair, _| candidates.binary_search(pair).is_ok());
+        frontier_pairs.clear();
+        frontier_pairs.extend(candidates.iter().filter(needed));
+        frontier_run.scene = scene.uid();
+        frontier_run.query = query;
+        frontier_run.versions.clear();
+        frontier_run.thresholds.clear();
+        for pair in frontier_pairs.iter() {
+            let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+            frontier_run.versions.push([a.version(), b.version()]);
+            let threshold = if query.distance {
+                let (ma, mb) = mesh_pair(scene, pair).expect("a mesh pair");
+                let pose_ab = Pose::relative(&a.pose, &b.pose).to_isometry();
+                let seed = frontier_seeds.get(pair).copied().unwrap_or([0, 0]);
+                distance_upper_bound(ma, mb, &pose_ab, seed)
+            } else {
+                a.margin + b.margin
+            };
+            frontier_run.thresholds.push(threshold);
+        }
+    }
+    let pairs: Vec<FrontierPair<'_, Rss>> = frontier_pairs
+        .iter()
+        .zip(&frontier_run.thresholds)
+        .map(|(pair, &threshold)| {
+            let (ma, mb) = mesh_pair(scene, pair).expect("a mesh pair");
+            let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+            FrontierPair {
+                a: &ma.distance_tree,
+                b: &mb.distance_tree,
+                pose_ab: Pose::relative(&a.pose, &b.pose).to_isometry(),
+                threshold,
+            }
+        })
+        .collect();
+    let before = if resume {
+        *frontier.stats()
+    } else {
+        frontier.start(&pairs);
+        FrontierStats::default()
+    };
+    frontier.run(
+        &pairs,
+        &mut Resumed {
+            inner: budget,
+            base: before.visits,
+        },
+    );
+    frontier.answers(&pairs, frontier_answers);
+    for (pair, answer) in frontier_pairs.iter().zip(frontier_answers.iter()) {
+        if let Some(w) = answer.witnesses {
+            frontier_seeds.insert(*pair, w.triangles);
+        }
+    }
+    let after = *frontier.stats();
+    FrontierStats {
+        visits: after.visits - before.visits,
+        bv_tests: after.bv_tests - before.bv_tests,
+        triangle_tests: after.triangle_tests - before.triangle_tests,
+        rounds: after.rounds - before.rounds,
+        polls: after.polls - before.polls,
+    }
+}
+
+/// What last frame's frontier ran over, to resume it.
+#[derive(Debug, Default)]
+struct FrontierRun {
+    /// [`Scene::uid`] of its scene.
+    scene: u64,
+    query: Query,
+    /// Both bodies' versions, per pair of `PipelineWorkspace::frontier_pairs`.
+    versions: Vec<[u64; 2]>,
+    /// The threshold of each pair.
+    thresholds: Vec<f64>,
+}
+
+impl FrontierRun {
+    /// Whether the last frontier (over `pairs`) can go on this frame: same scene and query,
+    /// every pair still a candidate with both bodies unchanged (so the same poses), and
+    /// work left. A resumed frontier reaches the state a single run with the summed
+    /// budgets would (as [`FrontierWorkspace::run`] documents), so a pair left truncated
+    /// by a budget too small for it is refined frame after frame while its bodies rest.
+    fn resumes(
+        &self,
+        scene: &Scene,
+        query: Query,
+        pairs: &[CandidatePair],
+        candidates: &[CandidatePair],
+    ) -> bool {
+        !pairs.is_empty()
+            && self.scene == scene.uid()
+            && self.query == query
+            && pairs.iter().zip(&self.versions).all(|(pair, versions)| {
+                candidates.binary_search(pair).is_ok()
+                    && *versions == [body(scene, pair.a).version(), body(scene, pair.b).version()]
+            })
+    }
+}
+
+/// A budget asked about the visits since `base` (a resumed frontier counts from its start).
+struct Resumed<'b> {
+    inner: &'b mut dyn Budget,
+    base: u64,
+}
+
+impl Budget for Resumed<'_> {
+    fn allows(&mut self, visits: u64) -> bool {
+        self.inner.allows(visits - self.base)
+    }
+}
+
+/// An upper bound of the distance between two meshes (B at `pose_ab` in A's frame): the
+/// distance of the triangle pair `seed` (ids; the first triangles when out of range), padded
+/// far above its rounding. The frontier's threshold under `DISTANCE`: nothing farther than
+/// it can hold the minimum, so the frontier prunes from its first round (with `+∞` it would
+/// descend every node pair down to the leaves before finding any distance). `+∞` for an
+/// empty mesh. One triangle test per pair, outside the budget.
+fn distance_upper_bound(
+    ma: &MeshShape,
+    mb: &MeshShape,
+    pose_ab: &crate::math::Isometry,
+    seed: [u32; 2],
+) -> f64 {
+    let (na, nb) = (ma.mesh.triangle_count(), mb.mesh.triangle_count());
+    if na == 0 || nb == 0 {
+        return f64::INFINITY;
+    }
+    let pick = |id: u32, n: usize| if (id as usize) < n { id as usize } else { 0 };
+    let (ta, tb) = (
+        ma.mesh.triangle(pick(seed[0], na)),
+        mb.mesh.triangle(pick(seed[1], nb)).transformed(pose_ab),
+    );
+    let d = distance_triangle_triangle(&ta, &tb).distance.max(0.0);
+    d * (1.0 + 1e-9) + 1e-9
 }
 
 /// Brings the workspace's broad phase up to date with `scene` (see the [module
@@ -1285,5 +1615,47 @@ mod tests {
             step(&scene, all, &mut workspace, &mut results);
             assert_eq!(capacities(&workspace, &results), warm);
         }
+    }
+
+    #[test]
+    fn a_frame_is_truncated_at_the_shallowest_level_of_its_pairs() {
+        let mut c = Completeness::Exact;
+        for (level, expected) in [(3, 3), (5, 3), (1, 1), (2, 1)] {
+            c = shallower(c, level);
+            assert_eq!(c, Completeness::Truncated { level: expected });
+        }
+    }
+
+    #[test]
+    fn the_distance_seed_is_an_upper_bound_of_the_mesh_distance() {
+        use crate::narrow::mesh_mesh::{
+            DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh,
+        };
+        let torus = MeshShape::new(meshes::torus(0.4, 0.12, 16, 8));
+        let mut rng = rng(61);
+        let mut below = 0;
+        for case in 0..300 {
+            let pose = Pose::new(point_in_cube(&mut rng, 1.5), rotation(&mut rng));
+            let seed = [rng.random_range(0..300), rng.random_range(0..300)];
+            let bound = distance_upper_bound(&torus, &torus, &pose.to_isometry(), seed);
+            let exact = distance_mesh_mesh(
+                &torus.distance_tree,
+                &torus.distance_tree,
+                &pose,
+                &DistanceParams::EXACT,
+                &mut DistanceCache::new(),
+                &mut MeshMeshWorkspace::new(),
+            );
+            assert!(
+                exact.distance <= bound,
+                "case {case}: {} > {bound}",
+                exact.distance
+            );
+            below += usize::from(exact.distance < bound);
+        }
+        assert!(
+            below > 250,
+            "the seed is a bound, rarely the minimum: {below}"
+        );
     }
 }
