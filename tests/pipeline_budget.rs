@@ -587,7 +587,10 @@ fn a_past_deadline_answers_at_level_0_and_a_distant_one_gives_the_exact_frame() 
             &mut Deadline(Instant::now() + Duration::from_secs(3600)),
         );
         assert_eq!(distant.report.completeness, Completeness::Exact, "{name}");
-        assert!(distant.report.frontier.visits > 0, "{name}: the frontier ran");
+        assert!(
+            distant.report.frontier.visits > 0,
+            "{name}: the frontier ran"
+        );
         assert_eq!(distant.pairs.len(), exact.pairs.len());
         for (g, w) in distant.pairs.iter().zip(&exact.pairs) {
             same_record((&distant, g), (&exact, w), name);

@@ -12,7 +12,11 @@
 //! A round takes the entries of the frontier in increasing order of their distance lower
 //! bound (ties by pair index, then node of A, then node of B: deterministic), and for each:
 //! - a root entry first gets its own bound ([`BoundingVolume::distance_lower_bound_within`],
-//!   one *visit*);
+//!   one *visit*); when it is within the threshold and the pair has no best distance yet
+//!   (no [`FrontierPair::seed`]), a greedy [`probe`] descends once to a leaf pair and tests
+//!   it, so the rounds prune with a real distance from the start (the warm start of the
+//!   depth-first queries; a touching pair whose probe finds intersecting triangles is then
+//!   exact);
 //! - an entry whose bound exceeds `threshold` is dropped (that part is proven apart); one
 //!   whose bound is not below the pair's best exact distance so far is dropped too (it
 //!   cannot improve the minimum; no visit);
@@ -88,6 +92,7 @@
 //!     b: &torus,
 //!     pose_ab: Isometry::from_translation(DVec3::new(2.65, 0.0, 0.0)),
 //!     threshold: 0.1,
+//!     seed: None,
 //! }];
 //! let (mut workspace, mut answers) = (FrontierWorkspace::new(), Vec::new());
 //! // A small budget: a truncated, conservative answer.
@@ -192,6 +197,14 @@ pub struct FrontierPair<'a, B> {
     /// asks for the exact distance of every pair (nothing is dropped for exceeding it,
     /// only for not beating the pair's best distance so far).
     pub threshold: f64,
+    /// A triangle pair to try first (ids into each mesh's own triangle list, as
+    /// [`FrontierWitnesses::triangles`]): typically last frame's closest pair. Its exact
+    /// distance starts the pair's best distance, so entries that cannot beat it are dropped
+    /// from the first round, as the warm start of the depth-first queries does; touching
+    /// pairs whose seed still intersects are exact at once. One visit; `None`, or ids out of
+    /// range, start from nothing. Exact distances do not depend on it (the witnesses of
+    /// tied pairs may); a truncated answer stays conservative, and is usually tighter.
+    pub seed: Option<[u32; 2]>,
 }
 
 /// Whether an answer is final.
@@ -388,14 +401,29 @@ impl FrontierWorkspace {
         for (i, p) in pairs.iter().enumerate() {
             debug_assert!(p.threshold >= 0.0, "threshold {} of pair {i}", p.threshold);
             let (ra, rb) = (p.a.root_bv(), p.b.root_bv());
-            self.pairs.push(PairState {
+            let mut state = PairState {
                 threshold: p.threshold,
                 best: f64::INFINITY,
                 witnesses: None,
                 floor: f64::INFINITY,
                 root_upper: centre_upper_bound(ra, rb, &p.pose_ab),
                 rounding: rounding_bound(ra, rb, &p.pose_ab),
-            });
+            };
+            if let Some([ia, ib]) = p.seed
+                && let (Some(sa), Some(sb)) = (p.a.slot_of(ia), p.b.slot_of(ib))
+            {
+                let tri_b = p.b.triangles()[sb].transformed(&p.pose_ab);
+                let d = distance_triangle_triangle(&p.a.triangles()[sa], &tri_b);
+                self.stats.visits += 1;
+                self.stats.triangle_tests += 1;
+                state.best = d.distance;
+                state.witnesses = Some(FrontierWitnesses {
+                    point_a: d.point_a,
+                    point_b: d.point_b,
+                    triangles: [ia, ib],
+                });
+            }
+            self.pairs.push(state);
             self.current.push(Entry {
                 bound: 0.0,
                 pair: i as u32,
@@ -522,7 +550,8 @@ impl FrontierWorkspace {
     }
 
     /// Processes one entry (see the module docs); bounded work: one bound, two child
-    /// bounds or one leaf pair's triangle tests.
+    /// bounds or one leaf pair's triangle tests, and for a live root without a best
+    /// distance its [`probe`] (one descent).
     fn process<B: BoundingVolume>(&mut self, pair: &FrontierPair<'_, B>, mut entry: Entry) {
         let state = &mut self.pairs[entry.pair as usize];
         let (na, nb) = (pair.a.nodes(), pair.b.nodes());
@@ -536,6 +565,9 @@ impl FrontierWorkspace {
             if entry.bound > state.threshold {
                 state.floor = state.floor.min(entry.bound);
                 return;
+            }
+            if state.best.is_infinite() && !(x.is_leaf() && y.is_leaf()) {
+                probe(pair, state, &mut self.stats);
             }
         }
         if !is_live(entry.bound, state) {
@@ -587,6 +619,62 @@ impl FrontierWorkspace {
                 });
             }
         }
+    }
+}
+
+/// The greedy probe of a pair with no best distance yet, run when its root entry is found
+/// live: one descent from the roots, always into the child pair with the smaller lower
+/// bound, to a leaf pair whose triangles are all tested (each BV bound and triangle test a
+/// visit). It gives the pair a best distance (a touching pair's intersecting triangles,
+/// most often) that the breadth-first rounds then prune with, as the depth-first queries
+/// prune with their warm start: without it a touching pair stays truncated until the rounds
+/// reach the leaves. Bounded by the trees' depths plus one leaf pair; stops early when both
+/// children are beyond the threshold.
+fn probe<B: BoundingVolume>(
+    pair: &FrontierPair<'_, B>,
+    state: &mut PairState,
+    stats: &mut FrontierStats,
+) {
+    let (na, nb) = (pair.a.nodes(), pair.b.nodes());
+    let iso = &pair.pose_ab;
+    let (mut a, mut b) = (0usize, 0usize);
+    loop {
+        let (x, y) = (&na[a], &nb[b]);
+        if x.is_leaf() && y.is_leaf() {
+            let (ta, tb) = (pair.a.triangles(), pair.b.triangles());
+            for sb in y.slots() {
+                let tri_b = tb[sb].transformed(iso);
+                for sa in x.slots() {
+                    let d = distance_triangle_triangle(&ta[sa], &tri_b);
+                    stats.visits += 1;
+                    stats.triangle_tests += 1;
+                    if d.distance < state.best {
+                        state.best = d.distance;
+                        state.witnesses = Some(FrontierWitnesses {
+                            point_a: d.point_a,
+                            point_b: d.point_b,
+                            triangles: [pair.a.triangle_id(sa), pair.b.triangle_id(sb)],
+                        });
+                    }
+                }
+            }
+            return;
+        }
+        let children = if descend_a(x, y) {
+            x.children().map(|c| (c, b))
+        } else {
+            y.children().map(|c| (a, c))
+        };
+        let bounds = children.map(|(ca, cb)| {
+            stats.visits += 1;
+            stats.bv_tests += 1;
+            na[ca].bv.distance_lower_bound(&nb[cb].bv, iso)
+        });
+        let pick = usize::from(bounds[1] < bounds[0]);
+        if bounds[pick] > state.threshold {
+            return;
+        }
+        (a, b) = children[pick];
     }
 }
 
@@ -670,6 +758,7 @@ mod tests {
                 b,
                 pose_ab: pose.to_isometry(),
                 threshold: 0.3,
+                seed: None,
             })
             .collect()
     }
@@ -742,8 +831,10 @@ mod tests {
             assert!(ws.run(&pairs, &mut Unlimited));
             ws.stats().visits
         };
-        // The most one entry costs: a bound plus 4 × 4 triangle tests (leaf size 4).
-        let entry_cost = 17;
+        // The most one entry costs: a root's bound and its probe (two bounds per level of
+        // one descent, then a leaf pair's 4 × 4 triangle tests), or a bound plus 4 × 4
+        // triangle tests (leaf size 4).
+        let entry_cost = 1 + 2 * (a.depth() + b.depth()) as u64 + 16;
         for poll_every in [1, 5, 32] {
             for limit in (0..unlimited + 40).step_by(7) {
                 let mut ws = FrontierWorkspace::with_poll_every(poll_every);
@@ -917,6 +1008,7 @@ mod tests {
             b: &t,
             pose_ab: Isometry::from_translation(DVec3::new(0.0, 0.0, z)),
             threshold: 1.0,
+            seed: None,
         });
         let (mut ws, mut out) = (FrontierWorkspace::new(), vec![]);
         assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut out));

@@ -790,6 +790,8 @@ fn run_frontier(
                 b: &mb.distance_tree,
                 pose_ab: Pose::relative(&a.pose, &b.pose).to_isometry(),
                 threshold,
+                // Last frame's closest triangles: the warm start the exact queries have.
+                seed: frontier_seeds.get(pair).copied(),
             }
         })
         .collect();
