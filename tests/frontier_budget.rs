@@ -40,7 +40,6 @@ use proxima::narrow::mesh_mesh::{
 };
 use rand::Rng;
 use std::collections::HashMap;
-use std::path::PathBuf;
 use support::meshes;
 use support::{rng, rotation};
 
@@ -320,21 +319,15 @@ fn placed(a: &Bvh<Obb>, b: &Bvh<Obb>, rotation: DQuat, direction: DVec3, target:
     Pose::new(start.position + normal * (target - d.distance), rotation)
 }
 
-fn shared_mesh(name: &str) -> Option<TriMesh> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/meshes")
-        .join(name);
-    path.exists()
-        .then(|| TriMesh::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
-}
-
 /// The bunny (×10, 69,451 triangles), fandisk (×0.3, 12,946 triangles) and a torus, both
 /// about 1.5 m across, at poses placed touching, within the threshold and beyond it.
 fn bunny_fandisk() -> Option<Scene> {
-    let bunny = shared_mesh("stanford-bunny.obj")?
+    let bunny = meshes::shared_data_mesh("stanford-bunny.obj")?
         .scaled(10.0)
         .centered_on_bounds();
-    let fandisk = shared_mesh("fandisk.obj")?.scaled(0.3).centered_on_bounds();
+    let fandisk = meshes::shared_data_mesh("fandisk.obj")?
+        .scaled(0.3)
+        .centered_on_bounds();
     let torus = meshes::torus(0.4, 0.1, 24, 12);
     let meshes = vec![bunny, fandisk, torus];
     let params = BuildParams::BINNED_SAH.with_leaf_size(4);

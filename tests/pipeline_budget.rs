@@ -19,7 +19,7 @@
 #[path = "support/mod.rs"]
 mod support;
 
-use proxima::geometry::{Cuboid, Sphere, TriMesh};
+use proxima::geometry::{Cuboid, Sphere};
 use proxima::math::{DVec3, Pose};
 use proxima::pipeline::{
     Budget, Completeness, ContactPoint, FrameResults, PairResult, PipelineWorkspace, Query,
@@ -28,7 +28,6 @@ use proxima::pipeline::{
 use proxima::scene::{BodyDesc, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape};
 use rand::Rng;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 use std::sync::Arc;
 use support::{meshes, point_in_cube, rng, rotation};
 
@@ -152,18 +151,12 @@ fn pile(seed: u64) -> Scene {
     scene
 }
 
-fn shared_mesh(name: &str) -> Option<TriMesh> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/meshes")
-        .join(name);
-    path.exists()
-        .then(|| TriMesh::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
-}
-
 /// The fandisk (×0.3, about 1.5 m across, 12,946 triangles) and two tori placed against
 /// it: one through it, one near it.
 fn fandisk_scene() -> Option<Scene> {
-    let fandisk = shared_mesh("fandisk.obj")?.scaled(0.3).centered_on_bounds();
+    let fandisk = meshes::shared_data_mesh("fandisk.obj")?
+        .scaled(0.3)
+        .centered_on_bounds();
     let mut scene = Scene::try_new(0.03, SceneLimits::STANDARD).unwrap();
     add(
         &mut scene,

@@ -574,23 +574,12 @@ impl FrontierWorkspace {
             return;
         }
         if x.is_leaf() && y.is_leaf() {
-            let (ta, tb) = (pair.a.triangles(), pair.b.triangles());
-            for sb in y.slots() {
-                let tri_b = tb[sb].transformed(iso);
-                for sa in x.slots() {
-                    let d = distance_triangle_triangle(&ta[sa], &tri_b);
-                    self.stats.visits += 1;
-                    self.stats.triangle_tests += 1;
-                    if d.distance < state.best {
-                        state.best = d.distance;
-                        state.witnesses = Some(FrontierWitnesses {
-                            point_a: d.point_a,
-                            point_b: d.point_b,
-                            triangles: [pair.a.triangle_id(sa), pair.b.triangle_id(sb)],
-                        });
-                    }
-                }
-            }
+            test_leaf_pair(
+                pair,
+                (entry.a as usize, entry.b as usize),
+                state,
+                &mut self.stats,
+            );
             return;
         }
         let children = if descend_a(x, y) {
@@ -622,6 +611,34 @@ impl FrontierWorkspace {
     }
 }
 
+/// Tests every triangle pair of the leaf pair `(a, b)` (node indices), one visit each,
+/// updating the pair's best distance and its witnesses.
+fn test_leaf_pair<B: BoundingVolume>(
+    pair: &FrontierPair<'_, B>,
+    (a, b): (usize, usize),
+    state: &mut PairState,
+    stats: &mut FrontierStats,
+) {
+    let (x, y) = (&pair.a.nodes()[a], &pair.b.nodes()[b]);
+    let (ta, tb) = (pair.a.triangles(), pair.b.triangles());
+    for sb in y.slots() {
+        let tri_b = tb[sb].transformed(&pair.pose_ab);
+        for sa in x.slots() {
+            let d = distance_triangle_triangle(&ta[sa], &tri_b);
+            stats.visits += 1;
+            stats.triangle_tests += 1;
+            if d.distance < state.best {
+                state.best = d.distance;
+                state.witnesses = Some(FrontierWitnesses {
+                    point_a: d.point_a,
+                    point_b: d.point_b,
+                    triangles: [pair.a.triangle_id(sa), pair.b.triangle_id(sb)],
+                });
+            }
+        }
+    }
+}
+
 /// The greedy probe of a pair with no best distance yet, run when its root entry is found
 /// live: one descent from the roots, always into the child pair with the smaller lower
 /// bound, to a leaf pair whose triangles are all tested (each BV bound and triangle test a
@@ -641,23 +658,7 @@ fn probe<B: BoundingVolume>(
     loop {
         let (x, y) = (&na[a], &nb[b]);
         if x.is_leaf() && y.is_leaf() {
-            let (ta, tb) = (pair.a.triangles(), pair.b.triangles());
-            for sb in y.slots() {
-                let tri_b = tb[sb].transformed(iso);
-                for sa in x.slots() {
-                    let d = distance_triangle_triangle(&ta[sa], &tri_b);
-                    stats.visits += 1;
-                    stats.triangle_tests += 1;
-                    if d.distance < state.best {
-                        state.best = d.distance;
-                        state.witnesses = Some(FrontierWitnesses {
-                            point_a: d.point_a,
-                            point_b: d.point_b,
-                            triangles: [pair.a.triangle_id(sa), pair.b.triangle_id(sb)],
-                        });
-                    }
-                }
-            }
+            test_leaf_pair(pair, (a, b), state, stats);
             return;
         }
         let children = if descend_a(x, y) {

@@ -232,3 +232,13 @@ pub fn data_mesh(file: &str) -> TriMesh {
         .join(file);
     TriMesh::load(&path).unwrap_or_else(|e| panic!("cannot load {}: {e}", path.display()))
 }
+
+/// A mesh of `../shared/data/meshes` (real meshes, not part of the repository; see its
+/// README), or `None` when that folder is not beside the checkout: tests using it skip.
+pub fn shared_data_mesh(file: &str) -> Option<TriMesh> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/meshes")
+        .join(file);
+    path.exists()
+        .then(|| TriMesh::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
+}
