@@ -557,23 +557,49 @@ fn a_past_deadline_answers_at_level_0_and_a_distant_one_gives_the_exact_frame() 
     use proxima::pipeline::{Deadline, FRONTIER_RESERVE};
     use std::time::{Duration, Instant};
     let scene = pile(2);
+    let truth: BTreeMap<(u32, u32), f64> = run_exact(&scene, Query::DISTANCE)
+        .pairs
+        .iter()
+        .map(|p| ((p.a, p.b), p.distance))
+        .collect();
+    let mut tally = Tally::default();
     for (name, query) in QUERIES {
         let zero = run(&scene, query, &mut VisitBudget(0));
         assert_eq!(
             zero.report.completeness,
             Completeness::Truncated { level: 0 }
         );
+        let exact = run_exact(&scene, query);
         for deadline in [Instant::now(), Instant::now() + FRONTIER_RESERVE / 2] {
             let past = run(&scene, query, &mut Deadline(deadline));
-            assert_eq!(
-                (&past.pairs, &past.contacts),
-                (&zero.pairs, &zero.contacts),
-                "{name}"
-            );
             assert_eq!(past.report.frontier.visits, 0);
             assert_eq!(past.report.completeness, zero.report.completeness);
+            // The mesh pairs answer as with no visits; the sphere and box pairs, off the
+            // frontier, take their world boxes' answer instead of their closed forms: every
+            // record is conservative, none exact.
+            check_conservative(&past, &exact, &truth, query, 8, name, &mut tally);
+            assert!(past.pairs.iter().all(|p| !p.exact), "{name}");
+            for got in past.pairs.iter().filter(|p| p.b < 8) {
+                let want = zero.pair(got.a, got.b).expect("the same mesh pairs");
+                // Contacts land elsewhere in the list: the primitive pairs' differ.
+                let unplaced = |p: &PairResult| PairResult {
+                    first_contact: 0,
+                    ..*p
+                };
+                assert_eq!(unplaced(got), unplaced(want), "{name}");
+                let unlinked = |f: &Frame, p: &PairResult| -> Vec<ContactPoint> {
+                    f.contacts_of(p)
+                        .iter()
+                        .map(|c| ContactPoint { pair: 0, ..*c })
+                        .collect()
+                };
+                assert_eq!(unlinked(&past, got), unlinked(&zero, want), "{name}");
+            }
+            assert!(
+                past.pairs.iter().any(|p| p.b >= 8) && zero.pairs.iter().any(|p| p.b >= 8),
+                "{name}: primitive pairs were asked"
+            );
         }
-        let exact = run_exact(&scene, query);
         let distant = run(
             &scene,
             query,
@@ -589,4 +615,5 @@ fn a_past_deadline_answers_at_level_0_and_a_distant_one_gives_the_exact_frame() 
             same_record((&distant, g), (&exact, w), name);
         }
     }
+    assert!(tally.truncated_records > 0, "{tally:?}");
 }

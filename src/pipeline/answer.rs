@@ -447,8 +447,10 @@ fn mesh_manifold(
     }
 }
 
-/// The conservative answer from two world boxes: their distance (a lower bound of the
-/// shapes' distance) with the sum of their diagonals as error bound, and [`box_normal`];
+/// The conservative answer from two world boxes: their distance when apart, minus their
+/// smallest overlap when they overlap (either way a lower bound of the shapes' signed
+/// distance), with the sum of their diagonals (plus that overlap) as error bound, and
+/// [`box_normal`];
 /// the pair *may* touch when the boxes do. Its contact (when asked and the boxes touch) is one point: the box
 /// witnesses, the box normal, distance 0 (the depth is unknown) with the box answer's error
 /// bound, which covers the true depth.
@@ -462,11 +464,20 @@ pub(super) fn boxes(
     let point_a = b.center().clamp(a.min, a.max);
     let point_b = point_a.clamp(b.min, b.max);
     let gap = (a.min - b.max).max(b.min - a.max).max(DVec3::ZERO);
+    // Overlapping boxes: moving one by their smallest overlap along its axis separates the
+    // boxes, hence the shapes, so the signed distance is at least minus that overlap (solid
+    // shapes can penetrate; 0 would not be a lower bound).
+    let overlap = (a.max.min(b.max) - a.min.max(b.min)).min_element().max(0.0);
+    let distance = if gap == DVec3::ZERO {
+        -overlap
+    } else {
+        gap.length()
+    };
     let result = PairResult {
         a: pair.a,
         b: pair.b,
-        distance: gap.length(),
-        error_bound: (a.max - a.min).length() + (b.max - b.min).length(),
+        distance,
+        error_bound: (a.max - a.min).length() + (b.max - b.min).length() + overlap,
         point_a,
         point_b,
         normal: box_normal(a, b, gap),

@@ -494,10 +494,14 @@ pub fn step(
 /// ([`StepReport::frontier`], [`StepReport::truncated_pairs`]) and time
 /// ([`StepReport::mid_ns`]).
 ///
-/// Not yet budgeted: the broad phase, the pairs outside the frontier (closed forms,
-/// GJK/EPA, convex–mesh walks), the exact contacts of finished touching mesh pairs and
-/// time of impact run to completion whatever the budget (the reserve is for them). The
-/// worker pool is not used for a budgeted frontier (one thread).
+/// The pairs outside the frontier (closed forms, GJK/EPA, convex–mesh walks) keep to a
+/// wall-clock deadline too: once it is within [`PUBLISH_RESERVE`] (checked every few
+/// pairs), each remaining one gets the conservative answer of its margin-grown world boxes
+/// (distance between the boxes, their diagonals as error bound, "may touch" when they
+/// touch: level 0), counted in [`StepReport::truncated_pairs`]. Counted budgets leave them
+/// exact. Not yet budgeted: the broad phase, the exact contacts of finished touching mesh
+/// pairs and time of impact run to completion whatever the budget (the frontier's reserve
+/// is for them). The worker pool is not used for a budgeted frontier (one thread).
 ///
 /// # Allocation
 /// As [`step`], plus, with a limited budget, one list of the frame's frontier pairs (it
@@ -599,6 +603,9 @@ pub fn step_within(
     let mut pooled = outcomes.iter();
     let mut from_frontier = frontier_pairs.iter().zip(frontier_answers.iter());
     let mut reused = 0;
+    // Pairs off the frontier's route keep to the frame's deadline too: once it is near,
+    // the rest get their world boxes' conservative answer.
+    let mut pair_clock = PairClock::new(budget.deadline().filter(|_| limited));
     for (slot, pair) in candidates.iter().enumerate() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let first_contact = results.contacts.len();
@@ -613,6 +620,11 @@ pub fn step_within(
         let (sa, sb) = (shape(scene, a), shape(scene, b));
         let mut truncated_level = None;
         let answer = match (dispatch::route(sa, sb), parallel) {
+            (Route::Direct, _) if pair_clock.expired() => {
+                truncated_pairs += 1;
+                let bounds = |body: &Body| body.world_bounds.grown(body.margin);
+                answer::boxes(pair, &bounds(a), &bounds(b), query, contacts)
+            }
             (Route::Direct, _) => {
                 answer::direct(pair, (a, sa), (b, sb), query, narrow, manifold, contacts)
             }
@@ -821,6 +833,49 @@ fn run_frontier(
         triangle_tests: after.triangle_tests - before.triangle_tests,
         rounds: after.rounds - before.rounds,
         polls: after.polls - before.polls,
+    }
+}
+
+/// Time kept back from a frame's deadline for writing and publishing its results, when the
+/// pairs off the frontier are cut short ([`PairClock`]). 30 µs: an estimate of the daemon's
+/// publish stage (loan, write, send, notify) on the 2-core VM, to be replaced by a measured
+/// value.
+pub const PUBLISH_RESERVE: std::time::Duration = std::time::Duration::from_micros(30);
+
+/// Pairs answered between two looks at the clock by [`PairClock`]: a closed form costs
+/// tens of nanoseconds, GJK or a convex–mesh walk a few microseconds.
+const PAIRS_PER_CLOCK_CHECK: u32 = 8;
+
+/// The deadline of the per-pair loop: [`PUBLISH_RESERVE`] before the frame's, checked every
+/// [`PAIRS_PER_CLOCK_CHECK`] pairs; once passed, it stays passed.
+struct PairClock {
+    deadline: Option<Instant>,
+    count: u32,
+    expired: bool,
+}
+
+impl PairClock {
+    fn new(frame_deadline: Option<Instant>) -> Self {
+        Self {
+            deadline: frame_deadline.map(|d| d.checked_sub(PUBLISH_RESERVE).unwrap_or(d)),
+            count: 0,
+            expired: false,
+        }
+    }
+
+    /// Whether the next pair must take the conservative box answer.
+    fn expired(&mut self) -> bool {
+        if self.expired {
+            return true;
+        }
+        let Some(deadline) = self.deadline else {
+            return false;
+        };
+        self.count += 1;
+        if self.count.is_multiple_of(PAIRS_PER_CLOCK_CHECK) || self.count == 1 {
+            self.expired = Instant::now() >= deadline;
+        }
+        self.expired
     }
 }
 
