@@ -29,10 +29,13 @@
 //!
 //! Writes `DIR/curve.csv` (one row per scene and budget), `DIR/error_vs_time.svg` (distance
 //! error and precision against median frame time) and `DIR/latency.svg` (each budget's
-//! latency distribution with its deadline marked), and prints the table.
+//! latency distribution with its deadline marked), and prints the table. `--order pair`
+//! runs the frontier's rounds in pair order instead of smallest bound first, to measure
+//! what the ordering buys.
 
 use clap::Parser;
 use plotters::prelude::*;
+use proxima::bvh::frontier::RoundOrder;
 use proxima::geometry::{Capsule, Cuboid, Sphere, TriMesh};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::pipeline::{
@@ -67,6 +70,10 @@ struct Args {
     /// Output directory for curve.csv and the plots.
     #[arg(long, default_value = "target/time_vs_error")]
     out: PathBuf,
+    /// Order of the frontier's rounds: `bound` (smallest lower bound first, the default)
+    /// or `pair` (the baseline, to measure what the ordering buys).
+    #[arg(long, default_value = "bound")]
+    order: String,
     /// Print the built-in scenes and exit.
     #[arg(long)]
     list_scenes: bool,
@@ -457,7 +464,12 @@ fn compare(row: &mut Row, got: &[PairResult], exact: &[PairResult], w: &Workload
     }
 }
 
-fn run_row(w: &mut Workload, frames: usize, (label, budget): &(String, RowBudget)) -> Row {
+fn run_row(
+    w: &mut Workload,
+    frames: usize,
+    order: RoundOrder,
+    (label, budget): &(String, RowBudget),
+) -> Row {
     let mut row = Row {
         budget: label.clone(),
         budget_us: match budget {
@@ -466,7 +478,8 @@ fn run_row(w: &mut Workload, frames: usize, (label, budget): &(String, RowBudget
         },
         ..Row::default()
     };
-    let (mut exact_ws, mut kept_ws) = (PipelineWorkspace::default(), PipelineWorkspace::default());
+    let mut exact_ws = PipelineWorkspace::default();
+    let mut kept_ws = PipelineWorkspace::default().with_frontier_order(order);
     let (mut exact, mut got) = (FrameResults::default(), FrameResults::default());
     for frame in 0..frames {
         w.pose_at(frame);
@@ -668,6 +681,12 @@ fn main() -> Result<(), Box<dyn Error>> {
         return Ok(());
     }
     let budgets = parse_budgets(&args)?;
+    let order = match args.order.as_str() {
+        "bound" => RoundOrder::SmallestBound,
+        "pair" => RoundOrder::Pair,
+        "largest" => RoundOrder::LargestBound,
+        other => return Err(format!("--order {other:?}: bound, pair or largest").into()),
+    };
     let mut workload = match (&args.mesh1, &args.mesh2) {
         (Some(a), Some(b)) => two_meshes(a, b)?,
         (None, None) => match args.scene.as_str() {
@@ -681,17 +700,18 @@ fn main() -> Result<(), Box<dyn Error>> {
     std::fs::create_dir_all(&args.out)?;
     let mut rows = Vec::new();
     for budget in &budgets {
-        rows.push(run_row(&mut workload, args.frames, budget));
+        rows.push(run_row(&mut workload, args.frames, order, budget));
     }
     let exact_p50 = rows
         .iter()
         .find(|r| r.budget == "inf")
         .map(|r| r.percentile(0.5));
     println!(
-        "scene {} ({} bodies), {} frames per budget, query CLOSE",
+        "scene {} ({} bodies), {} frames per budget, query CLOSE, frontier order {}",
         workload.name,
         workload.scene.body_count(),
-        args.frames
+        args.frames,
+        args.order
     );
     println!(
         "{:>12} {:>9} {:>7} {:>6} {:>9} {:>11} {:>10} {:>9} {:>9} {:>9} {:>9} {:>7}",

@@ -437,6 +437,15 @@ impl PipelineWorkspace {
         self.frontier = FrontierWorkspace::with_poll_every(visits);
         self
     }
+
+    /// This workspace with its budgeted frontier processing each round in `order` (the
+    /// default, smallest bound first, is what the pipeline is meant to run; the other is
+    /// the baseline `examples/time_vs_error --order pair` measures it against).
+    #[must_use]
+    pub fn with_frontier_order(mut self, order: crate::bvh::frontier::RoundOrder) -> Self {
+        self.frontier = std::mem::take(&mut self.frontier).with_order(order);
+        self
+    }
 }
 
 /// Runs one frame over `scene`: the pairs `query` asks for (see the [module docs](self)),
