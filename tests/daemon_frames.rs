@@ -18,7 +18,7 @@ use proxima::scene::{
     BodyDesc, BodyId, CollisionFilter, MeshShape, Motion as SceneMotion, Scene, SceneLimits, Shape,
 };
 use proxima_ipc::client::{BodySpec, Client, Primitive};
-use proxima_ipc::scene_link::ResultFrame;
+use proxima_ipc::scene_link::{ResultFrame, SceneLink};
 use proxima_ipc::wire::{self, ErrorCode, PoseRecord, RecordKind, ResultRecord, query};
 use rand::Rng;
 use std::sync::Arc;
@@ -173,6 +173,56 @@ fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame:
 
 /// Every pair's `index`/`count` runs over contact records that name it back (what
 /// `contacts_of` returns), and together they cover the contacts exactly once, in pair order.
+/// Publishes `records` as frame `frame` asking `q`, moves the in-process `oracle` the
+/// same way and steps it, then checks the daemon's result frame against it: status, counts,
+/// and every record ([`assert_same_records`], [`assert_linked`]). Returns the result frame
+/// and the in-process report.
+fn publish_and_compare(
+    link: &SceneLink<ipc::Service>,
+    oracle: &mut Scene,
+    (workspace, expected): (&mut PipelineWorkspace, &mut FrameResults),
+    frame: u64,
+    q: Query,
+    records: &[PoseRecord],
+) -> (ResultFrame<ipc::Service>, StepReport) {
+    link.publish_poses(frame, 0, flags(q), records).unwrap();
+    for r in records {
+        let [x, y, z, w] = r.orientation;
+        let pose = Pose::try_new(DVec3::from(r.position), DQuat::from_xyzw(x, y, z, w)).unwrap();
+        oracle.set_pose(BodyId(r.body), pose).unwrap();
+    }
+    let report = step(oracle, q, workspace, expected);
+    oracle.end_frame();
+    let result = link
+        .receive_results_for(frame, TIMEOUT)
+        .unwrap()
+        .expect("a result frame");
+    let header = result.header();
+    assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
+    assert_eq!(
+        (
+            header.candidate_count,
+            header.pair_count,
+            header.contact_count,
+            header.toi_count
+        ),
+        (
+            report.candidates.max(report.toi_candidates),
+            report.pairs,
+            report.contacts,
+            report.tois
+        ),
+        "frame {frame} {q:?}"
+    );
+    assert_eq!(
+        result.records().len(),
+        expected.pairs.len() + expected.contacts.len() + expected.tois.len()
+    );
+    assert_same_records(result.records(), expected, frame);
+    assert_linked(&result);
+    (result, report)
+}
+
 fn assert_linked(frame: &ResultFrame<ipc::Service>) {
     let (pairs, contacts) = (frame.pairs(), frame.contacts());
     let mut next = 0;
@@ -470,42 +520,14 @@ fn toi_frames_over_shared_memory_match_the_in_process_pipeline_record_for_record
                 ..pose_record(i as u32, pose.position)
             });
         }
-        link.publish_poses(frame, 0, flags(q), &records).unwrap();
-        for r in &records {
-            let [x, y, z, w] = r.orientation;
-            let pose =
-                Pose::try_new(DVec3::from(r.position), DQuat::from_xyzw(x, y, z, w)).unwrap();
-            oracle.set_pose(BodyId(r.body), pose).unwrap();
-        }
-        let report = step(&oracle, q, &mut workspace, &mut expected);
-        oracle.end_frame();
-        let result = link
-            .receive_results_for(frame, TIMEOUT)
-            .unwrap()
-            .expect("a result frame");
-        let header = result.header();
-        assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
-        assert_eq!(
-            (
-                header.candidate_count,
-                header.pair_count,
-                header.contact_count,
-                header.toi_count
-            ),
-            (
-                report.candidates.max(report.toi_candidates),
-                report.pairs,
-                report.contacts,
-                report.tois
-            ),
-            "frame {frame} {q:?}"
+        let (result, report) = publish_and_compare(
+            &link,
+            &mut oracle,
+            (&mut workspace, &mut expected),
+            frame,
+            q,
+            &records,
         );
-        assert_eq!(
-            result.records().len(),
-            expected.pairs.len() + expected.contacts.len() + expected.tois.len()
-        );
-        assert_same_records(result.records(), &expected, frame);
-        assert_linked(&result);
         assert_eq!(result.tois().len(), expected.tois.len());
         assert!(
             result
@@ -630,45 +652,17 @@ fn frames_with_a_fixed_incremental_sap_or_hash_grid_match_the_in_process_pipelin
                 ..pose_record(i as u32, pose.position)
             });
         }
-        link.publish_poses(frame, 0, flags(q), &records).unwrap();
-        for r in &records {
-            let [x, y, z, w] = r.orientation;
-            let pose =
-                Pose::try_new(DVec3::from(r.position), DQuat::from_xyzw(x, y, z, w)).unwrap();
-            oracle.set_pose(BodyId(r.body), pose).unwrap();
-        }
-        let report = step(&oracle, q, &mut workspace, &mut expected);
-        oracle.end_frame();
-        let result = link
-            .receive_results_for(frame, TIMEOUT)
-            .unwrap()
-            .expect("a result frame");
-        let header = result.header();
-        assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
-        assert_eq!(
-            (
-                header.candidate_count,
-                header.pair_count,
-                header.contact_count,
-                header.toi_count
-            ),
-            (
-                report.candidates.max(report.toi_candidates),
-                report.pairs,
-                report.contacts,
-                report.tois
-            ),
-            "frame {frame} {q:?}"
+        let (_, report) = publish_and_compare(
+            &link,
+            &mut oracle,
+            (&mut workspace, &mut expected),
+            frame,
+            q,
+            &records,
         );
         if let BroadPhaseChoice::Fixed(kind) = oracle.broad_phase() {
             assert_eq!(report.broad_kind, Some(kind));
         }
-        assert_eq!(
-            result.records().len(),
-            expected.pairs.len() + expected.contacts.len() + expected.tois.len()
-        );
-        assert_same_records(result.records(), &expected, frame);
-        assert_linked(&result);
         pairs_seen += expected.pairs.len();
     }
     assert!(pairs_seen > 100, "pairs {pairs_seen}");
