@@ -28,11 +28,17 @@ const TIMEOUT: Duration = Duration::from_secs(10);
 const MARGIN: f64 = 0.1;
 
 fn pose_record(body: u32, p: DVec3) -> PoseRecord {
+    posed_record(body, &Pose::new(p, DQuat::IDENTITY))
+}
+
+/// The wire record of `body` at `pose`.
+fn posed_record(body: u32, pose: &Pose) -> PoseRecord {
+    let r = pose.rotation;
     PoseRecord {
         body,
         reserved: 0,
-        position: p.to_array(),
-        orientation: [0.0, 0.0, 0.0, 1.0],
+        position: pose.position.to_array(),
+        orientation: [r.x, r.y, r.z, r.w],
     }
 }
 
@@ -274,11 +280,8 @@ fn every_query_combination_gets_the_in_process_pipelines_answer_over_shared_memo
         let q = queries[(frame as usize - 1) % queries.len()];
         let records: Vec<PoseRecord> = (0..oracle.body_count() as u32)
             .map(|i| {
-                let r = support::rotation(&mut rng);
-                PoseRecord {
-                    orientation: [r.x, r.y, r.z, r.w],
-                    ..pose_record(i, support::point_in_cube(&mut rng, 1.3))
-                }
+                let at = support::point_in_cube(&mut rng, 1.3);
+                posed_record(i, &Pose::new(at, support::rotation(&mut rng)))
             })
             .collect();
         link.publish_poses(frame, 0, flags(q), &records).unwrap();
@@ -514,11 +517,7 @@ fn toi_frames_over_shared_memory_match_the_in_process_pipeline_record_for_record
                     (turn * pose.rotation).normalize(),
                 );
             }
-            let r = pose.rotation;
-            records.push(PoseRecord {
-                orientation: [r.x, r.y, r.z, r.w],
-                ..pose_record(i as u32, pose.position)
-            });
+            records.push(posed_record(i as u32, pose));
         }
         let (result, report) = publish_and_compare(
             &link,
@@ -646,11 +645,7 @@ fn frames_with_a_fixed_incremental_sap_or_hash_grid_match_the_in_process_pipelin
                 pose.position + support::point_in_cube(&mut rng, 0.2),
                 (turn * pose.rotation).normalize(),
             );
-            let r = pose.rotation;
-            records.push(PoseRecord {
-                orientation: [r.x, r.y, r.z, r.w],
-                ..pose_record(i as u32, pose.position)
-            });
+            records.push(posed_record(i as u32, pose));
         }
         let (_, report) = publish_and_compare(
             &link,
@@ -698,11 +693,11 @@ fn twin_tori_pile(client: &Client<ipc::Service>) -> (TwinScenes, Vec<PoseRecord>
         };
         assert_eq!(oracle.add_body(&desc).unwrap(), BodyId(id));
         let cell = DVec3::new(f64::from(k % 4) - 1.5, f64::from(k / 4) - 0.5, 0.0) * 0.85;
-        let r = support::rotation(&mut rng);
-        records.push(PoseRecord {
-            orientation: [r.x, r.y, r.z, r.w],
-            ..pose_record(id, cell + support::point_in_cube(&mut rng, 0.2))
-        });
+        let at = cell + support::point_in_cube(&mut rng, 0.2);
+        records.push(posed_record(
+            id,
+            &Pose::new(at, support::rotation(&mut rng)),
+        ));
     }
     for r in &records {
         let [x, y, z, w] = r.orientation;
