@@ -41,34 +41,11 @@ use proxima::narrow::mesh_mesh::{
 use rand::Rng;
 use std::collections::HashMap;
 use support::meshes;
+use support::triangle_pairs::{TriangleBox, TrianglePairs};
 use support::{rng, rotation};
 
 // ---------------------------------------------------------------------------------------
 // The oracle.
-
-/// Axis-aligned box of one triangle.
-#[derive(Debug, Clone, Copy)]
-struct TriangleBox {
-    lo: DVec3,
-    hi: DVec3,
-}
-
-impl TriangleBox {
-    fn of(t: &Triangle) -> Self {
-        Self {
-            lo: t.a.min(t.b).min(t.c),
-            hi: t.a.max(t.b).max(t.c),
-        }
-    }
-
-    /// Length of the shortest vector between the boxes (0 when they overlap).
-    fn gap(&self, other: &Self) -> f64 {
-        (other.lo - self.hi)
-            .max(self.lo - other.hi)
-            .max(DVec3::ZERO)
-            .length()
-    }
-}
 
 /// A's triangles and B's mapped into A's frame, with their boxes.
 struct Oracle {
@@ -82,23 +59,18 @@ struct Oracle {
 
 impl Oracle {
     fn new(a: &TriMesh, b: &TriMesh, pose_ab: &Pose) -> Self {
-        let iso = pose_ab.to_isometry();
-        let a = meshes::triangles(a);
-        let b: Vec<Triangle> = meshes::triangles(b)
-            .iter()
-            .map(|t| t.transformed(&iso))
-            .collect();
-        let scale = a
-            .iter()
-            .chain(&b)
-            .flat_map(Triangle::vertices)
-            .map(|v| v.abs().max_element())
-            .fold(0.0, f64::max);
+        let TrianglePairs {
+            a,
+            a_boxes,
+            b,
+            b_boxes,
+            scale,
+        } = TrianglePairs::new(a, b, pose_ab);
         Self {
-            a_boxes: a.iter().map(TriangleBox::of).collect(),
-            b_boxes: b.iter().map(TriangleBox::of).collect(),
             a,
             b,
+            a_boxes,
+            b_boxes,
             slack: 1e-9 * scale + 1e-300,
         }
     }

@@ -38,6 +38,7 @@ use std::collections::HashSet;
 use std::fmt;
 use std::ops::ControlFlow;
 use support::meshes::{self, reach};
+use support::triangle_pairs::{TriangleBox, TrianglePairs};
 use support::{TestRng, rng, rotation};
 
 // ---------------------------------------------------------------------------------------
@@ -79,31 +80,6 @@ const _: () = assert!(TOTAL_RANDOM_POSES >= 2000);
 // ---------------------------------------------------------------------------------------
 // The oracle.
 
-/// Axis-aligned box of one triangle.
-#[derive(Debug, Clone, Copy)]
-struct TriangleBox {
-    lo: DVec3,
-    hi: DVec3,
-}
-
-impl TriangleBox {
-    fn of(t: &Triangle) -> Self {
-        Self {
-            lo: t.a.min(t.b).min(t.c),
-            hi: t.a.max(t.b).max(t.c),
-        }
-    }
-
-    /// Length of the shortest vector between the two boxes (0 when they overlap): a lower
-    /// bound of the distance of anything inside them, up to rounding.
-    fn gap(&self, other: &Self) -> f64 {
-        let per_axis = (other.lo - self.hi)
-            .max(self.lo - other.hi)
-            .max(DVec3::ZERO);
-        per_axis.length()
-    }
-}
-
 /// Every triangle pair of A and of B placed at one pose, both in A's frame.
 struct Oracle {
     a: Vec<Triangle>,
@@ -126,23 +102,18 @@ struct Truth {
 
 impl Oracle {
     fn new(a: &TriMesh, b: &TriMesh, pose_ab: &Pose) -> Self {
-        let iso = pose_ab.to_isometry();
-        let a = meshes::triangles(a);
-        let b: Vec<Triangle> = meshes::triangles(b)
-            .iter()
-            .map(|t| t.transformed(&iso))
-            .collect();
-        let scale = a
-            .iter()
-            .chain(&b)
-            .flat_map(Triangle::vertices)
-            .map(|v| v.abs().max_element())
-            .fold(0.0, f64::max);
-        Self {
-            a_boxes: a.iter().map(TriangleBox::of).collect(),
-            b_boxes: b.iter().map(TriangleBox::of).collect(),
+        let TrianglePairs {
             a,
+            a_boxes,
             b,
+            b_boxes,
+            scale,
+        } = TrianglePairs::new(a, b, pose_ab);
+        Self {
+            a,
+            a_boxes,
+            b,
+            b_boxes,
             scale,
             slack: 1e-6 * scale + 1e-300,
         }
