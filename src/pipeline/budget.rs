@@ -21,14 +21,19 @@ pub use crate::bvh::frontier::{Budget, Deadline, Unlimited, VisitBudget};
 /// tests here never measure time).
 pub const FRONTIER_RESERVE: Duration = Duration::from_micros(100);
 
-/// The deadline of the frontier inside a frame ending at `frame_deadline`:
-/// [`FRONTIER_RESERVE`] earlier. A frame with less than the reserve left gets a deadline
-/// already past: its frontier does no work and every mesh pair is answered at level 0.
+/// The deadline of a frontier starting at `start` inside a frame ending at
+/// `frame_deadline`: earlier by [`FRONTIER_RESERVE`] or by a quarter of the time left,
+/// whichever is less. A small budget keeps three quarters for the frontier (with
+/// the whole reserve, a 100 µs frame left it nothing: every mesh pair at level 0; the work
+/// after the frontier shrinks with the frame, and the pairs off the frontier keep to the
+/// deadline on their own). A deadline already past stays past.
 #[must_use]
-pub fn frontier_deadline(frame_deadline: Instant) -> Deadline {
+pub fn frontier_deadline(start: Instant, frame_deadline: Instant) -> Deadline {
+    let budget = frame_deadline.saturating_duration_since(start);
+    let reserve = FRONTIER_RESERVE.min(budget / 4);
     Deadline(
         frame_deadline
-            .checked_sub(FRONTIER_RESERVE)
+            .checked_sub(reserve)
             .unwrap_or(frame_deadline),
     )
 }
@@ -38,14 +43,22 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_frontier_deadline_is_the_frame_deadline_less_the_reserve() {
+    fn the_frontier_deadline_is_the_frame_deadline_less_the_reserve_or_a_quarter_budget() {
         let now = Instant::now();
         let frame = now + Duration::from_millis(2);
-        assert_eq!(frontier_deadline(frame).0 + FRONTIER_RESERVE, frame);
+        assert_eq!(frontier_deadline(now, frame).0 + FRONTIER_RESERVE, frame);
         assert_eq!(
-            frontier_deadline(frame).deadline(),
+            frontier_deadline(now, frame).deadline(),
             Some(frame - FRONTIER_RESERVE)
         );
+        let small = now + Duration::from_micros(200);
+        assert_eq!(
+            frontier_deadline(now, small).0,
+            now + Duration::from_micros(150)
+        );
+        // A deadline already past (before the frame started) stays where it is.
+        let past = now.checked_sub(Duration::from_micros(10)).unwrap_or(now);
+        assert_eq!(frontier_deadline(now, past).0, past);
     }
 
     #[test]

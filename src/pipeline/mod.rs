@@ -479,7 +479,7 @@ pub fn step(
 /// before the leaves and descends every node pair: about 1.5× the visits on the test
 /// piles, and still about 50× those of `CLOSE`: `DISTANCE` is the costly query under a
 /// budget.) The frontier runs on the calling thread under `budget`; a [`Deadline`] is
-/// moved [`FRONTIER_RESERVE`] earlier ([`frontier_deadline`]) to leave time for the rest
+/// moved earlier by [`FRONTIER_RESERVE`] or a quarter of the budget ([`frontier_deadline`]) to leave time for the rest
 /// of the frame.
 ///
 /// When last frame's frontier was cut short and every one of its pairs is still a
@@ -551,7 +551,7 @@ pub fn step_within(
     let mut mid_ns = 0;
     let mut frontier_stats = FrontierStats::default();
     if limited {
-        let mut reserved = budget.deadline().map(frontier_deadline);
+        let mut reserved = budget.deadline().map(|d| frontier_deadline(started, d));
         let frontier_budget: &mut dyn Budget = match reserved.as_mut() {
             Some(deadline) => deadline,
             None => &mut *budget,
