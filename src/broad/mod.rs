@@ -8,8 +8,9 @@
 //! boxes, so the narrow phase never misses a close pair.
 //!
 //! [`brute_force`] tests every pair: the reference the faster broad phases are checked
-//! against. [`sort_sweep`] sorts the boxes on one axis and tests only overlapping intervals;
-//! it takes the whole proxy list every frame. [`incremental_sap`] is stateful: bodies are
+//! against. [`sort_sweep`] sweeps the boxes along one axis within the columns of a grid over
+//! the other two, testing only overlapping intervals; it takes the whole proxy list every
+//! frame. [`incremental_sap`] is stateful: bodies are
 //! inserted, updated and removed one by one, and it keeps sorted endpoint lists on all three
 //! axes and the overlapping-pair set between frames, so a body that did not move costs
 //! nothing. [`hash_grid`] has the same stateful API: a hierarchy of hashed uniform grids

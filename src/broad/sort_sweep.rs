@@ -1,8 +1,9 @@
 //! Sort and sweep in grid columns: the sweep runs along the axis where the box centres
 //! spread most, but separately within each *column* of a square grid laid over the other
 //! two axes, so a proxy meets only the proxies near it on all three axes. A stateless broad
-//! phase: it takes the whole proxy list every frame and keeps only scratch space, so it
-//! costs the same whatever moved (the automatic choice uses it when most bodies move).
+//! phase: it takes the whole proxy list every frame and keeps only scratch space and its
+//! order of the proxies on the sweep axis, so it costs about the same whatever moved (the
+//! automatic choice uses it when most bodies move or bodies teleport).
 //!
 //! # Why columns
 //! A plain one-axis sweep tests every pair whose intervals overlap on that axis: for `n`
@@ -19,9 +20,11 @@
 //!    `v`, raised until the grid over the boxes has at most [`MAX_COLUMNS_PER_PROXY`] × `n`
 //!    columns (so tiny far-apart boxes do not make a huge empty grid); boxes wider than
 //!    [`BIG_COLUMNS`] columns on `u` or `v` are *big*: tested against every proxy instead.
-//! 3. Every other box is listed in each column its `u`, `v` extent meets (1 to 4 mostly), by
-//!    a counting sort on the column; each column's entries are sorted by their low end on
-//!    `s`.
+//! 3. The kept order of the proxies by their low end on `s` is brought up to date by
+//!    insertion sort (linear for coherent motion; a full sort past
+//!    [`MAX_SHIFTS_PER_PROXY`] shifts per proxy). Every other box is listed in each column
+//!    its `u`, `v` extent meets (1 to 4 mostly), by a counting sort on the column filled in
+//!    that order, so each column comes out sorted by low end with no sort of its own.
 //! 4. Each column is swept: entry `i` meets the entries after it whose low end is at most
 //!    its high end. A pair meeting in several columns is reported from one only: the column
 //!    holding the low corner of the two boxes' `u`, `v` overlap, which is the column pair of
@@ -34,8 +37,9 @@
 //! side; the pair rule is [`Aabb::intersects`](crate::bounding::Aabb::intersects) (closed
 //! boxes), as in every broad phase.
 //!
-//! Costs: `O(n + columns + e log e + t + k log k)` for `e` column entries, `t` box tests
-//! in the columns and `k` pairs; no allocation once the scratch has grown.
+//! Costs: `O(n + s + columns + e + t + k log k)` for `s` insertion-sort shifts (at most
+//! `n log n` work with the fallback), `e` column entries, `t` interval tests in the
+//! columns and `k` pairs; no allocation once the scratch has grown.
 
 use super::{CandidatePair, Proxy};
 use crate::bounding::BoundingVolume;
@@ -46,7 +50,7 @@ pub const MAX_COLUMNS_PER_PROXY: usize = 4;
 pub const BIG_COLUMNS: u64 = 4;
 /// Insertion sort of the kept order gives way to a full sort beyond this many shifts per
 /// proxy (teleports): coherent frames shift each proxy by a few places at most.
-const MAX_SHIFTS_PER_PROXY: usize = 8;
+pub const MAX_SHIFTS_PER_PROXY: usize = 8;
 
 /// The column grid of the last frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
