@@ -31,13 +31,7 @@ impl Phase {
     pub fn new(name: &str, proxies: &[Proxy], out: &mut Vec<CandidatePair>) -> Option<Self> {
         let mut phase = match name {
             "sort_sweep" => Self::SortSweep(SortAndSweep::new()),
-            "incremental_sap" => {
-                let mut s = IncrementalSap::new();
-                for p in proxies {
-                    s.insert(p.body, p.bounds, p.is_static, p.filter);
-                }
-                Self::Sap(s)
-            }
+            "incremental_sap" => Self::Sap(IncrementalSap::from_proxies(proxies)),
             "hash_grid" => {
                 let mut g = HashGrid::new();
                 for p in proxies {

@@ -56,7 +56,7 @@ use std::collections::BTreeSet;
 
 use super::body_map::BodyMap;
 use super::pair_set::PairSet;
-use super::{CandidatePair, CollisionFilter, Proxy, pairs_brute_force};
+use super::{CandidatePair, CollisionFilter, Proxy, SortAndSweep, pairs_brute_force};
 use crate::bounding::{Aabb, BoundingVolume};
 
 /// Index of a body's min endpoint in [`IncrementalSap::positions`].
@@ -151,6 +151,46 @@ impl IncrementalSap {
     #[must_use]
     pub fn proxies(&self) -> &[Proxy] {
         &self.proxies
+    }
+
+    /// A broad phase holding `proxies` (distinct ids), built in `O(n log n + k log k)`: each
+    /// axis's endpoints sorted once and the pairs found by one [`SortAndSweep`] pass,
+    /// instead of `n` insertions at `O(n)` each (300 ms for 10,000 bodies, 44 s for
+    /// 100,000). The same state as inserting them one by one, up to the order of equal
+    /// endpoints of the same kind (which changes no overlap).
+    #[must_use]
+    pub fn from_proxies(proxies: &[Proxy]) -> Self {
+        let mut sap = Self::new();
+        for (slot, p) in proxies.iter().enumerate() {
+            debug_assert_valid_bounds(&p.bounds);
+            let previous = sap.slot_of.insert(p.body, slot as u32);
+            debug_assert!(previous.is_none(), "body {} given twice", p.body);
+            sap.proxies.push(*p);
+            sap.positions.push([[0; 2]; 3]);
+        }
+        for axis in 0..3 {
+            let endpoints = &mut sap.axes[axis];
+            endpoints.extend(proxies.iter().enumerate().flat_map(|(slot, p)| {
+                [
+                    Endpoint::new(p.bounds.min[axis], slot, MIN),
+                    Endpoint::new(p.bounds.max[axis], slot, MAX),
+                ]
+            }));
+            // The order of `after`: coordinate (`-0.0 == 0.0`, no NaN), mins first at ties.
+            endpoints.sort_by(|x, y| {
+                x.value
+                    .partial_cmp(&y.value)
+                    .unwrap_or(std::cmp::Ordering::Equal)
+                    .then(x.kind().cmp(&y.kind()))
+            });
+            sap.renumber_from(axis, 0);
+        }
+        let mut found = Vec::new();
+        SortAndSweep::new().pairs(proxies, &mut found);
+        for pair in found {
+            sap.pairs.insert(pair);
+        }
+        sap
     }
 
     /// Adds `body` with its margin-grown world box `bounds` (metres; finite, `min <= max`).
@@ -464,6 +504,86 @@ mod tests {
     use rand::Rng;
 
     use crate::broad::conformance::{self, pairs_of, unit_at};
+
+    /// A body on a quarter-metre grid (ties everywhere), sometimes a point, sometimes huge,
+    /// sometimes static, some with filters; `-0.0` coordinates included.
+    fn grid_proxy(rng: &mut crate::test_support::TestRng, body: u32) -> Proxy {
+        let q = |rng: &mut crate::test_support::TestRng, n: i32| {
+            let v = f64::from(rng.random_range(-n..=n)) * 0.25;
+            if v == 0.0 && rng.random_bool(0.5) {
+                -0.0
+            } else {
+                v
+            }
+        };
+        let lo = DVec3::new(q(rng, 12), q(rng, 12), q(rng, 4));
+        let size = match rng.random_range(0..20) {
+            0 => DVec3::ZERO,
+            1 => DVec3::splat(8.0),
+            _ => DVec3::new(q(rng, 4).abs(), q(rng, 4).abs(), q(rng, 4).abs()),
+        };
+        Proxy {
+            body,
+            bounds: Aabb::new(lo, lo + size),
+            is_static: rng.random_bool(0.15),
+            filter: if rng.random_bool(0.2) {
+                CollisionFilter { group: 1, mask: 2 }
+            } else {
+                CollisionFilter::ALL
+            },
+        }
+    }
+
+    #[test]
+    fn built_at_once_it_equals_one_by_one_insertion_and_keeps_working() {
+        let mut rng = rng(0xb01c);
+        let mut nonempty = 0;
+        for scene in 0..40 {
+            let proxies: Vec<Proxy> = (0..rng.random_range(0..120))
+                .map(|i| grid_proxy(&mut rng, 3 * i + scene))
+                .collect();
+            let mut built = IncrementalSap::from_proxies(&proxies);
+            let mut inserted = IncrementalSap::new();
+            for p in &proxies {
+                inserted.insert(p.body, p.bounds, p.is_static, p.filter);
+            }
+            built
+                .validate()
+                .unwrap_or_else(|e| panic!("scene {scene}: {e}"));
+            assert_eq!(
+                pairs_of(&mut built),
+                pairs_of(&mut inserted),
+                "scene {scene}"
+            );
+            nonempty += usize::from(!pairs_of(&mut built).is_empty());
+            // Both keep answering alike through moves, removals and insertions.
+            for frame in 0..30 {
+                let body = match proxies.get(rng.random_range(0..proxies.len().max(1))) {
+                    Some(p) => p.body,
+                    None => break,
+                };
+                if !built.contains(body) {
+                    continue;
+                }
+                match rng.random_range(0..10) {
+                    0 => {
+                        built.remove(body);
+                        inserted.remove(body);
+                    }
+                    _ => {
+                        let p = grid_proxy(&mut rng, body);
+                        built.update(body, p.bounds);
+                        inserted.update(body, p.bounds);
+                    }
+                }
+                built
+                    .validate()
+                    .unwrap_or_else(|e| panic!("scene {scene} frame {frame}: {e}"));
+                assert_eq!(pairs_of(&mut built), pairs_of(&mut inserted));
+            }
+        }
+        assert!(nonempty > 30, "{nonempty}");
+    }
 
     #[test]
     fn boxes_touching_at_a_face_edge_or_corner_pair_and_a_gap_of_one_ulp_does_not() {

@@ -1027,10 +1027,7 @@ fn sync_broad_phase(
     if !listed {
         scene.proxies(proxies);
     }
-    let broad = broad.insert(BroadPhase::new(kind));
-    for p in proxies.iter() {
-        broad.insert(p.body, p.bounds, p.is_static, p.filter);
-    }
+    *broad = Some(BroadPhase::from_proxies(kind, proxies));
     proxies.len()
 }
 
