@@ -47,6 +47,23 @@ macro_rules! stateful {
 
 stateful!(IncrementalSap, HashGrid);
 
+/// A random box centred in the cube of half-size `spread`: one in `kinds` a point, one in
+/// `kinds` huge (half-extents 2 to 20 m), the rest ordinary (half-extents up to 1 m).
+pub(super) fn random_box(rng: &mut TestRng, spread: f64, kinds: u32) -> Aabb {
+    use rand::Rng;
+    let c = crate::test_support::point_in_cube(rng, spread);
+    let h = match rng.random_range(0..kinds) {
+        0 => DVec3::ZERO,
+        1 => DVec3::splat(rng.random_range(2.0..20.0)),
+        _ => DVec3::new(
+            rng.random_range(0.0..1.0),
+            rng.random_range(0.0..1.0),
+            rng.random_range(0.0..1.0),
+        ),
+    };
+    Aabb::new(c - h, c + h)
+}
+
 /// A 1 m cube with its low corner at `(x, y, z)`.
 pub(super) fn unit_at(x: f64, y: f64, z: f64) -> Aabb {
     Aabb::new(DVec3::new(x, y, z), DVec3::new(x + 1.0, y + 1.0, z + 1.0))

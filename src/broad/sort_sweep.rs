@@ -501,20 +501,9 @@ mod tests {
     use rand::Rng;
 
     fn random_proxy(rng: &mut crate::test_support::TestRng, body: u32, spread: f64) -> Proxy {
-        let c = point_in_cube(rng, spread);
-        // Zero-size, ordinary and huge boxes.
-        let h = match rng.random_range(0..10) {
-            0 => DVec3::ZERO,
-            1 => DVec3::splat(rng.random_range(2.0..20.0)),
-            _ => DVec3::new(
-                rng.random_range(0.0..1.0),
-                rng.random_range(0.0..1.0),
-                rng.random_range(0.0..1.0),
-            ),
-        };
         Proxy {
             body,
-            bounds: Aabb::new(c - h, c + h),
+            bounds: crate::broad::conformance::random_box(rng, spread, 10),
             is_static: rng.random_range(0..5) == 0,
             filter: CollisionFilter {
                 group: 1 << rng.random_range(0..3),
