@@ -4,7 +4,7 @@
 //! A balanced tree would pay a cache-missing `O(log k)` search per edit; a broad phase edits
 //! its set many times per frame but reads it once. Here an edit is a push onto the log, and
 //! [`PairSet::commit`] folds the log into the sorted list in one pass: the log sorted by pair
-//! (stably, so the edits of one pair keep their order and the last one wins), then merged
+//! (then by place in the log, so the edits of one pair keep their order and the last one wins), then merged
 //! with the list. `O(k + e log e)` per frame for `k` pairs and `e` edits, against
 //! `O(e log k)` tree edits plus an `O(k)` tree walk to list the pairs.
 //!
@@ -21,8 +21,9 @@ use super::CandidatePair;
 pub(crate) struct PairSet {
     /// The pairs as of the last commit, strictly increasing.
     sorted: Vec<CandidatePair>,
-    /// Edits since: the pair and whether it is now present, in the order made.
-    log: Vec<(CandidatePair, bool)>,
+    /// Edits since: the pair, the edit's place in the log, and whether the pair is now
+    /// present.
+    log: Vec<(CandidatePair, u32, bool)>,
     /// Merge target, swapped with `sorted` by each commit (no allocation once grown).
     spare: Vec<CandidatePair>,
 }
@@ -31,13 +32,13 @@ impl PairSet {
     /// Records that `pair` is now in the set.
     #[inline]
     pub(crate) fn insert(&mut self, pair: CandidatePair) {
-        self.log.push((pair, true));
+        self.log.push((pair, self.log.len() as u32, true));
     }
 
     /// Records that `pair` is no longer in the set.
     #[inline]
     pub(crate) fn remove(&mut self, pair: CandidatePair) {
-        self.log.push((pair, false));
+        self.log.push((pair, self.log.len() as u32, false));
     }
 
     /// Folds the pending edits into the sorted list and returns it, strictly increasing.
@@ -48,13 +49,15 @@ impl PairSet {
         if self.log.is_empty() {
             return &self.sorted;
         }
-        // Stable: the edits of one pair stay in order, so the last of each run wins.
-        self.log.sort_by_key(|&(pair, _)| pair);
+        // By pair, then by place in the log, so the last edit of each run wins. Unstable
+        // with the place as tie-break: the same order as a stable sort, without the
+        // scratch buffer a stable sort allocates every call.
+        self.log.sort_unstable_by_key(|&(pair, at, _)| (pair, at));
         self.spare.clear();
         let mut old = self.sorted.iter().copied().peekable();
         let mut edits = self.log.iter().copied().peekable();
-        while let Some((pair, mut present)) = edits.next() {
-            while let Some(&(next, state)) = edits.peek()
+        while let Some((pair, _, mut present)) = edits.next() {
+            while let Some(&(next, _, state)) = edits.peek()
                 && next == pair
             {
                 present = state;
