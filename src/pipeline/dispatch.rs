@@ -253,11 +253,14 @@ fn beyond(
     let distance = g.distance - radius_a - radius_b;
     let scale = g.point_a.abs().max_element() + g.point_b.abs().max_element() + g.distance;
     let certain = distance - GJK_RELATIVE_ERROR * scale > limit;
-    (g.outcome == GjkOutcome::Separated && certain).then(|| ShapeDistance {
-        distance,
-        point_a: g.point_a + g.normal * radius_a,
-        point_b: g.point_b - g.normal * radius_b,
-        normal: g.normal,
+    (g.outcome == GjkOutcome::Separated && certain).then(|| {
+        let normal = g.normal();
+        ShapeDistance {
+            distance,
+            point_a: g.point_a + normal * radius_a,
+            point_b: g.point_b - normal * radius_b,
+            normal,
+        }
     })
 }
 

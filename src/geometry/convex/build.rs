@@ -1,7 +1,7 @@
 //! Building a hull: the dimension test, then quickhull (solid) or the polygon (flat), and
 //! the corner pass.
 
-use super::{ConvexPolyhedron, Face, ROUNDING_ULPS, faces, flat, quickhull};
+use super::{ConvexPolyhedron, Face, ROUNDING_ULPS, VertexLanes, faces, flat, quickhull};
 use crate::math::DVec3;
 
 impl ConvexPolyhedron {
@@ -57,6 +57,9 @@ pub(super) fn build_with_corners(
         }
     }
     hull.centred = hull.vertices.iter().map(|v| *v - origin).collect();
+    if hull.uses_linear_search() {
+        hull.lanes = VertexLanes::new(&hull.centred);
+    }
     hull
 }
 
@@ -71,6 +74,7 @@ fn build(world: &[DVec3], local: &[DVec3], origin: DVec3, eps: f64) -> ConvexPol
         planes: Vec::new(),
         eps,
         centred: Vec::new(),
+        lanes: VertexLanes::default(),
         neighbour_start: Vec::new(),
         neighbours: Vec::new(),
     };

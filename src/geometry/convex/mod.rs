@@ -11,9 +11,11 @@ mod build;
 mod faces;
 mod flat;
 mod quickhull;
+mod scan;
 mod validate;
 
 use build::{bounds, build_with_corners};
+use scan::VertexLanes;
 
 use super::SupportMap;
 use crate::math::{DVec3, tolerance};
@@ -117,6 +119,8 @@ pub struct ConvexPolyhedron {
     eps: f64,
     /// `vertices − origin`, the support search's copy (as the hull was built on it).
     centred: Vec<DVec3>,
+    /// `centred` in lanes, for the linear search of small hulls (empty for large ones).
+    lanes: VertexLanes,
     /// Vertex adjacency in compressed rows: the neighbours of vertex `i` are
     /// `neighbours[neighbour_start[i]..neighbour_start[i + 1]]`. Empty below dimension 2.
     neighbour_start: Vec<u32>,
@@ -322,6 +326,14 @@ impl ConvexPolyhedron {
     }
 }
 
+impl ConvexPolyhedron {
+    /// Whether the support search scans every vertex (small hulls, and hulls without a
+    /// vertex graph) rather than climbing the graph.
+    fn uses_linear_search(&self) -> bool {
+        self.centred.len() < HILL_CLIMB_MIN_VERTICES || self.neighbours.is_empty()
+    }
+}
+
 impl SupportMap for ConvexPolyhedron {
     /// Hill climbing over the vertex graph (a local maximum of a linear function on a convex
     /// polytope is global), or a linear scan for small hulls. On a hull that is convex only
@@ -339,15 +351,8 @@ impl SupportMap for ConvexPolyhedron {
     fn support_from(&self, direction: DVec3, hint: &mut u32) -> DVec3 {
         let centred = &self.centred;
         let score = |i: usize| centred[i].dot(direction);
-        if centred.len() < HILL_CLIMB_MIN_VERTICES || self.neighbours.is_empty() {
-            let mut best = (score(0), 0);
-            for i in 1..centred.len() {
-                let s = score(i);
-                if s > best.0 {
-                    best = (s, i);
-                }
-            }
-            return self.vertices[best.1];
+        if self.uses_linear_search() {
+            return self.vertices[self.lanes.argmax(direction)];
         }
         let start = if (*hint as usize) < centred.len() {
             *hint as usize

@@ -4,8 +4,7 @@
 //! Signed-volume sub-distance after Montanari, Petrinic and Barbieri, "Improving the GJK
 //! algorithm for faster and more reliable distance queries between convex objects", ACM TOG
 //! 36(3), 2017: the barycentric coordinates of the origin's projection are ratios of signed
-//! volumes (tetrahedron) or of signed areas in the coordinate plane where the triangle's
-//! projection is largest (triangle); a vertex whose coordinate has the wrong sign sends the
+//! volumes (tetrahedron) or of signed areas (triangle); a vertex whose coordinate has the wrong sign sends the
 //! search to the faces that leave it out. Flat tetrahedra and needle triangles, whose
 //! determinants vanish, are replaced by the best of their faces, so no division by a zero
 //! (or rounding-sized) determinant ever happens and the result is never NaN.
@@ -42,7 +41,8 @@ const FLAT_TETRAHEDRON: f64 = 1e-13;
 /// The outcome of the sub-distance on some of the simplex's points.
 #[derive(Debug, Clone, Copy)]
 struct Reduced {
-    /// Indices into the simplex of the points kept.
+    /// Indices into the simplex of the points kept, increasing (every sub-feature is named
+    /// by increasing indices: `EDGE_OPPOSITE`, `FACE_OPPOSITE`).
     idx: [usize; 4],
     lambda: [f64; 4],
     len: usize,
@@ -140,8 +140,14 @@ impl Simplex {
     /// [`reduce`](Self::reduce) when the new closest point is closer to the origin than
     /// `dist2` (squared metres); otherwise drops the last pushed point and keeps the simplex
     /// as it was. Returns the new closest point, or `None` when there was no progress.
+    ///
+    /// The last point pushed must be a new support point that made progress (GJK's step):
+    /// the closer point then lies on a face holding it, and faces without it are searched
+    /// only when no other face is left (to rounding they can still win; the progress test
+    /// then rejects them).
+    #[inline(always)]
     pub fn reduce_if_closer(&mut self, dist2: f64) -> Option<DVec3> {
-        let r = self.sub_distance();
+        let r = self.sub_distance(Newest::Last);
         if r.v.length_squared() >= dist2 {
             self.pop();
             return None;
@@ -154,38 +160,61 @@ impl Simplex {
     /// origin, stores that point's weights and returns it (`w` part). A full tetrahedron is
     /// kept only when it contains the origin; the result is then exactly zero.
     pub fn reduce(&mut self) -> DVec3 {
-        let r = self.sub_distance();
+        let r = self.sub_distance(Newest::Unknown);
         self.apply(&r);
         r.v
     }
 
     /// The sub-distance of the current points (Montanari's signed volumes).
-    fn sub_distance(&self) -> Reduced {
+    fn sub_distance(&self, newest: Newest) -> Reduced {
         let p = &self.ws;
         match self.len {
             1 => Reduced::point(0, p),
             2 => segment(p, 0, 1),
-            3 => triangle(p, [0, 1, 2]),
-            _ => tetrahedron(p),
+            3 => triangle(p, [0, 1, 2], newest),
+            _ => tetrahedron(p, newest),
         }
     }
 
     /// Keeps the points and weights `r` selects.
     fn apply(&mut self, r: &Reduced) {
-        // Kept in increasing index order, so moving them down in place never overwrites a
-        // point still to be moved (PERF: no copy of the whole simplex).
-        let mut order = [0, 1, 2, 3];
-        let order = &mut order[..r.len];
-        order.sort_unstable_by_key(|&k| r.idx[k]);
-        for (slot, &k) in order.iter().enumerate() {
-            let from = r.idx[k];
-            self.points[slot] = self.points[from];
-            self.ws[slot] = self.ws[from];
-            self.lambda[slot] = r.lambda[k];
+        // `r.idx` is increasing (see `Reduced`), so moving the points down in place never
+        // overwrites one still to be moved, and a kept prefix does not move at all.
+        for slot in 0..r.len {
+            let from = r.idx[slot];
+            debug_assert!(from >= slot && (slot == 0 || from > r.idx[slot - 1]));
+            if from != slot {
+                self.points[slot] = self.points[from];
+                self.ws[slot] = self.ws[from];
+            }
+            self.lambda[slot] = r.lambda[slot];
         }
         self.len = r.len;
     }
 }
+
+/// Whether the last point of a simplex (or face) is the new support point of a GJK step,
+/// which lets the sub-distance skip the old face opposite it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Newest {
+    Last,
+    Unknown,
+}
+
+/// The sub-features to search, opposite the vertices whose barycentric sign is `wrong`:
+/// with [`Newest::Last`], the one opposite the last vertex (the old simplex, which cannot
+/// be closer) only when no other is named. PERF: spares a triangle (or segment) solve.
+fn to_search<const N: usize>(mut wrong: [bool; N], newest: Newest) -> [bool; N] {
+    if newest == Newest::Last && wrong[..N - 1].contains(&true) {
+        wrong[N - 1] = false;
+    }
+    wrong
+}
+
+/// The edges of a triangle `[0, 1, 2]` opposite each vertex, in increasing order.
+const EDGE_OPPOSITE: [[usize; 2]; 3] = [[1, 2], [0, 2], [0, 1]];
+/// The faces of a tetrahedron `[0, 1, 2, 3]` opposite each vertex, in increasing order.
+const FACE_OPPOSITE: [[usize; 3]; 4] = [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]];
 
 fn segment(p: &[DVec3; 4], i: usize, j: usize) -> Reduced {
     let (a, b) = (p[i], p[j]);
@@ -209,16 +238,11 @@ fn segment(p: &[DVec3; 4], i: usize, j: usize) -> Reduced {
     }
 }
 
-/// Signed area of the 2-D triangle `(x, y, z)`.
-fn area2(x: [f64; 2], y: [f64; 2], z: [f64; 2]) -> f64 {
-    (y[0] - x[0]) * (z[1] - x[1]) - (y[1] - x[1]) * (z[0] - x[0])
-}
-
 fn same_sign(a: f64, b: f64) -> bool {
     (a > 0.0 && b > 0.0) || (a < 0.0 && b < 0.0)
 }
 
-fn triangle(p: &[DVec3; 4], t: [usize; 3]) -> Reduced {
+fn triangle(p: &[DVec3; 4], t: [usize; 3], newest: Newest) -> Reduced {
     let (a, b, c) = (p[t[0]], p[t[1]], p[t[2]]);
     let (e1, e2) = (b - a, c - a);
     let n = e1.cross(e2);
@@ -227,7 +251,8 @@ fn triangle(p: &[DVec3; 4], t: [usize; 3]) -> Reduced {
         let mut best: Option<Reduced> = None;
         for (k, &s) in skip.iter().enumerate() {
             if s {
-                let r = segment(p, t[(k + 1) % 3], t[(k + 2) % 3]);
+                let [i, j] = EDGE_OPPOSITE[k];
+                let r = segment(p, t[i], t[j]);
                 best = Some(best.map_or(r, |b| b.better(r)));
             }
         }
@@ -236,14 +261,17 @@ fn triangle(p: &[DVec3; 4], t: [usize; 3]) -> Reduced {
     if nn <= FLAT_TRIANGLE * e1.length_squared() * e2.length_squared() || nn.is_nan() {
         return edges(&[true; 3]).expect("three edges");
     }
-    // Projection of the origin on the plane, then 2-D areas in the plane of largest
-    // projected area (Montanari's S2D).
+    // Projection of the origin on the plane, then the signed areas of the three
+    // sub-triangles it makes, measured along `n` from vertex-relative vectors (Montanari
+    // projects on the coordinate plane of largest area instead; both have the same signs,
+    // and this form needs no data-dependent choice of plane).
     let p0 = n * (a.dot(n) / nn);
-    let m = n.abs().max_position();
-    let (u, v) = ((m + 1) % 3, (m + 2) % 3);
-    let q = |x: DVec3| [x[u], x[v]];
-    let (qa, qb, qc, qo) = (q(a), q(b), q(c), q(p0));
-    let c_ = [area2(qo, qb, qc), area2(qa, qo, qc), area2(qa, qb, qo)];
+    let (ra, rb, rc) = (a - p0, b - p0, c - p0);
+    let c_ = [
+        n.dot(rb.cross(rc)),
+        n.dot(rc.cross(ra)),
+        n.dot(ra.cross(rb)),
+    ];
     let total = c_[0] + c_[1] + c_[2];
     let wrong = [
         !same_sign(c_[0], total),
@@ -259,10 +287,10 @@ fn triangle(p: &[DVec3; 4], t: [usize; 3]) -> Reduced {
             v: p0,
         };
     }
-    edges(&wrong).expect("a wrong sign names an edge")
+    edges(&to_search(wrong, newest)).expect("a wrong sign names an edge")
 }
 
-fn tetrahedron(p: &[DVec3; 4]) -> Reduced {
+fn tetrahedron(p: &[DVec3; 4], newest: Newest) -> Reduced {
     let [a, b, c, d] = *p;
     let vol = |x: DVec3, y: DVec3, z: DVec3, w: DVec3| (y - x).dot((z - x).cross(w - x));
     let o = DVec3::ZERO;
@@ -279,8 +307,9 @@ fn tetrahedron(p: &[DVec3; 4]) -> Reduced {
         let mut best: Option<Reduced> = None;
         for (k, &s) in skip.iter().enumerate() {
             if s {
-                let f = [(k + 1) % 4, (k + 2) % 4, (k + 3) % 4];
-                let r = triangle(p, f);
+                // Faces 0 to 2 hold vertex 3, last in each; face 3 does not.
+                let face_newest = if k < 3 { newest } else { Newest::Unknown };
+                let r = triangle(p, FACE_OPPOSITE[k], face_newest);
                 best = Some(best.map_or(r, |b| b.better(r)));
             }
         }
@@ -298,7 +327,7 @@ fn tetrahedron(p: &[DVec3; 4]) -> Reduced {
             v: DVec3::ZERO,
         };
     }
-    faces(wrong)
+    faces(to_search(wrong, newest))
 }
 
 #[cfg(test)]
