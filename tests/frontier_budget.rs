@@ -28,8 +28,8 @@ mod support;
 
 use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, Rss};
 use proxima::bvh::frontier::{
-    Completeness, FrontierAnswer, FrontierPair, FrontierWorkspace, Unlimited, VisitBudget,
-    query_frontier,
+    Completeness, FrontierAnswer, FrontierPair, FrontierWorkspace, MixedPair, PairTrees, Unlimited,
+    VisitBudget, query_frontier,
 };
 use proxima::bvh::{BuildParams, Bvh};
 use proxima::geometry::{TriMesh, Triangle};
@@ -473,6 +473,31 @@ struct Plan {
 
 /// Runs every check of the module docs on `scene` with volume type `B`; returns the
 /// unlimited run's visits and rounds.
+/// One interruption point: every answer conservative against the oracle and, after the
+/// first point, no worse than at the previous one (`prev`); counted into `tally`.
+fn check_state(
+    scene: &Scene,
+    prev: &[FrontierAnswer],
+    now: &[FrontierAnswer],
+    at: &str,
+    tally: &mut Tally,
+) {
+    tally.states += 1;
+    for (i, ((answer, spec), &truth)) in now.iter().zip(&scene.pairs).zip(&scene.truth).enumerate()
+    {
+        check_conservative(answer, truth, spec.threshold, &format!("{at}, pair {i}"));
+        if answer.is_exact() {
+            tally.exact += 1;
+        } else {
+            tally.truncated += 1;
+            tally.truncated_with_upper += usize::from(answer.distance_upper.is_some());
+        }
+    }
+    if !prev.is_empty() {
+        check_monotone(prev, now, at);
+    }
+}
+
 fn check_scene<B: BoundingVolume>(scene: &Scene, plan: Plan, tally: &mut Tally) -> (u64, u64) {
     let label = format!("{} / {} / poll {}", scene.name, B::NAME, plan.poll_every);
     let trees: Vec<Bvh<B>> = scene
@@ -569,21 +594,7 @@ fn check_scene<B: BoundingVolume>(scene: &Scene, plan: Plan, tally: &mut Tally) 
             last_visits = Some(visits);
             resumed.answers(&pairs, &mut now);
             let at = format!("{label}: budget {budget}, {visits} visits");
-            tally.states += 1;
-            for (i, ((answer, spec), &truth)) in
-                now.iter().zip(&scene.pairs).zip(&scene.truth).enumerate()
-            {
-                check_conservative(answer, truth, spec.threshold, &format!("{at}, pair {i}"));
-                if answer.is_exact() {
-                    tally.exact += 1;
-                } else {
-                    tally.truncated += 1;
-                    tally.truncated_with_upper += usize::from(answer.distance_upper.is_some());
-                }
-            }
-            if !prev.is_empty() {
-                check_monotone(&prev, &now, &at);
-            }
+            check_state(scene, &prev, &now, &at, tally);
             std::mem::swap(&mut prev, &mut now);
         }
         if iteration % fresh_every == 0 || finished {
@@ -714,6 +725,106 @@ fn every_interruption_point_of_the_tori_piles_is_conservative_and_monotone() {
     }
     eprintln!("{tally:?}");
     tally.assert_every_outcome("tori piles");
+}
+
+/// The unlimited answer of one pair run alone.
+fn alone<P: PairTrees>(pair: &P) -> FrontierAnswer {
+    let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+    assert!(query_frontier(
+        std::slice::from_ref(pair),
+        &mut Unlimited,
+        &mut ws,
+        &mut out
+    ));
+    out[0]
+}
+
+#[test]
+fn a_frontier_mixing_obb_and_rss_pairs_is_conservative_monotone_and_exact_per_pair() {
+    let mut tally = Tally::default();
+    for seed in PILE_SEEDS {
+        let scene = tori_pile(seed);
+        let build = BuildParams::BINNED_SAH.with_leaf_size(4);
+        let obb: Vec<Bvh<Obb>> = scene
+            .meshes
+            .iter()
+            .map(|m| Bvh::from_mesh(m, &build))
+            .collect();
+        let rss: Vec<Bvh<Rss>> = scene
+            .meshes
+            .iter()
+            .map(|m| Bvh::from_mesh(m, &build))
+            .collect();
+        // Alternate the volume type from pair to pair.
+        let pairs: Vec<MixedPair<'_>> = scene
+            .pairs
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let (pose_ab, threshold) = (p.pose_ab.to_isometry(), p.threshold);
+                if i % 2 == 0 {
+                    MixedPair::Obb(FrontierPair {
+                        a: &obb[p.a],
+                        b: &obb[p.b],
+                        pose_ab,
+                        threshold,
+                        seed: None,
+                    })
+                } else {
+                    MixedPair::Rss(FrontierPair {
+                        a: &rss[p.a],
+                        b: &rss[p.b],
+                        pose_ab,
+                        threshold,
+                        seed: None,
+                    })
+                }
+            })
+            .collect();
+        for (&t, p) in scene.truth.iter().zip(&scene.pairs) {
+            match t {
+                0.0 => tally.touching += 1,
+                t if t <= p.threshold => tally.near += 1,
+                _ => tally.apart += 1,
+            }
+        }
+        // Unlimited: every pair as exact as its own type's frontier run alone.
+        let (mut ws, mut exact) = (FrontierWorkspace::new(), Vec::new());
+        assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut exact));
+        for (i, (pair, answer)) in pairs.iter().zip(&exact).enumerate() {
+            let own = match pair {
+                MixedPair::Obb(p) => alone(p),
+                MixedPair::Rss(p) => alone(p),
+            };
+            assert!(same_bits(&[*answer], &[own]), "seed {seed}, pair {i}");
+        }
+        // Every interruption point: conservative and monotone; sampled fresh runs equal.
+        let mut resumed = FrontierWorkspace::with_poll_every(1);
+        resumed.start(&pairs);
+        let (mut prev, mut now, mut fresh) = (Vec::new(), Vec::new(), Vec::new());
+        for budget in 0.. {
+            let finished = resumed.run(&pairs, &mut VisitBudget(budget));
+            resumed.answers(&pairs, &mut now);
+            let at = format!("mixed tori pile {seed}: budget {budget}");
+            check_state(&scene, &prev, &now, &at, &mut tally);
+            if budget % 97 == 0 || finished {
+                let mut fresh_ws = FrontierWorkspace::with_poll_every(1);
+                query_frontier(&pairs, &mut VisitBudget(budget), &mut fresh_ws, &mut fresh);
+                assert!(same_bits(&fresh, &now), "{at}");
+                tally.fresh_runs += 1;
+            }
+            std::mem::swap(&mut prev, &mut now);
+            if finished {
+                assert!(
+                    same_bits(&prev, &exact),
+                    "{at}: the last state is the exact one"
+                );
+                break;
+            }
+        }
+    }
+    eprintln!("{tally:?}");
+    tally.assert_every_outcome("mixed tori piles");
 }
 
 #[test]

@@ -17,7 +17,7 @@ use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::contact::Manifold;
 use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
-    intersects_mesh_mesh, within_distance_mesh_mesh,
+    intersects_mesh_mesh, rounding_bound, within_distance_mesh_mesh,
 };
 use crate::scene::{Body, MeshShape, Shape};
 use std::ops::ControlFlow;
@@ -281,16 +281,19 @@ pub(super) fn mesh_mesh_finished(
 ) -> Answer {
     debug_assert!(frontier.is_exact());
     let wants_distance = query.close || query.distance;
+    let pose_ab = Pose::relative(&a.pose, &b.pose);
+    // The exact query's rounding bound (from the RSS trees, whichever trees the frontier
+    // refined), so that an unlimited budget gives the exact query's record bit for bit.
+    let rounding = rounding_bound(&ma.distance_tree, &mb.distance_tree, &pose_ab.to_isometry());
     let known = frontier
         .witnesses
         .filter(|_| frontier.maybe_close)
         .map(|w| KnownDistance {
             distance: frontier.distance_lower,
-            error_bound: frontier.error_bound,
+            error_bound: rounding,
             point_a: w.point_a,
             point_b: w.point_b,
         });
-    let pose_ab = Pose::relative(&a.pose, &b.pose);
     if wants_distance && known.is_none() {
         // Proven beyond the margins: every triangle pair's distance exceeds them, which is
         // what [`mesh_mesh`]'s tolerance query would find. It then answers "far" unless

@@ -113,18 +113,19 @@ pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold
 pub use dispatch::PathCounts;
 pub use toi::{PairToi, TOI_TOLERANCE};
 
-use crate::bounding::Rss;
 use crate::broad::{
     BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, Proxy,
     SortAndSweep, choose,
 };
-use crate::bvh::frontier::{self, FrontierAnswer, FrontierPair, FrontierStats, FrontierWorkspace};
+use crate::bvh::frontier::{
+    self, FrontierAnswer, FrontierPair, FrontierStats, FrontierWorkspace, MixedPair,
+};
 use crate::math::{DVec3, Pose};
 use crate::narrow::contact::Manifold;
 use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::DistanceCache;
-use crate::scene::MeshShape;
 use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
+use crate::scene::{FrontierVolume, MeshShape};
 use answer::{Answer, MeshScratch};
 use dispatch::{NarrowScratch, Route};
 use std::collections::HashMap;
@@ -470,7 +471,9 @@ pub fn step(
 ///
 /// # With a limited budget
 /// Before the per-pair loop, every mesh–mesh candidate pair not answered by a kept answer
-/// joins one frontier run, with threshold the pair's margin sum (`CLOSE`, `OVERLAP`,
+/// joins one frontier run, refined with the trees its meshes chose
+/// ([`FrontierVolume::for_pair`]: OBBs for box-like parts, RSSs for curved ones), with
+/// threshold the pair's margin sum (`CLOSE`, `OVERLAP`,
 /// `CONTACTS`) or, when `DISTANCE` is asked, an upper bound of the pair's distance: the
 /// distance of one triangle pair (the closest a previous budgeted frame found for it, else
 /// the first triangles; one triangle test outside the budget). The frontier then prunes
@@ -800,19 +803,30 @@ fn run_frontier(
             frontier_run.thresholds.push(threshold);
         }
     }
-    let pairs: Vec<FrontierPair<'_, Rss>> = frontier_pairs
+    let pairs: Vec<MixedPair<'_>> = frontier_pairs
         .iter()
         .zip(&frontier_run.thresholds)
         .map(|(pair, &threshold)| {
             let (ma, mb) = mesh_pair(scene, pair).expect("a mesh pair");
             let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-            FrontierPair {
-                a: &ma.distance_tree,
-                b: &mb.distance_tree,
-                pose_ab: Pose::relative(&a.pose, &b.pose).to_isometry(),
-                threshold,
-                // Last frame's closest triangles: the warm start the exact queries have.
-                seed: frontier_seeds.get(pair).copied(),
+            let pose_ab = Pose::relative(&a.pose, &b.pose).to_isometry();
+            // Last frame's closest triangles: the warm start the exact queries have.
+            let seed = frontier_seeds.get(pair).copied();
+            match FrontierVolume::for_pair(ma.frontier_volume, mb.frontier_volume) {
+                FrontierVolume::Obb => MixedPair::Obb(FrontierPair {
+                    a: &ma.overlap_tree,
+                    b: &mb.overlap_tree,
+                    pose_ab,
+                    threshold,
+                    seed,
+                }),
+                FrontierVolume::Rss => MixedPair::Rss(FrontierPair {
+                    a: &ma.distance_tree,
+                    b: &mb.distance_tree,
+                    pose_ab,
+                    threshold,
+                    seed,
+                }),
             }
         })
         .collect();

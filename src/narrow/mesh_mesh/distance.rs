@@ -115,8 +115,10 @@ pub fn within_distance_mesh_mesh<B: BoundingVolume>(
 }
 
 /// Rounding error of a triangle–triangle distance between these meshes at this pose: a few
-/// ulps of the largest coordinate involved.
-fn rounding_bound<B: BoundingVolume>(a: &Bvh<B>, b: &Bvh<B>, iso: &Isometry) -> f64 {
+/// ulps of the largest coordinate involved (measured on the root volumes, so it depends on
+/// the volume type a little; the pipeline states it from the RSS trees on every path).
+#[must_use]
+pub fn rounding_bound<B: BoundingVolume>(a: &Bvh<B>, b: &Bvh<B>, iso: &Isometry) -> f64 {
     let reach = |bv: &B| bv.center().abs().max_element() + bv.size();
     conservative_slack(
         reach(a.root_bv()) + reach(b.root_bv()) + iso.translation.abs().max_element(),

@@ -31,7 +31,7 @@ mod collide;
 mod distance;
 
 pub use collide::{contacts_mesh_mesh, intersects_mesh_mesh};
-pub use distance::{distance_mesh_mesh, within_distance_mesh_mesh};
+pub use distance::{distance_mesh_mesh, rounding_bound, within_distance_mesh_mesh};
 
 use crate::bvh::Bvh;
 use crate::bvh::tandem::RankedPair;

@@ -5,7 +5,8 @@
 //! # The question
 //! Each [`FrontierPair`] asks: *is the distance between the triangles of `a` and of `b`
 //! (placed at `pose_ab`) at most `threshold`, and if so, what is it?* The threshold is the
-//! pair's margin sum, metres.
+//! pair's margin sum, metres. The frontier sees a pair only through [`PairTrees`], so one
+//! run may hold pairs of different volume types ([`MixedPair`]).
 //!
 //! # The traversal
 //! [`FrontierWorkspace::start`] puts one root entry per pair on the frontier (round 1).
@@ -109,11 +110,11 @@
 //! The workspace owns the two entry vectors (swapped every round), the per-pair state and
 //! the per-round counters; none of them allocates once grown to the largest frame seen.
 
-use super::Bvh;
-use super::tandem::descend_a;
-use crate::bounding::BoundingVolume;
-use crate::math::{DVec3, Isometry, conservative_slack};
-use crate::narrow::distance_triangle_triangle;
+mod trees;
+
+pub use trees::{FrontierPair, MixedPair, PairTrees};
+
+use crate::math::DVec3;
 use std::cmp::Ordering;
 use std::time::Instant;
 
@@ -182,29 +183,6 @@ impl Budget for Unlimited {
     fn is_unlimited(&self) -> bool {
         true
     }
-}
-
-/// One mesh pair of the frame.
-#[derive(Debug, Clone, Copy)]
-pub struct FrontierPair<'a, B> {
-    /// Tree of mesh A (A's frame).
-    pub a: &'a Bvh<B>,
-    /// Tree of mesh B (B's frame).
-    pub b: &'a Bvh<B>,
-    /// B's frame expressed in A's frame.
-    pub pose_ab: Isometry,
-    /// The distance that counts as close (the pair's margin sum), metres, `≥ 0`; `+∞`
-    /// asks for the exact distance of every pair (nothing is dropped for exceeding it,
-    /// only for not beating the pair's best distance so far).
-    pub threshold: f64,
-    /// A triangle pair to try first (ids into each mesh's own triangle list, as
-    /// [`FrontierWitnesses::triangles`]): typically last frame's closest pair. Its exact
-    /// distance starts the pair's best distance, so entries that cannot beat it are dropped
-    /// from the first round, as the warm start of the depth-first queries does; touching
-    /// pairs whose seed still intersects are exact at once. One visit; `None`, or ids out of
-    /// range, start from nothing. Exact distances do not depend on it (the witnesses of
-    /// tied pairs may); a truncated answer stays conservative, and is usually tighter.
-    pub seed: Option<[u32; 2]>,
 }
 
 /// Whether an answer is final.
@@ -410,7 +388,7 @@ impl FrontierWorkspace {
 
     /// Resets the frontier to one root entry per pair of `pairs` (round 1, no visit yet).
     /// Thresholds must be `≥ 0` (`+∞` allowed, NaN not).
-    pub fn start<B: BoundingVolume>(&mut self, pairs: &[FrontierPair<'_, B>]) {
+    pub fn start<P: PairTrees>(&mut self, pairs: &[P]) {
         assert!(
             u32::try_from(pairs.len()).is_ok(),
             "too many pairs for one frontier"
@@ -423,29 +401,22 @@ impl FrontierWorkspace {
         self.entries_per_round.clear();
         self.next_poll = 0;
         for (i, p) in pairs.iter().enumerate() {
-            debug_assert!(p.threshold >= 0.0, "threshold {} of pair {i}", p.threshold);
-            let (ra, rb) = (p.a.root_bv(), p.b.root_bv());
+            let threshold = p.threshold();
+            debug_assert!(threshold >= 0.0, "threshold {threshold} of pair {i}");
+            let (root_upper, rounding) = p.root_bounds();
             let mut state = PairState {
-                threshold: p.threshold,
+                threshold,
                 best: f64::INFINITY,
                 witnesses: None,
                 floor: f64::INFINITY,
-                root_upper: centre_upper_bound(ra, rb, &p.pose_ab),
-                rounding: rounding_bound(ra, rb, &p.pose_ab),
+                root_upper,
+                rounding,
             };
-            if let Some([ia, ib]) = p.seed
-                && let (Some(sa), Some(sb)) = (p.a.slot_of(ia), p.b.slot_of(ib))
-            {
-                let tri_b = p.b.triangles()[sb].transformed(&p.pose_ab);
-                let d = distance_triangle_triangle(&p.a.triangles()[sa], &tri_b);
+            if let Some((distance, witnesses)) = p.seed_distance() {
                 self.stats.visits += 1;
                 self.stats.triangle_tests += 1;
-                state.best = d.distance;
-                state.witnesses = Some(FrontierWitnesses {
-                    point_a: d.point_a,
-                    point_b: d.point_b,
-                    triangles: [ia, ib],
-                });
+                state.best = distance;
+                state.witnesses = Some(witnesses);
             }
             self.pairs.push(state);
             self.current.push(Entry {
@@ -462,11 +433,7 @@ impl FrontierWorkspace {
     /// Refines the frontier until it is empty (returns `true`) or `budget` refuses at a
     /// poll (returns `false`); calling again resumes. `pairs` must be the slice given to
     /// [`start`](Self::start).
-    pub fn run<B: BoundingVolume, T: Budget + ?Sized>(
-        &mut self,
-        pairs: &[FrontierPair<'_, B>],
-        budget: &mut T,
-    ) -> bool {
+    pub fn run<P: PairTrees, T: Budget + ?Sized>(&mut self, pairs: &[P], budget: &mut T) -> bool {
         debug_assert_eq!(pairs.len(), self.pairs.len(), "pairs differ from start");
         loop {
             if self.cursor == self.current.len() {
@@ -516,11 +483,7 @@ impl FrontierWorkspace {
 
     /// The answer for every pair, in order, into `out` (cleared first); see the
     /// [module docs](self). `pairs` must be the slice given to [`start`](Self::start).
-    pub fn answers<B: BoundingVolume>(
-        &self,
-        pairs: &[FrontierPair<'_, B>],
-        out: &mut Vec<FrontierAnswer>,
-    ) {
+    pub fn answers<P: PairTrees>(&self, pairs: &[P], out: &mut Vec<FrontierAnswer>) {
         debug_assert_eq!(pairs.len(), self.pairs.len(), "pairs differ from start");
         out.clear();
         // First pass: `out` holds, per pair, the live minimum bound (`distance_lower`),
@@ -539,11 +502,10 @@ impl FrontierWorkspace {
             if !is_live(e.bound, state) {
                 continue;
             }
-            let p = &pairs[e.pair as usize];
-            let (x, y) = (&p.a.nodes()[e.a as usize].bv, &p.b.nodes()[e.b as usize].bv);
+            let upper = pairs[e.pair as usize].upper_bound([e.a, e.b]);
             let answer = &mut out[e.pair as usize];
             answer.distance_lower = answer.distance_lower.min(e.bound);
-            answer.error_bound = answer.error_bound.min(centre_upper_bound(x, y, &p.pose_ab));
+            answer.error_bound = answer.error_bound.min(upper);
             answer.completeness = match answer.completeness {
                 Completeness::Truncated { level } if level <= e.depth => answer.completeness,
                 _ => Completeness::Truncated { level: e.depth },
@@ -580,47 +542,32 @@ impl FrontierWorkspace {
     /// Processes one entry (see the module docs); bounded work: one bound, two child
     /// bounds or one leaf pair's triangle tests, and for a live root without a best
     /// distance its [`probe`] (one descent).
-    fn process<B: BoundingVolume>(&mut self, pair: &FrontierPair<'_, B>, mut entry: Entry) {
+    fn process<P: PairTrees>(&mut self, pair: &P, mut entry: Entry) {
         let state = &mut self.pairs[entry.pair as usize];
-        let (na, nb) = (pair.a.nodes(), pair.b.nodes());
-        let iso = &pair.pose_ab;
-        let (x, y) = (&na[entry.a as usize], &nb[entry.b as usize]);
+        let nodes = [entry.a, entry.b];
+        let leaves = pair.are_leaves(nodes);
         if entry.depth == 0 {
-            entry.bound =
-                x.bv.distance_lower_bound_within(&y.bv, iso, state.threshold);
+            entry.bound = pair.bound(nodes, state.threshold);
             self.stats.visits += 1;
             self.stats.bv_tests += 1;
             if entry.bound > state.threshold {
                 state.floor = state.floor.min(entry.bound);
                 return;
             }
-            if state.best.is_infinite() && !(x.is_leaf() && y.is_leaf()) {
+            if state.best.is_infinite() && !leaves {
                 probe(pair, state, &mut self.stats);
             }
         }
         if !is_live(entry.bound, state) {
             return;
         }
-        if x.is_leaf() && y.is_leaf() {
-            test_leaf_pair(
-                pair,
-                (entry.a as usize, entry.b as usize),
-                state,
-                &mut self.stats,
-            );
+        if leaves {
+            test_leaf_pair(pair, nodes, state, &mut self.stats);
             return;
         }
-        let children = if descend_a(x, y) {
-            x.children().map(|c| [c as u32, entry.b])
-        } else {
-            y.children().map(|c| [entry.a, c as u32])
-        };
-        for [ca, cb] in children {
+        for [ca, cb] in pair.split(nodes) {
             let limit = state.threshold.min(state.best);
-            let own =
-                na[ca as usize]
-                    .bv
-                    .distance_lower_bound_within(&nb[cb as usize].bv, iso, limit);
+            let own = pair.bound([ca, cb], limit);
             self.stats.visits += 1;
             self.stats.bv_tests += 1;
             let bound = own.max(entry.bound);
@@ -639,32 +586,17 @@ impl FrontierWorkspace {
     }
 }
 
-/// Tests every triangle pair of the leaf pair `(a, b)` (node indices), one visit each,
-/// updating the pair's best distance and its witnesses.
-fn test_leaf_pair<B: BoundingVolume>(
-    pair: &FrontierPair<'_, B>,
-    (a, b): (usize, usize),
+/// Tests every triangle pair of the leaf pair `nodes`, one visit each, updating the pair's
+/// best distance and its witnesses.
+fn test_leaf_pair<P: PairTrees>(
+    pair: &P,
+    nodes: [u32; 2],
     state: &mut PairState,
     stats: &mut FrontierStats,
 ) {
-    let (x, y) = (&pair.a.nodes()[a], &pair.b.nodes()[b]);
-    let (ta, tb) = (pair.a.triangles(), pair.b.triangles());
-    for sb in y.slots() {
-        let tri_b = tb[sb].transformed(&pair.pose_ab);
-        for sa in x.slots() {
-            let d = distance_triangle_triangle(&ta[sa], &tri_b);
-            stats.visits += 1;
-            stats.triangle_tests += 1;
-            if d.distance < state.best {
-                state.best = d.distance;
-                state.witnesses = Some(FrontierWitnesses {
-                    point_a: d.point_a,
-                    point_b: d.point_b,
-                    triangles: [pair.a.triangle_id(sa), pair.b.triangle_id(sb)],
-                });
-            }
-        }
-    }
+    let tests = pair.test_leaves(nodes, &mut state.best, &mut state.witnesses);
+    stats.visits += tests;
+    stats.triangle_tests += tests;
 }
 
 /// The greedy probe of a pair with no best distance yet, run when its root entry is found
@@ -675,42 +607,31 @@ fn test_leaf_pair<B: BoundingVolume>(
 /// prune with their warm start: without it a touching pair stays truncated until the rounds
 /// reach the leaves. Bounded by the trees' depths plus one leaf pair; stops early when both
 /// children are beyond the threshold.
-fn probe<B: BoundingVolume>(
-    pair: &FrontierPair<'_, B>,
-    state: &mut PairState,
-    stats: &mut FrontierStats,
-) {
-    let (na, nb) = (pair.a.nodes(), pair.b.nodes());
-    let iso = &pair.pose_ab;
-    let (mut a, mut b) = (0usize, 0usize);
+fn probe<P: PairTrees>(pair: &P, state: &mut PairState, stats: &mut FrontierStats) {
+    let mut nodes = [0, 0];
     loop {
-        let (x, y) = (&na[a], &nb[b]);
-        if x.is_leaf() && y.is_leaf() {
-            test_leaf_pair(pair, (a, b), state, stats);
+        if pair.are_leaves(nodes) {
+            test_leaf_pair(pair, nodes, state, stats);
             return;
         }
-        let children = if descend_a(x, y) {
-            x.children().map(|c| (c, b))
-        } else {
-            y.children().map(|c| (a, c))
-        };
-        let bounds = children.map(|(ca, cb)| {
+        let children = pair.split(nodes);
+        let bounds = children.map(|child| {
             stats.visits += 1;
             stats.bv_tests += 1;
-            na[ca].bv.distance_lower_bound(&nb[cb].bv, iso)
+            pair.bound(child, f64::INFINITY)
         });
         let pick = usize::from(bounds[1] < bounds[0]);
         if bounds[pick] > state.threshold {
             return;
         }
-        (a, b) = children[pick];
+        nodes = children[pick];
     }
 }
 
 /// Runs a fresh frontier over `pairs` under `budget` and writes every pair's answer to
 /// `out`; returns whether every answer is Exact.
-pub fn query_frontier<B: BoundingVolume, T: Budget + ?Sized>(
-    pairs: &[FrontierPair<'_, B>],
+pub fn query_frontier<P: PairTrees, T: Budget + ?Sized>(
+    pairs: &[P],
     budget: &mut T,
     workspace: &mut FrontierWorkspace,
     out: &mut Vec<FrontierAnswer>,
@@ -727,32 +648,15 @@ fn is_live(bound: f64, state: &PairState) -> bool {
     bound <= state.threshold && bound < state.best
 }
 
-/// An upper bound of the distance between the geometry bounded by `x` (frame A) and by `y`
-/// (frame B): each volume's centre lies inside it, hence within its stand-off of its
-/// geometry. Padded for the rounding of the centre's transform.
-#[must_use]
-fn centre_upper_bound<B: BoundingVolume>(x: &B, y: &B, pose_ab: &Isometry) -> f64 {
-    let (cx, cy) = (x.center(), pose_ab.transform_point(y.center()));
-    let slack =
-        conservative_slack(cx.abs().max_element() + cy.abs().max_element() + x.size() + y.size());
-    cx.distance(cy) + x.stand_off() + y.stand_off() + slack
-}
-
-/// Rounding error of a triangle–triangle distance between these meshes at this pose: a few
-/// ulps of the largest coordinate involved (as the exact mesh–mesh distance states it).
-#[must_use]
-fn rounding_bound<B: BoundingVolume>(a: &B, b: &B, pose_ab: &Isometry) -> f64 {
-    let reach = |bv: &B| bv.center().abs().max_element() + bv.size();
-    conservative_slack(reach(a) + reach(b) + pose_ab.translation.abs().max_element())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bounding::{Obb, Rss};
-    use crate::bvh::BuildParams;
+    use crate::bounding::{BoundingVolume, Obb, Rss};
+    use crate::bvh::{BuildParams, Bvh};
     use crate::geometry::TriMesh;
+    use crate::math::Isometry;
     use crate::math::{DQuat, Pose};
+    use crate::narrow::distance_triangle_triangle;
     use crate::narrow::mesh_mesh::{
         DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh,
     };

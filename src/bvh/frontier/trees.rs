@@ -1,0 +1,243 @@
+//! The trees of one frontier pair, seen through [`PairTrees`]: the few operations the
+//! frontier needs (node bounds, splits, leaf tests), so that one frontier can hold pairs of
+//! different volume types ([`MixedPair`]), each pair's chosen by measured tightness.
+
+use super::FrontierWitnesses;
+use crate::bounding::{BoundingVolume, Obb, Rss};
+use crate::bvh::Bvh;
+use crate::bvh::tandem::descend_a;
+use crate::math::{Isometry, conservative_slack};
+use crate::narrow::distance_triangle_triangle;
+
+/// One mesh pair of the frame.
+#[derive(Debug, Clone, Copy)]
+pub struct FrontierPair<'a, B> {
+    /// Tree of mesh A (A's frame).
+    pub a: &'a Bvh<B>,
+    /// Tree of mesh B (B's frame).
+    pub b: &'a Bvh<B>,
+    /// B's frame expressed in A's frame.
+    pub pose_ab: Isometry,
+    /// The distance that counts as close (the pair's margin sum), metres, `≥ 0`; `+∞`
+    /// asks for the exact distance of every pair (nothing is dropped for exceeding it,
+    /// only for not beating the pair's best distance so far).
+    pub threshold: f64,
+    /// A triangle pair to try first (ids into each mesh's own triangle list, as
+    /// [`FrontierWitnesses::triangles`]): typically last frame's closest pair. Its exact
+    /// distance starts the pair's best distance, so entries that cannot beat it are dropped
+    /// from the first round, as the warm start of the depth-first queries does; touching
+    /// pairs whose seed still intersects are exact at once. One visit; `None`, or ids out of
+    /// range, start from nothing. Exact distances do not depend on it (the witnesses of
+    /// tied pairs may); a truncated answer stays conservative, and is usually tighter.
+    pub seed: Option<[u32; 2]>,
+}
+
+/// What the frontier needs of a pair's two trees. Nodes are named `[node of A, node of B]`
+/// (indices into each tree's nodes; `[0, 0]` is the root pair). Implemented by
+/// [`FrontierPair`] for every volume type and by [`MixedPair`].
+pub trait PairTrees {
+    /// The pair's threshold ([`FrontierPair::threshold`]).
+    fn threshold(&self) -> f64;
+
+    /// The roots' upper bound of the distance ([`FrontierPair`]'s centres plus stand-offs)
+    /// and the rounding of a triangle distance at the pair's scale, metres.
+    fn root_bounds(&self) -> (f64, f64);
+
+    /// The seed triangle pair's distance and witnesses (one triangle test), when the pair
+    /// has a seed naming triangles of both meshes.
+    fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)>;
+
+    /// A lower bound of the distance between the two nodes' triangles, metres
+    /// ([`BoundingVolume::distance_lower_bound_within`] with `limit`).
+    fn bound(&self, nodes: [u32; 2], limit: f64) -> f64;
+
+    /// An upper bound of the distance between the two nodes' triangles (centres plus
+    /// stand-offs, padded for rounding), metres.
+    fn upper_bound(&self, nodes: [u32; 2]) -> f64;
+
+    /// Whether both nodes are leaves.
+    fn are_leaves(&self, nodes: [u32; 2]) -> bool;
+
+    /// The two child node pairs, splitting the side [`descend_a`] chooses.
+    fn split(&self, nodes: [u32; 2]) -> [[u32; 2]; 2];
+
+    /// Tests every triangle pair of the leaf pair `nodes`, lowering `best` (metres) and
+    /// replacing `witnesses` on each strictly closer pair; returns the number of tests.
+    fn test_leaves(
+        &self,
+        nodes: [u32; 2],
+        best: &mut f64,
+        witnesses: &mut Option<FrontierWitnesses>,
+    ) -> u64;
+}
+
+impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
+    #[inline]
+    fn threshold(&self) -> f64 {
+        self.threshold
+    }
+
+    fn root_bounds(&self) -> (f64, f64) {
+        let (ra, rb) = (self.a.root_bv(), self.b.root_bv());
+        (
+            centre_upper_bound(ra, rb, &self.pose_ab),
+            rounding_bound(ra, rb, &self.pose_ab),
+        )
+    }
+
+    fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
+        let [ia, ib] = self.seed?;
+        let (sa, sb) = (self.a.slot_of(ia)?, self.b.slot_of(ib)?);
+        let tri_b = self.b.triangles()[sb].transformed(&self.pose_ab);
+        let d = distance_triangle_triangle(&self.a.triangles()[sa], &tri_b);
+        Some((
+            d.distance,
+            FrontierWitnesses {
+                point_a: d.point_a,
+                point_b: d.point_b,
+                triangles: [ia, ib],
+            },
+        ))
+    }
+
+    #[inline]
+    fn bound(&self, [a, b]: [u32; 2], limit: f64) -> f64 {
+        let (x, y) = (
+            &self.a.nodes()[a as usize].bv,
+            &self.b.nodes()[b as usize].bv,
+        );
+        x.distance_lower_bound_within(y, &self.pose_ab, limit)
+    }
+
+    fn upper_bound(&self, [a, b]: [u32; 2]) -> f64 {
+        let (x, y) = (
+            &self.a.nodes()[a as usize].bv,
+            &self.b.nodes()[b as usize].bv,
+        );
+        centre_upper_bound(x, y, &self.pose_ab)
+    }
+
+    #[inline]
+    fn are_leaves(&self, [a, b]: [u32; 2]) -> bool {
+        self.a.nodes()[a as usize].is_leaf() && self.b.nodes()[b as usize].is_leaf()
+    }
+
+    #[inline]
+    fn split(&self, [a, b]: [u32; 2]) -> [[u32; 2]; 2] {
+        let (x, y) = (&self.a.nodes()[a as usize], &self.b.nodes()[b as usize]);
+        if descend_a(x, y) {
+            x.children().map(|c| [c as u32, b])
+        } else {
+            y.children().map(|c| [a, c as u32])
+        }
+    }
+
+    fn test_leaves(
+        &self,
+        [a, b]: [u32; 2],
+        best: &mut f64,
+        witnesses: &mut Option<FrontierWitnesses>,
+    ) -> u64 {
+        let (x, y) = (&self.a.nodes()[a as usize], &self.b.nodes()[b as usize]);
+        let (ta, tb) = (self.a.triangles(), self.b.triangles());
+        let mut tests = 0;
+        for sb in y.slots() {
+            let tri_b = tb[sb].transformed(&self.pose_ab);
+            for sa in x.slots() {
+                let d = distance_triangle_triangle(&ta[sa], &tri_b);
+                tests += 1;
+                if d.distance < *best {
+                    *best = d.distance;
+                    *witnesses = Some(FrontierWitnesses {
+                        point_a: d.point_a,
+                        point_b: d.point_b,
+                        triangles: [self.a.triangle_id(sa), self.b.triangle_id(sb)],
+                    });
+                }
+            }
+        }
+        tests
+    }
+}
+
+/// A frontier pair whose trees are of the volume type chosen for it: one frontier then
+/// holds pairs of both types ([`MeshShape::frontier_volume`](crate::scene::MeshShape)).
+#[derive(Debug, Clone, Copy)]
+pub enum MixedPair<'a> {
+    /// Oriented boxes: the cheaper bound (a separating-axis gap), tight on box-like parts.
+    Obb(FrontierPair<'a, Obb>),
+    /// Rectangle swept spheres: the exact distance of two rounded rectangles, tighter on
+    /// curved parts.
+    Rss(FrontierPair<'a, Rss>),
+}
+
+/// Forwards a [`PairTrees`] call to the pair inside a [`MixedPair`].
+macro_rules! forward {
+    ($self:ident, $pair:ident => $call:expr) => {
+        match $self {
+            MixedPair::Obb($pair) => $call,
+            MixedPair::Rss($pair) => $call,
+        }
+    };
+}
+
+impl PairTrees for MixedPair<'_> {
+    fn threshold(&self) -> f64 {
+        forward!(self, p => p.threshold)
+    }
+
+    fn root_bounds(&self) -> (f64, f64) {
+        forward!(self, p => p.root_bounds())
+    }
+
+    fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
+        forward!(self, p => p.seed_distance())
+    }
+
+    #[inline]
+    fn bound(&self, nodes: [u32; 2], limit: f64) -> f64 {
+        forward!(self, p => p.bound(nodes, limit))
+    }
+
+    fn upper_bound(&self, nodes: [u32; 2]) -> f64 {
+        forward!(self, p => p.upper_bound(nodes))
+    }
+
+    #[inline]
+    fn are_leaves(&self, nodes: [u32; 2]) -> bool {
+        forward!(self, p => p.are_leaves(nodes))
+    }
+
+    #[inline]
+    fn split(&self, nodes: [u32; 2]) -> [[u32; 2]; 2] {
+        forward!(self, p => p.split(nodes))
+    }
+
+    fn test_leaves(
+        &self,
+        nodes: [u32; 2],
+        best: &mut f64,
+        witnesses: &mut Option<FrontierWitnesses>,
+    ) -> u64 {
+        forward!(self, p => p.test_leaves(nodes, best, witnesses))
+    }
+}
+
+/// An upper bound of the distance between the geometry bounded by `x` (frame A) and by `y`
+/// (frame B): each volume's centre lies inside it, hence within its stand-off of its
+/// geometry. Padded for the rounding of the centre's transform.
+#[must_use]
+fn centre_upper_bound<B: BoundingVolume>(x: &B, y: &B, pose_ab: &Isometry) -> f64 {
+    let (cx, cy) = (x.center(), pose_ab.transform_point(y.center()));
+    let slack =
+        conservative_slack(cx.abs().max_element() + cy.abs().max_element() + x.size() + y.size());
+    cx.distance(cy) + x.stand_off() + y.stand_off() + slack
+}
+
+/// Rounding error of a triangle–triangle distance between these meshes at this pose: a few
+/// ulps of the largest coordinate involved (as the exact mesh–mesh distance states it).
+#[must_use]
+fn rounding_bound<B: BoundingVolume>(a: &B, b: &B, pose_ab: &Isometry) -> f64 {
+    let reach = |bv: &B| bv.center().abs().max_element() + bv.size();
+    conservative_slack(reach(a) + reach(b) + pose_ab.translation.abs().max_element())
+}
