@@ -314,6 +314,12 @@ impl BoundingVolume for Obb {
     }
 
     fn distance_lower_bound(&self, other: &Self, pose_ab: &Isometry) -> f64 {
+        self.distance_lower_bound_within(other, pose_ab, f64::INFINITY)
+    }
+
+    /// The face axes first; their gap is returned as soon as it reaches `limit` (the nine
+    /// edge axes, each needing a square root, are then skipped).
+    fn distance_lower_bound_within(&self, other: &Self, pose_ab: &Isometry, limit: f64) -> f64 {
         let (r, t, slack) = self.relative(other, pose_ab);
         let (a, b) = (self.half_extents.to_array(), other.half_extents.to_array());
         let abs = r.map(|row| row.map(|x| x.abs() + tolerance::SAT_PARALLEL));
@@ -332,6 +338,9 @@ impl BoundingVolume for Obb {
             if gap > best {
                 best = gap;
             }
+        }
+        if best >= limit {
+            return best;
         }
         for i in 0..3 {
             let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
