@@ -104,6 +104,7 @@ mod answer;
 pub mod budget;
 mod contacts;
 mod dispatch;
+mod frontier_pairs;
 mod mesh_contacts;
 mod toi;
 pub mod workers;
@@ -117,17 +118,16 @@ use crate::broad::{
     BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, Proxy,
     SortAndSweep, choose,
 };
-use crate::bvh::frontier::{
-    self, FrontierAnswer, FrontierPair, FrontierStats, FrontierWorkspace, MixedPair,
-};
+use crate::bvh::frontier::{self, FrontierAnswer, FrontierStats, FrontierWorkspace};
 use crate::math::{DVec3, Pose};
 use crate::narrow::contact::Manifold;
 use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::DistanceCache;
+use crate::scene::MeshShape;
 use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
-use crate::scene::{FrontierVolume, MeshShape};
 use answer::{Answer, MeshScratch};
 use dispatch::{NarrowScratch, Route};
+use frontier_pairs::MeshPairTrees;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
@@ -774,6 +774,7 @@ fn run_frontier(
         // Nothing to answer: no run (and nothing left to resume later).
         frontier_pairs.clear();
         frontier_answers.clear();
+        frontier_run.trees.clear();
         return FrontierStats::default();
     }
     let resume = frontier_run.resumes(scene, query, frontier_pairs, candidates)
@@ -788,62 +789,40 @@ fn run_frontier(
         frontier_run.scene = scene.uid();
         frontier_run.query = query;
         frontier_run.versions.clear();
-        frontier_run.thresholds.clear();
+        frontier_run.trees.clear();
         for pair in frontier_pairs.iter() {
             let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-            frontier_run.versions.push([a.version(), b.version()]);
-            let threshold = if query.distance {
-                let (ma, mb) = mesh_pair(scene, pair).expect("a mesh pair");
-                let pose_ab = Pose::relative(&a.pose, &b.pose).to_isometry();
-                let seed = frontier_seeds.get(pair).copied().unwrap_or([0, 0]);
-                distance_upper_bound(ma, mb, &pose_ab, seed)
-            } else {
-                a.margin + b.margin
-            };
-            frontier_run.thresholds.push(threshold);
-        }
-    }
-    let pairs: Vec<MixedPair<'_>> = frontier_pairs
-        .iter()
-        .zip(&frontier_run.thresholds)
-        .map(|(pair, &threshold)| {
             let (ma, mb) = mesh_pair(scene, pair).expect("a mesh pair");
-            let (a, b) = (body(scene, pair.a), body(scene, pair.b));
             let pose_ab = Pose::relative(&a.pose, &b.pose).to_isometry();
             // Last frame's closest triangles: the warm start the exact queries have.
             let seed = frontier_seeds.get(pair).copied();
-            match FrontierVolume::for_pair(ma.frontier_volume, mb.frontier_volume) {
-                FrontierVolume::Obb => MixedPair::Obb(FrontierPair {
-                    a: &ma.overlap_tree,
-                    b: &mb.overlap_tree,
-                    pose_ab,
-                    threshold,
-                    seed,
-                }),
-                FrontierVolume::Rss => MixedPair::Rss(FrontierPair {
-                    a: &ma.distance_tree,
-                    b: &mb.distance_tree,
-                    pose_ab,
-                    threshold,
-                    seed,
-                }),
-            }
-        })
-        .collect();
+            let threshold = if query.distance {
+                distance_upper_bound(ma, mb, &pose_ab, seed.unwrap_or([0, 0]))
+            } else {
+                a.margin + b.margin
+            };
+            frontier_run.versions.push([a.version(), b.version()]);
+            frontier_run
+                .trees
+                .push(MeshPairTrees::new(ma, mb, pose_ab, threshold, seed));
+        }
+    }
+    // A resumed frontier's pairs are the same (unchanged bodies, so the same poses).
+    let pairs = &frontier_run.trees;
     let before = if resume {
         *frontier.stats()
     } else {
-        frontier.start(&pairs);
+        frontier.start(pairs);
         FrontierStats::default()
     };
     frontier.run(
-        &pairs,
+        pairs,
         &mut Resumed {
             inner: budget,
             base: before.visits,
         },
     );
-    frontier.answers(&pairs, frontier_answers);
+    frontier.answers(pairs, frontier_answers);
     for (pair, answer) in frontier_pairs.iter().zip(frontier_answers.iter()) {
         if let Some(w) = answer.witnesses {
             frontier_seeds.insert(*pair, w.triangles);
@@ -910,8 +889,8 @@ struct FrontierRun {
     query: Query,
     /// Both bodies' versions, per pair of `PipelineWorkspace::frontier_pairs`.
     versions: Vec<[u64; 2]>,
-    /// The threshold of each pair.
-    thresholds: Vec<f64>,
+    /// Each pair as the frontier refines it (trees, pose, threshold, seed).
+    trees: Vec<MeshPairTrees>,
 }
 
 impl FrontierRun {

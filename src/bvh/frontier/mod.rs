@@ -112,7 +112,7 @@
 
 mod trees;
 
-pub use trees::{FrontierPair, MixedPair, PairTrees};
+pub use trees::{FrontierPair, MixedPair, PairTrees, TreesAt};
 
 use crate::math::DVec3;
 use std::cmp::Ordering;

@@ -71,24 +71,35 @@ pub trait PairTrees {
     ) -> u64;
 }
 
-impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
-    #[inline]
-    fn threshold(&self) -> f64 {
-        self.threshold
-    }
+/// Two trees and B's pose in A's frame, borrowed: the operations of [`PairTrees`] on them,
+/// shared by every implementation.
+#[derive(Debug, Clone, Copy)]
+pub struct TreesAt<'a, B> {
+    /// Tree of mesh A (A's frame).
+    pub a: &'a Bvh<B>,
+    /// Tree of mesh B (B's frame).
+    pub b: &'a Bvh<B>,
+    /// B's frame expressed in A's frame.
+    pub pose_ab: &'a Isometry,
+}
 
-    fn root_bounds(&self) -> (f64, f64) {
+impl<B: BoundingVolume> TreesAt<'_, B> {
+    /// See [`PairTrees::root_bounds`].
+    #[must_use]
+    pub fn root_bounds(&self) -> (f64, f64) {
         let (ra, rb) = (self.a.root_bv(), self.b.root_bv());
         (
-            centre_upper_bound(ra, rb, &self.pose_ab),
-            rounding_bound(ra, rb, &self.pose_ab),
+            centre_upper_bound(ra, rb, self.pose_ab),
+            rounding_bound(ra, rb, self.pose_ab),
         )
     }
 
-    fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
-        let [ia, ib] = self.seed?;
+    /// See [`PairTrees::seed_distance`]; `seed` names a triangle of each mesh.
+    #[must_use]
+    pub fn seed_distance(&self, seed: Option<[u32; 2]>) -> Option<(f64, FrontierWitnesses)> {
+        let [ia, ib] = seed?;
         let (sa, sb) = (self.a.slot_of(ia)?, self.b.slot_of(ib)?);
-        let tri_b = self.b.triangles()[sb].transformed(&self.pose_ab);
+        let tri_b = self.b.triangles()[sb].transformed(self.pose_ab);
         let d = distance_triangle_triangle(&self.a.triangles()[sa], &tri_b);
         Some((
             d.distance,
@@ -100,30 +111,38 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
         ))
     }
 
+    /// See [`PairTrees::bound`].
     #[inline]
-    fn bound(&self, [a, b]: [u32; 2], limit: f64) -> f64 {
+    #[must_use]
+    pub fn bound(&self, [a, b]: [u32; 2], limit: f64) -> f64 {
         let (x, y) = (
             &self.a.nodes()[a as usize].bv,
             &self.b.nodes()[b as usize].bv,
         );
-        x.distance_lower_bound_within(y, &self.pose_ab, limit)
+        x.distance_lower_bound_within(y, self.pose_ab, limit)
     }
 
-    fn upper_bound(&self, [a, b]: [u32; 2]) -> f64 {
+    /// See [`PairTrees::upper_bound`].
+    #[must_use]
+    pub fn upper_bound(&self, [a, b]: [u32; 2]) -> f64 {
         let (x, y) = (
             &self.a.nodes()[a as usize].bv,
             &self.b.nodes()[b as usize].bv,
         );
-        centre_upper_bound(x, y, &self.pose_ab)
+        centre_upper_bound(x, y, self.pose_ab)
     }
 
+    /// See [`PairTrees::are_leaves`].
     #[inline]
-    fn are_leaves(&self, [a, b]: [u32; 2]) -> bool {
+    #[must_use]
+    pub fn are_leaves(&self, [a, b]: [u32; 2]) -> bool {
         self.a.nodes()[a as usize].is_leaf() && self.b.nodes()[b as usize].is_leaf()
     }
 
+    /// See [`PairTrees::split`].
     #[inline]
-    fn split(&self, [a, b]: [u32; 2]) -> [[u32; 2]; 2] {
+    #[must_use]
+    pub fn split(&self, [a, b]: [u32; 2]) -> [[u32; 2]; 2] {
         let (x, y) = (&self.a.nodes()[a as usize], &self.b.nodes()[b as usize]);
         if descend_a(x, y) {
             x.children().map(|c| [c as u32, b])
@@ -132,7 +151,8 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
         }
     }
 
-    fn test_leaves(
+    /// See [`PairTrees::test_leaves`].
+    pub fn test_leaves(
         &self,
         [a, b]: [u32; 2],
         best: &mut f64,
@@ -142,7 +162,7 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
         let (ta, tb) = (self.a.triangles(), self.b.triangles());
         let mut tests = 0;
         for sb in y.slots() {
-            let tri_b = tb[sb].transformed(&self.pose_ab);
+            let tri_b = tb[sb].transformed(self.pose_ab);
             for sa in x.slots() {
                 let d = distance_triangle_triangle(&ta[sa], &tri_b);
                 tests += 1;
@@ -157,6 +177,62 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
             }
         }
         tests
+    }
+}
+
+impl<'a, B> FrontierPair<'a, B> {
+    /// Its trees and pose, borrowed.
+    #[inline]
+    #[must_use]
+    pub fn trees(&self) -> TreesAt<'_, B> {
+        TreesAt {
+            a: self.a,
+            b: self.b,
+            pose_ab: &self.pose_ab,
+        }
+    }
+}
+
+impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
+    #[inline]
+    fn threshold(&self) -> f64 {
+        self.threshold
+    }
+
+    fn root_bounds(&self) -> (f64, f64) {
+        self.trees().root_bounds()
+    }
+
+    fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
+        self.trees().seed_distance(self.seed)
+    }
+
+    #[inline]
+    fn bound(&self, nodes: [u32; 2], limit: f64) -> f64 {
+        self.trees().bound(nodes, limit)
+    }
+
+    fn upper_bound(&self, nodes: [u32; 2]) -> f64 {
+        self.trees().upper_bound(nodes)
+    }
+
+    #[inline]
+    fn are_leaves(&self, nodes: [u32; 2]) -> bool {
+        self.trees().are_leaves(nodes)
+    }
+
+    #[inline]
+    fn split(&self, nodes: [u32; 2]) -> [[u32; 2]; 2] {
+        self.trees().split(nodes)
+    }
+
+    fn test_leaves(
+        &self,
+        nodes: [u32; 2],
+        best: &mut f64,
+        witnesses: &mut Option<FrontierWitnesses>,
+    ) -> u64 {
+        self.trees().test_leaves(nodes, best, witnesses)
     }
 }
 

@@ -1,0 +1,111 @@
+//! The frame's mesh pairs as the budgeted frontier sees them ([`PairTrees`]), owned by the
+//! pipeline's workspace: listing them clones two `Arc`s per pair and allocates nothing once
+//! the list has grown to the largest frame seen.
+
+use crate::bvh::frontier::{FrontierWitnesses, PairTrees, TreesAt};
+use crate::math::Isometry;
+use crate::scene::{FrontierVolume, MeshShape};
+use std::sync::Arc;
+
+/// One mesh pair of a budgeted frame.
+#[derive(Debug, Clone)]
+pub(super) struct MeshPairTrees {
+    /// Mesh of body A, mesh of body B (held while the frontier refers to their trees).
+    pub meshes: [Arc<MeshShape>; 2],
+    /// Which of the meshes' trees the pair is refined with
+    /// ([`FrontierVolume::for_pair`]).
+    pub volume: FrontierVolume,
+    /// B's frame expressed in A's frame.
+    pub pose_ab: Isometry,
+    /// The pair's threshold, metres ([`crate::bvh::frontier::FrontierPair::threshold`]).
+    pub threshold: f64,
+    /// Triangles to try first ([`crate::bvh::frontier::FrontierPair::seed`]).
+    pub seed: Option<[u32; 2]>,
+}
+
+impl MeshPairTrees {
+    /// The pair of `a` (at the origin) and `b` placed by `pose_ab`, refined with the trees
+    /// both meshes chose.
+    pub fn new(
+        a: &Arc<MeshShape>,
+        b: &Arc<MeshShape>,
+        pose_ab: Isometry,
+        threshold: f64,
+        seed: Option<[u32; 2]>,
+    ) -> Self {
+        Self {
+            volume: FrontierVolume::for_pair(a.frontier_volume, b.frontier_volume),
+            meshes: [Arc::clone(a), Arc::clone(b)],
+            pose_ab,
+            threshold,
+            seed,
+        }
+    }
+}
+
+/// Evaluates `$call` with `$trees` bound to the pair's [`TreesAt`] of its volume type.
+macro_rules! on_trees {
+    ($pair:ident, $trees:ident => $call:expr) => {{
+        let [a, b] = &$pair.meshes;
+        match $pair.volume {
+            FrontierVolume::Obb => {
+                let $trees = TreesAt {
+                    a: &a.overlap_tree,
+                    b: &b.overlap_tree,
+                    pose_ab: &$pair.pose_ab,
+                };
+                $call
+            }
+            FrontierVolume::Rss => {
+                let $trees = TreesAt {
+                    a: &a.distance_tree,
+                    b: &b.distance_tree,
+                    pose_ab: &$pair.pose_ab,
+                };
+                $call
+            }
+        }
+    }};
+}
+
+impl PairTrees for MeshPairTrees {
+    fn threshold(&self) -> f64 {
+        self.threshold
+    }
+
+    fn root_bounds(&self) -> (f64, f64) {
+        on_trees!(self, t => t.root_bounds())
+    }
+
+    fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
+        on_trees!(self, t => t.seed_distance(self.seed))
+    }
+
+    #[inline]
+    fn bound(&self, nodes: [u32; 2], limit: f64) -> f64 {
+        on_trees!(self, t => t.bound(nodes, limit))
+    }
+
+    fn upper_bound(&self, nodes: [u32; 2]) -> f64 {
+        on_trees!(self, t => t.upper_bound(nodes))
+    }
+
+    #[inline]
+    fn are_leaves(&self, nodes: [u32; 2]) -> bool {
+        on_trees!(self, t => t.are_leaves(nodes))
+    }
+
+    #[inline]
+    fn split(&self, nodes: [u32; 2]) -> [[u32; 2]; 2] {
+        on_trees!(self, t => t.split(nodes))
+    }
+
+    fn test_leaves(
+        &self,
+        nodes: [u32; 2],
+        best: &mut f64,
+        witnesses: &mut Option<FrontierWitnesses>,
+    ) -> u64 {
+        on_trees!(self, t => t.test_leaves(nodes, best, witnesses))
+    }
+}
