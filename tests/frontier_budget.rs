@@ -28,7 +28,7 @@ mod support;
 
 use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, Rss};
 use proxima::bvh::frontier::{
-    Completeness, FrontierAnswer, FrontierPair, FrontierWorkspace, MixedPair, PairTrees, Unlimited,
+    Completeness, FrontierAnswer, FrontierPair, FrontierWorkspace, PairTrees, Unlimited,
     VisitBudget, query_frontier,
 };
 use proxima::bvh::{BuildParams, Bvh};
@@ -38,8 +38,11 @@ use proxima::narrow::distance_triangle_triangle;
 use proxima::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh, within_distance_mesh_mesh,
 };
+use proxima::pipeline::MeshPairTrees;
+use proxima::scene::{FrontierVolume, MeshShape};
 use rand::Rng;
 use std::collections::HashMap;
+use std::sync::Arc;
 use support::meshes;
 use support::triangle_pairs::{TriangleBox, TrianglePairs};
 use support::{rng, rotation};
@@ -727,6 +730,17 @@ fn every_interruption_point_of_the_tori_piles_is_conservative_and_monotone() {
     tally.assert_every_outcome("tori piles");
 }
 
+/// `pair` on the given trees of its meshes, as a pair of one volume type.
+fn typed<'a, B>(a: &'a Bvh<B>, b: &'a Bvh<B>, pair: &MeshPairTrees) -> FrontierPair<'a, B> {
+    FrontierPair {
+        a,
+        b,
+        pose_ab: pair.pose_ab,
+        threshold: pair.threshold,
+        seed: pair.seed,
+    }
+}
+
 /// The unlimited answer of one pair run alone.
 fn alone<P: PairTrees>(pair: &P) -> FrontierAnswer {
     let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
@@ -744,41 +758,29 @@ fn a_frontier_mixing_obb_and_rss_pairs_is_conservative_monotone_and_exact_per_pa
     let mut tally = Tally::default();
     for seed in PILE_SEEDS {
         let scene = tori_pile(seed);
-        let build = BuildParams::BINNED_SAH.with_leaf_size(4);
-        let obb: Vec<Bvh<Obb>> = scene
+        let meshes: Vec<Arc<MeshShape>> = scene
             .meshes
             .iter()
-            .map(|m| Bvh::from_mesh(m, &build))
+            .map(|m| Arc::new(MeshShape::new(m.clone())))
             .collect();
-        let rss: Vec<Bvh<Rss>> = scene
-            .meshes
-            .iter()
-            .map(|m| Bvh::from_mesh(m, &build))
-            .collect();
-        // Alternate the volume type from pair to pair.
-        let pairs: Vec<MixedPair<'_>> = scene
+        // Alternate the volume type from pair to pair, whatever the meshes chose.
+        let pairs: Vec<MeshPairTrees> = scene
             .pairs
             .iter()
             .enumerate()
-            .map(|(i, p)| {
-                let (pose_ab, threshold) = (p.pose_ab.to_isometry(), p.threshold);
-                if i % 2 == 0 {
-                    MixedPair::Obb(FrontierPair {
-                        a: &obb[p.a],
-                        b: &obb[p.b],
-                        pose_ab,
-                        threshold,
-                        seed: None,
-                    })
+            .map(|(i, p)| MeshPairTrees {
+                volume: if i % 2 == 0 {
+                    FrontierVolume::Obb
                 } else {
-                    MixedPair::Rss(FrontierPair {
-                        a: &rss[p.a],
-                        b: &rss[p.b],
-                        pose_ab,
-                        threshold,
-                        seed: None,
-                    })
-                }
+                    FrontierVolume::Rss
+                },
+                ..MeshPairTrees::new(
+                    &meshes[p.a],
+                    &meshes[p.b],
+                    p.pose_ab.to_isometry(),
+                    p.threshold,
+                    None,
+                )
             })
             .collect();
         for (&t, p) in scene.truth.iter().zip(&scene.pairs) {
@@ -792,9 +794,10 @@ fn a_frontier_mixing_obb_and_rss_pairs_is_conservative_monotone_and_exact_per_pa
         let (mut ws, mut exact) = (FrontierWorkspace::new(), Vec::new());
         assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut exact));
         for (i, (pair, answer)) in pairs.iter().zip(&exact).enumerate() {
-            let own = match pair {
-                MixedPair::Obb(p) => alone(p),
-                MixedPair::Rss(p) => alone(p),
+            let [a, b] = &pair.meshes;
+            let own = match pair.volume {
+                FrontierVolume::Obb => alone(&typed(&a.overlap_tree, &b.overlap_tree, pair)),
+                FrontierVolume::Rss => alone(&typed(&a.distance_tree, &b.distance_tree, pair)),
             };
             assert!(same_bits(&[*answer], &[own]), "seed {seed}, pair {i}");
         }

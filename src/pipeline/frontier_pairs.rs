@@ -7,9 +7,9 @@ use crate::math::Isometry;
 use crate::scene::{FrontierVolume, MeshShape};
 use std::sync::Arc;
 
-/// One mesh pair of a budgeted frame.
+/// One mesh pair of a budgeted frame, refined with the trees of its [`FrontierVolume`].
 #[derive(Debug, Clone)]
-pub(super) struct MeshPairTrees {
+pub struct MeshPairTrees {
     /// Mesh of body A, mesh of body B (held while the frontier refers to their trees).
     pub meshes: [Arc<MeshShape>; 2],
     /// Which of the meshes' trees the pair is refined with
@@ -26,6 +26,7 @@ pub(super) struct MeshPairTrees {
 impl MeshPairTrees {
     /// The pair of `a` (at the origin) and `b` placed by `pose_ab`, refined with the trees
     /// both meshes chose.
+    #[must_use]
     pub fn new(
         a: &Arc<MeshShape>,
         b: &Arc<MeshShape>,

@@ -112,6 +112,7 @@ pub mod workers;
 pub use budget::{Budget, Deadline, FRONTIER_RESERVE, Unlimited, VisitBudget, frontier_deadline};
 pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
 pub use dispatch::PathCounts;
+pub use frontier_pairs::MeshPairTrees;
 pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{
@@ -127,7 +128,6 @@ use crate::scene::MeshShape;
 use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
 use answer::{Answer, MeshScratch};
 use dispatch::{NarrowScratch, Route};
-use frontier_pairs::MeshPairTrees;
 use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;

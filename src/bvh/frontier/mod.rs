@@ -6,7 +6,8 @@
 //! Each [`FrontierPair`] asks: *is the distance between the triangles of `a` and of `b`
 //! (placed at `pose_ab`) at most `threshold`, and if so, what is it?* The threshold is the
 //! pair's margin sum, metres. The frontier sees a pair only through [`PairTrees`], so one
-//! run may hold pairs of different volume types ([`MixedPair`]).
+//! run may hold pairs of different volume types
+//! ([`MeshPairTrees`](crate::pipeline::MeshPairTrees)).
 //!
 //! # The traversal
 //! [`FrontierWorkspace::start`] puts one root entry per pair on the frontier (round 1).
@@ -112,7 +113,7 @@
 
 mod trees;
 
-pub use trees::{FrontierPair, MixedPair, PairTrees, TreesAt};
+pub use trees::{FrontierPair, PairTrees, TreesAt};
 
 use crate::math::DVec3;
 use std::cmp::Ordering;

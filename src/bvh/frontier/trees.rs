@@ -1,9 +1,10 @@
 //! The trees of one frontier pair, seen through [`PairTrees`]: the few operations the
 //! frontier needs (node bounds, splits, leaf tests), so that one frontier can hold pairs of
-//! different volume types ([`MixedPair`]), each pair's chosen by measured tightness.
+//! different volume types, each pair's chosen by measured tightness (the pipeline's
+//! [`MeshPairTrees`](crate::pipeline::MeshPairTrees)).
 
 use super::FrontierWitnesses;
-use crate::bounding::{BoundingVolume, Obb, Rss};
+use crate::bounding::BoundingVolume;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::descend_a;
 use crate::math::{Isometry, conservative_slack};
@@ -34,7 +35,8 @@ pub struct FrontierPair<'a, B> {
 
 /// What the frontier needs of a pair's two trees. Nodes are named `[node of A, node of B]`
 /// (indices into each tree's nodes; `[0, 0]` is the root pair). Implemented by
-/// [`FrontierPair`] for every volume type and by [`MixedPair`].
+/// [`FrontierPair`] for every volume type and by the pipeline's
+/// [`MeshPairTrees`](crate::pipeline::MeshPairTrees), whose type is chosen per pair.
 pub trait PairTrees {
     /// The pair's threshold ([`FrontierPair::threshold`]).
     fn threshold(&self) -> f64;
@@ -233,69 +235,6 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
         witnesses: &mut Option<FrontierWitnesses>,
     ) -> u64 {
         self.trees().test_leaves(nodes, best, witnesses)
-    }
-}
-
-/// A frontier pair whose trees are of the volume type chosen for it: one frontier then
-/// holds pairs of both types ([`MeshShape::frontier_volume`](crate::scene::MeshShape)).
-#[derive(Debug, Clone, Copy)]
-pub enum MixedPair<'a> {
-    /// Oriented boxes: the cheaper bound (a separating-axis gap), tight on box-like parts.
-    Obb(FrontierPair<'a, Obb>),
-    /// Rectangle swept spheres: the exact distance of two rounded rectangles, tighter on
-    /// curved parts.
-    Rss(FrontierPair<'a, Rss>),
-}
-
-/// Forwards a [`PairTrees`] call to the pair inside a [`MixedPair`].
-macro_rules! forward {
-    ($self:ident, $pair:ident => $call:expr) => {
-        match $self {
-            MixedPair::Obb($pair) => $call,
-            MixedPair::Rss($pair) => $call,
-        }
-    };
-}
-
-impl PairTrees for MixedPair<'_> {
-    fn threshold(&self) -> f64 {
-        forward!(self, p => p.threshold)
-    }
-
-    fn root_bounds(&self) -> (f64, f64) {
-        forward!(self, p => p.root_bounds())
-    }
-
-    fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
-        forward!(self, p => p.seed_distance())
-    }
-
-    #[inline]
-    fn bound(&self, nodes: [u32; 2], limit: f64) -> f64 {
-        forward!(self, p => p.bound(nodes, limit))
-    }
-
-    fn upper_bound(&self, nodes: [u32; 2]) -> f64 {
-        forward!(self, p => p.upper_bound(nodes))
-    }
-
-    #[inline]
-    fn are_leaves(&self, nodes: [u32; 2]) -> bool {
-        forward!(self, p => p.are_leaves(nodes))
-    }
-
-    #[inline]
-    fn split(&self, nodes: [u32; 2]) -> [[u32; 2]; 2] {
-        forward!(self, p => p.split(nodes))
-    }
-
-    fn test_leaves(
-        &self,
-        nodes: [u32; 2],
-        best: &mut f64,
-        witnesses: &mut Option<FrontierWitnesses>,
-    ) -> u64 {
-        forward!(self, p => p.test_leaves(nodes, best, witnesses))
     }
 }
 
