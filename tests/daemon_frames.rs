@@ -254,6 +254,16 @@ fn assert_linked(frame: &ResultFrame<ipc::Service>) {
     assert_eq!(next, contacts.len());
 }
 
+/// `pose` turned by a random rotation of up to `turn` radians about each axis, then moved
+/// by up to `shift` metres along each (the draws in that order).
+fn jittered(pose: &Pose, rng: &mut support::TestRng, turn: f64, shift: f64) -> Pose {
+    let turn = DQuat::from_scaled_axis(support::point_in_cube(rng, turn));
+    Pose::new(
+        pose.position + support::point_in_cube(rng, shift),
+        (turn * pose.rotation).normalize(),
+    )
+}
+
 #[test]
 fn every_query_combination_gets_the_in_process_pipelines_answer_over_shared_memory() {
     let daemon = Daemon::start();
@@ -511,11 +521,7 @@ fn toi_frames_over_shared_memory_match_the_in_process_pipeline_record_for_record
                 continue;
             }
             if frame > 1 {
-                let turn = DQuat::from_scaled_axis(support::point_in_cube(&mut rng, 0.3));
-                *pose = Pose::new(
-                    pose.position + support::point_in_cube(&mut rng, 0.35),
-                    (turn * pose.rotation).normalize(),
-                );
+                *pose = jittered(pose, &mut rng, 0.3, 0.35);
             }
             records.push(posed_record(i as u32, pose));
         }
@@ -640,11 +646,7 @@ fn frames_with_a_fixed_incremental_sap_or_hash_grid_match_the_in_process_pipelin
             if frame > 1 && !(i + frame as usize).is_multiple_of(3) {
                 continue;
             }
-            let turn = DQuat::from_scaled_axis(support::point_in_cube(&mut rng, 0.2));
-            *pose = Pose::new(
-                pose.position + support::point_in_cube(&mut rng, 0.2),
-                (turn * pose.rotation).normalize(),
-            );
+            *pose = jittered(pose, &mut rng, 0.2, 0.2);
             records.push(posed_record(i as u32, pose));
         }
         let (_, report) = publish_and_compare(

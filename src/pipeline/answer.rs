@@ -282,15 +282,18 @@ pub(super) fn mesh_mesh_finished(
     debug_assert!(frontier.is_exact());
     let wants_distance = query.close || query.distance;
     let pose_ab = Pose::relative(&a.pose, &b.pose);
-    // The exact query's rounding bound (from the RSS trees, whichever trees the frontier
-    // refined), so that an unlimited budget gives the exact query's record bit for bit.
-    let rounding = rounding_bound(&ma.distance_tree, &mb.distance_tree, &pose_ab.to_isometry());
     let known = frontier
         .witnesses
         .filter(|_| frontier.maybe_close)
         .map(|w| KnownDistance {
             distance: frontier.distance_lower,
-            error_bound: rounding,
+            // The exact query's rounding bound (from the RSS trees, whichever trees the
+            // frontier refined), so that an unlimited budget gives its record bit for bit.
+            error_bound: rounding_bound(
+                &ma.distance_tree,
+                &mb.distance_tree,
+                &pose_ab.to_isometry(),
+            ),
             point_a: w.point_a,
             point_b: w.point_b,
         });

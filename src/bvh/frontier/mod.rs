@@ -659,7 +659,7 @@ mod tests {
     use crate::math::{DQuat, Pose};
     use crate::narrow::distance_triangle_triangle;
     use crate::narrow::mesh_mesh::{
-        DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh,
+        DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, distance_mesh_mesh,
     };
 
     fn entry(bound: f64, pair: u32, a: u32, b: u32) -> Entry {
@@ -822,6 +822,18 @@ mod tests {
         }
     }
 
+    /// The exact mesh–mesh distance query's answer, cold.
+    fn exact_distance(a: &Bvh<Rss>, b: &Bvh<Rss>, pose: &Pose) -> MeshDistance {
+        distance_mesh_mesh(
+            a,
+            b,
+            pose,
+            &DistanceParams::EXACT,
+            &mut DistanceCache::new(),
+            &mut MeshMeshWorkspace::new(),
+        )
+    }
+
     #[test]
     fn an_unlimited_run_gives_the_exact_distance_query_answers() {
         let (a, b, poses) = scene::<Rss>();
@@ -836,14 +848,7 @@ mod tests {
         let mut close = 0;
         for ((p, pose), answer) in pairs.iter().zip(&poses).zip(&out) {
             assert!(answer.is_exact());
-            let exact = distance_mesh_mesh(
-                &a,
-                &b,
-                pose,
-                &DistanceParams::EXACT,
-                &mut DistanceCache::new(),
-                &mut MeshMeshWorkspace::new(),
-            );
+            let exact = exact_distance(&a, &b, pose);
             assert_eq!(answer.maybe_close, exact.distance <= p.threshold);
             if answer.maybe_close {
                 close += 1;
@@ -883,14 +888,7 @@ mod tests {
         );
         assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut out));
         for (pose, answer) in poses.iter().zip(&out) {
-            let exact = distance_mesh_mesh(
-                &a,
-                &b,
-                pose,
-                &DistanceParams::EXACT,
-                &mut DistanceCache::new(),
-                &mut MeshMeshWorkspace::new(),
-            );
+            let exact = exact_distance(&a, &b, pose);
             assert!(answer.is_exact() && answer.maybe_close);
             assert_eq!(answer.distance_lower, exact.distance);
             assert_eq!(answer.clamped_error_bound(), answer.error_bound);
