@@ -1,5 +1,5 @@
-//! Broad phase per frame: Proxima's sort and sweep, incremental sweep and prune and
-//! hierarchical hash grid, and rapier's broad phase on parry3d-f64's BVH (the peer; see
+//! Broad phase per frame: Proxima's sort and sweep, incremental sweep and prune,
+//! hierarchical hash grid and column grid, and rapier's broad phase on parry3d-f64's BVH (the peer; see
 //! `common/parry_broad.rs`), on the same frames in the same run.
 //!
 //! Workloads (`common/broad_scenes.rs`): uniform, clustered and stacked boxes, 10 % of the

@@ -15,6 +15,7 @@
 //!   itself, so applying the moves costs it nothing);
 //! - `incremental_sap`, `hash_grid`: `update` of each moved body, then `pairs` (the sorted
 //!   list);
+//! - `column_grid`: `update_all` of the frame's moves, then `pairs`;
 //! - `parry_bvh` (change margin 1 nm, the exact pair set to within 2 nm) and `rapier_bvh` (rapier's 1 cm
 //!   change margin): rapier's update loop, its pair map kept current; no list produced.
 //!
@@ -65,10 +66,10 @@ struct Args {
     #[arg(long, default_value_t = 100)]
     frames: usize,
     /// Broad phases to run, comma-separated (sort_sweep, incremental_sap, hash_grid,
-    /// parry_bvh, rapier_bvh).
+    /// column_grid, parry_bvh, rapier_bvh).
     #[arg(
         long,
-        default_value = "sort_sweep,incremental_sap,hash_grid,parry_bvh,rapier_bvh"
+        default_value = "sort_sweep,incremental_sap,hash_grid,column_grid,parry_bvh,rapier_bvh"
     )]
     algos: String,
     /// Check every broad phase's pair set against the others every this many frames

@@ -34,7 +34,7 @@ use std::time::Instant;
 
 use proxima::bounding::{Aabb, BoundingVolume};
 use proxima::broad::{
-    CandidatePair, CollisionFilter, HashGrid, IncrementalSap, Proxy, SortAndSweep,
+    CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, Proxy, SortAndSweep,
     pairs_brute_force,
 };
 use proxima::math::DVec3;
@@ -91,7 +91,43 @@ macro_rules! stateful_broad_phase {
     )+};
 }
 
-stateful_broad_phase!(IncrementalSap, HashGrid);
+stateful_broad_phase!(IncrementalSap, HashGrid, ColumnGrid);
+
+/// The column grid with a frame's moves gathered and handed over by `update_all`, as the
+/// pipeline does: the batch is flushed before any insertion, removal or pair listing.
+struct BatchedColumns {
+    grid: ColumnGrid,
+    moves: Vec<(u32, Aabb)>,
+}
+
+impl BatchedColumns {
+    fn flush(&mut self) {
+        self.grid.update_all(&self.moves);
+        self.moves.clear();
+    }
+}
+
+impl BroadPhase for BatchedColumns {
+    fn insert(&mut self, p: &Proxy) {
+        self.flush();
+        self.grid.insert(p.body, p.bounds, p.is_static, p.filter);
+    }
+    fn remove(&mut self, body: u32) {
+        self.flush();
+        assert!(self.grid.remove(body), "{body} was present");
+    }
+    fn update(&mut self, body: u32, bounds: Aabb) {
+        self.moves.push((body, bounds));
+    }
+    fn pairs(&mut self, proxies: &[Proxy], out: &mut Vec<CandidatePair>) {
+        self.flush();
+        BroadPhase::pairs(&mut self.grid, proxies, out);
+    }
+    fn validate(&self, proxies: &[Proxy]) -> Result<(), String> {
+        assert!(self.moves.is_empty(), "validated with moves pending");
+        BroadPhase::validate(&self.grid, proxies)
+    }
+}
 
 impl BroadPhase for SortAndSweep {
     fn insert(&mut self, _: &Proxy) {}
@@ -479,5 +515,29 @@ fn hash_grid_equals_brute_force_after_every_one_of_ten_thousand_frames() {
     let start = Instant::now();
     let counts = run(|| Box::new(HashGrid::new()), 6_200);
     eprintln!("hash grid: {counts:?} in {:?}", start.elapsed());
+    assert_scenarios_happened(&counts);
+}
+
+#[test]
+fn column_grid_equals_brute_force_after_every_one_of_ten_thousand_frames() {
+    let start = Instant::now();
+    let counts = run(|| Box::new(ColumnGrid::new()), 6_300);
+    eprintln!("column grid: {counts:?} in {:?}", start.elapsed());
+    assert_scenarios_happened(&counts);
+}
+
+#[test]
+fn column_grid_with_batched_moves_equals_brute_force_after_every_one_of_ten_thousand_frames() {
+    let start = Instant::now();
+    let counts = run(
+        || {
+            Box::new(BatchedColumns {
+                grid: ColumnGrid::new(),
+                moves: Vec::new(),
+            })
+        },
+        6_400,
+    );
+    eprintln!("column grid, batched: {counts:?} in {:?}", start.elapsed());
     assert_scenarios_happened(&counts);
 }

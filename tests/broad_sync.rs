@@ -29,11 +29,12 @@ use support::{TestRng, point_in_cube, rng, rotation};
 
 const FRAMES: u64 = 600;
 
-const CHOICES: [BroadPhaseChoice; 4] = [
+const CHOICES: [BroadPhaseChoice; 5] = [
     BroadPhaseChoice::Auto,
     BroadPhaseChoice::Fixed(BroadPhaseKind::SortAndSweep),
     BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap),
     BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid),
+    BroadPhaseChoice::Fixed(BroadPhaseKind::ColumnGrid),
 ];
 
 /// The scene under test and this test's own record of what changed in the current frame.
@@ -210,16 +211,21 @@ fn kept_broad_phases_answer_like_a_fresh_workspace_and_reread_only_changed_bodie
     let mut world = World::new(&mut rng, 6.0, 90);
     let mut other = World::new(&mut rng, 3.0, 30);
     // One per choice, one whose choice cycles, one per fixed kind shared by both scenes.
-    let mut kept: Vec<PipelineWorkspace> = (0..5).map(|_| PipelineWorkspace::default()).collect();
-    let mut shared: Vec<PipelineWorkspace> = (0..3).map(|_| PipelineWorkspace::default()).collect();
+    const KEPT: usize = CHOICES.len() + 1;
+    let mut kept: Vec<PipelineWorkspace> =
+        (0..KEPT).map(|_| PipelineWorkspace::default()).collect();
+    let mut shared: Vec<PipelineWorkspace> = BroadPhaseKind::ALL
+        .iter()
+        .map(|_| PipelineWorkspace::default())
+        .collect();
     let cycling = |frame: u64| CHOICES[(frame / 40) as usize % CHOICES.len()];
     // What Auto measured last, and at which frame.
     let mut auto_kind = None;
     let mut auto_measured_at = 0;
     // Whether each kept workspace must rebuild this frame (first frame, after a TOI-only
     // frame, after changes made past the step, after its kind changed).
-    let mut must_rebuild = [true; 5];
-    let mut last_kind: [Option<BroadPhaseKind>; 5] = [None; 5];
+    let mut must_rebuild = [true; KEPT];
+    let mut last_kind: [Option<BroadPhaseKind>; KEPT] = [None; KEPT];
     let mut tally = [0usize; 6]; // quiet, incremental, rebuilt, twice, late edits, toi-only
     for frame in 0..FRAMES {
         let quiet = frame % 11 == 5;
@@ -238,7 +244,11 @@ fn kept_broad_phases_answer_like_a_fresh_workspace_and_reread_only_changed_bodie
         let fresh = run(&world.scene, query, &mut PipelineWorkspace::default());
         let changed = world.changed.len() as u32;
         for (i, workspace) in kept.iter_mut().enumerate() {
-            let choice = if i < 4 { CHOICES[i] } else { cycling(frame) };
+            let choice = if i < CHOICES.len() {
+                CHOICES[i]
+            } else {
+                cycling(frame)
+            };
             world.scene.set_broad_phase(choice);
             let got = run(&world.scene, query, workspace);
             let what = format!("frame {frame}, workspace {i} ({choice:?})");
@@ -329,7 +339,11 @@ fn kept_broad_phases_answer_like_a_fresh_workspace_and_reread_only_changed_bodie
             world.move_some(&mut rng);
             let fresh = run(&world.scene, query, &mut PipelineWorkspace::default());
             for (i, workspace) in kept.iter_mut().enumerate() {
-                let choice = if i < 4 { CHOICES[i] } else { cycling(frame) };
+                let choice = if i < CHOICES.len() {
+                    CHOICES[i]
+                } else {
+                    cycling(frame)
+                };
                 world.scene.set_broad_phase(choice);
                 let first = run(&world.scene, query, workspace);
                 let second = run(&world.scene, query, workspace);
@@ -345,7 +359,7 @@ fn kept_broad_phases_answer_like_a_fresh_workspace_and_reread_only_changed_bodie
         if frame % 13 == 7 {
             world.update(&mut rng);
             world.move_some(&mut rng);
-            must_rebuild = [true; 5];
+            must_rebuild = [true; KEPT];
             tally[4] += 1;
         }
         tally[5] += usize::from(toi_only);

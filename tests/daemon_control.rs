@@ -232,6 +232,7 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
     for (i, code) in [
         BroadPhaseCode::IncrementalSap,
         BroadPhaseCode::HashGrid,
+        BroadPhaseCode::ColumnGrid,
         BroadPhaseCode::SortAndSweep,
         BroadPhaseCode::Auto,
     ]
@@ -247,7 +248,7 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
         protocol_version: proxima_ipc::PROTOCOL_VERSION,
         command: Command::SetSceneParams as u32,
         scene,
-        broad_phase: 4,
+        broad_phase: 5,
         ..ControlRequest::default()
     };
     let reply = client.request(&bad, &[]).unwrap();
@@ -256,7 +257,7 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
         Some(ErrorCode::MalformedMessage)
     );
     assert!(
-        reply.reason().contains("broad phase 4"),
+        reply.reason().contains("broad phase 5"),
         "{}",
         reply.reason()
     );
@@ -277,7 +278,7 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
         rejected(client.set_broad_phase(scene + 9, BroadPhaseCode::HashGrid)),
         ErrorCode::UnknownScene
     );
-    // Still served: control, and frames (four spheres 0.75 m apart, radius 0.5: three
+    // Still served: control, and frames (five spheres 0.75 m apart, radius 0.5: four
     // touching pairs).
     client.add_body(scene, &body(sphere, 10.0)).unwrap();
     let link = client.open_scene(scene).unwrap();
@@ -292,6 +293,6 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
             ErrorCode::from_u32(result.header().status),
             Some(ErrorCode::Ok)
         );
-        assert_eq!(result.header().pair_count, 3, "frame {frame}");
+        assert_eq!(result.header().pair_count, 4, "frame {frame}");
     }
 }

@@ -3,13 +3,14 @@
 
 use super::parry_broad::{EXACT_CHANGE_MARGIN, ParryBroadPhase, RAPIER_CHANGE_MARGIN};
 use proxima::bounding::Aabb;
-use proxima::broad::{CandidatePair, HashGrid, IncrementalSap, Proxy, SortAndSweep};
+use proxima::broad::{CandidatePair, ColumnGrid, HashGrid, IncrementalSap, Proxy, SortAndSweep};
 
 /// Every broad phase by name, Proxima's first.
-pub const NAMES: [&str; 5] = [
+pub const NAMES: [&str; 6] = [
     "sort_sweep",
     "incremental_sap",
     "hash_grid",
+    "column_grid",
     "parry_bvh",
     "rapier_bvh",
 ];
@@ -22,6 +23,9 @@ pub enum Phase {
     Sap(IncrementalSap),
     /// Proxima's hierarchical hash grid.
     Grid(HashGrid),
+    /// Proxima's column grid, a frame's moves handed over as one batch (as the pipeline
+    /// does).
+    Columns(ColumnGrid),
     /// rapier's broad phase on parry's BVH; `exact` for the 1 nm change margin.
     Parry { phase: ParryBroadPhase, exact: bool },
 }
@@ -39,6 +43,7 @@ impl Phase {
                 }
                 Self::Grid(g)
             }
+            "column_grid" => Self::Columns(ColumnGrid::from_proxies(proxies)),
             "parry_bvh" | "rapier_bvh" => {
                 let exact = name == "parry_bvh";
                 let margin = if exact {
@@ -75,6 +80,10 @@ impl Phase {
                     g.update(body, bounds);
                 }
                 g.pairs(out);
+            }
+            Self::Columns(c) => {
+                c.update_all(moved);
+                c.pairs(out);
             }
             Self::Parry { phase, .. } => phase.update(moved),
         }

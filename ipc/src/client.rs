@@ -948,6 +948,7 @@ mod tests {
             BroadPhaseCode::SortAndSweep,
             BroadPhaseCode::IncrementalSap,
             BroadPhaseCode::HashGrid,
+            BroadPhaseCode::ColumnGrid,
         ] {
             client.set_broad_phase(6, code).unwrap();
             let (header, payload) = responder.next();

@@ -465,6 +465,9 @@ pub enum BroadPhaseCode {
     IncrementalSap = 2,
     /// Hierarchical hash grid: a body that did not move costs nothing.
     HashGrid = 3,
+    /// Hierarchical grid of columns sorted along one axis: a body that did not move costs
+    /// nothing (since protocol version 5).
+    ColumnGrid = 4,
 }
 
 impl BroadPhaseCode {
@@ -476,6 +479,7 @@ impl BroadPhaseCode {
             1 => Self::SortAndSweep,
             2 => Self::IncrementalSap,
             3 => Self::HashGrid,
+            4 => Self::ColumnGrid,
             _ => return None,
         })
     }

@@ -1,7 +1,7 @@
-//! What every stateful broad phase ([`IncrementalSap`], [`HashGrid`]) owes, as generic test
+//! What every stateful broad phase ([`IncrementalSap`], [`HashGrid`], [`ColumnGrid`]) owes, as generic test
 //! bodies that each one's unit tests run with its own constructor and sizes.
 
-use super::{CandidatePair, CollisionFilter, HashGrid, IncrementalSap};
+use super::{CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap};
 use crate::bounding::Aabb;
 use crate::math::DVec3;
 use crate::test_support::TestRng;
@@ -45,7 +45,7 @@ macro_rules! stateful {
     )+};
 }
 
-stateful!(IncrementalSap, HashGrid);
+stateful!(IncrementalSap, HashGrid, ColumnGrid);
 
 /// A random box centred in the cube of half-size `spread`: one in `kinds` a point, one in
 /// `kinds` huge (half-extents 2 to 20 m), the rest ordinary (half-extents up to 1 m).

@@ -92,12 +92,12 @@
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant), checked by
 //! `debug_assert!`.
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 use std::hash::{BuildHasher, Hash, Hasher};
 
 use super::body_map::BodyMap;
 use super::pair_set::PairSet;
-use super::{CandidatePair, CollisionFilter, Proxy, pairs_brute_force};
+use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64};
 use crate::bounding::{Aabb, BoundingVolume};
 
 /// Cell-size ratio between consecutive levels chosen by [`HashGrid::new`].
@@ -465,7 +465,7 @@ impl HashGrid {
         for &other in &self.scratch {
             let q = &self.proxies[other as usize];
             if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
-                self.pairs.remove(pair_of(body, q.body));
+                self.pairs.remove(CandidatePair::of(body, q.body));
             }
         }
         self.unregister(slot);
@@ -616,19 +616,7 @@ impl HashGrid {
                 ));
             }
         }
-        let mut expected = Vec::new();
-        pairs_brute_force(&self.proxies, &mut expected);
-        let have = self.pairs.snapshot();
-        if have != expected {
-            let (have, want): (BTreeSet<_>, BTreeSet<_>) =
-                (have.into_iter().collect(), expected.into_iter().collect());
-            return Err(format!(
-                "pair set differs from brute force: extra {:?}, missing {:?}",
-                have.difference(&want).collect::<Vec<_>>(),
-                want.difference(&have).collect::<Vec<_>>()
-            ));
-        }
-        Ok(())
+        self.pairs.check_against_brute_force(&self.proxies)
     }
 
     /// Builds the levels (see [`with_levels`](Self::with_levels) for the panics).
@@ -884,7 +872,7 @@ impl HashGrid {
             let was = old.is_some_and(|old| old.intersects(&q.bounds));
             let is = p.bounds.intersects(&q.bounds);
             if was != is {
-                let key = pair_of(p.body, q.body);
+                let key = CandidatePair::of(p.body, q.body);
                 if is {
                     self.pairs.insert(key);
                 } else {
@@ -895,38 +883,14 @@ impl HashGrid {
     }
 }
 
-/// `⌊x⌋` clamped to `i64`, exactly (as `x.floor() as i64`), without the library call
-/// `f64::floor` compiles to on baseline x86-64 (no SSE4.1 `roundsd`): the truncating
-/// conversion, one lower for negative non-integers. Monotone, so the tie rule holds.
-#[inline]
-fn floor_to_i64(x: f64) -> i64 {
-    let t = x as i64;
-    t.saturating_sub(i64::from((t as f64) > x))
-}
-
-/// The pair of two distinct ids, smaller first.
-#[inline]
-fn pair_of(a: u32, b: u32) -> CandidatePair {
-    CandidatePair {
-        a: a.min(b),
-        b: a.max(b),
-    }
-}
-
-#[inline]
-fn debug_assert_valid_bounds(bounds: &Aabb) {
-    debug_assert!(
-        bounds.min.is_finite() && bounds.max.is_finite() && bounds.min.cmple(bounds.max).all(),
-        "broad-phase bounds must be finite and not inverted: {bounds:?}"
-    );
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broad::pairs_brute_force;
     use crate::math::DVec3;
     use crate::test_support::{TestRng, point_in_cube, rng};
     use rand::Rng;
+    use std::collections::BTreeSet;
 
     fn cube(lo: DVec3, size: f64) -> Aabb {
         Aabb::new(lo, lo + DVec3::splat(size))
@@ -1043,7 +1007,7 @@ mod tests {
             grid.pairs(&mut found);
             assert_eq!(found, expected, "step {step}");
             grid.validate().unwrap();
-            seen[usize::from(found.contains(&pair_of(7, 10)))] += 1;
+            seen[usize::from(found.contains(&CandidatePair::of(7, 10)))] += 1;
         }
         assert!(seen[0] > 0 && seen[1] > 0, "{seen:?}");
     }
@@ -1284,8 +1248,8 @@ mod tests {
             tiny.validate()
                 .unwrap_or_else(|e| panic!("tiny op {op}: {e}"));
         }
-        assert!(grid.pairs.contains(&pair_of(60, 61)));
-        assert!(!grid.pairs.contains(&pair_of(60, 62)));
+        assert!(grid.pairs.contains(&CandidatePair::of(60, 61)));
+        assert!(!grid.pairs.contains(&CandidatePair::of(60, 62)));
         assert!(pairs > 5_000, "{pairs}");
     }
 

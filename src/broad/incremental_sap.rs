@@ -52,11 +52,9 @@
 //! validates poses before they reach the broad phase), checked by `debug_assert!`. A NaN
 //! would break the sort order and is never allowed in.
 
-use std::collections::BTreeSet;
-
 use super::body_map::BodyMap;
 use super::pair_set::PairSet;
-use super::{CandidatePair, CollisionFilter, Proxy, SortAndSweep, pairs_brute_force};
+use super::{CandidatePair, CollisionFilter, Proxy, SortAndSweep, debug_assert_valid_bounds};
 use crate::bounding::{Aabb, BoundingVolume};
 
 /// Index of a body's min endpoint in [`IncrementalSap::positions`].
@@ -236,7 +234,7 @@ impl IncrementalSap {
             }
             let other = &self.proxies[e.slot()];
             if proxy.may_pair(other) && proxy.bounds.intersects(&other.bounds) {
-                self.pairs.insert(pair_of(body, other.body));
+                self.pairs.insert(CandidatePair::of(body, other.body));
             }
         }
     }
@@ -254,7 +252,7 @@ impl IncrementalSap {
             if !e.is_max() && e.slot() != slot {
                 let (p, q) = (&self.proxies[slot], &self.proxies[e.slot()]);
                 if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
-                    self.pairs.remove(pair_of(body, q.body));
+                    self.pairs.remove(CandidatePair::of(body, q.body));
                 }
             }
         }
@@ -371,19 +369,7 @@ impl IncrementalSap {
                 }
             }
         }
-        let mut expected = Vec::new();
-        pairs_brute_force(&self.proxies, &mut expected);
-        let have = self.pairs.snapshot();
-        if have != expected {
-            let have: BTreeSet<_> = have.into_iter().collect();
-            let want: BTreeSet<_> = expected.into_iter().collect();
-            return Err(format!(
-                "pair set differs from brute force: extra {:?}, missing {:?}",
-                have.difference(&want).collect::<Vec<_>>(),
-                want.difference(&have).collect::<Vec<_>>()
-            ));
-        }
-        Ok(())
+        self.pairs.check_against_brute_force(&self.proxies)
     }
 
     /// Sets one coordinate of slot `slot`'s box and moves that endpoint to its sorted place
@@ -468,37 +454,21 @@ fn crossed(
     }
     if starts {
         if p.bounds.intersects(&q.bounds) {
-            pairs.insert(pair_of(p.body, q.body));
+            pairs.insert(CandidatePair::of(p.body, q.body));
         }
     } else {
         let (a, b) = (&p.bounds, &q.bounds);
         let overlaps_on = |k: usize| a.min[k] <= b.max[k] && b.min[k] <= a.max[k];
         if overlaps_on((axis + 1) % 3) && overlaps_on((axis + 2) % 3) {
-            pairs.remove(pair_of(p.body, q.body));
+            pairs.remove(CandidatePair::of(p.body, q.body));
         }
     }
-}
-
-/// The pair of two distinct ids, smaller first.
-#[inline]
-fn pair_of(a: u32, b: u32) -> CandidatePair {
-    CandidatePair {
-        a: a.min(b),
-        b: a.max(b),
-    }
-}
-
-#[inline]
-fn debug_assert_valid_bounds(bounds: &Aabb) {
-    debug_assert!(
-        bounds.min.is_finite() && bounds.max.is_finite() && bounds.min.cmple(bounds.max).all(),
-        "broad-phase bounds must be finite and not inverted: {bounds:?}"
-    );
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broad::pairs_brute_force;
     use crate::math::DVec3;
     use crate::test_support::{point_in_cube, rng};
     use rand::Rng;

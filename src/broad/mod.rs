@@ -18,9 +18,13 @@
 //! that fits its size (bodies larger than the coarsest cell in an oversized list tested
 //! against all), and the overlapping-pair set kept between frames, so a moved body re-tests
 //! only the bodies in its cells; it does not degrade when boxes share a coordinate range
-//! ("dice on a table"), which costs the three-axis sweep endpoint swaps.
+//! ("dice on a table"), which costs the three-axis sweep endpoint swaps. [`column_grid`] has
+//! the same stateful API over a hierarchy of 2-D grids of columns, each body listed once,
+//! in the column of its box's low corner, each column sorted along the third axis: a moved
+//! body re-tests the bodies of the 1 to 4 columns around it, each run found by a binary
+//! search, none met twice.
 //!
-//! [`select`] puts the three behind one stateful API ([`BroadPhase`]: insert, update, remove,
+//! [`select`] puts the four behind one stateful API ([`BroadPhase`]: insert, update, remove,
 //! pairs) and chooses among them from measured scene statistics ([`BroadPhaseStats`],
 //! [`choose`]); the pipeline keeps one per scene in sync with the scene's change log, so a
 //! body that did not change is never touched.
@@ -30,6 +34,7 @@
 
 mod body_map;
 pub mod brute_force;
+pub mod column_grid;
 #[cfg(test)]
 mod conformance;
 pub mod hash_grid;
@@ -39,6 +44,7 @@ pub mod select;
 pub mod sort_sweep;
 
 pub use brute_force::pairs_brute_force;
+pub use column_grid::ColumnGrid;
 pub use hash_grid::HashGrid;
 pub use incremental_sap::IncrementalSap;
 pub use select::{BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, choose};
@@ -102,4 +108,36 @@ pub struct CandidatePair {
     pub a: u32,
     /// The larger body id.
     pub b: u32,
+}
+
+impl CandidatePair {
+    /// The pair of two distinct ids, in either order (stored smaller first).
+    #[must_use]
+    #[inline]
+    pub fn of(a: u32, b: u32) -> Self {
+        Self {
+            a: a.min(b),
+            b: a.max(b),
+        }
+    }
+}
+
+/// The stateful broad phases' input check: bounds are trusted (finite, `min <= max`, the
+/// [`Aabb`] invariant), and checked in debug builds.
+#[inline]
+fn debug_assert_valid_bounds(bounds: &Aabb) {
+    debug_assert!(
+        bounds.min.is_finite() && bounds.max.is_finite() && bounds.min.cmple(bounds.max).all(),
+        "broad-phase bounds must be finite and not inverted: {bounds:?}"
+    );
+}
+
+/// `⌊x⌋` clamped to `i64`, exactly (as `x.floor() as i64`), without the library call
+/// `f64::floor` compiles to on baseline x86-64 (no SSE4.1 `roundsd`): the truncating
+/// conversion, one lower for negative non-integers. Monotone, so a larger coordinate never
+/// falls in an earlier cell or column.
+#[inline]
+fn floor_to_i64(x: f64) -> i64 {
+    let t = x as i64;
+    t.saturating_sub(i64::from((t as f64) > x))
 }

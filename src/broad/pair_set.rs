@@ -14,7 +14,9 @@
 //! removing an absent one changes nothing. The broad phases still log only real changes, to
 //! keep the log short.
 
-use super::CandidatePair;
+use std::collections::BTreeSet;
+
+use super::{CandidatePair, Proxy, pairs_brute_force};
 
 /// Sorted pair list plus pending edits.
 #[derive(Debug, Clone, Default)]
@@ -92,6 +94,25 @@ impl PairSet {
     #[cfg(test)]
     pub(crate) fn contains(&mut self, pair: &CandidatePair) -> bool {
         self.commit().binary_search(pair).is_ok()
+    }
+
+    /// `Ok` when the set as of now (pending edits applied) is exactly
+    /// [`pairs_brute_force`] over `proxies`; else the extra and the missing pairs (for the
+    /// broad phases' `validate`). `O(n²)`.
+    pub(crate) fn check_against_brute_force(&self, proxies: &[Proxy]) -> Result<(), String> {
+        let mut expected = Vec::new();
+        pairs_brute_force(proxies, &mut expected);
+        let have = self.snapshot();
+        if have == expected {
+            return Ok(());
+        }
+        let (have, want): (BTreeSet<_>, BTreeSet<_>) =
+            (have.into_iter().collect(), expected.into_iter().collect());
+        Err(format!(
+            "pair set differs from brute force: extra {:?}, missing {:?}",
+            have.difference(&want).collect::<Vec<_>>(),
+            want.difference(&have).collect::<Vec<_>>()
+        ))
     }
 
     /// The set as of now, pending edits applied, without committing (for `validate`).

@@ -15,7 +15,9 @@
 
 use super::body_map::BodyMap;
 use super::sort_sweep::widest_spread_axis;
-use super::{CandidatePair, CollisionFilter, HashGrid, IncrementalSap, Proxy, SortAndSweep};
+use super::{
+    CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, Proxy, SortAndSweep,
+};
 use crate::bounding::Aabb;
 
 /// Which broad-phase algorithm.
@@ -27,11 +29,18 @@ pub enum BroadPhaseKind {
     IncrementalSap,
     /// Hierarchical hash grid ([`HashGrid`]).
     HashGrid,
+    /// Hierarchical grid of sorted columns ([`ColumnGrid`]).
+    ColumnGrid,
 }
 
 impl BroadPhaseKind {
     /// Every kind.
-    pub const ALL: [Self; 3] = [Self::SortAndSweep, Self::IncrementalSap, Self::HashGrid];
+    pub const ALL: [Self; 4] = [
+        Self::SortAndSweep,
+        Self::IncrementalSap,
+        Self::HashGrid,
+        Self::ColumnGrid,
+    ];
 }
 
 /// Which broad phase a scene runs: chosen from measured statistics, or fixed.
@@ -70,6 +79,7 @@ enum Inner {
     Sweep(Sweep),
     Sap(IncrementalSap),
     Grid(HashGrid),
+    Columns(ColumnGrid),
 }
 
 /// One broad phase of any [`BroadPhaseKind`] behind one stateful API over bodies identified
@@ -82,6 +92,8 @@ pub struct BroadPhase {
     /// them were far moves.
     moves: u64,
     far_moves: u64,
+    /// [`set_all`](Self::set_all)'s batch of plain moves.
+    batch: Vec<(u32, Aabb)>,
 }
 
 impl BroadPhase {
@@ -92,28 +104,35 @@ impl BroadPhase {
             BroadPhaseKind::SortAndSweep => Inner::Sweep(Sweep::default()),
             BroadPhaseKind::IncrementalSap => Inner::Sap(IncrementalSap::new()),
             BroadPhaseKind::HashGrid => Inner::Grid(HashGrid::new()),
+            BroadPhaseKind::ColumnGrid => Inner::Columns(ColumnGrid::new()),
         };
         Self {
             inner,
             entries: BodyMap::default(),
             moves: 0,
             far_moves: 0,
+            batch: Vec::new(),
         }
     }
 
     /// A broad phase of kind `kind` holding `proxies` (distinct ids). The incremental sweep
     /// and prune is built at once ([`IncrementalSap::from_proxies`]: endpoints sorted once)
-    /// rather than by `n` insertions of `O(n)` each; the others insert one by one.
+    /// rather than by `n` insertions of `O(n)` each, and so is the column grid
+    /// ([`ColumnGrid::from_proxies`]: its levels chosen once, from every body); the others
+    /// insert one by one.
     #[must_use]
     pub fn from_proxies(kind: BroadPhaseKind, proxies: &[Proxy]) -> Self {
         let mut broad = Self::new(kind);
-        if kind != BroadPhaseKind::IncrementalSap {
-            for p in proxies {
-                broad.insert(p.body, p.bounds, p.is_static, p.filter);
+        broad.inner = match kind {
+            BroadPhaseKind::IncrementalSap => Inner::Sap(IncrementalSap::from_proxies(proxies)),
+            BroadPhaseKind::ColumnGrid => Inner::Columns(ColumnGrid::from_proxies(proxies)),
+            BroadPhaseKind::SortAndSweep | BroadPhaseKind::HashGrid => {
+                for p in proxies {
+                    broad.insert(p.body, p.bounds, p.is_static, p.filter);
+                }
+                return broad;
             }
-            return broad;
-        }
-        broad.inner = Inner::Sap(IncrementalSap::from_proxies(proxies));
+        };
         broad.entries.extend(proxies.iter().map(|p| {
             (
                 p.body,
@@ -135,6 +154,7 @@ impl BroadPhase {
             Inner::Sweep(_) => BroadPhaseKind::SortAndSweep,
             Inner::Sap(_) => BroadPhaseKind::IncrementalSap,
             Inner::Grid(_) => BroadPhaseKind::HashGrid,
+            Inner::Columns(_) => BroadPhaseKind::ColumnGrid,
         }
     }
 
@@ -163,6 +183,7 @@ impl BroadPhase {
             Inner::Sweep(s) => &s.proxies,
             Inner::Sap(s) => s.proxies(),
             Inner::Grid(g) => g.proxies(),
+            Inner::Columns(c) => c.proxies(),
         }
     }
 
@@ -191,6 +212,7 @@ impl BroadPhase {
             }
             Inner::Sap(s) => s.insert(body, bounds, is_static, filter),
             Inner::Grid(g) => g.insert(body, bounds, is_static, filter),
+            Inner::Columns(c) => c.insert(body, bounds, is_static, filter),
         }
         self.entries.insert(
             body,
@@ -226,6 +248,9 @@ impl BroadPhase {
             Inner::Grid(g) => {
                 g.remove(body);
             }
+            Inner::Columns(c) => {
+                c.remove(body);
+            }
         }
         true
     }
@@ -233,13 +258,9 @@ impl BroadPhase {
     /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`). Updating a body that is
     /// not present is a contract violation (`debug_assert!`; ignored in release builds).
     pub fn update(&mut self, body: u32, bounds: Aabb) {
-        let Some(entry) = self.entries.get_mut(&body) else {
-            debug_assert!(false, "update of absent body {body}");
+        let Some(slot) = self.record_move(body, bounds) else {
             return;
         };
-        self.moves += 1;
-        self.far_moves += u64::from(is_far_move(&entry.bounds, &bounds));
-        entry.bounds = bounds;
         match &mut self.inner {
             Inner::Sweep(s) => {
                 debug_assert!(
@@ -248,12 +269,26 @@ impl BroadPhase {
                         && bounds.min.cmple(bounds.max).all(),
                     "invalid bounds {bounds:?}"
                 );
-                s.proxies[entry.slot as usize].bounds = bounds;
+                s.proxies[slot as usize].bounds = bounds;
                 s.swept = false;
             }
             Inner::Sap(s) => s.update(body, bounds),
             Inner::Grid(g) => g.update(body, bounds),
+            Inner::Columns(c) => c.update(body, bounds),
         }
+    }
+
+    /// Counts `body`'s move to `bounds` and keeps its box; its sort-and-sweep slot, `None`
+    /// (with a `debug_assert!`) when absent.
+    fn record_move(&mut self, body: u32, bounds: Aabb) -> Option<u32> {
+        let Some(entry) = self.entries.get_mut(&body) else {
+            debug_assert!(false, "update of absent body {body}");
+            return None;
+        };
+        self.moves += 1;
+        self.far_moves += u64::from(is_far_move(&entry.bounds, &bounds));
+        entry.bounds = bounds;
+        Some(entry.slot)
     }
 
     /// Updates since the last call, and how many of them were *far moves*: the box's centre
@@ -278,6 +313,40 @@ impl BroadPhase {
         }
     }
 
+    /// [`set`](Self::set) of every proxy in `proxies`, the plain moves (same static flag
+    /// and filter) handed over as one batch: [`ColumnGrid::update_all`] reads all their
+    /// records before moving any; the other kinds update one by one.
+    ///
+    /// # Allocation
+    /// None once the batch buffer has grown to the largest batch.
+    pub fn set_all(&mut self, proxies: &[Proxy]) {
+        let mut moves = std::mem::take(&mut self.batch);
+        moves.clear();
+        for proxy in proxies {
+            let plain_move = matches!(
+                self.entries.get(&proxy.body),
+                Some(e) if e.is_static == proxy.is_static && e.filter == proxy.filter
+            );
+            match &mut self.inner {
+                Inner::Columns(_) if plain_move => {
+                    moves.push((proxy.body, proxy.bounds));
+                    self.record_move(proxy.body, proxy.bounds);
+                }
+                Inner::Columns(c) => {
+                    // The batch first: a later move of a replaced body must not undo it.
+                    c.update_all(&moves);
+                    moves.clear();
+                    self.insert(proxy.body, proxy.bounds, proxy.is_static, proxy.filter);
+                }
+                _ => self.set(proxy),
+            }
+        }
+        if let Inner::Columns(c) = &mut self.inner {
+            c.update_all(&moves);
+        }
+        self.batch = moves;
+    }
+
     /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
     /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
     /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over
@@ -290,6 +359,7 @@ impl BroadPhase {
             }
             Inner::Sap(s) => s.pairs(out),
             Inner::Grid(g) => g.pairs(out),
+            Inner::Columns(c) => c.pairs(out),
         }
     }
 
@@ -329,6 +399,7 @@ impl BroadPhase {
             Inner::Sweep(_) => Ok(()),
             Inner::Sap(s) => s.validate(),
             Inner::Grid(g) => g.validate(),
+            Inner::Columns(c) => c.validate(),
         }
     }
 }

@@ -182,7 +182,7 @@ impl SortAndSweep {
                     }
                     let (p, q) = (&proxies[e.proxy as usize], &proxies[f.proxy as usize]);
                     if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
-                        out.push(pair_of(p.body, q.body));
+                        out.push(CandidatePair::of(p.body, q.body));
                     }
                 }
             }
@@ -196,7 +196,7 @@ impl SortAndSweep {
                     continue;
                 }
                 if b.may_pair(q) && b.bounds.intersects(&q.bounds) {
-                    out.push(pair_of(b.body, q.body));
+                    out.push(CandidatePair::of(b.body, q.body));
                 }
             }
         }
@@ -435,15 +435,6 @@ impl SortAndSweep {
             }
         }
         Ok(())
-    }
-}
-
-/// The pair of two distinct ids, smaller first.
-#[inline]
-fn pair_of(a: u32, b: u32) -> CandidatePair {
-    CandidatePair {
-        a: a.min(b),
-        b: a.max(b),
     }
 }
 

@@ -159,7 +159,7 @@ fn broad_phase(code: u32) -> Result<BroadPhaseChoice, Rejection> {
     let code = BroadPhaseCode::from_u32(code).ok_or_else(|| {
         Rejection::new(
             ErrorCode::MalformedMessage,
-            format!("unknown broad phase {code} (0 auto, 1 sort and sweep, 2 incremental SAP, 3 hash grid)"),
+            format!("unknown broad phase {code} (0 auto, 1 sort and sweep, 2 incremental SAP, 3 hash grid, 4 column grid)"),
         )
     })?;
     Ok(match code {
@@ -167,6 +167,7 @@ fn broad_phase(code: u32) -> Result<BroadPhaseChoice, Rejection> {
         BroadPhaseCode::SortAndSweep => BroadPhaseChoice::Fixed(BroadPhaseKind::SortAndSweep),
         BroadPhaseCode::IncrementalSap => BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap),
         BroadPhaseCode::HashGrid => BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid),
+        BroadPhaseCode::ColumnGrid => BroadPhaseChoice::Fixed(BroadPhaseKind::ColumnGrid),
     })
 }
 
@@ -294,6 +295,7 @@ mod tests {
         assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::Ok);
         assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::UnknownBody);
         for (wire_code, choice) in [
+            (4, BroadPhaseChoice::Fixed(BroadPhaseKind::ColumnGrid)),
             (3, BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid)),
             (2, BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap)),
             (1, BroadPhaseChoice::Fixed(BroadPhaseKind::SortAndSweep)),
@@ -475,7 +477,7 @@ mod tests {
             (
                 ControlRequest {
                     scene,
-                    broad_phase: 4,
+                    broad_phase: 5,
                     ..request(Command::SetSceneParams)
                 },
                 vec![],

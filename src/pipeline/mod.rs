@@ -373,7 +373,8 @@ struct AutoChoice {
 /// last frame, and the worker pool when there is one.
 #[derive(Debug, Default)]
 pub struct PipelineWorkspace {
-    /// Every body's proxy, when the broad phase is rebuilt or the scene measured.
+    /// Every body's proxy, when the broad phase is rebuilt or the scene measured; the
+    /// changed bodies' proxies, when it is synced.
     proxies: Vec<Proxy>,
     /// The broad phase over the current boxes, kept in sync with the scene (module docs).
     broad: Option<BroadPhase>,
@@ -1007,14 +1008,16 @@ fn sync_broad_phase(
     if let (Some(broad), Some(changes)) = (broad.as_mut(), changes)
         && broad.kind() == kind
     {
+        proxies.clear();
         for &id in changes {
             match scene.proxy(BodyId(id)) {
-                Some(proxy) => broad.set(&proxy),
+                Some(proxy) => proxies.push(proxy),
                 None => {
                     broad.remove(id);
                 }
             }
         }
+        broad.set_all(proxies);
         return changes.len();
     }
     if !listed {

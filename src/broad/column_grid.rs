@@ -1,0 +1,1100 @@
+//! Column grid: a stateful broad phase for large scenes where a fraction of the bodies moves
+//! each frame. Each body is stored once, in one column of a hierarchy of 2-D grids, and each
+//! column keeps its bodies sorted along the third axis, so a moved body re-tests only the
+//! few bodies of the 1 to 4 columns around it, each found by a binary search.
+//!
+//! # Why columns, and why sorted
+//! A hash grid stores a body in every cell its box covers, so a query probes up to 8 hashed
+//! cells per level and must drop the candidates it meets twice. Here a body is listed once,
+//! in the column of its box's *low corner*, and every body of a level is at most `reach`
+//! wide on every axis. So the bodies whose boxes can meet a window `W` have their low corner
+//! in `[W.min − reach, W.max]` on each axis: on the two column axes that names a rectangle of
+//! columns (1 or 2 per axis for a body of the same level, as a column is `2 · reach` wide),
+//! and on the sweep axis a run of each column's sorted list. No candidate is met twice, and
+//! a column's list is contiguous memory.
+//!
+//! # Levels
+//! Level `k` takes the bodies whose largest box extent is at most `reach₀ · 4ᵏ` (and above
+//! the level below), in columns `2 · reach₀ · 4ᵏ` wide. A body queries every level that holds
+//! bodies; at a coarser level than its own it meets few, larger columns, at a finer one the
+//! small bodies near it. Bodies wider than the coarsest reach are *oversized*: kept in a
+//! list, tested against every moved body and, when they move, against every body.
+//!
+//! **Choosing the levels.** As for the [`HashGrid`](super::HashGrid): until the grid has held
+//! [`AUTO_SAMPLE`] bodies every body is oversized (all pairs tested: the right algorithm for
+//! so few). Then, and again whenever the body count has doubled since, the grid is rebuilt
+//! from all its bodies: the sweep axis is the one along which the box centres spread the
+//! most (the columns split the other two); `reach₀` is the 90th percentile of the bodies'
+//! positive largest extents, or the largest extent when that is within 1.5 × of it (one level
+//! for a narrow spread of sizes); levels are added until the coarsest reach is at least 4 ×
+//! the largest extent (up to [`MAX_LEVELS`]).
+//!
+//! **The column table.** A level's columns are a table of `2^a × 2^b` buckets, column
+//! `(i, j)` in bucket `(i mod 2^a, j mod 2^b)`: neighbouring columns are neighbouring buckets,
+//! and the table never needs growing, as columns farther apart than its size share a bucket
+//! (their bodies are told apart by the box test, at some cost in candidates). The size is
+//! chosen at each rebuild to cover the level's bodies' spread without aliasing, at most
+//! about two buckets per body.
+//!
+//! # Finding a body's pairs
+//! A body whose pairs must be refreshed (inserted, moved, removed) queries the union of its
+//! old and new box once when the two overlap, else each box on its own (after a jump their
+//! union may span the world). Each candidate `c` (every other body whose low corner is in the
+//! window's reach) is tested against both: the pair was in the set exactly when the old box
+//! met `c`'s stored box, and is now when the new one does; only a change, for bodies that
+//! may pair ([`Proxy::may_pair`]), is logged in the [`PairSet`]. Bodies are updated one at a
+//! time, so a candidate's stored box is the one the pair set already reflects.
+//!
+//! Measured and not kept (`examples/broad_bench`, 100,000 uniform bodies, 10 % moving): a
+//! batch update applying a frame's moves sorted by the column they land in, so consecutive
+//! queries share columns, was no faster than the moves in id order (6.6–6.9 ms a frame
+//! both). With a tenth of the bodies moving everywhere, a frame reads every column either
+//! way; what a move costs is its binary searches and box tests.
+//!
+//! # Exactness
+//! A pair is reported by [`Aabb::intersects`] on the stored boxes, as in every broad phase;
+//! the columns only prune, and prune conservatively: the low end of a window,
+//! `W.min − reach`, is computed with `reach` raised by a relative 1e-9 and then stepped one
+//! representable value down, so it is at or below the exact value even after rounding, far
+//! from the origin too; column indices are `⌊x / width⌋` by a monotone map, so any low corner
+//! at or above that end falls in a column at or after the window's first. Zero-size boxes,
+//! boxes ending on a column boundary and `-0.0` need no special case.
+//!
+//! # Costs (`n` bodies, `k` pairs, `c` candidates a query meets)
+//! - [`update`](ColumnGrid::update): one query (`O(c)`, plus a binary search per column per
+//!   level with bodies) and the body's move in its column list: in place when it stays in its
+//!   column (a few swaps if it passed a neighbour on the sweep axis), else a removal and an
+//!   insertion, `O(column length)`. `O(n)` for an oversized body, and every query also tests
+//!   every oversized one.
+//! - [`insert`](ColumnGrid::insert), [`remove`](ColumnGrid::remove): the same, plus an
+//!   `O(n log n)` rebuild each time the body count doubles.
+//! - [`pairs`](ColumnGrid::pairs): `O(k + e log e)` for `e` pair changes (the [`PairSet`]
+//!   commit).
+//!
+//! # Input
+//! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant), checked by
+//! `debug_assert!`.
+
+use super::body_map::BodyMap;
+use super::pair_set::PairSet;
+use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64};
+use crate::bounding::{Aabb, BoundingVolume};
+use crate::math::DVec3;
+
+/// Bodies held before the first rebuild chooses the levels (all oversized until then).
+pub const AUTO_SAMPLE: usize = 64;
+/// Most levels.
+pub const MAX_LEVELS: usize = 16;
+/// Reach of level `k + 1` over level `k`.
+const REACH_RATIO: f64 = 4.0;
+/// Column width over the level's reach.
+const WIDTH_PER_REACH: f64 = 2.0;
+/// Largest share of bodies the finest level may leave to coarser ones (the 90th percentile).
+const FINEST_QUANTILE: f64 = 0.9;
+/// Finest reach taken as the largest extent when that is within this factor of the quantile.
+const ONE_LEVEL_SPREAD: f64 = 1.5;
+/// [`Placement::level`] of an oversized body.
+const OVERSIZED: u8 = u8::MAX;
+
+/// A body as its column stores it: its box and slot.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    bounds: Aabb,
+    slot: u32,
+}
+
+/// One bucket of a level's table: its bodies sorted by the low end of their boxes on the
+/// sweep axis (`low[i]` is `entries[i].bounds.min[sweep]`, kept apart for the binary search).
+#[derive(Debug, Clone, Default)]
+struct Column {
+    low: Vec<f64>,
+    entries: Vec<Entry>,
+}
+
+impl Column {
+    /// Index of `slot`'s entry, whose low end on the sweep axis is `low`.
+    fn find(&self, low: f64, slot: u32) -> usize {
+        let start = self.low.partition_point(|&x| x < low);
+        let found = self.entries[start..]
+            .iter()
+            .position(|e| e.slot == slot)
+            .map(|i| start + i);
+        debug_assert!(found.is_some(), "slot {slot} not in its column");
+        found.unwrap_or(0)
+    }
+
+    /// Inserts `entry` in order.
+    fn insert(&mut self, low: f64, entry: Entry) {
+        let at = self.low.partition_point(|&x| x <= low);
+        self.low.insert(at, low);
+        self.entries.insert(at, entry);
+    }
+
+    fn remove(&mut self, at: usize) {
+        self.low.remove(at);
+        self.entries.remove(at);
+    }
+
+    /// Sets entry `at` to `entry` (low end `low`) and swaps it into order.
+    fn replace(&mut self, mut at: usize, low: f64, entry: Entry) {
+        self.low[at] = low;
+        self.entries[at] = entry;
+        while at > 0 && self.low[at - 1] > low {
+            self.low.swap(at - 1, at);
+            self.entries.swap(at - 1, at);
+            at -= 1;
+        }
+        while at + 1 < self.low.len() && self.low[at + 1] < low {
+            self.low.swap(at, at + 1);
+            self.entries.swap(at, at + 1);
+            at += 1;
+        }
+    }
+}
+
+/// The three axes: the columns split `u` and `v`, each column is sorted along `sweep`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Axes {
+    sweep: usize,
+    u: usize,
+    v: usize,
+}
+
+impl Axes {
+    fn with_sweep(sweep: usize) -> Self {
+        Self {
+            sweep,
+            u: (sweep + 1) % 3,
+            v: (sweep + 2) % 3,
+        }
+    }
+}
+
+/// Columns of one size.
+#[derive(Debug, Clone)]
+struct Level {
+    /// Largest extent, on every axis, of a body of this level, metres.
+    reach: f64,
+    /// `1 / column width`, per metre.
+    inv_width: f64,
+    /// The table is `2^bits_u` buckets along `u` by `mask_v + 1` along `v`.
+    bits_u: u32,
+    mask_u: u64,
+    mask_v: u64,
+    columns: Vec<Column>,
+    /// Bodies at this level.
+    count: usize,
+}
+
+/// Where an entry is: its bucket in its level's table and its index in that column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Place {
+    bucket: usize,
+    at: usize,
+}
+
+/// Consecutive column indices along one axis, as buckets: `first` and how many (at most
+/// the table's size along the axis, so none is visited twice).
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    first: u64,
+    len: u64,
+}
+
+impl Run {
+    fn new(low: f64, high: f64, inv_width: f64, mask: u64) -> Self {
+        let (a, b) = (
+            floor_to_i64(low * inv_width),
+            floor_to_i64(high * inv_width),
+        );
+        let len = (i128::from(b) - i128::from(a) + 1).clamp(0, i128::from(mask) + 1) as u64;
+        Self {
+            first: a as u64,
+            len,
+        }
+    }
+
+    fn bucket(&self, i: u64, mask: u64) -> u64 {
+        self.first.wrapping_add(i) & mask
+    }
+}
+
+impl Level {
+    fn new(reach: f64) -> Self {
+        Self {
+            reach,
+            inv_width: 1.0 / (WIDTH_PER_REACH * reach),
+            bits_u: 0,
+            mask_u: 0,
+            mask_v: 0,
+            columns: vec![Column::default()],
+            count: 0,
+        }
+    }
+
+    /// Sizes the (empty) table for bodies whose low corners span `span_u × span_v` metres.
+    fn size_table(&mut self, span_u: f64, span_v: f64) {
+        let cells = |span: f64| {
+            let c = (span * self.inv_width).ceil() + 2.0;
+            if c.is_finite() && c < 1e6 {
+                (c as u64).next_power_of_two()
+            } else {
+                1 << 20
+            }
+        };
+        let (mut nu, mut nv) = (cells(span_u), cells(span_v));
+        let cap = (2 * self.count as u64).max(16).next_power_of_two();
+        while nu * nv > cap {
+            if nu >= nv {
+                nu /= 2;
+            } else {
+                nv /= 2;
+            }
+        }
+        self.bits_u = nu.trailing_zeros();
+        self.mask_u = nu - 1;
+        self.mask_v = nv - 1;
+        self.columns = vec![Column::default(); (nu * nv) as usize];
+    }
+
+    /// Bucket of the column holding a box whose low corner is `min`.
+    fn home(&self, min: DVec3, axes: Axes) -> usize {
+        let u = floor_to_i64(min[axes.u] * self.inv_width) as u64 & self.mask_u;
+        let v = floor_to_i64(min[axes.v] * self.inv_width) as u64 & self.mask_v;
+        (u | (v << self.bits_u)) as usize
+    }
+
+    /// Calls `f` with every entry of this level whose box may meet `window`: whose low corner
+    /// is within [`low_end`] of `window` on every axis. Entries outside `window` may be
+    /// passed too.
+    #[inline]
+    fn for_each_near(&self, window: &Aabb, axes: Axes, mut f: impl FnMut(&Entry, Place)) {
+        let low = |axis: usize| low_end(window.min[axis], self.reach);
+        let runs = [axes.u, axes.v].map(|axis| (low(axis), window.max[axis]));
+        let ru = Run::new(runs[0].0, runs[0].1, self.inv_width, self.mask_u);
+        let rv = Run::new(runs[1].0, runs[1].1, self.inv_width, self.mask_v);
+        let (low_sweep, high_sweep) = (low(axes.sweep), window.max[axes.sweep]);
+        for j in 0..rv.len {
+            let row = rv.bucket(j, self.mask_v) << self.bits_u;
+            for i in 0..ru.len {
+                let bucket = (row | ru.bucket(i, self.mask_u)) as usize;
+                let column = &self.columns[bucket];
+                let start = column.low.partition_point(|&x| x < low_sweep);
+                for (at, (x, entry)) in column.low[start..]
+                    .iter()
+                    .zip(&column.entries[start..])
+                    .enumerate()
+                {
+                    if *x > high_sweep {
+                        break;
+                    }
+                    let at = start + at;
+                    f(entry, Place { bucket, at });
+                }
+            }
+        }
+    }
+}
+
+/// `x − reach`, rounded down past any rounding error: the exact difference with `reach`
+/// raised by a relative 1e-9 (more than the rounding of an extent computed as
+/// `max − min`), stepped one representable value down (more than the subtraction's own
+/// rounding). See the module docs, "Exactness".
+#[inline]
+fn low_end(x: f64, reach: f64) -> f64 {
+    (x - reach * (1.0 + 1e-9)).next_down()
+}
+
+/// Column grid over bodies identified by `u32` ids; see the module docs. Same body-level API
+/// and output contract as [`IncrementalSap`](super::IncrementalSap) and
+/// [`HashGrid`](super::HashGrid).
+#[derive(Debug, Clone)]
+pub struct ColumnGrid {
+    /// Finest first; empty until the first rebuild (every body oversized until then).
+    levels: Vec<Level>,
+    axes: Axes,
+    /// The bodies, densely by slot; `proxies[s].bounds` is what its column holds.
+    proxies: Vec<Proxy>,
+    /// Level of each slot, or [`OVERSIZED`].
+    level_of: Vec<u8>,
+    /// Slots of the oversized bodies.
+    oversized: Vec<u32>,
+    /// Slot of each body id.
+    slot_of: BodyMap,
+    /// The pairs whose boxes overlap and that may pair, `a < b`.
+    pairs: PairSet,
+    /// Body count at the last rebuild (0: never built).
+    built_at: usize,
+    /// [`update_all`](Self::update_all)'s moves.
+    batch: Vec<BatchMove>,
+    /// Per slot, the number of the last batch that moved it and the index of that move.
+    last_move: Vec<(u32, u32)>,
+    /// Number of the current (or last) batch; never 0 (the number `last_move` starts at).
+    batch_number: u32,
+}
+
+/// One move of an [`update_all`](ColumnGrid::update_all) batch.
+#[derive(Debug, Clone, Copy)]
+struct BatchMove {
+    /// The body's record before the batch.
+    old: Proxy,
+    /// Its box after.
+    new: Aabb,
+    slot: u32,
+    /// Whether this is the body's last move in the batch (the only one applied).
+    last: bool,
+}
+
+impl Default for ColumnGrid {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl ColumnGrid {
+    /// An empty grid; its levels are chosen at the [`AUTO_SAMPLE`]-th body (module docs).
+    #[must_use]
+    pub fn new() -> Self {
+        Self {
+            levels: Vec::new(),
+            axes: Axes::with_sweep(0),
+            proxies: Vec::new(),
+            level_of: Vec::new(),
+            oversized: Vec::new(),
+            slot_of: BodyMap::default(),
+            pairs: PairSet::default(),
+            built_at: 0,
+            batch: Vec::new(),
+            last_move: Vec::new(),
+            batch_number: 0,
+        }
+    }
+
+    /// A grid holding `proxies` (distinct ids), built at once: placed in sorted columns in
+    /// `O(n log n)`, then each body's pairs found by one query.
+    #[must_use]
+    pub fn from_proxies(proxies: &[Proxy]) -> Self {
+        let mut grid = Self::new();
+        for p in proxies {
+            debug_assert_valid_bounds(&p.bounds);
+            grid.slot_of.insert(p.body, grid.proxies.len() as u32);
+            grid.proxies.push(*p);
+            grid.level_of.push(OVERSIZED);
+            grid.last_move.push((0, 0));
+            grid.oversized.push(grid.proxies.len() as u32 - 1);
+        }
+        if grid.proxies.len() >= AUTO_SAMPLE {
+            grid.rebuild();
+        }
+        for slot in 0..grid.proxies.len() {
+            let p = grid.proxies[slot];
+            grid.for_each_candidate(&p.bounds, slot, |pairs, proxies, bounds, other| {
+                let q = &proxies[other];
+                if other > slot && p.bounds.intersects(bounds) && p.may_pair(q) {
+                    pairs.insert(CandidatePair::of(p.body, q.body));
+                }
+            });
+        }
+        grid
+    }
+
+    /// Number of bodies.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.proxies.len()
+    }
+
+    /// Whether there are no bodies.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.proxies.is_empty()
+    }
+
+    /// Whether `body` is present.
+    #[must_use]
+    pub fn contains(&self, body: u32) -> bool {
+        self.slot_of.contains_key(&body)
+    }
+
+    /// The bodies as proxies, in slot order (no particular order).
+    #[must_use]
+    pub fn proxies(&self) -> &[Proxy] {
+        &self.proxies
+    }
+
+    /// Largest extent of a body at each level, finest first, metres (empty until chosen).
+    pub fn reaches(&self) -> impl ExactSizeIterator<Item = f64> + '_ {
+        self.levels.iter().map(|l| l.reach)
+    }
+
+    /// Adds `body` with box `bounds` (metres; finite, `min <= max`). Inserting an id that
+    /// is already present replaces that body.
+    pub fn insert(&mut self, body: u32, bounds: Aabb, is_static: bool, filter: CollisionFilter) {
+        debug_assert_valid_bounds(&bounds);
+        if self.contains(body) {
+            self.remove(body);
+        }
+        let slot = self.proxies.len();
+        self.proxies.push(Proxy {
+            body,
+            bounds,
+            is_static,
+            filter,
+        });
+        self.slot_of.insert(body, slot as u32);
+        self.level_of.push(OVERSIZED);
+        self.last_move.push((0, 0));
+        let p = self.proxies[slot];
+        self.refresh(&p, None, Some(&bounds), slot);
+        self.level_of[slot] = self.level_for(&bounds);
+        self.place(slot);
+        let n = self.proxies.len();
+        if (self.built_at == 0 && n >= AUTO_SAMPLE) || (self.built_at > 0 && n > 2 * self.built_at)
+        {
+            self.rebuild();
+        }
+    }
+
+    /// Removes `body` and its pairs; `false` when it was not present.
+    pub fn remove(&mut self, body: u32) -> bool {
+        let Some(slot) = self.slot_of.remove(&body) else {
+            return false;
+        };
+        let slot = slot as usize;
+        let p = self.proxies[slot];
+        self.refresh(&p, Some(&p.bounds), None, slot);
+        self.unplace(slot);
+        // The last slot moves into the freed one.
+        let last = self.proxies.len() - 1;
+        if slot != last {
+            self.rename(last, slot);
+            self.slot_of.insert(self.proxies[last].body, slot as u32);
+        }
+        self.proxies.swap_remove(slot);
+        self.level_of.swap_remove(slot);
+        self.last_move.swap_remove(slot);
+        true
+    }
+
+    /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`) and refreshes its pairs
+    /// (module docs, "Finding a body's pairs"). A body that did not move need not be updated.
+    /// Updating a body that is not present is a contract violation (`debug_assert!`; ignored
+    /// in release builds).
+    pub fn update(&mut self, body: u32, bounds: Aabb) {
+        debug_assert_valid_bounds(&bounds);
+        let Some(&slot) = self.slot_of.get(&body) else {
+            debug_assert!(false, "update of absent body {body}");
+            return;
+        };
+        let old = self.proxies[slot as usize];
+        self.move_slot(slot as usize, &old, bounds);
+    }
+
+    /// [`update`](Self::update) of every `(body, bounds)` in `moves`; a body listed twice
+    /// ends at its last box. The same pair set as updating one by one in the given order.
+    ///
+    /// Two passes: the first reads every moved body's record (independent look-ups the
+    /// processor overlaps), the second moves them.
+    ///
+    /// # Allocation
+    /// None once the batch buffer has grown to the largest batch.
+    pub fn update_all(&mut self, moves: &[(u32, Aabb)]) {
+        let mut batch = std::mem::take(&mut self.batch);
+        batch.clear();
+        self.batch_number = self.batch_number.wrapping_add(1);
+        if self.batch_number == 0 {
+            self.last_move.fill((0, 0));
+            self.batch_number = 1;
+        }
+        for &(body, bounds) in moves {
+            debug_assert_valid_bounds(&bounds);
+            let Some(&slot) = self.slot_of.get(&body) else {
+                debug_assert!(false, "update of absent body {body}");
+                continue;
+            };
+            let at = batch.len() as u32;
+            let (number, earlier) =
+                std::mem::replace(&mut self.last_move[slot as usize], (self.batch_number, at));
+            if number == self.batch_number {
+                // Only a body's last move counts: its pairs depend on its final box alone.
+                batch[earlier as usize].last = false;
+            }
+            batch.push(BatchMove {
+                old: self.proxies[slot as usize],
+                new: bounds,
+                slot,
+                last: true,
+            });
+        }
+        for m in &batch {
+            if m.last {
+                self.move_slot(m.slot as usize, &m.old, m.new);
+            }
+        }
+        self.batch = batch;
+    }
+
+    /// Moves slot `slot`, whose stored record is `old`, to box `bounds`: its pairs
+    /// refreshed, then its listing moved.
+    fn move_slot(&mut self, slot: usize, old: &Proxy, bounds: Aabb) {
+        let own = self.refresh(old, Some(&old.bounds), Some(&bounds), slot);
+        let old = old.bounds;
+        let level = self.level_for(&bounds);
+        let (axes, was) = (self.axes, self.level_of[slot]);
+        if was == level && level != OVERSIZED {
+            let grid = &mut self.levels[usize::from(level)];
+            let (from, to) = (grid.home(old.min, axes), grid.home(bounds.min, axes));
+            if from == to {
+                let column = &mut grid.columns[from];
+                let at = match own {
+                    Some(place) if place.bucket == from => place.at,
+                    _ => column.find(old.min[axes.sweep], slot as u32),
+                };
+                debug_assert_eq!(column.entries[at].slot as usize, slot);
+                let entry = Entry {
+                    bounds,
+                    slot: slot as u32,
+                };
+                column.replace(at, bounds.min[axes.sweep], entry);
+                self.proxies[slot].bounds = bounds;
+                return;
+            }
+        }
+        self.unplace(slot);
+        self.proxies[slot].bounds = bounds;
+        self.level_of[slot] = level;
+        self.place(slot);
+    }
+
+    /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
+    /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
+    /// exactly the pairs of [`pairs_brute_force`] over [`proxies`](Self::proxies).
+    ///
+    /// # Cost
+    /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
+    pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
+        out.clear();
+        out.extend_from_slice(self.pairs.commit());
+    }
+
+    /// Checks every invariant: the slot table and id map agree; stored boxes are finite and
+    /// not inverted; each body is at the level its box calls for (oversized before the first
+    /// rebuild), listed exactly once: in the oversized list, or in its home column with its
+    /// stored box; every column sorted; and the pair set equals [`pairs_brute_force`] over
+    /// the stored boxes. `O(n²)`: for tests.
+    ///
+    /// # Errors
+    /// A description of the first violated invariant.
+    pub fn validate(&self) -> Result<(), String> {
+        let n = self.proxies.len();
+        if self.level_of.len() != n || self.slot_of.len() != n {
+            return Err(format!("{n} proxies, per-slot tables disagree"));
+        }
+        for (slot, p) in self.proxies.iter().enumerate() {
+            if self.slot_of.get(&p.body) != Some(&(slot as u32)) {
+                return Err(format!("body {} at slot {slot} not mapped to it", p.body));
+            }
+            let b = &p.bounds;
+            if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
+                return Err(format!("body {} has invalid bounds {b:?}", p.body));
+            }
+            let level = self.level_of[slot];
+            if level != self.level_for(b) {
+                return Err(format!(
+                    "body {} at level {level}, its box calls for {}",
+                    p.body,
+                    self.level_for(b)
+                ));
+            }
+            let listed = if level == OVERSIZED {
+                self.oversized
+                    .iter()
+                    .filter(|&&s| s as usize == slot)
+                    .count()
+            } else {
+                let grid = &self.levels[usize::from(level)];
+                let column = &grid.columns[grid.home(b.min, self.axes)];
+                column
+                    .entries
+                    .iter()
+                    .filter(|e| e.slot as usize == slot && e.bounds == *b)
+                    .count()
+            };
+            if listed != 1 {
+                return Err(format!(
+                    "body {} listed {listed} times where it belongs",
+                    p.body
+                ));
+            }
+        }
+        let mut stored = self.oversized.len();
+        for (k, grid) in self.levels.iter().enumerate() {
+            let here: usize = grid.columns.iter().map(|c| c.entries.len()).sum();
+            if here != grid.count {
+                return Err(format!(
+                    "level {k} holds {here} entries, counts {}",
+                    grid.count
+                ));
+            }
+            for column in &grid.columns {
+                let keys = column.entries.iter().map(|e| e.bounds.min[self.axes.sweep]);
+                if column.low.len() != column.entries.len()
+                    || !column.low.iter().copied().eq(keys)
+                    || !column.low.is_sorted()
+                {
+                    return Err(format!("level {k}: a column is out of order"));
+                }
+            }
+            stored += here;
+        }
+        if stored != n {
+            return Err(format!("{stored} entries stored, {n} bodies"));
+        }
+        self.pairs.check_against_brute_force(&self.proxies)
+    }
+
+    /// The level a box belongs at: the finest whose reach is at least its largest extent,
+    /// or [`OVERSIZED`] (always, before the first rebuild).
+    fn level_for(&self, bounds: &Aabb) -> u8 {
+        let extent = bounds.extents().max_element();
+        self.levels
+            .iter()
+            .position(|l| extent <= l.reach)
+            .map_or(OVERSIZED, |k| k as u8)
+    }
+
+    /// Calls `f(pairs, proxies, bounds, slot)` with the stored box and slot of every body
+    /// other than `skip` whose box meets `window`, each once; returns where `skip` itself
+    /// was met (a query over a window holding its stored box meets it), if it was.
+    #[inline]
+    fn for_each_candidate(
+        &mut self,
+        window: &Aabb,
+        skip: usize,
+        mut f: impl FnMut(&mut PairSet, &[Proxy], &Aabb, usize),
+    ) -> Option<Place> {
+        let Self {
+            levels,
+            axes,
+            proxies,
+            oversized,
+            pairs,
+            ..
+        } = self;
+        for &s in oversized.iter() {
+            let bounds = &proxies[s as usize].bounds;
+            if s as usize != skip && bounds.intersects(window) {
+                f(pairs, proxies, bounds, s as usize);
+            }
+        }
+        let mut own = None;
+        for level in levels.iter().filter(|l| l.count > 0) {
+            level.for_each_near(window, *axes, |entry, place| {
+                let s = entry.slot as usize;
+                if entry.bounds.intersects(window) {
+                    if s != skip {
+                        f(pairs, proxies, &entry.bounds, s);
+                    } else {
+                        own = Some(place);
+                    }
+                }
+            });
+        }
+        own
+    }
+
+    /// Logs the pair changes of body `p` (at slot `slot`) whose box goes from `old` to `new`
+    /// (`None`: not present), against every other body's stored box (module docs, "Finding
+    /// a body's pairs"). Returns where the query met the body's own stored entry, if it
+    /// did.
+    #[inline]
+    fn refresh(
+        &mut self,
+        p: &Proxy,
+        old: Option<&Aabb>,
+        new: Option<&Aabb>,
+        slot: usize,
+    ) -> Option<Place> {
+        let mut changes = |pairs: &mut PairSet, proxies: &[Proxy], bounds: &Aabb, other: usize| {
+            let was = old.is_some_and(|b| b.intersects(bounds));
+            let is = new.is_some_and(|b| b.intersects(bounds));
+            if was != is {
+                let q = &proxies[other];
+                if p.may_pair(q) {
+                    if is {
+                        pairs.insert(CandidatePair::of(p.body, q.body));
+                    } else {
+                        pairs.remove(CandidatePair::of(p.body, q.body));
+                    }
+                }
+            }
+        };
+        match (old, new) {
+            (Some(a), Some(b)) if a.intersects(b) => {
+                self.for_each_candidate(&a.merged(b), slot, &mut changes)
+            }
+            _ => {
+                // Apart (a jump), or only one: each box on its own, as their union may
+                // span the world. A body meeting only the old box is met only there, one
+                // meeting only the new box only there: each change is logged once.
+                let mut own = None;
+                for window in [old, new].into_iter().flatten() {
+                    own = own.or(self.for_each_candidate(window, slot, &mut changes));
+                }
+                own
+            }
+        }
+    }
+
+    /// Lists slot `slot` where its level and stored box say.
+    fn place(&mut self, slot: usize) {
+        let level = self.level_of[slot];
+        if level == OVERSIZED {
+            self.oversized.push(slot as u32);
+            return;
+        }
+        let bounds = self.proxies[slot].bounds;
+        let grid = &mut self.levels[usize::from(level)];
+        let home = grid.home(bounds.min, self.axes);
+        let entry = Entry {
+            bounds,
+            slot: slot as u32,
+        };
+        grid.columns[home].insert(bounds.min[self.axes.sweep], entry);
+        grid.count += 1;
+    }
+
+    /// Undoes [`place`](Self::place) (from the stored box and level).
+    fn unplace(&mut self, slot: usize) {
+        let level = self.level_of[slot];
+        if level == OVERSIZED {
+            if let Some(i) = self.oversized.iter().position(|&s| s as usize == slot) {
+                self.oversized.swap_remove(i);
+            }
+            return;
+        }
+        let bounds = self.proxies[slot].bounds;
+        let grid = &mut self.levels[usize::from(level)];
+        let home = grid.home(bounds.min, self.axes);
+        let column = &mut grid.columns[home];
+        let at = column.find(bounds.min[self.axes.sweep], slot as u32);
+        column.remove(at);
+        grid.count -= 1;
+    }
+
+    /// Renames slot `from`'s listing to `to` (the last slot filling a freed one).
+    fn rename(&mut self, from: usize, to: usize) {
+        let level = self.level_of[from];
+        if level == OVERSIZED {
+            for s in self.oversized.iter_mut().filter(|s| **s as usize == from) {
+                *s = to as u32;
+            }
+            return;
+        }
+        let bounds = self.proxies[from].bounds;
+        let grid = &mut self.levels[usize::from(level)];
+        let home = grid.home(bounds.min, self.axes);
+        let column = &mut grid.columns[home];
+        let at = column.find(bounds.min[self.axes.sweep], from as u32);
+        column.entries[at].slot = to as u32;
+    }
+
+    /// Chooses the axes and levels from every body and lists each afresh (module docs,
+    /// "Choosing the levels").
+    fn rebuild(&mut self) {
+        self.axes = Axes::with_sweep(super::sort_sweep::widest_spread_axis(&self.proxies));
+        let mut extents: Vec<f64> = self
+            .proxies
+            .iter()
+            .map(|p| p.bounds.extents().max_element())
+            .filter(|&e| e > 0.0)
+            .collect();
+        extents.sort_unstable_by(f64::total_cmp);
+        let quantile = ((extents.len() as f64 * FINEST_QUANTILE) as usize).min(extents.len());
+        let (finest, largest) = match (extents.get(quantile.saturating_sub(1)), extents.last()) {
+            (Some(&q), Some(&largest)) if largest <= ONE_LEVEL_SPREAD * q => (largest, largest),
+            (Some(&q), Some(&largest)) => (q, largest),
+            _ => (1.0, 1.0),
+        };
+        let mut reach = finest;
+        self.levels = vec![Level::new(reach)];
+        while reach < 4.0 * largest && self.levels.len() < MAX_LEVELS {
+            reach *= REACH_RATIO;
+            self.levels.push(Level::new(reach));
+        }
+        self.oversized.clear();
+        let axes = self.axes;
+        let mut spans = vec![
+            (
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY
+            );
+            self.levels.len()
+        ];
+        for slot in 0..self.proxies.len() {
+            let bounds = self.proxies[slot].bounds;
+            let level = self.level_for(&bounds);
+            self.level_of[slot] = level;
+            if level == OVERSIZED {
+                self.oversized.push(slot as u32);
+                continue;
+            }
+            let k = usize::from(level);
+            self.levels[k].count += 1;
+            let (u, v) = (bounds.min[axes.u], bounds.min[axes.v]);
+            let s = &mut spans[k];
+            *s = (s.0.min(u), s.1.max(u), s.2.min(v), s.3.max(v));
+        }
+        for (level, s) in self.levels.iter_mut().zip(&spans) {
+            let span = |lo: f64, hi: f64| if hi >= lo { hi - lo } else { 0.0 };
+            level.size_table(span(s.0, s.1), span(s.2, s.3));
+        }
+        for slot in 0..self.proxies.len() {
+            let level = self.level_of[slot];
+            if level == OVERSIZED {
+                continue;
+            }
+            let bounds = self.proxies[slot].bounds;
+            let grid = &mut self.levels[usize::from(level)];
+            let home = grid.home(bounds.min, axes);
+            let column = &mut grid.columns[home];
+            column.entries.push(Entry {
+                bounds,
+                slot: slot as u32,
+            });
+        }
+        for column in self.levels.iter_mut().flat_map(|l| l.columns.iter_mut()) {
+            column.entries.sort_unstable_by(|a, b| {
+                a.bounds.min[axes.sweep].total_cmp(&b.bounds.min[axes.sweep])
+            });
+            column.low = column
+                .entries
+                .iter()
+                .map(|e| e.bounds.min[axes.sweep])
+                .collect();
+        }
+        self.built_at = self.proxies.len();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::broad::conformance::{self, pairs_of};
+    use crate::test_support::{TestRng, point_in_cube, rng};
+    use rand::Rng;
+
+    /// A box at `offset` + a random point of the cube of half-size `spread`: one in 16 a
+    /// point, one in 16 on a 0.5 m lattice (ends on column boundaries, touching
+    /// neighbours), one in 32 huge, the rest with half-extents log-uniform over 1 mm–1 m.
+    fn random_box(rng: &mut TestRng, offset: DVec3, spread: f64) -> Aabb {
+        let c = offset + point_in_cube(rng, spread);
+        let h = match rng.random_range(0..32) {
+            0 | 1 => DVec3::ZERO,
+            2 | 3 => {
+                let snap = |x: f64| (x / 0.5).round() * 0.5;
+                let c = DVec3::new(snap(c.x), snap(c.y), snap(c.z));
+                return Aabb::new(c, c + DVec3::splat(0.5 * rng.random_range(1..4) as f64));
+            }
+            4 => DVec3::splat(rng.random_range(5.0..40.0)),
+            _ => DVec3::from_array(std::array::from_fn(|_| {
+                rng.random_range(1e-3f64.ln()..0.0).exp()
+            })),
+        };
+        Aabb::new(c - h, c + h)
+    }
+
+    fn random_filter(rng: &mut TestRng) -> CollisionFilter {
+        CollisionFilter {
+            group: 1 << rng.random_range(0..3),
+            mask: rng.random_range(1..8),
+        }
+    }
+
+    #[test]
+    fn a_removed_id_can_be_reinserted_with_new_bounds_kind_and_filter() {
+        let mut grid = ColumnGrid::new();
+        conformance::removed_ids_come_back_with_new_bounds_kind_and_filter(
+            &mut grid,
+            Aabb::new(DVec3::splat(-9.0), DVec3::splat(-6.0)),
+        );
+        conformance::removing_every_body_empties_it(&mut grid);
+    }
+
+    #[test]
+    fn static_bodies_never_pair_with_each_other_however_they_overlap() {
+        let boxed = |rng: &mut TestRng| {
+            let c = point_in_cube(rng, 1.0);
+            let h = DVec3::splat(rng.random_range(0.0..1.0));
+            Aabb::new(c - h, c + h)
+        };
+        let mut grid = ColumnGrid::new();
+        conformance::static_bodies_never_pair_with_each_other(
+            &mut grid,
+            &mut rng(706),
+            100,
+            boxed,
+            10_000,
+        );
+        assert!(!grid.levels.is_empty());
+    }
+
+    /// Far from the origin and near it, seeded frames of small moves, teleports, resizes
+    /// across levels, insertions and removals, with each frame's moves applied one by one
+    /// to one grid and as one batch (with repeated bodies) to another: both validate
+    /// against brute force every frame and agree; pairs appear and disappear, and bodies
+    /// sit at several levels, oversized, and in tables whose buckets alias far columns.
+    #[test]
+    fn one_by_one_and_batched_moves_agree_with_brute_force_far_and_near_the_origin() {
+        let mut rng = rng(707);
+        let (mut created, mut destroyed, mut repeated) = (0usize, 0usize, 0usize);
+        let (mut multi_level, mut oversized, mut aliased) = (false, false, false);
+        for scene in 0..8 {
+            let offset = [DVec3::ZERO, DVec3::new(1e7, -3e6, 2e5)][scene % 2];
+            let spread = [4.0, 30.0, 400.0, 10.0][scene % 4];
+            let mut truth: Vec<Proxy> = (0..150)
+                .map(|i| Proxy {
+                    body: 3 * i + 1,
+                    bounds: random_box(&mut rng, offset, spread),
+                    is_static: rng.random_range(0..5) == 0,
+                    filter: random_filter(&mut rng),
+                })
+                .collect();
+            let mut single = ColumnGrid::new();
+            for p in &truth {
+                single.insert(p.body, p.bounds, p.is_static, p.filter);
+            }
+            let mut batched = ColumnGrid::from_proxies(&truth);
+            let (mut before, mut a, mut b) = (Vec::new(), Vec::new(), Vec::new());
+            single.pairs(&mut before);
+            let mut moves = Vec::new();
+            for frame in 0..40 {
+                moves.clear();
+                for p in truth.iter_mut().filter(|p| !p.is_static) {
+                    if rng.random_range(0..2) == 0 {
+                        continue;
+                    }
+                    p.bounds = if rng.random_range(0..20) == 0 {
+                        random_box(&mut rng, offset, spread)
+                    } else {
+                        let d = point_in_cube(&mut rng, 0.05 * spread.sqrt());
+                        Aabb::new(p.bounds.min + d, p.bounds.max + d)
+                    };
+                    if rng.random_range(0..10) == 0 {
+                        // A stale move first: the batch keeps the last.
+                        moves.push((p.body, random_box(&mut rng, offset, spread)));
+                        repeated += 1;
+                    }
+                    moves.push((p.body, p.bounds));
+                    single.update(p.body, p.bounds);
+                }
+                batched.update_all(&moves);
+                if rng.random_range(0..4) == 0 {
+                    let i = rng.random_range(0..truth.len());
+                    let gone = truth.swap_remove(i);
+                    assert!(single.remove(gone.body) && batched.remove(gone.body));
+                }
+                if rng.random_range(0..3) == 0 {
+                    let bounds = if rng.random_range(0..5) == 0 {
+                        // Wider than any level chosen so far: oversized.
+                        let c = offset + point_in_cube(&mut rng, spread);
+                        Aabb::new(c - DVec3::splat(1e4), c + DVec3::splat(1e4))
+                    } else {
+                        random_box(&mut rng, offset, spread)
+                    };
+                    let p = Proxy {
+                        body: 10_000 + (scene * 100 + frame) as u32,
+                        bounds,
+                        is_static: false,
+                        filter: random_filter(&mut rng),
+                    };
+                    single.insert(p.body, p.bounds, p.is_static, p.filter);
+                    batched.insert(p.body, p.bounds, p.is_static, p.filter);
+                    truth.push(p);
+                }
+                single
+                    .validate()
+                    .unwrap_or_else(|e| panic!("{scene}/{frame}: {e}"));
+                batched
+                    .validate()
+                    .unwrap_or_else(|e| panic!("{scene}/{frame}: {e}"));
+                single.pairs(&mut a);
+                batched.pairs(&mut b);
+                assert_eq!(a, b, "scene {scene} frame {frame}");
+                created += a
+                    .iter()
+                    .filter(|p| before.binary_search(p).is_err())
+                    .count();
+                destroyed += before
+                    .iter()
+                    .filter(|p| a.binary_search(p).is_err())
+                    .count();
+                std::mem::swap(&mut before, &mut a);
+                for grid in [&single, &batched] {
+                    multi_level |= grid.levels.iter().filter(|l| l.count > 0).count() > 1;
+                    oversized |= !grid.oversized.is_empty() && !grid.levels.is_empty();
+                    aliased |= grid.levels.iter().any(|l| {
+                        let columns = |axis: usize| {
+                            let homes: Vec<i64> = grid
+                                .proxies
+                                .iter()
+                                .map(|p| floor_to_i64(p.bounds.min[axis] * l.inv_width))
+                                .collect();
+                            homes.iter().max().unwrap() - homes.iter().min().unwrap()
+                        };
+                        columns(grid.axes.u) > l.mask_u as i64
+                            || columns(grid.axes.v) > l.mask_v as i64
+                    });
+                }
+            }
+        }
+        assert!(created > 500 && destroyed > 500, "{created} {destroyed}");
+        assert!(repeated > 100, "{repeated}");
+        assert!(
+            multi_level && oversized && aliased,
+            "{multi_level} {oversized} {aliased}"
+        );
+    }
+
+    /// A grid built at once lists the same pairs as one filled by insertion, and the
+    /// levels it chooses follow the sizes: one level for a narrow spread, more for a wide
+    /// one.
+    #[test]
+    fn built_at_once_equals_inserted_one_by_one_and_levels_follow_the_sizes() {
+        let mut rng = rng(708);
+        for (spread_of_sizes, levels_with_bodies) in [(1.2f64, 1), (1000.0, 2)] {
+            let proxies: Vec<Proxy> = (0..500)
+                .map(|i| {
+                    let h = rng.random_range(0.0f64..spread_of_sizes.ln()).exp() * 0.1;
+                    let c = point_in_cube(&mut rng, 5.0);
+                    Proxy {
+                        body: i,
+                        bounds: Aabb::new(c - DVec3::splat(h), c + DVec3::splat(h)),
+                        is_static: false,
+                        filter: CollisionFilter::ALL,
+                    }
+                })
+                .collect();
+            let mut built = ColumnGrid::from_proxies(&proxies);
+            let mut inserted = ColumnGrid::new();
+            for p in &proxies {
+                inserted.insert(p.body, p.bounds, p.is_static, p.filter);
+            }
+            built.validate().unwrap();
+            inserted.validate().unwrap();
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            built.pairs(&mut a);
+            inserted.pairs(&mut b);
+            assert_eq!(a, b);
+            assert!(!a.is_empty());
+            let used = built.levels.iter().filter(|l| l.count > 0).count();
+            assert!(
+                (used == 1) == (levels_with_bodies == 1),
+                "size spread {spread_of_sizes}: {used} levels"
+            );
+        }
+        assert_eq!(pairs_of(&mut ColumnGrid::new()), []);
+    }
+}
