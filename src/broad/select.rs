@@ -470,69 +470,82 @@ fn is_far_move(old: &Aabb, new: &Aabb) -> bool {
 }
 
 /// Above this fraction of bodies changing per frame, the stateless sort and sweep (which
-/// costs the same whatever moved) beats per-body updates.
+/// costs the same whatever moved) beats per-body updates at every size measured.
 pub const MOSTLY_MOVING: f64 = 0.5;
-/// Above this fraction of bodies changing per frame in a large scene, likewise.
-pub const LARGE_SCENE_MOVING: f64 = 0.15;
+/// Above this fraction of bodies changing per frame in a scene larger than
+/// [`SAP_MAX_BODIES`], likewise.
+pub const LARGE_SCENE_MOVING: f64 = 0.25;
 /// Above this fraction of far moves among the updates, a scene counts as teleporting.
 pub const TELEPORTING: f64 = 0.01;
-/// Most bodies for [`IncrementalSap`] on a coherent scene; more go to the [`HashGrid`].
-pub const SAP_MAX_BODIES: usize = 3_000;
+/// Most bodies for [`IncrementalSap`] on a coherent scene; more go to the [`ColumnGrid`].
+pub const SAP_MAX_BODIES: usize = 1_000;
 
 /// The broad phase a scene with [`BroadPhaseChoice::Auto`] runs, given its statistics:
 ///
-/// 1. more than [`MOSTLY_MOVING`] of the bodies changing per frame, or more than
-///    [`TELEPORTING`] of the updates far moves: [`SortAndSweep`];
-/// 2. up to [`SAP_MAX_BODIES`] bodies: [`IncrementalSap`];
+/// 1. more than [`MOSTLY_MOVING`] of the bodies changing per frame: [`SortAndSweep`];
+/// 2. up to [`SAP_MAX_BODIES`] bodies, with at most [`TELEPORTING`] of the updates far
+///    moves: [`IncrementalSap`] (a jump costs it a swap with every endpoint passed);
 /// 3. more than [`LARGE_SCENE_MOVING`] changing per frame: [`SortAndSweep`];
-/// 4. else [`HashGrid`].
+/// 4. else [`ColumnGrid`] (a jump costs it two queries).
+///
+/// The [`HashGrid`] is never chosen: the column grid was faster on every measured class
+/// (below); it stays available as a fixed choice.
 ///
 /// # The measurements behind it
-/// `examples/broad_bench` on this machine (2-core AMD EPYC VM, one core used), mean µs per
-/// frame, the three broad phases and rapier's BVH broad phase (`parry_bvh`) in lockstep on
-/// the same frames, uniform / clustered / stacked layouts of `common/broad_scenes.rs`
-/// (taken while another build ran on the other core: ratios within a row are what count):
+/// `examples/broad_bench` on this machine (2-core AMD EPYC VM, one core used, nothing else
+/// running), mean µs per frame, every broad phase and rapier's BVH broad phase on parry's
+/// BVH (the faster of its 1 nm and 1 cm change margins: "peer") in lockstep on the same
+/// frames, uniform / clustered / stacked layouts of `common/broad_scenes.rs`, one run
+/// (2026-11-21). Bold: what the rule takes.
 ///
-/// | bodies | motion (share moving) | sort & sweep | incremental SAP | hash grid | parry BVH |
-/// |---|---|---|---|---|---|
-/// | 1,000 | coherent (10 %) | 60 / 46 / 68 | **32 / 21 / 17** | 40 / 44 / 39 | 64 / 43 / 46 |
-/// | 1,000 | coherent (25 %) | 75 / 95 / 134 | **68 / 51 / 86** | 99 / 187 / 180 | 90 / 55 / 84 |
-/// | 1,000 | coherent (all) | **158 / 87 / 146** | 375 / 250 / 275 | 549 / 635 / 741 | 193 / 108 / 90 |
-/// | 1,000 | teleporting (10 %) | **201 / 143** / 125 | 5,757 / 4,616 / 190 | 242 / 201 / **58** | 532 / 291 / 52 |
-/// | 1,000 | teleporting (all) | **120 / 106 / 194** | 39,534 / 40,733 / 1,892 | 1,514 / 2,080 / 726 | 2,650 / 2,573 / 155 |
-/// | 10,000 | coherent (5 %) | 1,661 / 1,654 / 840 | 478 / **411** / 827 | **770** / 582 / **416** | 1,044 / 1,129 / 691 |
-/// | 10,000 | coherent (10 %) | 1,288 / 1,064 / **983** | 1,454 / **714** / 1,319 | **930** / 1,112 / 1,478 | 1,017 / 963 / 733 |
-/// | 10,000 | coherent (25 %) | **1,118 / 1,125 / 1,354** | 1,936 / 1,629 / 2,509 | 1,577 / 2,902 / 1,870 | 1,379 / 1,384 / 1,237 |
-/// | 10,000 | coherent (all) | **1,158 / 1,265 / 1,665** | 7,942 / 5,521 / 14,073 | 5,546 / 10,702 / 7,023 | 1,660 / 2,120 / 1,546 |
-/// | 10,000 | teleporting (10 %) | **1,445 / 1,554** / 1,224 | 392,653 / 406,826 / 9,418 | 2,450 / 2,948 / **1,023** | 29,391 / 23,764 / 693 |
+/// | bodies | motion (share moving) | sort & sweep | incremental SAP | hash grid | column grid | peer |
+/// |---|---|---|---|---|---|---|
+/// | 1,000 | coherent (10 %) | 69 / 46 / 69 | **34 / 22 / 18** | 49 / 45 / 43 | 32 / 17 / 34 | 71 / 41 / 43 |
+/// | 1,000 | coherent (25 %) | 88 / 55 / 98 | **71 / 52 / 46** | 111 / 117 / 124 | 77 / 49 / 89 | 96 / 50 / 55 |
+/// | 1,000 | coherent (all) | **100 / 66 / 144** | 251 / 182 / 249 | 424 / 481 / 652 | 290 / 214 / 463 | 120 / 73 / 87 |
+/// | 1,000 | teleporting (10 %) | 121 / 105 / 93 | 4,490 / 3,638 / 136 | 202 / 190 / 62 | **106 / 55 / 43** | 454 / 205 / 51 |
+/// | 3,000 | coherent (10 %) | 304 / 259 / 272 | 146 / 100 / 102 | 170 / 194 / 173 | **117 / 93 / 92** | 277 / 171 / 122 |
+/// | 10,000 | coherent (5 %) | 1,087 / 1,038 / 852 | 604 / 429 / 468 | 474 / 586 / 507 | **302 / 290 / 303** | 866 / 696 / 473 |
+/// | 10,000 | coherent (10 %) | 1,064 / 1,068 / 926 | 972 / 847 / 883 | 847 / 1,403 / 907 | **519 / 631 / 508** | 1,053 / 963 / 614 |
+/// | 10,000 | coherent (15 %) | 1,107 / 1,039 / 977 | | 1,154 / 1,520 / 965 | **709 / 749 / 527** | 1,205 / 1,022 / 498 |
+/// | 10,000 | coherent (25 %) | 1,111 / 1,087 / 1,107 | | 1,899 / 2,474 / 1,573 | **1,118 / 1,173 / 862** | 1,414 / 1,210 / 595 |
+/// | 10,000 | coherent (50 %) | **1,262 / 1,144 / 1,331** | | 3,610 / 5,199 / 3,257 | 2,141 / 2,317 / 1,709 | 1,755 / 1,572 / 813 |
+/// | 10,000 | coherent (all) | **1,319 / 1,242 / 1,419** | | 6,401 / 10,237 / 6,254 | 3,773 / 4,504 / 3,190 | 1,897 / 1,814 / 1,008 |
+/// | 10,000 | teleporting (10 %) | 1,311 / 1,238 / 1,216 | | 2,411 / 3,110 / 902 | **1,263 / 858 / 504** | 25,859 / 18,015 / 596 |
+/// | 10,000 | teleporting (30 %) | **1,365** / – / **1,333** | | | 3,307 / – / 1,126 | 85,118 / – / 728 |
+/// | 10,000 | teleporting (50 %) | **1,283** / – / **1,440** | | | 4,731 / – / 1,866 | 133,878 / – / 846 |
+/// | 100,000 | coherent (10 %) | 16,736 / 15,872 / 11,174 | | 14,219 / 21,968 / 10,121 | **8,127 / 9,469 / 5,967** | 17,318 / 19,192 / 9,856 |
 ///
-/// The incremental sweep and prune is the fastest of the three on coherent scenes up to a
-/// few thousand bodies, but a far move costs it a swap with every endpoint passed (20 to
-/// 300 times slower when bodies teleport) and its insertions are `O(n)` each. The hash
-/// grid's cost follows the bodies that moved, about the same whatever the motion, and it
-/// leads among large coherent scenes with few bodies moving. Sort and sweep in grid
-/// columns costs the same whatever moved: it wins once a quarter of a large scene moves,
-/// and whenever bodies teleport. Where two kinds are within about 30 % the rule takes the
-/// one without a bad case. Stacked dice are where parry's BVH (refit and one
-/// self-traversal) beats all three: see issue #6's notes.
+/// (The teleporting 30 % and 50 % rows are from a second run, uniform and stacked only. The
+/// incremental sweep and prune was not run on the larger moving and teleporting scenes: its teleports cost it 0.4 s a frame at 10,000 bodies, and its 25 % and more
+/// moving rows lost to the other kinds at 1,000 and 10,000 in earlier runs.)
+///
+/// The incremental sweep and prune is the fastest on small coherent scenes, stacked dice
+/// above all, but a far move costs it a swap with every endpoint passed and its insertions
+/// are `O(n)`; from 3,000 bodies the column grid beats it on every layout. The column
+/// grid's cost follows the bodies that moved, jumps included; sort and sweep in grid
+/// columns costs the same whatever moved, and wins once more than about a quarter of a
+/// large scene moves (at 25 % the two are even on scattered bodies, and the grid is faster
+/// on stacked dice). Stacked dice with many bodies moving are where parry's BVH (refit and
+/// one self-traversal) beats all four: see issue #6's notes.
 ///
 /// [`BroadPhaseStats::size_spread`] and [`BroadPhaseStats::sweep_overlap_ratio`] are
 /// measured and reported ([`StepReport::broad_stats`](crate::pipeline::StepReport)) but the
 /// rule does not read them: on the measured layouts (tenfold size spread in the clustered
-/// one, stacked dice sharing z ranges) no threshold on them picked a faster kind than
-/// motion and body count already do, except the clustered 10,000-body scene, where the
-/// incremental sweep and prune beats the grid (627 against 969 µs): one layout is not
-/// enough to set a threshold from.
+/// one, stacked dice sharing z ranges) the same kind won on all three layouts of each row
+/// but two (1,000 bodies: 10 % moving, where the column grid edges out the sweep and prune
+/// on scattered bodies; 25 %, on clustered ones), so no threshold on them would pick a
+/// faster kind.
 #[must_use]
 pub fn choose(stats: &BroadPhaseStats) -> BroadPhaseKind {
-    if stats.moving_fraction > MOSTLY_MOVING || stats.far_move_fraction > TELEPORTING {
+    if stats.moving_fraction > MOSTLY_MOVING {
         BroadPhaseKind::SortAndSweep
-    } else if stats.bodies <= SAP_MAX_BODIES {
+    } else if stats.bodies <= SAP_MAX_BODIES && stats.far_move_fraction <= TELEPORTING {
         BroadPhaseKind::IncrementalSap
     } else if stats.moving_fraction > LARGE_SCENE_MOVING {
         BroadPhaseKind::SortAndSweep
     } else {
-        BroadPhaseKind::HashGrid
+        BroadPhaseKind::ColumnGrid
     }
 }
 
@@ -797,7 +810,7 @@ mod tests {
 
     #[test]
     fn the_rule_picks_the_measured_fastest_kind_for_each_scene_class() {
-        use BroadPhaseKind::{HashGrid as Grid, IncrementalSap as Sap, SortAndSweep as Sweep};
+        use BroadPhaseKind::{ColumnGrid as Grid, IncrementalSap as Sap, SortAndSweep as Sweep};
         let stats = |bodies, moving_fraction, far_move_fraction| BroadPhaseStats {
             bodies,
             moving_fraction,
@@ -809,16 +822,22 @@ mod tests {
             // (bodies, moving, far moves) → kind, as the table in `choose` measured.
             ((1_000, 0.1, 0.0), Sap),
             ((1_000, 0.25, 0.0), Sap),
-            ((3_000, 0.1, 0.0), Sap),
-            ((3_001, 0.1, 0.0), Grid),
+            ((1_000, 0.5, 0.0), Sap),
+            ((1_001, 0.1, 0.0), Grid),
+            ((3_000, 0.1, 0.0), Grid),
             ((10_000, 0.05, 0.0), Grid),
-            ((10_000, 0.25, 0.0), Sweep),
-            ((1_000, 0.1, 1.0), Sweep),
-            ((1_000, 0.1, 0.02), Sweep),
+            ((10_000, 0.25, 0.0), Grid),
+            ((10_000, 0.26, 0.0), Sweep),
+            ((100_000, 0.1, 0.0), Grid),
+            ((1_000, 0.1, 1.0), Grid),
+            ((1_000, 0.1, 0.02), Grid),
             ((1_000, 0.1, 0.005), Sap),
             ((1_000, 1.0, 0.0), Sweep),
             ((100_000, 1.0, 1.0), Sweep),
-            ((10_000, 0.1, 0.5), Sweep),
+            ((10_000, 0.1, 0.5), Grid),
+            ((10_000, 0.3, 0.5), Sweep),
+            ((1_000, 0.3, 0.02), Sweep),
+            ((1_000, 0.25, 0.02), Grid),
             ((0, 0.0, 0.0), Sap),
         ];
         for ((bodies, moving, far), kind) in cases {
