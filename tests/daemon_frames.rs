@@ -118,7 +118,17 @@ fn twin_scenes(client: &Client<ipc::Service>) -> TwinScenes {
     TwinScenes { scene_id, oracle }
 }
 
-/// Field-by-field equality of a result frame's records with the in-process results.
+/// The wire flags of an answer that is `exact` or not.
+fn approximate_flag(exact: bool) -> u32 {
+    if exact {
+        0
+    } else {
+        wire::record_flags::APPROXIMATE
+    }
+}
+
+/// The records of a result frame equal, field for field, to the in-process `expected`
+/// (pairs, then contacts, then times of impact), flags included.
 fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame: u64) {
     let (pairs, rest) = records.split_at(expected.pairs.len());
     let (contacts, tois) = rest.split_at(expected.contacts.len());
@@ -130,7 +140,7 @@ fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame:
             body_b: want.b,
             index: 0,
             count: u32::from(want.reached),
-            reserved: 0,
+            flags: 0,
             distance: want.distance,
             error_bound: want.error_bound,
             point_a: want.point_a.to_array(),
@@ -147,7 +157,7 @@ fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame:
             body_b: want.b,
             index: want.first_contact,
             count: want.contact_count,
-            reserved: 0,
+            flags: approximate_flag(want.exact),
             distance: want.distance,
             error_bound: want.error_bound,
             point_a: want.point_a.to_array(),
@@ -165,7 +175,7 @@ fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame:
             body_b: pair.b,
             index: want.pair,
             count: 0,
-            reserved: 0,
+            flags: approximate_flag(pair.exact),
             distance: want.distance,
             error_bound: want.error_bound,
             point_a: want.point_a.to_array(),
@@ -772,6 +782,11 @@ fn a_budgeted_torus_pile_frame_is_truncated_and_conservative_and_budget_zero_is_
     assert_eq!(header.budget_met, 0);
     assert_same_records(result.records(), &expected, 1);
     assert_linked(&result);
+    let approximate = |r: &ResultRecord| r.flags & wire::record_flags::APPROXIMATE != 0;
+    assert!(
+        result.pairs().iter().any(approximate),
+        "a truncated frame marks its approximate records"
+    );
     for t in &close {
         let got = result
             .pairs()
@@ -810,4 +825,8 @@ fn a_budgeted_torus_pile_frame_is_truncated_and_conservative_and_budget_zero_is_
     assert_same_records(result.records(), &expected, 2);
     assert_linked(&result);
     assert_eq!(result.pairs().len(), close.len(), "exactly the close pairs");
+    assert!(
+        result.records().iter().all(|r| r.flags == 0),
+        "an exact frame"
+    );
 }

@@ -275,6 +275,17 @@ pub struct ResultFrameHeader {
     pub stage_ns: [u64; stage::COUNT],
 }
 
+/// Bits of [`ResultRecord::flags`]; undefined bits are 0.
+pub mod record_flags {
+    /// The answer is conservative, not exact: the pair's traversal was cut short by the
+    /// frame's deadline (or the pair got the box answer). `distance` is then a lower bound on
+    /// the true distance, within `error_bound` of it, and the pair is reported because it
+    /// *may* qualify (DESIGN §4). Set on a `Pair` record and on each of its `Contact`
+    /// records; never on `Toi` records (a stopped search says so by `count` 0). A frame
+    /// whose header says `Truncated` has at least one record with it, an `Exact` frame none.
+    pub const APPROXIMATE: u32 = 1 << 0;
+}
+
 /// What a [`ResultRecord`] describes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u32)]
@@ -320,8 +331,8 @@ pub struct ResultRecord {
     pub index: u32,
     /// See the type docs.
     pub count: u32,
-    /// Always 0.
-    pub reserved: u32,
+    /// [`record_flags`] bits (since protocol version 5).
+    pub flags: u32,
     /// Signed distance, metres (see the type docs).
     pub distance: f64,
     /// `|distance − true distance| ≤ error_bound`, metres.

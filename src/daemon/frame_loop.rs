@@ -35,6 +35,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use proxima_ipc::wire::{
     self, ErrorCode, PoseFrameHeader, PoseRecord, RecordKind, ResultFrameHeader, ResultRecord,
+    record_flags,
 };
 use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION};
 use std::sync::Arc;
@@ -240,13 +241,22 @@ fn pair_record(r: &PairResult) -> ResultRecord {
         body_b: r.b,
         index: r.first_contact,
         count: r.contact_count,
-        reserved: 0,
+        flags: approximate_flag(r),
         distance: r.distance,
         error_bound: r.error_bound,
         point_a: r.point_a.to_array(),
         point_b: r.point_b.to_array(),
         normal: r.normal.to_array(),
         time: 0.0,
+    }
+}
+
+/// [`record_flags::APPROXIMATE`] when `r` is not exact.
+fn approximate_flag(r: &PairResult) -> u32 {
+    if r.exact {
+        0
+    } else {
+        record_flags::APPROXIMATE
     }
 }
 
@@ -259,7 +269,7 @@ fn contact_record(pairs: &[PairResult], c: &ContactPoint) -> ResultRecord {
         body_b: pair.b,
         index: c.pair,
         count: 0,
-        reserved: 0,
+        flags: approximate_flag(pair),
         distance: c.distance,
         error_bound: c.error_bound,
         point_a: c.point_a.to_array(),
@@ -277,7 +287,7 @@ fn toi_record(r: &PairToi) -> ResultRecord {
         body_b: r.b,
         index: 0,
         count: u32::from(r.reached),
-        reserved: 0,
+        flags: 0,
         distance: r.distance,
         error_bound: r.error_bound,
         point_a: r.point_a.to_array(),
