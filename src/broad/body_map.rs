@@ -1,4 +1,5 @@
-//! Body id maps of the stateful broad phases, with a hash fit for `u32` ids.
+//! Body id maps of the stateful broad phases: [`SlotTable`], id → slot, a plain array while
+//! the ids are small; [`BodyMap`], a hash map with a hash fit for `u32` ids.
 //!
 //! The standard library's SipHash guards against adversarial keys and costs about 20 ns a
 //! look-up; body ids are chosen by the scene, not by an adversary, and every moved body is
@@ -38,5 +39,137 @@ impl Hasher for IdHasher {
     #[inline]
     fn finish(&self) -> u64 {
         self.state ^ (self.state >> 32)
+    }
+}
+
+/// Body id → slot, as a plain array while the ids are small (every id below four times the
+/// count plus [`DENSE_SLACK`], so the array is at most about four cells per body plus
+/// 256 KiB: one read of a 4-byte cell where a hash map probes a table three times the
+/// size), and as a [`BodyMap`] from the first id beyond that. Measured
+/// (`examples/broad_bench`, column grid, 100,000 bodies, 10 % moving, six alternating
+/// runs): 6.5 ms median per frame against 7.1 with the map.
+#[derive(Debug, Clone)]
+pub(crate) enum SlotTable {
+    /// `slots[id]` is the slot of body `id`, or [`ABSENT`]; `count` ids are present.
+    Dense {
+        slots: Vec<u32>,
+        count: usize,
+    },
+    Sparse(BodyMap),
+}
+
+/// Ids a dense table allows beyond four times its count.
+const DENSE_SLACK: usize = 1 << 16;
+/// A free cell of a dense table.
+const ABSENT: u32 = u32::MAX;
+
+impl Default for SlotTable {
+    fn default() -> Self {
+        Self::Dense {
+            slots: Vec::new(),
+            count: 0,
+        }
+    }
+}
+
+impl SlotTable {
+    #[inline]
+    pub(crate) fn get(&self, id: u32) -> Option<u32> {
+        match self {
+            Self::Dense { slots, .. } => slots.get(id as usize).copied().filter(|&s| s != ABSENT),
+            Self::Sparse(map) => map.get(&id).copied(),
+        }
+    }
+
+    pub(crate) fn contains(&self, id: u32) -> bool {
+        self.get(id).is_some()
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            Self::Dense { count, .. } => *count,
+            Self::Sparse(map) => map.len(),
+        }
+    }
+
+    /// Sets `id`'s slot (present or not), returning the slot it had.
+    pub(crate) fn insert(&mut self, id: u32, slot: u32) -> Option<u32> {
+        if let Self::Dense { slots, count } = self {
+            let i = id as usize;
+            if i < slots.len() || i < 4 * (*count + 1) + DENSE_SLACK {
+                if i >= slots.len() {
+                    slots.resize(i + 1, ABSENT);
+                }
+                let previous = std::mem::replace(&mut slots[i], slot);
+                *count += usize::from(previous == ABSENT);
+                return (previous != ABSENT).then_some(previous);
+            }
+            let map: BodyMap = slots
+                .iter()
+                .enumerate()
+                .filter(|&(_, &s)| s != ABSENT)
+                .map(|(i, &s)| (i as u32, s))
+                .collect();
+            *self = Self::Sparse(map);
+        }
+        match self {
+            Self::Sparse(map) => map.insert(id, slot),
+            Self::Dense { .. } => unreachable!("converted above"),
+        }
+    }
+
+    /// Removes `id`, returning its slot if it was present.
+    pub(crate) fn remove(&mut self, id: u32) -> Option<u32> {
+        match self {
+            Self::Dense { slots, count } => {
+                let cell = slots.get_mut(id as usize)?;
+                let slot = std::mem::replace(cell, ABSENT);
+                (slot != ABSENT).then(|| {
+                    *count -= 1;
+                    slot
+                })
+            }
+            Self::Sparse(map) => map.remove(&id),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::rng;
+    use rand::Rng;
+    use std::collections::HashMap;
+
+    /// Random inserts, replacements and removals agree with a `HashMap`, on small ids (the
+    /// table stays dense) and with a few huge ones mixed in (it turns sparse, keeping
+    /// every entry).
+    #[test]
+    fn a_slot_table_agrees_with_a_hash_map_dense_and_after_turning_sparse() {
+        let mut rng = rng(41);
+        for huge_ids in [false, true] {
+            let (mut table, mut truth) = (SlotTable::default(), HashMap::new());
+            for step in 0..20_000u32 {
+                let id = if huge_ids && rng.random_range(0..500) == 0 {
+                    rng.random_range(1_000_000..u32::MAX)
+                } else {
+                    rng.random_range(0..3_000)
+                };
+                if rng.random_range(0..3) == 0 {
+                    assert_eq!(table.remove(id), truth.remove(&id), "step {step}");
+                } else {
+                    assert_eq!(
+                        table.insert(id, step),
+                        truth.insert(id, step),
+                        "step {step}"
+                    );
+                }
+                assert_eq!(table.len(), truth.len());
+                let probe = rng.random_range(0..3_000);
+                assert_eq!(table.get(probe), truth.get(&probe).copied());
+                assert_eq!(table.contains(probe), truth.contains_key(&probe));
+            }
+            assert_eq!(matches!(table, SlotTable::Sparse(_)), huge_ids);
+        }
     }
 }

@@ -79,7 +79,7 @@
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant), checked by
 //! `debug_assert!`.
 
-use super::body_map::BodyMap;
+use super::body_map::SlotTable;
 use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64};
 use crate::bounding::{Aabb, BoundingVolume};
@@ -376,7 +376,7 @@ pub struct ColumnGrid {
     /// Slots of the oversized bodies.
     oversized: Vec<u32>,
     /// Slot of each body id.
-    slot_of: BodyMap,
+    slot_of: SlotTable,
     /// The pairs whose boxes overlap and that may pair, `a < b`.
     pairs: PairSet,
     /// Body count at the last rebuild (0: never built).
@@ -417,7 +417,7 @@ impl ColumnGrid {
             proxies: Vec::new(),
             level_of: Vec::new(),
             oversized: Vec::new(),
-            slot_of: BodyMap::default(),
+            slot_of: SlotTable::default(),
             pairs: PairSet::default(),
             built_at: 0,
             batch: Vec::new(),
@@ -469,7 +469,7 @@ impl ColumnGrid {
     /// Whether `body` is present.
     #[must_use]
     pub fn contains(&self, body: u32) -> bool {
-        self.slot_of.contains_key(&body)
+        self.slot_of.contains(body)
     }
 
     /// The bodies as proxies, in slot order (no particular order).
@@ -513,7 +513,7 @@ impl ColumnGrid {
 
     /// Removes `body` and its pairs; `false` when it was not present.
     pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.slot_of.remove(&body) else {
+        let Some(slot) = self.slot_of.remove(body) else {
             return false;
         };
         let slot = slot as usize;
@@ -538,7 +538,7 @@ impl ColumnGrid {
     /// in release builds).
     pub fn update(&mut self, body: u32, bounds: Aabb) {
         debug_assert_valid_bounds(&bounds);
-        let Some(&slot) = self.slot_of.get(&body) else {
+        let Some(slot) = self.slot_of.get(body) else {
             debug_assert!(false, "update of absent body {body}");
             return;
         };
@@ -564,7 +564,7 @@ impl ColumnGrid {
         }
         for &(body, bounds) in moves {
             debug_assert_valid_bounds(&bounds);
-            let Some(&slot) = self.slot_of.get(&body) else {
+            let Some(slot) = self.slot_of.get(body) else {
                 debug_assert!(false, "update of absent body {body}");
                 continue;
             };
@@ -647,7 +647,7 @@ impl ColumnGrid {
             return Err(format!("{n} proxies, per-slot tables disagree"));
         }
         for (slot, p) in self.proxies.iter().enumerate() {
-            if self.slot_of.get(&p.body) != Some(&(slot as u32)) {
+            if self.slot_of.get(p.body) != Some(slot as u32) {
                 return Err(format!("body {} at slot {slot} not mapped to it", p.body));
             }
             let b = &p.bounds;

@@ -95,7 +95,7 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hash, Hasher};
 
-use super::body_map::BodyMap;
+use super::body_map::SlotTable;
 use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64};
 use crate::bounding::{Aabb, BoundingVolume};
@@ -334,7 +334,7 @@ pub struct HashGrid {
     /// Slots of the oversized bodies.
     oversized: Vec<u32>,
     /// Slot of each body id.
-    slot_of: BodyMap,
+    slot_of: SlotTable,
     /// The pairs whose boxes overlap and that may pair, `a < b`.
     pairs: PairSet,
     /// Per slot, the query stamp that last gathered it (no candidate tested twice).
@@ -362,7 +362,7 @@ impl HashGrid {
             level_of: Vec::new(),
             member_at: Vec::new(),
             oversized: Vec::new(),
-            slot_of: BodyMap::default(),
+            slot_of: SlotTable::default(),
             pairs: PairSet::default(),
             seen: Vec::new(),
             stamp: 1,
@@ -403,13 +403,13 @@ impl HashGrid {
     /// Whether `body` is in the grid.
     #[must_use]
     pub fn contains(&self, body: u32) -> bool {
-        self.slot_of.contains_key(&body)
+        self.slot_of.contains(body)
     }
 
     /// The level `body` is stored at (`Some(None)` when it is oversized), `None` when absent.
     #[must_use]
     pub fn level(&self, body: u32) -> Option<Option<usize>> {
-        let slot = *self.slot_of.get(&body)? as usize;
+        let slot = self.slot_of.get(body)? as usize;
         let level = self.level_of[slot];
         Some((level != OVERSIZED).then_some(usize::from(level)))
     }
@@ -455,7 +455,7 @@ impl HashGrid {
 
     /// Removes `body` and its pairs; `false` when it was not present.
     pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.slot_of.remove(&body) else {
+        let Some(slot) = self.slot_of.remove(body) else {
             return false;
         };
         let slot = slot as usize;
@@ -488,7 +488,7 @@ impl HashGrid {
     /// in release builds).
     pub fn update(&mut self, body: u32, bounds: Aabb) {
         debug_assert_valid_bounds(&bounds);
-        let Some(&slot) = self.slot_of.get(&body) else {
+        let Some(slot) = self.slot_of.get(body) else {
             debug_assert!(false, "update of absent body {body}");
             return;
         };
@@ -552,7 +552,7 @@ impl HashGrid {
         }
         let mut entries = vec![0usize; self.levels.len()];
         for (slot, p) in self.proxies.iter().enumerate() {
-            if self.slot_of.get(&p.body) != Some(&(slot as u32)) {
+            if self.slot_of.get(p.body) != Some(slot as u32) {
                 return Err(format!("body {} at slot {slot} not mapped to it", p.body));
             }
             let b = &p.bounds;
@@ -900,7 +900,7 @@ mod tests {
 
     /// The cells of `level` that list `body`.
     fn cells_of(grid: &HashGrid, body: u32, level: usize) -> Vec<[i64; 3]> {
-        let slot = grid.slot_of[&body];
+        let slot = grid.slot_of.get(body).unwrap();
         let mut cells: Vec<[i64; 3]> = grid.levels[level]
             .cells
             .iter()
@@ -1040,7 +1040,7 @@ mod tests {
         let (mut with_floor, mut with_wall) = (0, 0);
         for frame in 0..200 {
             for id in 0..60u32 {
-                let b = grid.proxies[grid.slot_of[&id] as usize].bounds;
+                let b = grid.proxies[grid.slot_of.get(id).unwrap() as usize].bounds;
                 let s = point_in_cube(&mut rng, 0.5);
                 grid.update(id, Aabb::new(b.min + s, b.max + s));
             }
@@ -1128,7 +1128,7 @@ mod tests {
         }
         for op in 0..3_000 {
             let id = rng.random_range(0..200u32);
-            let slot = grid.slot_of[&id] as usize;
+            let slot = grid.slot_of.get(id).unwrap() as usize;
             let old = grid.proxies[slot].bounds;
             let bounds = if rng.random_bool(0.7) {
                 let s = point_in_cube(&mut rng, 0.2 * old.extents().max_element().max(1e-3));

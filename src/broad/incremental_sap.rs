@@ -52,7 +52,7 @@
 //! validates poses before they reach the broad phase), checked by `debug_assert!`. A NaN
 //! would break the sort order and is never allowed in.
 
-use super::body_map::BodyMap;
+use super::body_map::SlotTable;
 use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, SortAndSweep, debug_assert_valid_bounds};
 use crate::bounding::{Aabb, BoundingVolume};
@@ -115,7 +115,7 @@ pub struct IncrementalSap {
     /// Per axis, all endpoints sorted by [`Endpoint::after`].
     axes: [Vec<Endpoint>; 3],
     /// Slot of each body id.
-    slot_of: BodyMap,
+    slot_of: SlotTable,
     /// The pairs whose boxes overlap and that may pair, `a < b`.
     pairs: PairSet,
 }
@@ -142,7 +142,7 @@ impl IncrementalSap {
     /// Whether `body` is in the broad phase.
     #[must_use]
     pub fn contains(&self, body: u32) -> bool {
-        self.slot_of.contains_key(&body)
+        self.slot_of.contains(body)
     }
 
     /// The bodies as proxies, in no particular order.
@@ -241,7 +241,7 @@ impl IncrementalSap {
 
     /// Removes `body` and its pairs; `false` when it was not present.
     pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.slot_of.remove(&body) else {
+        let Some(slot) = self.slot_of.remove(body) else {
             return false;
         };
         let slot = slot as usize;
@@ -284,7 +284,7 @@ impl IncrementalSap {
     /// in release builds).
     pub fn update(&mut self, body: u32, bounds: Aabb) {
         debug_assert_valid_bounds(&bounds);
-        let Some(&slot) = self.slot_of.get(&body) else {
+        let Some(slot) = self.slot_of.get(body) else {
             debug_assert!(false, "update of absent body {body}");
             return;
         };
@@ -331,7 +331,7 @@ impl IncrementalSap {
             ));
         }
         for (slot, p) in self.proxies.iter().enumerate() {
-            if self.slot_of.get(&p.body) != Some(&(slot as u32)) {
+            if self.slot_of.get(p.body) != Some(slot as u32) {
                 return Err(format!("body {} at slot {slot} not mapped to it", p.body));
             }
             let b = &p.bounds;
