@@ -65,6 +65,16 @@ struct Entry {
     slot: u32,
 }
 
+impl Entry {
+    /// Keeps the body's new box, counting the move and whether it was a far move
+    /// ([`BroadPhase::take_move_counts`]) in `(moves, far_moves)`.
+    fn note_move(&mut self, bounds: Aabb, (moves, far_moves): (&mut u64, &mut u64)) {
+        *moves += 1;
+        *far_moves += u64::from(is_far_move(&self.bounds, &bounds));
+        self.bounds = bounds;
+    }
+}
+
 /// Sort and sweep with its proxy list.
 #[derive(Debug, Clone, Default)]
 struct Sweep {
@@ -285,9 +295,7 @@ impl BroadPhase {
             debug_assert!(false, "update of absent body {body}");
             return None;
         };
-        self.moves += 1;
-        self.far_moves += u64::from(is_far_move(&entry.bounds, &bounds));
-        entry.bounds = bounds;
+        entry.note_move(bounds, (&mut self.moves, &mut self.far_moves));
         Some(entry.slot)
     }
 
@@ -320,25 +328,29 @@ impl BroadPhase {
     /// # Allocation
     /// None once the batch buffer has grown to the largest batch.
     pub fn set_all(&mut self, proxies: &[Proxy]) {
+        let Inner::Columns(_) = self.inner else {
+            for proxy in proxies {
+                self.set(proxy);
+            }
+            return;
+        };
         let mut moves = std::mem::take(&mut self.batch);
         moves.clear();
         for proxy in proxies {
-            let plain_move = matches!(
-                self.entries.get(&proxy.body),
-                Some(e) if e.is_static == proxy.is_static && e.filter == proxy.filter
-            );
-            match &mut self.inner {
-                Inner::Columns(_) if plain_move => {
+            // One look-up: the check that it is a plain move, and the move's record.
+            match self.entries.get_mut(&proxy.body) {
+                Some(e) if e.is_static == proxy.is_static && e.filter == proxy.filter => {
+                    e.note_move(proxy.bounds, (&mut self.moves, &mut self.far_moves));
                     moves.push((proxy.body, proxy.bounds));
-                    self.record_move(proxy.body, proxy.bounds);
                 }
-                Inner::Columns(c) => {
+                _ => {
                     // The batch first: a later move of a replaced body must not undo it.
-                    c.update_all(&moves);
+                    if let Inner::Columns(c) = &mut self.inner {
+                        c.update_all(&moves);
+                    }
                     moves.clear();
                     self.insert(proxy.body, proxy.bounds, proxy.is_static, proxy.filter);
                 }
-                _ => self.set(proxy),
             }
         }
         if let Inner::Columns(c) = &mut self.inner {
@@ -594,13 +606,14 @@ mod tests {
     }
 
     /// Seeded frames of coherent motion with teleports, insertions, removals, re-filtered
-    /// and re-flagged bodies (through `set`) and repeated `set`s: every kind reports exactly
+    /// and re-flagged bodies (through `set`, and in batches through `set_all` with some
+    /// bodies listed twice) and repeated `set`s: every kind reports exactly
     /// brute force's pairs over the bodies it was given, and validates, every frame.
     #[test]
     fn every_kind_reports_brute_force_pairs_over_random_insert_update_remove_frames() {
         for (k, kind) in BroadPhaseKind::ALL.into_iter().enumerate() {
             let mut rng = rng(600 + k as u64);
-            let mut ops = [0usize; 5]; // update, insert, remove, set, absent remove
+            let mut ops = [0usize; 6]; // update, insert, remove, set, absent remove, set_all
             let (mut total_pairs, mut empty_frames, mut frames) = (0usize, 0usize, 0usize);
             let (mut expected, mut found) = (Vec::new(), Vec::new());
             for scene in 0..6 {
@@ -668,6 +681,30 @@ mod tests {
                         phase.set(p);
                         phase.set(p); // idempotent
                         ops[3] += 1;
+                    }
+                    if rng.random_range(0..3) == 0 && !truth.is_empty() {
+                        // A batch of moves, re-filters and re-flags, some bodies listed
+                        // with an older state first: the last state of each counts.
+                        let mut batch = Vec::new();
+                        for _ in 0..rng.random_range(1..8) {
+                            let i = rng.random_range(0..truth.len());
+                            if rng.random_range(0..4) == 0 {
+                                let older = truth[i].bounds;
+                                batch.push(Proxy {
+                                    bounds: shifted(&older, point_in_cube(&mut rng, 2.0)),
+                                    ..truth[i]
+                                });
+                            }
+                            let p = &mut truth[i];
+                            match rng.random_range(0..5) {
+                                0 => p.filter = random_filter(&mut rng),
+                                1 => p.is_static = !p.is_static,
+                                _ => p.bounds = shifted(&p.bounds, point_in_cube(&mut rng, 0.3)),
+                            }
+                            batch.push(*p);
+                        }
+                        phase.set_all(&batch);
+                        ops[5] += 1;
                     }
                     if rng.random_range(0..10) == 0 {
                         assert!(!phase.remove(1)); // ids are 7 + 3k: never present
