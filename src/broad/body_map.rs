@@ -7,6 +7,8 @@
 //! the high bits, and folding the high half down reaches the low bits the table indexes by.
 
 use std::collections::HashMap;
+
+use super::Proxy;
 use std::hash::{BuildHasherDefault, Hasher};
 
 /// Body id → a value (by default its slot).
@@ -131,6 +133,80 @@ impl SlotTable {
             }
             Self::Sparse(map) => map.remove(&id),
         }
+    }
+}
+
+/// The bodies of a stateful broad phase: their proxies densely by slot, and each id's slot.
+/// Slots are dense: removing a body moves the last one into its slot.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Bodies {
+    /// The proxies by slot. Only their boxes may be changed in place; bodies come and go
+    /// through [`push`](Self::push), [`unmap`](Self::unmap) and
+    /// [`swap_remove`](Self::swap_remove).
+    pub(crate) proxies: Vec<Proxy>,
+    slot_of: SlotTable,
+}
+
+impl Bodies {
+    pub(crate) fn len(&self) -> usize {
+        self.proxies.len()
+    }
+
+    pub(crate) fn is_empty(&self) -> bool {
+        self.proxies.is_empty()
+    }
+
+    pub(crate) fn contains(&self, body: u32) -> bool {
+        self.slot_of.contains(body)
+    }
+
+    /// The slot of `body`, if present.
+    #[inline]
+    pub(crate) fn slot(&self, body: u32) -> Option<usize> {
+        self.slot_of.get(body).map(|s| s as usize)
+    }
+
+    /// Adds `proxy` (its id not present) at the next slot, returned.
+    pub(crate) fn push(&mut self, proxy: Proxy) -> usize {
+        let slot = self.proxies.len();
+        let previous = self.slot_of.insert(proxy.body, slot as u32);
+        debug_assert!(previous.is_none(), "body {} given twice", proxy.body);
+        self.proxies.push(proxy);
+        slot
+    }
+
+    /// Unmaps `body` and returns its slot, which keeps the body's proxy until
+    /// [`swap_remove`](Self::swap_remove).
+    pub(crate) fn unmap(&mut self, body: u32) -> Option<usize> {
+        self.slot_of.remove(body).map(|s| s as usize)
+    }
+
+    /// Empties slot `slot` (already unmapped): the last slot's body moves into it and is
+    /// remapped. The caller moves its own per-slot records alike (`Vec::swap_remove`), and
+    /// renames the last slot's listings to `slot` first.
+    pub(crate) fn swap_remove(&mut self, slot: usize) {
+        let last = self.proxies.len() - 1;
+        if slot != last {
+            self.slot_of.insert(self.proxies[last].body, slot as u32);
+        }
+        self.proxies.swap_remove(slot);
+    }
+
+    /// Checks that the id table and the proxies agree: one id per slot, mapped to it.
+    pub(crate) fn check(&self) -> Result<(), String> {
+        if self.slot_of.len() != self.proxies.len() {
+            return Err(format!(
+                "{} proxies, {} ids mapped",
+                self.proxies.len(),
+                self.slot_of.len()
+            ));
+        }
+        for (slot, p) in self.proxies.iter().enumerate() {
+            if self.slot(p.body) != Some(slot) {
+                return Err(format!("body {} at slot {slot} not mapped to it", p.body));
+            }
+        }
+        Ok(())
     }
 }
 

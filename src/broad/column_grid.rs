@@ -79,7 +79,7 @@
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant), checked by
 //! `debug_assert!`.
 
-use super::body_map::SlotTable;
+use super::body_map::Bodies;
 use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64};
 use crate::bounding::{Aabb, BoundingVolume};
@@ -369,14 +369,12 @@ pub struct ColumnGrid {
     /// Finest first; empty until the first rebuild (every body oversized until then).
     levels: Vec<Level>,
     axes: Axes,
-    /// The bodies, densely by slot; `proxies[s].bounds` is what its column holds.
-    proxies: Vec<Proxy>,
+    /// The bodies, densely by slot; `bodies.proxies[s].bounds` is what its column holds.
+    bodies: Bodies,
     /// Level of each slot, or [`OVERSIZED`].
     level_of: Vec<u8>,
     /// Slots of the oversized bodies.
     oversized: Vec<u32>,
-    /// Slot of each body id.
-    slot_of: SlotTable,
     /// The pairs whose boxes overlap and that may pair, `a < b`.
     pairs: PairSet,
     /// Body count at the last rebuild (0: never built).
@@ -414,10 +412,9 @@ impl ColumnGrid {
         Self {
             levels: Vec::new(),
             axes: Axes::with_sweep(0),
-            proxies: Vec::new(),
+            bodies: Bodies::default(),
             level_of: Vec::new(),
             oversized: Vec::new(),
-            slot_of: SlotTable::default(),
             pairs: PairSet::default(),
             built_at: 0,
             batch: Vec::new(),
@@ -433,17 +430,16 @@ impl ColumnGrid {
         let mut grid = Self::new();
         for p in proxies {
             debug_assert_valid_bounds(&p.bounds);
-            grid.slot_of.insert(p.body, grid.proxies.len() as u32);
-            grid.proxies.push(*p);
+            let slot = grid.bodies.push(*p);
             grid.level_of.push(OVERSIZED);
             grid.last_move.push((0, 0));
-            grid.oversized.push(grid.proxies.len() as u32 - 1);
+            grid.oversized.push(slot as u32);
         }
-        if grid.proxies.len() >= AUTO_SAMPLE {
+        if grid.bodies.proxies.len() >= AUTO_SAMPLE {
             grid.rebuild();
         }
-        for slot in 0..grid.proxies.len() {
-            let p = grid.proxies[slot];
+        for slot in 0..grid.bodies.proxies.len() {
+            let p = grid.bodies.proxies[slot];
             grid.for_each_candidate(&p.bounds, slot, |pairs, proxies, bounds, other| {
                 let q = &proxies[other];
                 if other > slot && p.bounds.intersects(bounds) && p.may_pair(q) {
@@ -457,25 +453,25 @@ impl ColumnGrid {
     /// Number of bodies.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.proxies.len()
+        self.bodies.len()
     }
 
     /// Whether there are no bodies.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.proxies.is_empty()
+        self.bodies.is_empty()
     }
 
     /// Whether `body` is present.
     #[must_use]
     pub fn contains(&self, body: u32) -> bool {
-        self.slot_of.contains(body)
+        self.bodies.contains(body)
     }
 
     /// The bodies as proxies, in slot order (no particular order).
     #[must_use]
     pub fn proxies(&self) -> &[Proxy] {
-        &self.proxies
+        &self.bodies.proxies
     }
 
     /// Largest extent of a body at each level, finest first, metres (empty until chosen).
@@ -490,21 +486,19 @@ impl ColumnGrid {
         if self.contains(body) {
             self.remove(body);
         }
-        let slot = self.proxies.len();
-        self.proxies.push(Proxy {
+        let slot = self.bodies.push(Proxy {
             body,
             bounds,
             is_static,
             filter,
         });
-        self.slot_of.insert(body, slot as u32);
         self.level_of.push(OVERSIZED);
         self.last_move.push((0, 0));
-        let p = self.proxies[slot];
+        let p = self.bodies.proxies[slot];
         self.refresh(&p, None, Some(&bounds), slot);
         self.level_of[slot] = self.level_for(&bounds);
         self.place(slot);
-        let n = self.proxies.len();
+        let n = self.bodies.proxies.len();
         if (self.built_at == 0 && n >= AUTO_SAMPLE) || (self.built_at > 0 && n > 2 * self.built_at)
         {
             self.rebuild();
@@ -513,20 +507,18 @@ impl ColumnGrid {
 
     /// Removes `body` and its pairs; `false` when it was not present.
     pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.slot_of.remove(body) else {
+        let Some(slot) = self.bodies.unmap(body) else {
             return false;
         };
-        let slot = slot as usize;
-        let p = self.proxies[slot];
+        let p = self.bodies.proxies[slot];
         self.refresh(&p, Some(&p.bounds), None, slot);
         self.unplace(slot);
         // The last slot moves into the freed one.
-        let last = self.proxies.len() - 1;
+        let last = self.bodies.len() - 1;
         if slot != last {
             self.rename(last, slot);
-            self.slot_of.insert(self.proxies[last].body, slot as u32);
         }
-        self.proxies.swap_remove(slot);
+        self.bodies.swap_remove(slot);
         self.level_of.swap_remove(slot);
         self.last_move.swap_remove(slot);
         true
@@ -538,12 +530,12 @@ impl ColumnGrid {
     /// in release builds).
     pub fn update(&mut self, body: u32, bounds: Aabb) {
         debug_assert_valid_bounds(&bounds);
-        let Some(slot) = self.slot_of.get(body) else {
+        let Some(slot) = self.bodies.slot(body) else {
             debug_assert!(false, "update of absent body {body}");
             return;
         };
-        let old = self.proxies[slot as usize];
-        self.move_slot(slot as usize, &old, bounds);
+        let old = self.bodies.proxies[slot];
+        self.move_slot(slot, &old, bounds);
     }
 
     /// [`update`](Self::update) of every `(body, bounds)` in `moves`; a body listed twice
@@ -564,21 +556,21 @@ impl ColumnGrid {
         }
         for &(body, bounds) in moves {
             debug_assert_valid_bounds(&bounds);
-            let Some(slot) = self.slot_of.get(body) else {
+            let Some(slot) = self.bodies.slot(body) else {
                 debug_assert!(false, "update of absent body {body}");
                 continue;
             };
             let at = batch.len() as u32;
             let (number, earlier) =
-                std::mem::replace(&mut self.last_move[slot as usize], (self.batch_number, at));
+                std::mem::replace(&mut self.last_move[slot], (self.batch_number, at));
             if number == self.batch_number {
                 // Only a body's last move counts: its pairs depend on its final box alone.
                 batch[earlier as usize].last = false;
             }
             batch.push(BatchMove {
-                old: self.proxies[slot as usize],
+                old: self.bodies.proxies[slot],
                 new: bounds,
-                slot,
+                slot: slot as u32,
                 last: true,
             });
         }
@@ -612,12 +604,12 @@ impl ColumnGrid {
                     slot: slot as u32,
                 };
                 column.replace(at, bounds.min[axes.sweep], entry);
-                self.proxies[slot].bounds = bounds;
+                self.bodies.proxies[slot].bounds = bounds;
                 return;
             }
         }
         self.unplace(slot);
-        self.proxies[slot].bounds = bounds;
+        self.bodies.proxies[slot].bounds = bounds;
         self.level_of[slot] = level;
         self.place(slot);
     }
@@ -642,14 +634,12 @@ impl ColumnGrid {
     /// # Errors
     /// A description of the first violated invariant.
     pub fn validate(&self) -> Result<(), String> {
-        let n = self.proxies.len();
-        if self.level_of.len() != n || self.slot_of.len() != n {
+        self.bodies.check()?;
+        let n = self.bodies.len();
+        if self.level_of.len() != n || self.last_move.len() != n {
             return Err(format!("{n} proxies, per-slot tables disagree"));
         }
-        for (slot, p) in self.proxies.iter().enumerate() {
-            if self.slot_of.get(p.body) != Some(slot as u32) {
-                return Err(format!("body {} at slot {slot} not mapped to it", p.body));
-            }
+        for (slot, p) in self.bodies.proxies.iter().enumerate() {
             let b = &p.bounds;
             if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
                 return Err(format!("body {} has invalid bounds {b:?}", p.body));
@@ -708,7 +698,7 @@ impl ColumnGrid {
         if stored != n {
             return Err(format!("{stored} entries stored, {n} bodies"));
         }
-        self.pairs.check_against_brute_force(&self.proxies)
+        self.pairs.check_against_brute_force(&self.bodies.proxies)
     }
 
     /// The level a box belongs at: the finest whose reach is at least its largest extent,
@@ -734,11 +724,12 @@ impl ColumnGrid {
         let Self {
             levels,
             axes,
-            proxies,
+            bodies,
             oversized,
             pairs,
             ..
         } = self;
+        let proxies = &bodies.proxies[..];
         for &s in oversized.iter() {
             let bounds = &proxies[s as usize].bounds;
             if s as usize != skip && bounds.intersects(window) {
@@ -811,7 +802,7 @@ impl ColumnGrid {
             self.oversized.push(slot as u32);
             return;
         }
-        let bounds = self.proxies[slot].bounds;
+        let bounds = self.bodies.proxies[slot].bounds;
         let grid = &mut self.levels[usize::from(level)];
         let home = grid.home(bounds.min, self.axes);
         let entry = Entry {
@@ -831,7 +822,7 @@ impl ColumnGrid {
             }
             return;
         }
-        let bounds = self.proxies[slot].bounds;
+        let bounds = self.bodies.proxies[slot].bounds;
         let grid = &mut self.levels[usize::from(level)];
         let home = grid.home(bounds.min, self.axes);
         let column = &mut grid.columns[home];
@@ -849,7 +840,7 @@ impl ColumnGrid {
             }
             return;
         }
-        let bounds = self.proxies[from].bounds;
+        let bounds = self.bodies.proxies[from].bounds;
         let grid = &mut self.levels[usize::from(level)];
         let home = grid.home(bounds.min, self.axes);
         let column = &mut grid.columns[home];
@@ -860,8 +851,9 @@ impl ColumnGrid {
     /// Chooses the axes and levels from every body and lists each afresh (module docs,
     /// "Choosing the levels").
     fn rebuild(&mut self) {
-        self.axes = Axes::with_sweep(super::sort_sweep::widest_spread_axis(&self.proxies));
+        self.axes = Axes::with_sweep(super::sort_sweep::widest_spread_axis(&self.bodies.proxies));
         let mut extents: Vec<f64> = self
+            .bodies
             .proxies
             .iter()
             .map(|p| p.bounds.extents().max_element())
@@ -891,8 +883,8 @@ impl ColumnGrid {
             );
             self.levels.len()
         ];
-        for slot in 0..self.proxies.len() {
-            let bounds = self.proxies[slot].bounds;
+        for slot in 0..self.bodies.proxies.len() {
+            let bounds = self.bodies.proxies[slot].bounds;
             let level = self.level_for(&bounds);
             self.level_of[slot] = level;
             if level == OVERSIZED {
@@ -909,12 +901,12 @@ impl ColumnGrid {
             let span = |lo: f64, hi: f64| if hi >= lo { hi - lo } else { 0.0 };
             level.size_table(span(s.0, s.1), span(s.2, s.3));
         }
-        for slot in 0..self.proxies.len() {
+        for slot in 0..self.bodies.proxies.len() {
             let level = self.level_of[slot];
             if level == OVERSIZED {
                 continue;
             }
-            let bounds = self.proxies[slot].bounds;
+            let bounds = self.bodies.proxies[slot].bounds;
             let grid = &mut self.levels[usize::from(level)];
             let home = grid.home(bounds.min, axes);
             let column = &mut grid.columns[home];
@@ -934,7 +926,7 @@ impl ColumnGrid {
                 .collect();
             column.index_from(0);
         }
-        self.built_at = self.proxies.len();
+        self.built_at = self.bodies.proxies.len();
     }
 }
 
@@ -1097,6 +1089,7 @@ mod tests {
                     aliased |= grid.levels.iter().any(|l| {
                         let columns = |axis: usize| {
                             let homes: Vec<i64> = grid
+                                .bodies
                                 .proxies
                                 .iter()
                                 .map(|p| floor_to_i64(p.bounds.min[axis] * l.inv_width))

@@ -95,7 +95,7 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hash, Hasher};
 
-use super::body_map::SlotTable;
+use super::body_map::Bodies;
 use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64};
 use crate::bounding::{Aabb, BoundingVolume};
@@ -325,16 +325,14 @@ struct Level {
 pub struct HashGrid {
     /// Finest first; empty until chosen (then every body is oversized).
     levels: Vec<Level>,
-    /// The bodies, densely by slot; `proxies[s].bounds` is what the cells hold.
-    proxies: Vec<Proxy>,
+    /// The bodies, densely by slot; `bodies.proxies[s].bounds` is what the cells hold.
+    bodies: Bodies,
     /// Level of each slot, or [`OVERSIZED`].
     level_of: Vec<u8>,
     /// Index of each slot in its level's (or the oversized) member list.
     member_at: Vec<u32>,
     /// Slots of the oversized bodies.
     oversized: Vec<u32>,
-    /// Slot of each body id.
-    slot_of: SlotTable,
     /// The pairs whose boxes overlap and that may pair, `a < b`.
     pairs: PairSet,
     /// Per slot, the query stamp that last gathered it (no candidate tested twice).
@@ -358,11 +356,10 @@ impl HashGrid {
     pub fn new() -> Self {
         Self {
             levels: Vec::new(),
-            proxies: Vec::new(),
+            bodies: Bodies::default(),
             level_of: Vec::new(),
             member_at: Vec::new(),
             oversized: Vec::new(),
-            slot_of: SlotTable::default(),
             pairs: PairSet::default(),
             seen: Vec::new(),
             stamp: 1,
@@ -391,25 +388,25 @@ impl HashGrid {
     /// Number of bodies.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.proxies.len()
+        self.bodies.len()
     }
 
     /// Whether there are no bodies.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.proxies.is_empty()
+        self.bodies.is_empty()
     }
 
     /// Whether `body` is in the grid.
     #[must_use]
     pub fn contains(&self, body: u32) -> bool {
-        self.slot_of.contains(body)
+        self.bodies.contains(body)
     }
 
     /// The level `body` is stored at (`Some(None)` when it is oversized), `None` when absent.
     #[must_use]
     pub fn level(&self, body: u32) -> Option<Option<usize>> {
-        let slot = self.slot_of.get(body)? as usize;
+        let slot = self.bodies.slot(body)?;
         let level = self.level_of[slot];
         Some((level != OVERSIZED).then_some(usize::from(level)))
     }
@@ -417,7 +414,7 @@ impl HashGrid {
     /// The bodies as proxies, in no particular order.
     #[must_use]
     pub fn proxies(&self) -> &[Proxy] {
-        &self.proxies
+        &self.bodies.proxies
     }
 
     /// Adds `body` with its margin-grown world box `bounds` (metres; finite, `min <= max`)
@@ -431,19 +428,17 @@ impl HashGrid {
         if self.contains(body) {
             self.remove(body);
         }
-        let slot = self.proxies.len();
-        debug_assert!(slot < FROM_FINER as usize, "too many bodies");
-        self.proxies.push(Proxy {
+        let slot = self.bodies.push(Proxy {
             body,
             bounds,
             is_static,
             filter,
         });
-        self.slot_of.insert(body, slot as u32);
+        debug_assert!(slot < FROM_FINER as usize, "too many bodies");
         self.level_of.push(self.level_for(&bounds));
         self.member_at.push(0);
         self.seen.push(0);
-        if self.levels.is_empty() && self.proxies.len() == AUTO_SAMPLE {
+        if self.levels.is_empty() && self.bodies.proxies.len() == AUTO_SAMPLE {
             self.choose_levels_from_bodies();
         } else {
             self.register(slot);
@@ -455,27 +450,25 @@ impl HashGrid {
 
     /// Removes `body` and its pairs; `false` when it was not present.
     pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.slot_of.remove(body) else {
+        let Some(slot) = self.bodies.unmap(body) else {
             return false;
         };
-        let slot = slot as usize;
         self.next_stamp();
-        let p = self.proxies[slot];
+        let p = self.bodies.proxies[slot];
         self.gather(slot, &p.bounds, self.level_of[slot]);
         for &other in &self.scratch {
-            let q = &self.proxies[other as usize];
+            let q = &self.bodies.proxies[other as usize];
             if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
                 self.pairs.remove(CandidatePair::of(body, q.body));
             }
         }
         self.unregister(slot);
         // The last slot moves into the freed one.
-        let last = self.proxies.len() - 1;
+        let last = self.bodies.len() - 1;
         if slot != last {
             self.rename(last, slot);
-            self.slot_of.insert(self.proxies[last].body, slot as u32);
         }
-        self.proxies.swap_remove(slot);
+        self.bodies.swap_remove(slot);
         self.level_of.swap_remove(slot);
         self.member_at.swap_remove(slot);
         self.seen.swap_remove(slot);
@@ -488,12 +481,11 @@ impl HashGrid {
     /// in release builds).
     pub fn update(&mut self, body: u32, bounds: Aabb) {
         debug_assert_valid_bounds(&bounds);
-        let Some(slot) = self.slot_of.get(body) else {
+        let Some(slot) = self.bodies.slot(body) else {
             debug_assert!(false, "update of absent body {body}");
             return;
         };
-        let slot = slot as usize;
-        let old = self.proxies[slot].bounds;
+        let old = self.bodies.proxies[slot].bounds;
         let (old_level, new_level) = (self.level_of[slot], self.level_for(&bounds));
         self.next_stamp();
         self.gather(slot, &old, old_level);
@@ -502,7 +494,7 @@ impl HashGrid {
         }
         if old_level != new_level {
             self.unregister(slot);
-            self.proxies[slot].bounds = bounds;
+            self.bodies.proxies[slot].bounds = bounds;
             self.level_of[slot] = new_level;
             self.register(slot);
         } else {
@@ -517,7 +509,7 @@ impl HashGrid {
                     }
                 }
             }
-            self.proxies[slot].bounds = bounds;
+            self.bodies.proxies[slot].bounds = bounds;
         }
         self.refresh(slot, Some(&old));
     }
@@ -544,17 +536,13 @@ impl HashGrid {
     /// # Errors
     /// A description of the first violated invariant.
     pub fn validate(&self) -> Result<(), String> {
-        let n = self.proxies.len();
-        if [self.level_of.len(), self.member_at.len(), self.seen.len()] != [n; 3]
-            || self.slot_of.len() != n
-        {
+        self.bodies.check()?;
+        let n = self.bodies.len();
+        if [self.level_of.len(), self.member_at.len(), self.seen.len()] != [n; 3] {
             return Err(format!("{n} proxies, per-slot tables disagree"));
         }
         let mut entries = vec![0usize; self.levels.len()];
-        for (slot, p) in self.proxies.iter().enumerate() {
-            if self.slot_of.get(p.body) != Some(slot as u32) {
-                return Err(format!("body {} at slot {slot} not mapped to it", p.body));
-            }
+        for (slot, p) in self.bodies.proxies.iter().enumerate() {
             let b = &p.bounds;
             if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
                 return Err(format!("body {} has invalid bounds {b:?}", p.body));
@@ -616,7 +604,7 @@ impl HashGrid {
                 ));
             }
         }
-        self.pairs.check_against_brute_force(&self.proxies)
+        self.pairs.check_against_brute_force(&self.bodies.proxies)
     }
 
     /// Builds the levels (see [`with_levels`](Self::with_levels) for the panics).
@@ -656,6 +644,7 @@ impl HashGrid {
     /// The automatic level choice (module docs), then every body placed.
     fn choose_levels_from_bodies(&mut self) {
         let mut extents: Vec<f64> = self
+            .bodies
             .proxies
             .iter()
             .map(|p| p.bounds.extents().max_element())
@@ -674,8 +663,8 @@ impl HashGrid {
         }
         self.set_levels(min_cell, DEFAULT_RATIO, count);
         self.oversized.clear();
-        for slot in 0..self.proxies.len() {
-            self.level_of[slot] = self.level_for(&self.proxies[slot].bounds);
+        for slot in 0..self.bodies.proxies.len() {
+            self.level_of[slot] = self.level_for(&self.bodies.proxies[slot].bounds);
             self.register(slot);
         }
     }
@@ -715,7 +704,7 @@ impl HashGrid {
         members.push(slot as u32);
         self.member_at[slot] = at;
         if level != OVERSIZED {
-            let bounds = self.proxies[slot].bounds;
+            let bounds = self.bodies.proxies[slot].bounds;
             for k in usize::from(level)..self.levels.len() {
                 self.list_at(slot, k, &bounds, usize::from(level));
             }
@@ -760,7 +749,7 @@ impl HashGrid {
             self.member_at[moved as usize] = at as u32;
         }
         if level != OVERSIZED {
-            let bounds = self.proxies[slot].bounds;
+            let bounds = self.bodies.proxies[slot].bounds;
             for k in usize::from(level)..self.levels.len() {
                 self.unlist_at(slot, k, &bounds);
             }
@@ -773,7 +762,7 @@ impl HashGrid {
         let at = self.member_at[from] as usize;
         self.members_mut(level)[at] = to as u32;
         if level != OVERSIZED {
-            let bounds = self.proxies[from].bounds;
+            let bounds = self.bodies.proxies[from].bounds;
             for grid in &mut self.levels[usize::from(level)..] {
                 CellRange::of(&bounds, grid.inv).for_each(|cell| {
                     let list = grid.cells.get_mut(&cell).expect("registered cell exists");
@@ -863,9 +852,9 @@ impl HashGrid {
     /// the pairs that changed: a pair was in the set exactly when `old` (slot's box before
     /// this update; `None` for a new body) met the candidate's box, which did not move.
     fn refresh(&mut self, slot: usize, old: Option<&Aabb>) {
-        let p = self.proxies[slot];
+        let p = self.bodies.proxies[slot];
         for &other in &self.scratch {
-            let q = &self.proxies[other as usize];
+            let q = &self.bodies.proxies[other as usize];
             if !p.may_pair(q) {
                 continue;
             }
@@ -900,7 +889,7 @@ mod tests {
 
     /// The cells of `level` that list `body`.
     fn cells_of(grid: &HashGrid, body: u32, level: usize) -> Vec<[i64; 3]> {
-        let slot = grid.slot_of.get(body).unwrap();
+        let slot = grid.bodies.slot(body).unwrap() as u32;
         let mut cells: Vec<[i64; 3]> = grid.levels[level]
             .cells
             .iter()
@@ -1040,7 +1029,7 @@ mod tests {
         let (mut with_floor, mut with_wall) = (0, 0);
         for frame in 0..200 {
             for id in 0..60u32 {
-                let b = grid.proxies[grid.slot_of.get(id).unwrap() as usize].bounds;
+                let b = grid.bodies.proxies[grid.bodies.slot(id).unwrap()].bounds;
                 let s = point_in_cube(&mut rng, 0.5);
                 grid.update(id, Aabb::new(b.min + s, b.max + s));
             }
@@ -1128,8 +1117,8 @@ mod tests {
         }
         for op in 0..3_000 {
             let id = rng.random_range(0..200u32);
-            let slot = grid.slot_of.get(id).unwrap() as usize;
-            let old = grid.proxies[slot].bounds;
+            let slot = grid.bodies.slot(id).unwrap();
+            let old = grid.bodies.proxies[slot].bounds;
             let bounds = if rng.random_bool(0.7) {
                 let s = point_in_cube(&mut rng, 0.2 * old.extents().max_element().max(1e-3));
                 Aabb::new(old.min + s, old.max + s)

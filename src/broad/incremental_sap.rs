@@ -52,7 +52,7 @@
 //! validates poses before they reach the broad phase), checked by `debug_assert!`. A NaN
 //! would break the sort order and is never allowed in.
 
-use super::body_map::SlotTable;
+use super::body_map::Bodies;
 use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, SortAndSweep, debug_assert_valid_bounds};
 use crate::bounding::{Aabb, BoundingVolume};
@@ -108,14 +108,12 @@ impl Endpoint {
 /// module docs for the algorithm, the tie rule and the costs.
 #[derive(Debug, Clone, Default)]
 pub struct IncrementalSap {
-    /// The bodies, densely by slot; `proxies[s].bounds` is what the endpoint lists hold.
-    proxies: Vec<Proxy>,
+    /// The bodies, densely by slot.
+    bodies: Bodies,
     /// `positions[s][axis][MIN | MAX]`: where slot `s`'s endpoints are in `axes[axis]`.
     positions: Vec<[[u32; 2]; 3]>,
     /// Per axis, all endpoints sorted by [`Endpoint::after`].
     axes: [Vec<Endpoint>; 3],
-    /// Slot of each body id.
-    slot_of: SlotTable,
     /// The pairs whose boxes overlap and that may pair, `a < b`.
     pairs: PairSet,
 }
@@ -130,25 +128,25 @@ impl IncrementalSap {
     /// Number of bodies.
     #[must_use]
     pub fn len(&self) -> usize {
-        self.proxies.len()
+        self.bodies.len()
     }
 
     /// Whether there are no bodies.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.proxies.is_empty()
+        self.bodies.is_empty()
     }
 
     /// Whether `body` is in the broad phase.
     #[must_use]
     pub fn contains(&self, body: u32) -> bool {
-        self.slot_of.contains(body)
+        self.bodies.contains(body)
     }
 
     /// The bodies as proxies, in no particular order.
     #[must_use]
     pub fn proxies(&self) -> &[Proxy] {
-        &self.proxies
+        &self.bodies.proxies
     }
 
     /// A broad phase holding `proxies` (distinct ids), built in `O(n log n + k log k)`: each
@@ -159,11 +157,9 @@ impl IncrementalSap {
     #[must_use]
     pub fn from_proxies(proxies: &[Proxy]) -> Self {
         let mut sap = Self::new();
-        for (slot, p) in proxies.iter().enumerate() {
+        for p in proxies {
             debug_assert_valid_bounds(&p.bounds);
-            let previous = sap.slot_of.insert(p.body, slot as u32);
-            debug_assert!(previous.is_none(), "body {} given twice", p.body);
-            sap.proxies.push(*p);
+            sap.bodies.push(*p);
             sap.positions.push([[0; 2]; 3]);
         }
         for axis in 0..3 {
@@ -202,16 +198,14 @@ impl IncrementalSap {
         if self.contains(body) {
             self.remove(body);
         }
-        let slot = self.proxies.len();
         let proxy = Proxy {
             body,
             bounds,
             is_static,
             filter,
         };
-        self.proxies.push(proxy);
+        let slot = self.bodies.push(proxy);
         self.positions.push([[0; 2]; 3]);
-        self.slot_of.insert(body, slot as u32);
         for axis in 0..3 {
             let endpoints = &mut self.axes[axis];
             // After every endpoint that does not sort after it (stable among ties); the max
@@ -232,7 +226,7 @@ impl IncrementalSap {
             if e.is_max() || e.slot() == slot {
                 continue;
             }
-            let other = &self.proxies[e.slot()];
+            let other = &self.bodies.proxies[e.slot()];
             if proxy.may_pair(other) && proxy.bounds.intersects(&other.bounds) {
                 self.pairs.insert(CandidatePair::of(body, other.body));
             }
@@ -241,16 +235,15 @@ impl IncrementalSap {
 
     /// Removes `body` and its pairs; `false` when it was not present.
     pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.slot_of.remove(body) else {
+        let Some(slot) = self.bodies.unmap(body) else {
             return false;
         };
-        let slot = slot as usize;
         // Its pairs all have their min before its max on every axis.
         let axis = self.axis_with_fewest_before_max(slot);
         let end = self.positions[slot][axis][MAX] as usize;
         for e in &self.axes[axis][..end] {
             if !e.is_max() && e.slot() != slot {
-                let (p, q) = (&self.proxies[slot], &self.proxies[e.slot()]);
+                let (p, q) = (&self.bodies.proxies[slot], &self.bodies.proxies[e.slot()]);
                 if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
                     self.pairs.remove(CandidatePair::of(body, q.body));
                 }
@@ -263,8 +256,8 @@ impl IncrementalSap {
             self.renumber_from(axis, min_at as usize);
         }
         // The last slot moves into the freed one.
-        let last = self.proxies.len() - 1;
-        self.proxies.swap_remove(slot);
+        let last = self.bodies.len() - 1;
+        self.bodies.swap_remove(slot);
         self.positions.swap_remove(slot);
         if slot != last {
             for axis in 0..3 {
@@ -273,7 +266,6 @@ impl IncrementalSap {
                     self.axes[axis][at] = Endpoint::new(self.axes[axis][at].value, slot, kind);
                 }
             }
-            self.slot_of.insert(self.proxies[slot].body, slot as u32);
         }
         true
     }
@@ -284,15 +276,14 @@ impl IncrementalSap {
     /// in release builds).
     pub fn update(&mut self, body: u32, bounds: Aabb) {
         debug_assert_valid_bounds(&bounds);
-        let Some(slot) = self.slot_of.get(body) else {
+        let Some(slot) = self.bodies.slot(body) else {
             debug_assert!(false, "update of absent body {body}");
             return;
         };
-        let slot = slot as usize;
         for axis in 0..3 {
             let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
             // Order the two moves so the stored interval is never inverted.
-            if lo < self.proxies[slot].bounds.min[axis] {
+            if lo < self.bodies.proxies[slot].bounds.min[axis] {
                 self.move_endpoint(slot, axis, MIN, lo);
                 self.move_endpoint(slot, axis, MAX, hi);
             } else {
@@ -322,18 +313,15 @@ impl IncrementalSap {
     /// # Errors
     /// A description of the first violated invariant.
     pub fn validate(&self) -> Result<(), String> {
-        let n = self.proxies.len();
-        if self.positions.len() != n || self.slot_of.len() != n {
+        self.bodies.check()?;
+        let n = self.bodies.len();
+        if self.positions.len() != n {
             return Err(format!(
-                "{n} proxies, {} position rows, {} ids",
-                self.positions.len(),
-                self.slot_of.len()
+                "{n} proxies, {} position rows",
+                self.positions.len()
             ));
         }
-        for (slot, p) in self.proxies.iter().enumerate() {
-            if self.slot_of.get(p.body) != Some(slot as u32) {
-                return Err(format!("body {} at slot {slot} not mapped to it", p.body));
-            }
+        for p in &self.bodies.proxies {
             let b = &p.bounds;
             if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
                 return Err(format!("body {} has invalid bounds {b:?}", p.body));
@@ -353,7 +341,7 @@ impl IncrementalSap {
                         "axis {axis}: endpoint {i} ({e:?}) not where recorded"
                     ));
                 }
-                let b = &self.proxies[slot].bounds;
+                let b = &self.bodies.proxies[slot].bounds;
                 let stored = if e.is_max() { b.max[axis] } else { b.min[axis] };
                 if stored.to_bits() != e.value.to_bits() {
                     return Err(format!(
@@ -369,13 +357,13 @@ impl IncrementalSap {
                 }
             }
         }
-        self.pairs.check_against_brute_force(&self.proxies)
+        self.pairs.check_against_brute_force(&self.bodies.proxies)
     }
 
     /// Sets one coordinate of slot `slot`'s box and moves that endpoint to its sorted place
     /// by adjacent swaps, updating the pair set at each min/max swap with another body.
     fn move_endpoint(&mut self, slot: usize, axis: usize, kind: usize, value: f64) {
-        let bounds = &mut self.proxies[slot].bounds;
+        let bounds = &mut self.bodies.proxies[slot].bounds;
         if kind == MIN {
             bounds.min[axis] = value;
         } else {
@@ -391,7 +379,7 @@ impl IncrementalSap {
             self.positions[other.slot()][axis][other.kind()] = i as u32;
             if other.kind() != kind {
                 crossed(
-                    &self.proxies,
+                    &self.bodies.proxies,
                     &mut self.pairs,
                     (slot, other.slot()),
                     axis,
@@ -407,7 +395,7 @@ impl IncrementalSap {
             self.positions[other.slot()][axis][other.kind()] = i as u32;
             if other.kind() != kind {
                 crossed(
-                    &self.proxies,
+                    &self.bodies.proxies,
                     &mut self.pairs,
                     (slot, other.slot()),
                     axis,
