@@ -1,5 +1,5 @@
-//! What every stateful broad phase ([`IncrementalSap`], [`HashGrid`], [`ColumnGrid`]) owes, as generic test
-//! bodies that each one's unit tests run with its own constructor and sizes.
+//! What every stateful broad phase ([`IncrementalSap`], [`HashGrid`], [`ColumnGrid`]) owes,
+//! as generic test bodies that each one's unit tests run with its own constructor and sizes.
 
 use super::{CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap};
 use crate::bounding::Aabb;
