@@ -42,8 +42,9 @@
 //! union may span the world). Each candidate `c` (every other body whose low corner is in the
 //! window's reach) is tested against both: the pair was in the set exactly when the old box
 //! met `c`'s stored box, and is now when the new one does; only a change, for bodies that
-//! may pair ([`Proxy::may_pair`]), is logged in the [`PairSet`]. Bodies are updated one at a
-//! time, so a candidate's stored box is the one the pair set already reflects.
+//! may pair ([`Proxy::may_pair`]), is logged in the pair set (`pair_set.rs`). Bodies are
+//! updated one at a time, so a candidate's stored box is the one the pair set already
+//! reflects.
 //!
 //! Measured and not kept (`examples/broad_bench`, 100,000 uniform bodies, 10 % moving): a
 //! batch update applying a frame's moves sorted by the column they land in, so consecutive
@@ -74,7 +75,7 @@
 //!   every oversized one.
 //! - [`insert`](ColumnGrid::insert), [`remove`](ColumnGrid::remove): the same, plus an
 //!   `O(n log n)` rebuild each time the body count doubles.
-//! - [`pairs`](ColumnGrid::pairs): `O(k + e log e)` for `e` pair changes (the [`PairSet`]
+//! - [`pairs`](ColumnGrid::pairs): `O(k + e log e)` for `e` pair changes (the pair set's
 //!   commit).
 //!
 //! # Input
@@ -99,7 +100,7 @@ const WIDTH_PER_REACH: f64 = 2.0;
 const FINEST_QUANTILE: f64 = 0.9;
 /// Finest reach taken as the largest extent when that is within this factor of the quantile.
 const ONE_LEVEL_SPREAD: f64 = 1.5;
-/// [`Placement::level`] of an oversized body.
+/// What [`ColumnGrid::level_for`] says of a body wider than every level's reach.
 const OVERSIZED: u8 = u8::MAX;
 
 /// A body as its column stores it: its box and slot.
@@ -373,8 +374,6 @@ pub struct ColumnGrid {
     axes: Axes,
     /// The bodies, densely by slot; `bodies.proxies[s].bounds` is what its column holds.
     bodies: Bodies,
-    /// Level of each slot, or [`OVERSIZED`].
-    level_of: Vec<u8>,
     /// Slots of the oversized bodies.
     oversized: Vec<u32>,
     /// The pairs whose boxes overlap and that may pair, `a < b`.
@@ -415,7 +414,6 @@ impl ColumnGrid {
             levels: Vec::new(),
             axes: Axes::with_sweep(0),
             bodies: Bodies::default(),
-            level_of: Vec::new(),
             oversized: Vec::new(),
             pairs: PairSet::default(),
             built_at: 0,
@@ -433,14 +431,13 @@ impl ColumnGrid {
         for p in proxies {
             debug_assert_valid_bounds(&p.bounds);
             let slot = grid.bodies.push(*p);
-            grid.level_of.push(OVERSIZED);
             grid.last_move.push((0, 0));
             grid.oversized.push(slot as u32);
         }
-        if grid.bodies.proxies.len() >= AUTO_SAMPLE {
+        if grid.bodies.len() >= AUTO_SAMPLE {
             grid.rebuild();
         }
-        for slot in 0..grid.bodies.proxies.len() {
+        for slot in 0..grid.bodies.len() {
             let p = grid.bodies.proxies[slot];
             grid.for_each_candidate(&p.bounds, slot, |pairs, proxies, bounds, other| {
                 let q = &proxies[other];
@@ -476,11 +473,6 @@ impl ColumnGrid {
         &self.bodies.proxies
     }
 
-    /// Largest extent of a body at each level, finest first, metres (empty until chosen).
-    pub fn reaches(&self) -> impl ExactSizeIterator<Item = f64> + '_ {
-        self.levels.iter().map(|l| l.reach)
-    }
-
     /// Adds `body` with box `bounds` (metres; finite, `min <= max`). Inserting an id that
     /// is already present replaces that body.
     pub fn insert(&mut self, body: u32, bounds: Aabb, is_static: bool, filter: CollisionFilter) {
@@ -494,13 +486,11 @@ impl ColumnGrid {
             is_static,
             filter,
         });
-        self.level_of.push(OVERSIZED);
         self.last_move.push((0, 0));
         let p = self.bodies.proxies[slot];
         self.refresh(&p, None, Some(&bounds), slot);
-        self.level_of[slot] = self.level_for(&bounds);
         self.place(slot);
-        let n = self.bodies.proxies.len();
+        let n = self.bodies.len();
         if (self.built_at == 0 && n >= AUTO_SAMPLE) || (self.built_at > 0 && n > 2 * self.built_at)
         {
             self.rebuild();
@@ -521,7 +511,6 @@ impl ColumnGrid {
             self.rename(last, slot);
         }
         self.bodies.swap_remove(slot);
-        self.level_of.swap_remove(slot);
         self.last_move.swap_remove(slot);
         true
     }
@@ -590,7 +579,7 @@ impl ColumnGrid {
         let own = self.refresh(old, Some(&old.bounds), Some(&bounds), slot);
         let old = old.bounds;
         let level = self.level_for(&bounds);
-        let (axes, was) = (self.axes, self.level_of[slot]);
+        let (axes, was) = (self.axes, self.level_for(&old));
         if was == level && level != OVERSIZED {
             let grid = &mut self.levels[usize::from(level)];
             let (from, to) = (grid.home(old.min, axes), grid.home(bounds.min, axes));
@@ -612,13 +601,12 @@ impl ColumnGrid {
         }
         self.unplace(slot);
         self.bodies.proxies[slot].bounds = bounds;
-        self.level_of[slot] = level;
         self.place(slot);
     }
 
     /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
     /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
-    /// exactly the pairs of [`pairs_brute_force`] over [`proxies`](Self::proxies).
+    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over [`proxies`](Self::proxies).
     ///
     /// # Cost
     /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
@@ -630,7 +618,7 @@ impl ColumnGrid {
     /// Checks every invariant: the slot table and id map agree; stored boxes are finite and
     /// not inverted; each body is at the level its box calls for (oversized before the first
     /// rebuild), listed exactly once: in the oversized list, or in its home column with its
-    /// stored box; every column sorted; and the pair set equals [`pairs_brute_force`] over
+    /// stored box; every column sorted; and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over
     /// the stored boxes. `O(n²)`: for tests.
     ///
     /// # Errors
@@ -638,7 +626,7 @@ impl ColumnGrid {
     pub fn validate(&self) -> Result<(), String> {
         self.bodies.check()?;
         let n = self.bodies.len();
-        if self.level_of.len() != n || self.last_move.len() != n {
+        if self.last_move.len() != n {
             return Err(format!("{n} proxies, per-slot tables disagree"));
         }
         for (slot, p) in self.bodies.proxies.iter().enumerate() {
@@ -646,14 +634,7 @@ impl ColumnGrid {
             if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
                 return Err(format!("body {} has invalid bounds {b:?}", p.body));
             }
-            let level = self.level_of[slot];
-            if level != self.level_for(b) {
-                return Err(format!(
-                    "body {} at level {level}, its box calls for {}",
-                    p.body,
-                    self.level_for(b)
-                ));
-            }
+            let level = self.level_for(b);
             let listed = if level == OVERSIZED {
                 self.oversized
                     .iter()
@@ -797,14 +778,15 @@ impl ColumnGrid {
         }
     }
 
-    /// Lists slot `slot` where its level and stored box say.
+    /// Lists slot `slot` where its stored box says: at the level its size calls for, in
+    /// the column of its low corner.
     fn place(&mut self, slot: usize) {
-        let level = self.level_of[slot];
+        let bounds = self.bodies.proxies[slot].bounds;
+        let level = self.level_for(&bounds);
         if level == OVERSIZED {
             self.oversized.push(slot as u32);
             return;
         }
-        let bounds = self.bodies.proxies[slot].bounds;
         let grid = &mut self.levels[usize::from(level)];
         let home = grid.home(bounds.min, self.axes);
         let entry = Entry {
@@ -815,16 +797,16 @@ impl ColumnGrid {
         grid.count += 1;
     }
 
-    /// Undoes [`place`](Self::place) (from the stored box and level).
+    /// Undoes [`place`](Self::place) (from the stored box).
     fn unplace(&mut self, slot: usize) {
-        let level = self.level_of[slot];
+        let bounds = self.bodies.proxies[slot].bounds;
+        let level = self.level_for(&bounds);
         if level == OVERSIZED {
             if let Some(i) = self.oversized.iter().position(|&s| s as usize == slot) {
                 self.oversized.swap_remove(i);
             }
             return;
         }
-        let bounds = self.bodies.proxies[slot].bounds;
         let grid = &mut self.levels[usize::from(level)];
         let home = grid.home(bounds.min, self.axes);
         let column = &mut grid.columns[home];
@@ -835,14 +817,14 @@ impl ColumnGrid {
 
     /// Renames slot `from`'s listing to `to` (the last slot filling a freed one).
     fn rename(&mut self, from: usize, to: usize) {
-        let level = self.level_of[from];
+        let bounds = self.bodies.proxies[from].bounds;
+        let level = self.level_for(&bounds);
         if level == OVERSIZED {
             for s in self.oversized.iter_mut().filter(|s| **s as usize == from) {
                 *s = to as u32;
             }
             return;
         }
-        let bounds = self.bodies.proxies[from].bounds;
         let grid = &mut self.levels[usize::from(level)];
         let home = grid.home(bounds.min, self.axes);
         let column = &mut grid.columns[home];
@@ -885,10 +867,9 @@ impl ColumnGrid {
             );
             self.levels.len()
         ];
-        for slot in 0..self.bodies.proxies.len() {
+        for slot in 0..self.bodies.len() {
             let bounds = self.bodies.proxies[slot].bounds;
             let level = self.level_for(&bounds);
-            self.level_of[slot] = level;
             if level == OVERSIZED {
                 self.oversized.push(slot as u32);
                 continue;
@@ -903,12 +884,12 @@ impl ColumnGrid {
             let span = |lo: f64, hi: f64| if hi >= lo { hi - lo } else { 0.0 };
             level.size_table(span(s.0, s.1), span(s.2, s.3));
         }
-        for slot in 0..self.bodies.proxies.len() {
-            let level = self.level_of[slot];
+        for slot in 0..self.bodies.len() {
+            let bounds = self.bodies.proxies[slot].bounds;
+            let level = self.level_for(&bounds);
             if level == OVERSIZED {
                 continue;
             }
-            let bounds = self.bodies.proxies[slot].bounds;
             let grid = &mut self.levels[usize::from(level)];
             let home = grid.home(bounds.min, axes);
             let column = &mut grid.columns[home];
@@ -928,7 +909,7 @@ impl ColumnGrid {
                 .collect();
             column.index_from(0);
         }
-        self.built_at = self.bodies.proxies.len();
+        self.built_at = self.bodies.len();
     }
 }
 

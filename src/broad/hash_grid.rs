@@ -516,7 +516,7 @@ impl HashGrid {
 
     /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
     /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
-    /// exactly the pairs of [`pairs_brute_force`] over [`proxies`](Self::proxies).
+    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over [`proxies`](Self::proxies).
     ///
     /// # Cost
     /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
@@ -530,7 +530,7 @@ impl HashGrid {
     /// while the levels are not chosen), listed once among that level's members at the
     /// recorded index, and in exactly the cells its box covers at its level and (flagged
     /// [`FROM_FINER`]) at every coarser one, once each, with no empty or foreign cell
-    /// entries; and the pair set equals [`pairs_brute_force`] over
+    /// entries; and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over
     /// the stored boxes. `O(n²)`: for tests.
     ///
     /// # Errors

@@ -108,7 +108,8 @@ impl Endpoint {
 /// module docs for the algorithm, the tie rule and the costs.
 #[derive(Debug, Clone, Default)]
 pub struct IncrementalSap {
-    /// The bodies, densely by slot.
+    /// The bodies, densely by slot; `bodies.proxies[s].bounds` is what the endpoint lists
+    /// hold.
     bodies: Bodies,
     /// `positions[s][axis][MIN | MAX]`: where slot `s`'s endpoints are in `axes[axis]`.
     positions: Vec<[[u32; 2]; 3]>,
@@ -295,7 +296,7 @@ impl IncrementalSap {
 
     /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
     /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
-    /// exactly the pairs of [`pairs_brute_force`] over [`proxies`](Self::proxies).
+    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over [`proxies`](Self::proxies).
     ///
     /// # Cost
     /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
@@ -307,7 +308,7 @@ impl IncrementalSap {
     /// Checks every invariant: the slot table and id map agree; each axis holds exactly the
     /// two endpoints of every body, at the positions recorded, with the body's stored
     /// coordinates, sorted (mins first at ties); stored boxes are finite and not inverted;
-    /// and the pair set equals [`pairs_brute_force`] over the stored boxes. `O(n²)`: for
+    /// and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over the stored boxes. `O(n²)`: for
     /// tests.
     ///
     /// # Errors

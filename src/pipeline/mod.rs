@@ -85,14 +85,14 @@
 //! the same workspace history, since a resting scene's frontier resumes), never worse with
 //! more.
 //!
-//! # What is exact today
-//! Sphere–sphere (closed form) and mesh–mesh (exact BVH queries, meshes as surfaces:
-//! intersecting meshes report 0) pairs are exact. Every other pair of shape kinds gets the
-//! conservative answer DESIGN §5 prescribes for a truncated traversal at level 0: the
-//! distance between the two world boxes (a lower bound), with the boxes' diagonals as error
-//! bound, "may touch" when the boxes touch, and the report says
-//! [`Completeness::Truncated`]. TODO(#5): the narrow phase for every pair of shape kinds
-//! replaces that.
+//! # What is exact
+//! Every pair of shape kinds has an exact narrow phase (`dispatch.rs`; meshes as surfaces:
+//! intersecting meshes report 0). The conservative answer DESIGN §5 prescribes for a
+//! traversal truncated at level 0 (the distance between the two world boxes, a lower bound,
+//! with the boxes' diagonals as error bound, "may touch" when the boxes touch, and the
+//! report saying [`Completeness::Truncated`]) is given only under a budget, to a pair of
+//! convex shapes whose turn comes after the deadline, and when the worker pool fails to
+//! answer a pair; a mesh pair cut short gets the frontier's tighter bounds instead.
 //!
 //! # Allocation
 //! None once the workspace and the output have grown to the largest frame, except one
@@ -267,17 +267,9 @@ pub struct FrameResults {
     pub tois: Vec<PairToi>,
 }
 
-/// Whether a frame's answers are all exact.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Completeness {
-    /// Every pair exact.
-    Exact,
-    /// Some pairs carry a conservative answer from level `level` of their hierarchies.
-    Truncated {
-        /// The shallowest level any pair stopped at (0 = world boxes).
-        level: u32,
-    },
-}
+/// Whether a frame's answers are all exact: `Truncated` at the shallowest level any pair
+/// stopped at (0 = world boxes) when some pairs carry a conservative answer.
+pub use crate::bvh::frontier::Completeness;
 
 /// What [`step`] did: completeness, stage timings, counts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -688,7 +680,7 @@ pub fn step_within(
         if !answer.result.exact {
             // A truncated frontier answer, or the worker pool's fallback box answer (level
             // 0: world boxes).
-            completeness = shallower(completeness, truncated_level.unwrap_or(0));
+            completeness = completeness.truncated_at(truncated_level.unwrap_or(0));
             report(query, answer, (a, b), first_contact, results);
             kept.remove(pair);
             continue;
@@ -734,14 +726,6 @@ pub fn step_within(
         mid_ns,
         frontier: frontier_stats,
         truncated_pairs,
-    }
-}
-
-/// The completeness of a frame with one more answer truncated at `level`: the shallowest.
-fn shallower(completeness: Completeness, level: u32) -> Completeness {
-    match completeness {
-        Completeness::Truncated { level: seen } if seen <= level => completeness,
-        _ => Completeness::Truncated { level },
     }
 }
 
@@ -1680,7 +1664,7 @@ mod tests {
     fn a_frame_is_truncated_at_the_shallowest_level_of_its_pairs() {
         let mut c = Completeness::Exact;
         for (level, expected) in [(3, 3), (5, 3), (1, 1), (2, 1)] {
-            c = shallower(c, level);
+            c = c.truncated_at(level);
             assert_eq!(c, Completeness::Truncated { level: expected });
         }
     }

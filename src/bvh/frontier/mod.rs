@@ -186,17 +186,30 @@ impl Budget for Unlimited {
     }
 }
 
-/// Whether an answer is final.
+/// Whether an answer is final: one pair's (here), or a whole frame's (the pipeline's
+/// [`StepReport`](crate::pipeline::StepReport): the shallowest of its pairs').
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Completeness {
-    /// The traversal of this pair finished: the answer is the exact one.
+    /// The traversal finished: the answer is the exact one (every pair's, for a frame).
     Exact,
-    /// The budget ran out with work of this pair left; `level` is the shallowest depth
-    /// (descents from the root pair) of its waiting node pairs.
+    /// The budget ran out with work left; `level` is the shallowest depth (descents from
+    /// the root pair; 0 = the world boxes) of the waiting node pairs.
     Truncated {
-        /// Shallowest depth of the pair's waiting entries.
+        /// Shallowest depth of the waiting entries.
         level: u32,
     },
+}
+
+impl Completeness {
+    /// `self` with one more answer truncated at `level`: truncated at the shallower of the
+    /// two levels.
+    #[must_use]
+    pub fn truncated_at(self, level: u32) -> Self {
+        match self {
+            Self::Truncated { level: seen } if seen <= level => self,
+            _ => Self::Truncated { level },
+        }
+    }
 }
 
 /// The closest triangle pair computed so far, A's frame.
@@ -507,10 +520,7 @@ impl FrontierWorkspace {
             let answer = &mut out[e.pair as usize];
             answer.distance_lower = answer.distance_lower.min(e.bound);
             answer.error_bound = answer.error_bound.min(upper);
-            answer.completeness = match answer.completeness {
-                Completeness::Truncated { level } if level <= e.depth => answer.completeness,
-                _ => Completeness::Truncated { level: e.depth },
-            };
+            answer.completeness = answer.completeness.truncated_at(e.depth);
         }
         for (answer, state) in out.iter_mut().zip(&self.pairs) {
             let best = state.best;

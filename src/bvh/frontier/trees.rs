@@ -9,6 +9,7 @@ use crate::bvh::Bvh;
 use crate::bvh::tandem::descend_a;
 use crate::math::{Isometry, conservative_slack};
 use crate::narrow::distance_triangle_triangle;
+use crate::narrow::mesh_mesh::rounding_bound;
 
 /// One mesh pair of the frame.
 #[derive(Debug, Clone, Copy)]
@@ -92,7 +93,7 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
         let (ra, rb) = (self.a.root_bv(), self.b.root_bv());
         (
             centre_upper_bound(ra, rb, self.pose_ab),
-            rounding_bound(ra, rb, self.pose_ab),
+            rounding_bound(self.a, self.b, self.pose_ab),
         )
     }
 
@@ -247,12 +248,4 @@ fn centre_upper_bound<B: BoundingVolume>(x: &B, y: &B, pose_ab: &Isometry) -> f6
     let slack =
         conservative_slack(cx.abs().max_element() + cy.abs().max_element() + x.size() + y.size());
     cx.distance(cy) + x.stand_off() + y.stand_off() + slack
-}
-
-/// Rounding error of a triangle–triangle distance between these meshes at this pose: a few
-/// ulps of the largest coordinate involved (as the exact mesh–mesh distance states it).
-#[must_use]
-fn rounding_bound<B: BoundingVolume>(a: &B, b: &B, pose_ab: &Isometry) -> f64 {
-    let reach = |bv: &B| bv.center().abs().max_element() + bv.size();
-    conservative_slack(reach(a) + reach(b) + pose_ab.translation.abs().max_element())
 }
