@@ -252,6 +252,14 @@ struct Place {
     at: usize,
 }
 
+/// Where a body is listed: its index in the oversized list (`None` only if the lists are
+/// broken, which `validate` reports), or its level and place.
+#[derive(Debug, Clone, Copy)]
+enum Listing {
+    Oversized(Option<usize>),
+    Column { level: usize, place: Place },
+}
+
 /// Consecutive column indices along one axis, as buckets: `first` and how many (at most
 /// the table's size along the axis, so none is visited twice).
 #[derive(Debug, Clone, Copy)]
@@ -797,39 +805,52 @@ impl ColumnGrid {
         grid.count += 1;
     }
 
-    /// Undoes [`place`](Self::place) (from the stored box).
-    fn unplace(&mut self, slot: usize) {
+    /// Where slot `slot` is listed, found from its stored box.
+    fn listing(&self, slot: usize) -> Listing {
         let bounds = self.bodies.proxies[slot].bounds;
         let level = self.level_for(&bounds);
         if level == OVERSIZED {
-            if let Some(i) = self.oversized.iter().position(|&s| s as usize == slot) {
-                self.oversized.swap_remove(i);
-            }
-            return;
+            let at = self.oversized.iter().position(|&s| s as usize == slot);
+            debug_assert!(at.is_some(), "slot {slot} not in the oversized list");
+            return Listing::Oversized(at);
         }
-        let grid = &mut self.levels[usize::from(level)];
-        let home = grid.home(bounds.min, self.axes);
-        let column = &mut grid.columns[home];
-        let at = column.find(bounds.min[self.axes.sweep], slot as u32);
-        column.remove(at);
-        grid.count -= 1;
+        let grid = &self.levels[usize::from(level)];
+        let bucket = grid.home(bounds.min, self.axes);
+        let at = grid.columns[bucket].find(bounds.min[self.axes.sweep], slot as u32);
+        Listing::Column {
+            level: usize::from(level),
+            place: Place { bucket, at },
+        }
+    }
+
+    /// Undoes [`place`](Self::place) (from the stored box).
+    fn unplace(&mut self, slot: usize) {
+        match self.listing(slot) {
+            Listing::Oversized(i) => {
+                if let Some(i) = i {
+                    self.oversized.swap_remove(i);
+                }
+            }
+            Listing::Column { level, place } => {
+                let grid = &mut self.levels[level];
+                grid.columns[place.bucket].remove(place.at);
+                grid.count -= 1;
+            }
+        }
     }
 
     /// Renames slot `from`'s listing to `to` (the last slot filling a freed one).
     fn rename(&mut self, from: usize, to: usize) {
-        let bounds = self.bodies.proxies[from].bounds;
-        let level = self.level_for(&bounds);
-        if level == OVERSIZED {
-            for s in self.oversized.iter_mut().filter(|s| **s as usize == from) {
-                *s = to as u32;
+        match self.listing(from) {
+            Listing::Oversized(i) => {
+                if let Some(i) = i {
+                    self.oversized[i] = to as u32;
+                }
             }
-            return;
+            Listing::Column { level, place } => {
+                self.levels[level].columns[place.bucket].entries[place.at].slot = to as u32;
+            }
         }
-        let grid = &mut self.levels[usize::from(level)];
-        let home = grid.home(bounds.min, self.axes);
-        let column = &mut grid.columns[home];
-        let at = column.find(bounds.min[self.axes.sweep], from as u32);
-        column.entries[at].slot = to as u32;
     }
 
     /// Chooses the axes and levels from every body and lists each afresh (module docs,
