@@ -28,8 +28,8 @@ mod support;
 
 use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, Rss};
 use proxima::bvh::frontier::{
-    Completeness, FrontierAnswer, FrontierPair, FrontierWorkspace, PairTrees, Unlimited,
-    VisitBudget, query_frontier,
+    Completeness, FrontierAnswer, FrontierPair, FrontierWorkspace, PairTrees, RoundOrder,
+    Unlimited, VisitBudget, query_frontier,
 };
 use proxima::bvh::{BuildParams, Bvh};
 use proxima::geometry::{TriMesh, Triangle};
@@ -472,6 +472,8 @@ struct Plan {
     /// Whether pairs start from a seed triangle pair (`FrontierPair::seed`): the exact
     /// closest pair for even pairs, an arbitrary one for odd pairs.
     seeded: bool,
+    /// The frontier's order of processing.
+    order: RoundOrder,
 }
 
 /// Runs every check of the module docs on `scene` with volume type `B`; returns the
@@ -502,7 +504,13 @@ fn check_state(
 }
 
 fn check_scene<B: BoundingVolume>(scene: &Scene, plan: Plan, tally: &mut Tally) -> (u64, u64) {
-    let label = format!("{} / {} / poll {}", scene.name, B::NAME, plan.poll_every);
+    let label = format!(
+        "{} / {} / poll {} / {:?}",
+        scene.name,
+        B::NAME,
+        plan.poll_every,
+        plan.order
+    );
     let trees: Vec<Bvh<B>> = scene
         .meshes
         .iter()
@@ -546,7 +554,8 @@ fn check_scene<B: BoundingVolume>(scene: &Scene, plan: Plan, tally: &mut Tally) 
     }
 
     // Unlimited: the exact answers.
-    let mut ws = FrontierWorkspace::with_poll_every(plan.poll_every);
+    let workspace = || FrontierWorkspace::with_poll_every(plan.poll_every).with_order(plan.order);
+    let mut ws = workspace();
     let mut exact = Vec::new();
     assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut exact));
     let (total, rounds) = (ws.stats().visits, ws.stats().rounds);
@@ -580,15 +589,11 @@ fn check_scene<B: BoundingVolume>(scene: &Scene, plan: Plan, tally: &mut Tally) 
     let states_before = tally.states;
     // Every interruption point, by resuming one traversal with a growing budget.
     let fresh_every = (total / plan.step / plan.fresh.max(1)).max(1);
-    let mut resumed = FrontierWorkspace::with_poll_every(plan.poll_every);
+    let mut resumed = workspace();
     resumed.start(&pairs);
     let (mut prev, mut now) = (Vec::new(), Vec::new());
     let mut last_visits = None;
-    let (mut fresh_ws, mut fresh_out, mut again) = (
-        FrontierWorkspace::with_poll_every(plan.poll_every),
-        Vec::new(),
-        Vec::new(),
-    );
+    let (mut fresh_ws, mut fresh_out, mut again) = (workspace(), Vec::new(), Vec::new());
     let (mut budget, mut iteration) = (0, 0u64);
     loop {
         let finished = resumed.run(&pairs, &mut VisitBudget(budget));
@@ -684,8 +689,18 @@ fn every_interruption_point_of_the_tori_piles_is_conservative_and_monotone() {
             fresh: 40,
             build: BuildParams::BINNED_SAH.with_leaf_size(4),
             seeded: false,
+            order: RoundOrder::default(),
         };
         check_scene::<Obb>(&scene, fine, &mut tally);
+        // Plain breadth-first rounds, without the default's stages.
+        check_scene::<Obb>(
+            &scene,
+            Plan {
+                order: RoundOrder::SmallestBound,
+                ..fine
+            },
+            &mut tally,
+        );
         // Warm-started from a seed triangle pair, as the pipeline runs it.
         check_scene::<Obb>(
             &scene,
@@ -841,6 +856,7 @@ fn every_interruption_point_of_degenerate_pairs_is_conservative_and_monotone() {
             fresh: 20,
             build: BuildParams::BINNED_SAH.with_leaf_size(2),
             seeded: false,
+            order: RoundOrder::default(),
         };
         check_scene::<Obb>(&scene, plan, &mut tally);
         check_scene::<Obb>(
@@ -903,6 +919,7 @@ fn every_interruption_point_of_bunny_fandisk_and_a_torus_is_conservative_and_mon
         fresh: 12,
         build,
         seeded: true,
+        order: RoundOrder::default(),
     };
     check_scene::<Rss>(&scene, plan, &mut tally);
     check_scene::<Obb>(

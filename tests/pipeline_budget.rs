@@ -527,7 +527,7 @@ fn truncated_answers_are_refined_frame_after_frame_until_the_frame_is_exact() {
         let report = step_within(
             &scene,
             query,
-            &mut VisitBudget(budget / 2),
+            &mut VisitBudget(budget / 4),
             &mut workspace,
             &mut results,
         );
