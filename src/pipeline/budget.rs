@@ -15,10 +15,15 @@ pub use crate::bvh::frontier::{Budget, Deadline, Unlimited, VisitBudget};
 /// (loan, write, send, notify) is part of a raw iceoryx2 round trip, measured at 78 µs p50
 /// and 128 µs p99 there and back on the 2-core VM (README, `ipc_latency`), so about half
 /// of that one way; the rest of the narrow phase for a few hundred primitive pairs is of
-/// the same order (closed forms 3–900 ns, GJK 0.5–7 µs per pair, README). Not measured
-/// on budgeted frames yet: to be replaced by the value `examples/time_vs_error.rs`
-/// measures from the daemon's `stage_ns[NARROW]` and `stage_ns[PUBLISH]` (release builds;
-/// tests here never measure time).
+/// the same order (closed forms 3–900 ns, GJK 0.5–7 µs per pair, README).
+///
+/// Measured and not kept: a reserve measured per workspace, the held peak of recent
+/// frames' time after their frontier plus 10 µs. On `examples/time_vs_error --scene
+/// robot-chain` those frames spent about 5 µs there, so the frontier got 90 µs of a 100 µs
+/// budget instead of 75; but its own overrun of its deadline (a round's sort, which is not
+/// polled, and the answers) then made 45–70 of 300 frames miss a 200 µs budget (0–2 with
+/// the quarter), for no gain in precision (0.84–0.91 against 0.88–0.91 at 100 µs, three
+/// alternating runs). The quarter is the frontier's slack as much as the tail's.
 pub const FRONTIER_RESERVE: Duration = Duration::from_micros(100);
 
 /// The deadline of a frontier starting at `start` inside a frame ending at

@@ -432,9 +432,9 @@ impl PipelineWorkspace {
         self
     }
 
-    /// This workspace with its budgeted frontier processing each round in `order` (the
-    /// default, smallest bound first, is what the pipeline is meant to run; the other is
-    /// the baseline `examples/time_vs_error --order pair` measures it against).
+    /// This workspace with its budgeted frontier processing its entries in `order` (the
+    /// default, stages by width, is what the pipeline is meant to run; the others are the
+    /// baselines `examples/time_vs_error --order` measures it against).
     #[must_use]
     pub fn with_frontier_order(mut self, order: crate::bvh::frontier::RoundOrder) -> Self {
         self.frontier = std::mem::take(&mut self.frontier).with_order(order);
