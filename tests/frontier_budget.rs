@@ -39,7 +39,7 @@ use proxima::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh, within_distance_mesh_mesh,
 };
 use proxima::pipeline::MeshPairTrees;
-use proxima::scene::{FrontierVolume, MeshShape};
+use proxima::scene::{MeshShape, QueryVolume};
 use rand::Rng;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -785,9 +785,9 @@ fn a_frontier_mixing_obb_and_rss_pairs_is_conservative_monotone_and_exact_per_pa
             .enumerate()
             .map(|(i, p)| MeshPairTrees {
                 volume: if i % 2 == 0 {
-                    FrontierVolume::Obb
+                    QueryVolume::Obb
                 } else {
-                    FrontierVolume::Rss
+                    QueryVolume::Rss
                 },
                 ..MeshPairTrees::new(
                     &meshes[p.a],
@@ -811,8 +811,8 @@ fn a_frontier_mixing_obb_and_rss_pairs_is_conservative_monotone_and_exact_per_pa
         for (i, (pair, answer)) in pairs.iter().zip(&exact).enumerate() {
             let [a, b] = &pair.meshes;
             let own = match pair.volume {
-                FrontierVolume::Obb => alone(&typed(&a.overlap_tree, &b.overlap_tree, pair)),
-                FrontierVolume::Rss => alone(&typed(&a.distance_tree, &b.distance_tree, pair)),
+                QueryVolume::Obb => alone(&typed(&a.overlap_tree, &b.overlap_tree, pair)),
+                QueryVolume::Rss => alone(&typed(&a.distance_tree, &b.distance_tree, pair)),
             };
             assert!(same_bits(&[*answer], &[own]), "seed {seed}, pair {i}");
         }

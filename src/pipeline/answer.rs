@@ -16,8 +16,7 @@ use crate::bvh::frontier::FrontierAnswer;
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::contact::Manifold;
 use crate::narrow::mesh_mesh::{
-    DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
-    intersects_mesh_mesh, rounding_bound, within_distance_mesh_mesh,
+    DistanceCache, MeshMeshWorkspace, contacts_mesh_mesh, intersects_mesh_mesh, rounding_bound,
 };
 use crate::scene::{Body, MeshShape, Shape};
 use std::ops::ControlFlow;
@@ -154,13 +153,7 @@ pub(super) fn mesh_mesh(
     let margins = a.margin + b.margin;
     if query.close
         && !query.distance
-        && !within_distance_mesh_mesh(
-            &ma.distance_tree,
-            &mb.distance_tree,
-            &pose_ab,
-            margins,
-            &mut scratch.traversal,
-        )
+        && !ma.is_within(mb, &pose_ab, margins, &mut scratch.traversal)
         && !((query.overlap || query.contacts)
             && intersects_mesh_mesh(
                 &ma.overlap_tree,
@@ -176,14 +169,7 @@ pub(super) fn mesh_mesh(
         };
     }
     let known = (query.close || query.distance).then(|| {
-        let d = distance_mesh_mesh(
-            &ma.distance_tree,
-            &mb.distance_tree,
-            &pose_ab,
-            &DistanceParams::EXACT,
-            cache,
-            &mut scratch.traversal,
-        );
+        let d = ma.distance_to(mb, &pose_ab, cache, &mut scratch.traversal);
         KnownDistance {
             distance: d.distance,
             error_bound: d.error_bound,

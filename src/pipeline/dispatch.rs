@@ -28,9 +28,7 @@ use crate::narrow::gjk::{
     EpaWorkspace, GjkCache, GjkOutcome, GjkParams, POINT, Rounded, gjk_distance,
     signed_distance_convex,
 };
-use crate::narrow::mesh_mesh::{
-    DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh,
-};
+use crate::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
 use crate::narrow::pairs;
 use crate::scene::{MeshShape, Shape};
 use std::sync::Arc;
@@ -165,11 +163,9 @@ pub(super) fn distance(
         (M(_), convex!()) => flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso),
         (M(x), M(y)) => {
             paths.mesh_mesh += 1;
-            let d = distance_mesh_mesh(
-                &x.distance_tree,
-                &y.distance_tree,
+            let d = x.distance_to(
+                y,
                 pose_ab,
-                &DistanceParams::EXACT,
                 &mut DistanceCache::new(),
                 &mut scratch.mesh_mesh,
             );

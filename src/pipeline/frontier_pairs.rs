@@ -4,17 +4,17 @@
 
 use crate::bvh::frontier::{FrontierWitnesses, PairTrees, TreesAt};
 use crate::math::Isometry;
-use crate::scene::{FrontierVolume, MeshShape};
+use crate::scene::{MeshShape, QueryVolume};
 use std::sync::Arc;
 
-/// One mesh pair of a budgeted frame, refined with the trees of its [`FrontierVolume`].
+/// One mesh pair of a budgeted frame, refined with the trees of its [`QueryVolume`].
 #[derive(Debug, Clone)]
 pub struct MeshPairTrees {
     /// Mesh of body A, mesh of body B (held while the frontier refers to their trees).
     pub meshes: [Arc<MeshShape>; 2],
     /// Which of the meshes' trees the pair is refined with
-    /// ([`FrontierVolume::for_pair`]).
-    pub volume: FrontierVolume,
+    /// ([`QueryVolume::for_pair`]).
+    pub volume: QueryVolume,
     /// B's frame expressed in A's frame.
     pub pose_ab: Isometry,
     /// The pair's threshold, metres ([`crate::bvh::frontier::FrontierPair::threshold`]).
@@ -35,7 +35,7 @@ impl MeshPairTrees {
         seed: Option<[u32; 2]>,
     ) -> Self {
         Self {
-            volume: FrontierVolume::for_pair(a.frontier_volume, b.frontier_volume),
+            volume: QueryVolume::for_pair(a.query_volume, b.query_volume),
             meshes: [Arc::clone(a), Arc::clone(b)],
             pose_ab,
             threshold,
@@ -49,7 +49,7 @@ macro_rules! on_trees {
     ($pair:ident, $trees:ident => $call:expr) => {{
         let [a, b] = &$pair.meshes;
         match $pair.volume {
-            FrontierVolume::Obb => {
+            QueryVolume::Obb => {
                 let $trees = TreesAt {
                     a: &a.overlap_tree,
                     b: &b.overlap_tree,
@@ -57,7 +57,7 @@ macro_rules! on_trees {
                 };
                 $call
             }
-            FrontierVolume::Rss => {
+            QueryVolume::Rss => {
                 let $trees = TreesAt {
                     a: &a.distance_tree,
                     b: &b.distance_tree,
