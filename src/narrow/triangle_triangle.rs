@@ -16,10 +16,9 @@
 //! - **Distance** ([`distance_triangle_triangle`]): the closest pair of two disjoint
 //!   triangles is realised by one of the 9 edge–edge pairs or the 6 vertex–face pairs, each
 //!   computed in closed form (Ericson §5.1.9; Larsen, Gottschalk, Lin and Manocha, PQP's
-//!   `TriDist`, 1999), the search stopping at the first edge pair whose slab separates the
-//!   triangles, as `TriDist` does. When the plane normal to the best of those pairs does
-//!   not separate the triangles by more than rounding, the exact overlap test decides
-//!   whether they meet (distance 0).
+//!   `TriDist`, 1999). When the plane normal to the best of those pairs does not separate
+//!   the triangles by more than rounding, the exact overlap test decides whether they meet
+//!   (distance 0).
 //!
 //! Citations: T. Möller, "A Fast Triangle-Triangle Intersection Test", JGT 2(2), 1997;
 //! O. Devillers and P. Guigue, "Faster Triangle-Triangle Intersection Tests", INRIA RR-4488,
@@ -137,32 +136,21 @@ pub fn distance_triangle_triangle(a: &Triangle, b: &Triangle) -> TriangleDistanc
 
 /// The closest of the 9 edge–edge and 6 vertex–face pairs: the closest pair of the two
 /// triangles when they are disjoint.
-///
-/// An edge pair whose closest points `x`, `y` have each triangle's third vertex on its own
-/// side of the slab between the planes through `x` and `y` normal to `y − x` is the closest
-/// pair of the triangles (each edge lies on its side already, as `x`, `y` are the edges'
-/// closest points; PQP's `TriDist`): the search stops there, most often within the first
-/// few edge pairs of two disjoint triangles, and skips the vertex–face pairs.
 #[inline]
 fn closest_feature_pair(va: &[DVec3; 3], vb: &[DVec3; 3]) -> Closest {
     let mut best = Closest::new(va[0], vb[0]);
     for i in 0..3 {
-        let (p, q, third_a) = (va[i], va[(i + 1) % 3], va[(i + 2) % 3]);
+        let (p, q) = (va[i], va[(i + 1) % 3]);
         for j in 0..3 {
             let (x, y) = closest_points_segment_segment(p, q, vb[j], vb[(j + 1) % 3]);
-            if best.offer(x, y) {
-                let v = y - x;
-                if (third_a - x).dot(v) <= 0.0 && (vb[(j + 2) % 3] - y).dot(v) >= 0.0 {
-                    return best;
-                }
-            }
+            best.offer(x, y);
         }
     }
     for p in *va {
-        let _ = best.offer(p, closest_point_triangle(p, vb[0], vb[1], vb[2]));
+        best.offer(p, closest_point_triangle(p, vb[0], vb[1], vb[2]));
     }
     for q in *vb {
-        let _ = best.offer(closest_point_triangle(q, va[0], va[1], va[2]), q);
+        best.offer(closest_point_triangle(q, va[0], va[1], va[2]), q);
     }
     best
 }
@@ -206,10 +194,8 @@ impl Closest {
         }
     }
 
-    /// Takes the pair when it is closer than the best so far; returns whether it is at
-    /// least as close (a tie keeps the earlier pair).
     #[inline]
-    fn offer(&mut self, point_a: DVec3, point_b: DVec3) -> bool {
+    fn offer(&mut self, point_a: DVec3, point_b: DVec3) {
         let d2 = point_a.distance_squared(point_b);
         if d2 < self.distance_squared {
             *self = Self {
@@ -218,7 +204,6 @@ impl Closest {
                 point_b,
             };
         }
-        d2 <= self.distance_squared
     }
 }
 
