@@ -50,14 +50,13 @@
 //! bound and depth: the answers read it like any waiting entry.
 //!
 //! Measured (`examples/time_vs_error --scene robot-chain`, 300 frames, three alternating
-//! runs each): precision of the reported close pairs 0.83–0.84 with plain rounds and
-//! 0.90–0.91 in stages at 100 µs (0.25–0.3 of the exact queries' time then, on the RSS
-//! trees), 0.88 and 0.95 at 200 µs.
-//! The mesh pile, where the pairs are alike, measured the same either way. Measured and not
-//! kept: setting aside the entries of pairs already proven close (a triangle pair within the
-//! threshold found), to spend the budget on the pairs still open first: no change (0.83
-//! and 0.82 at 100 µs); nor did any order *within* a round (smallest or largest bound first,
-//! fewest entries per pair first, pair order: 0.81–0.82 at 100 µs).
+//! runs each): precision of the reported close pairs 0.79–0.84 with plain rounds and
+//! 0.914–0.915 in stages at 100 µs, 0.88 and 0.96 at 200 µs, 0.64–0.67 and 0.74–0.78 at
+//! 50 µs. The mesh pile, where the pairs are alike, measured the same either way. Measured
+//! and not kept: setting aside the entries of pairs already proven close (a triangle pair
+//! within the threshold found), to spend the budget on the pairs still open first: no
+//! change (0.83 and 0.82 at 100 µs); nor did any order *within* a round (smallest or largest
+//! bound first, fewest entries per pair first, pair order: 0.81–0.82 at 100 µs).
 //!
 //! The [`Budget`] is polled between entries once at least `poll_every` visits (default
 //! [`DEFAULT_POLL_EVERY`]) were made since the last poll, never inside an entry (so never
