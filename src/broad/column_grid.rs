@@ -622,9 +622,9 @@ impl ColumnGrid {
     /// ends at its last box. The same pair set as updating one by one in the given order.
     ///
     /// Two passes: the first reads every moved body's record (independent look-ups the
-    /// processor overlaps), the second moves them. In a grid of [`PREFETCH_FROM_BODIES`]
-    /// bodies or more, the second pass also starts fetching the first entries of the query
-    /// [`PREFETCH_AHEAD`] moves on, so that its cache misses overlap this move's work.
+    /// processor overlaps), the second moves them. In a grid of 30,000 bodies or more, the
+    /// second pass also starts fetching the first entries of the query four moves on, so
+    /// that its cache misses overlap this move's work.
     ///
     /// # Allocation
     /// None once the batch buffer has grown to the largest batch.

@@ -465,7 +465,8 @@ pub fn step(
 /// # With a limited budget
 /// Before the per-pair loop, every mesh–mesh candidate pair not answered by a kept answer
 /// joins one frontier run, refined with the trees its meshes chose
-/// ([`QueryVolume::for_pair`]: OBBs for box-like parts, RSSs for curved ones), with
+/// ([`QueryVolume::for_pair`](crate::scene::QueryVolume::for_pair): OBBs for box-like
+/// parts, RSSs for curved ones), with
 /// threshold the pair's margin sum (`CLOSE`, `OVERLAP`,
 /// `CONTACTS`) or, when `DISTANCE` is asked, an upper bound of the pair's distance: the
 /// distance of one triangle pair (the closest a previous budgeted frame found for it, else
