@@ -21,33 +21,33 @@ extern crate self as proxima;
 
 // Stages in data-flow order (kept apart so rustfmt does not sort them).
 
-/// Poses, isometries, tolerances.
+// Poses, isometries, tolerances.
 pub mod math;
 
-/// Shapes, meshes, convex hulls, exact predicates.
+// Shapes, meshes, convex hulls, exact predicates.
 pub mod geometry;
 
-/// Bounding volumes.
+// Bounding volumes.
 pub mod bounding;
 
-/// Bounding-volume hierarchies and their tandem traversal.
+// Bounding-volume hierarchies and their tandem traversal.
 pub mod bvh;
 
-/// Broad phase: candidate pairs from margin-grown world boxes.
+// Broad phase: candidate pairs from margin-grown world boxes.
 pub mod broad;
 
-/// Exact queries: triangle–triangle overlap, intersection and distance; mesh–mesh queries.
+// Exact queries: triangle–triangle overlap, intersection and distance; mesh–mesh queries.
 pub mod narrow;
 
 #[cfg(test)]
 #[path = "../tests/support/mod.rs"]
 pub(crate) mod test_support;
 
-/// Scene state: registered shapes and placed bodies.
+// Scene state: registered shapes and placed bodies.
 pub mod scene;
 
-/// One frame of collision work over a scene.
+// One frame of collision work over a scene.
 pub mod pipeline;
 
-/// The daemon's service loop and wire conversion (the only user of `proxima-ipc`).
+// The daemon's service loop and wire conversion (the only user of `proxima-ipc`).
 pub mod daemon;

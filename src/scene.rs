@@ -180,8 +180,8 @@ impl QueryVolume {
     const OBB_TIGHTER: f64 = 1.15;
 
     /// The choice for a mesh with these trees: OBBs when the RSSs of the nodes down to
-    /// [`MEASURED_DEPTH`](Self::MEASURED_DEPTH) hold more than
-    /// [`OBB_TIGHTER`](Self::OBB_TIGHTER) times the boxes' volume, else RSSs.
+    /// depth 5 (`MEASURED_DEPTH`) hold more than 1.15 (`OBB_TIGHTER`) times the boxes'
+    /// volume, else RSSs.
     #[must_use]
     pub fn measure(overlap_tree: &Bvh<Obb>, distance_tree: &Bvh<Rss>) -> Self {
         let (obb, rss) = (

@@ -86,7 +86,7 @@
 //!   8 cell-list edits per level at or above its own, and an `O(1)` slot move; the [`AUTO_SAMPLE`]-th insertion of
 //!   [`HashGrid::new`] also places every body once.
 //! - [`pairs`](HashGrid::pairs): `O(k + e log e)` for `e` pair changes since the last call
-//!   (the [`PairSet`] commit).
+//!   (the pair set's commit, `pair_set.rs`).
 //!
 //! # Input
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant), checked by
@@ -529,7 +529,7 @@ impl HashGrid {
     /// not inverted; each body is at the level its box calls for (oversized when none, or
     /// while the levels are not chosen), listed once among that level's members at the
     /// recorded index, and in exactly the cells its box covers at its level and (flagged
-    /// [`FROM_FINER`]) at every coarser one, once each, with no empty or foreign cell
+    /// `FROM_FINER`) at every coarser one, once each, with no empty or foreign cell
     /// entries; and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over
     /// the stored boxes. `O(n²)`: for tests.
     ///

@@ -39,7 +39,7 @@
 //!   renumbering of the shifted endpoints on each axis, and the body's pairs found by one
 //!   direct scan of the axis where the fewest endpoints precede its max.
 //! - [`pairs`](IncrementalSap::pairs): `O(k + e log e)` for `e` pair changes since the
-//!   last call: the set is a [`PairSet`], whose edits are logged in `O(1)` and merged here.
+//!   last call: the set is a `PairSet` (`pair_set.rs`), whose edits are logged in `O(1)` and merged here.
 //!
 //! # Teleports
 //! A body that jumps far is moved by the same insertion sort, paying one swap per endpoint

@@ -9,7 +9,7 @@
 //!   (1997) and Devillers–Guigue (2002) with exact [`orient3d`] signs, then an
 //!   edge-against-triangle test (a closed triangle pair meets iff an edge of one meets the
 //!   other); coplanar pairs are decided with exact [`orient2d`] in a projection that is
-//!   one-to-one on their plane. See [`super::triangle_overlap`] for the case analysis.
+//!   one-to-one on their plane. See `triangle_overlap.rs` for the case analysis.
 //! - **Segment** ([`intersection_segment_triangle_triangle`]): each triangle cut by the
 //!   other's plane gives an interval of the planes' common line; the result is the overlap of
 //!   the two intervals (Möller's interval method).

@@ -825,7 +825,7 @@ fn run_frontier(
 }
 
 /// Time kept back from a frame's deadline for writing and publishing its results, when the
-/// pairs off the frontier are cut short ([`PairClock`]). 30 µs: an estimate of the daemon's
+/// pairs off the frontier are cut short (`PairClock`). 30 µs: an estimate of the daemon's
 /// publish stage (loan, write, send, notify) on the 2-core VM, to be replaced by a measured
 /// value.
 pub const PUBLISH_RESERVE: std::time::Duration = std::time::Duration::from_micros(30);

@@ -1,8 +1,8 @@
 //! BVH construction: split or cluster the triangles into a tree, then fit every node.
 //!
-//! Building is two steps. A *builder* decides the tree's shape only, as a [`Topology`]
-//! (top-down splits in [`top_down`], agglomerative clustering in [`bottom_up`]); then
-//! [`fit_topology`] copies the triangles into leaf order and fits each node's volume to all
+//! Building is two steps. A *builder* decides the tree's shape only, as a `Topology`
+//! (top-down splits in `top_down`, agglomerative clustering in `bottom_up`); then
+//! `fit_topology` copies the triangles into leaf order and fits each node's volume to all
 //! triangles of its subtree with [`BoundingVolume::fit_triangles`] (tighter than merging the
 //! children's volumes, which is what refit does).
 //!

@@ -14,19 +14,19 @@
 //! A round takes the entries of the frontier in increasing order of their distance lower
 //! bound (ties by pair index, then node of A, then node of B: deterministic), and for each
 //! (unless the stage sets it aside, below):
-//! - a root entry first gets its own bound ([`BoundingVolume::distance_lower_bound_within`],
+//! - a root entry first gets its own bound ([`BoundingVolume::distance_lower_bound_within`](crate::bounding::BoundingVolume::distance_lower_bound_within),
 //!   one *visit*); when it is within the threshold and the pair has no best distance yet
-//!   (no [`FrontierPair::seed`]), a greedy [`probe`] descends once to a leaf pair and tests
+//!   (no [`FrontierPair::seed`]), a greedy `probe` descends once to a leaf pair and tests
 //!   it, so the rounds prune with a real distance from the start (the warm start of the
 //!   depth-first queries; a touching pair whose probe finds intersecting triangles is then
 //!   exact);
 //! - an entry whose bound exceeds `threshold` is dropped (that part is proven apart); one
 //!   whose bound is not below the pair's best exact distance so far is dropped too (it
 //!   cannot improve the minimum; no visit);
-//! - an entry of two leaves runs [`distance_triangle_triangle`] on each triangle pair (one
+//! - an entry of two leaves runs [`distance_triangle_triangle`](crate::narrow::distance_triangle_triangle) on each triangle pair (one
 //!   visit each), updating the pair's best exact distance and its witnesses;
 //! - any other entry is replaced by its children on the side chosen by
-//!   [`descend_a`]: each child's bound is computed (one visit)
+//!   [`descend_a`](crate::bvh::tandem::descend_a): each child's bound is computed (one visit)
 //!   and the child joins the *next* round unless it is dropped by the rules above. A
 //!   child's bound is the larger of its own and its parent's (both bound the child's
 //!   triangles), so bounds never decrease along a descent.
