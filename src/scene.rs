@@ -37,7 +37,7 @@ use crate::broad::{BroadPhaseChoice, Proxy};
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::mesh::MeshEdges;
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
-use crate::math::{DVec3, Pose, conservative_slack};
+use crate::math::{DVec3, Isometry, Pose, conservative_slack};
 use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, distance_mesh_mesh,
     rounding_bound, within_distance_mesh_mesh,
@@ -88,11 +88,18 @@ impl MeshShape {
         }
     }
 
+    /// The rounding bound of a triangle distance between this mesh and `other` placed at
+    /// `iso`, as every path states it: [`rounding_bound`] of the RSS trees, whichever trees
+    /// a query refined, so that a record does not depend on the choice.
+    #[must_use]
+    pub fn rounding_with(&self, other: &Self, iso: &Isometry) -> f64 {
+        rounding_bound(&self.distance_tree, &other.distance_tree, iso)
+    }
+
     /// The exact distance between this mesh and `other` placed at `pose_ab` (`other`'s
     /// frame in this one's), warm-started from `cache`: [`distance_mesh_mesh`] on the trees
-    /// [`QueryVolume::for_pair`] chooses. The error bound is the RSS trees' rounding bound
-    /// whichever trees were refined, as on every path of the pipeline, so a record does not
-    /// depend on the choice.
+    /// [`QueryVolume::for_pair`] chooses, with the error bound of
+    /// [`rounding_with`](Self::rounding_with).
     #[must_use]
     pub fn distance_to(
         &self,
@@ -106,9 +113,8 @@ impl MeshShape {
             QueryVolume::Obb => {
                 let (a, b) = (&self.overlap_tree, &other.overlap_tree);
                 let d = distance_mesh_mesh(a, b, pose_ab, exact, cache, workspace);
-                let iso = pose_ab.to_isometry();
                 MeshDistance {
-                    error_bound: rounding_bound(&self.distance_tree, &other.distance_tree, &iso),
+                    error_bound: self.rounding_with(other, &pose_ab.to_isometry()),
                     ..d
                 }
             }

@@ -658,7 +658,7 @@ impl ColumnGrid {
         }
         let prefetch = self.bodies.len() >= self.prefetch_from_bodies;
         for (k, m) in batch.iter().enumerate() {
-            if let Some(next) = batch.get(k + PREFETCH_AHEAD).filter(|m| prefetch && m.last) {
+            if let Some(next) = batch.get(k + PREFETCH_AHEAD).filter(|n| prefetch && n.last) {
                 self.prefetch_query(&next.old.bounds, &next.new);
             }
             if m.last {

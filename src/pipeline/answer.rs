@@ -16,7 +16,7 @@ use crate::bvh::frontier::FrontierAnswer;
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::contact::Manifold;
 use crate::narrow::mesh_mesh::{
-    DistanceCache, MeshMeshWorkspace, contacts_mesh_mesh, intersects_mesh_mesh, rounding_bound,
+    DistanceCache, MeshMeshWorkspace, contacts_mesh_mesh, intersects_mesh_mesh,
 };
 use crate::scene::{Body, MeshShape, Shape};
 use std::ops::ControlFlow;
@@ -273,13 +273,9 @@ pub(super) fn mesh_mesh_finished(
         .filter(|_| frontier.maybe_close)
         .map(|w| KnownDistance {
             distance: frontier.distance_lower,
-            // The exact query's rounding bound (from the RSS trees, whichever trees the
-            // frontier refined), so that an unlimited budget gives its record bit for bit.
-            error_bound: rounding_bound(
-                &ma.distance_tree,
-                &mb.distance_tree,
-                &pose_ab.to_isometry(),
-            ),
+            // The exact query's rounding bound, whichever trees the frontier refined, so
+            // that an unlimited budget gives its record bit for bit.
+            error_bound: ma.rounding_with(mb, &pose_ab.to_isometry()),
             point_a: w.point_a,
             point_b: w.point_b,
         });
