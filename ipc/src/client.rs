@@ -256,12 +256,7 @@ impl ClientBuilder {
             .map_err(|e| {
                 ClientConnectError::Transport(format!("opening the control service: {e}"))
             })?;
-        let port = service
-            .client_builder()
-            .initial_max_slice_len(CONTROL_INITIAL_MAX_SLICE_LEN)
-            .allocation_strategy(AllocationStrategy::PowerOfTwo)
-            .create()
-            .map_err(|e| ClientConnectError::Transport(format!("creating the client port: {e}")))?;
+        let port = control_port(&service)?;
         let events = crate::control_events_service_builder(&node, &self.root)
             .map_err(|_| ClientConnectError::InvalidRoot(self.root.clone()))?
             .open_or_create()
@@ -293,17 +288,46 @@ impl ClientBuilder {
             command: Command::Hello as u32,
             ..ControlRequest::default()
         };
-        let reply = match client.request_until(&hello, 0, |_| {}, deadline) {
-            Ok((reply, daemon)) => {
-                client.daemon = Some(daemon);
-                reply
+        // iceoryx2 makes a port's connections once, when the other side's port list changes:
+        // one that fails (its creation timed out on a loaded host) leaves this client unheard
+        // for good. An unanswered Hello is therefore sent again from a fresh port, whose
+        // arrival makes the daemon connect anew; Hello changes nothing, so a late reply to
+        // the first is harmless.
+        let mut wait = FIRST_HELLO_WAIT;
+        let reply = loop {
+            let attempt_deadline = deadline.min(Instant::now() + wait);
+            match client.request_until(&hello, 0, |_| {}, attempt_deadline) {
+                Ok((reply, daemon)) => {
+                    client.daemon = Some(daemon);
+                    break reply;
+                }
+                Err(ControlError::Timeout) if Instant::now() < deadline => {
+                    client.port = control_port(&client.service)?;
+                    wait *= 2;
+                }
+                Err(ControlError::Timeout) => return Err(ClientConnectError::NoDaemon),
+                Err(e) => return Err(ClientConnectError::Transport(e.to_string())),
             }
-            Err(ControlError::Timeout) => return Err(ClientConnectError::NoDaemon),
-            Err(e) => return Err(ClientConnectError::Transport(e.to_string())),
         };
         check_hello(&reply)?;
         Ok(client)
     }
+}
+
+/// How long connect waits for the first `Hello`'s reply before it sends `Hello` again from
+/// a fresh port; each further wait is twice the last.
+const FIRST_HELLO_WAIT: Duration = Duration::from_millis(250);
+
+/// A new client port of the control service.
+fn control_port<S: Service>(
+    service: &PortFactory<S, [u8], ControlRequest, ControlReply, ()>,
+) -> Result<ClientPort<S, [u8], ControlRequest, ControlReply, ()>, ClientConnectError> {
+    service
+        .client_builder()
+        .initial_max_slice_len(CONTROL_INITIAL_MAX_SLICE_LEN)
+        .allocation_strategy(AllocationStrategy::PowerOfTwo)
+        .create()
+        .map_err(|e| ClientConnectError::Transport(format!("creating the client port: {e}")))
 }
 
 /// The daemon's answer to `Hello`: success with our version, or why not.
@@ -690,7 +714,7 @@ mod tests {
     use crate::wire::REASON_BYTES;
     use iceoryx2::prelude::local;
     use std::sync::Arc;
-    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
     use std::sync::mpsc;
     use std::thread::JoinHandle;
 
@@ -1164,6 +1188,31 @@ mod tests {
         let reply = client.request(&header, &payload).unwrap();
         assert_eq!(reply, ControlReply::ok(fingerprint(&header, &payload)));
         assert_eq!(responder.next(), (header, payload));
+    }
+
+    #[test]
+    fn an_unanswered_hello_is_sent_again_from_a_fresh_port() {
+        /// Ignores the first Hello it sees (as a daemon whose connection to the client
+        /// failed would), then conforms.
+        fn deaf_to_the_first_hello(
+            header: &ControlRequest,
+            payload: &[u8],
+        ) -> Option<ControlReply> {
+            static HELLOS: AtomicU32 = AtomicU32::new(0);
+            let is_hello = header.command == Command::Hello as u32;
+            if is_hello && HELLOS.fetch_add(1, Ordering::Relaxed) == 0 {
+                return None;
+            }
+            conformance(header, payload)
+        }
+        let root = root("deaf");
+        let responder = Responder::start::<local::Service>(&root, None, deaf_to_the_first_hello);
+        let client = connect(&root);
+        let (first, second) = (responder.next().0, responder.next().0);
+        assert_eq!(first.command, Command::Hello as u32);
+        assert_eq!(second.command, Command::Hello as u32);
+        assert!(client.create_scene().is_ok());
+        assert_eq!(responder.next().0.command, Command::CreateScene as u32);
     }
 
     #[test]
