@@ -25,7 +25,13 @@
 //!   that over the smaller body's size; `depth_err_max`: the same over touching pairs;
 //! - `normal_err_deg_max`: angle between the reported and exact normals of pairs both
 //!   report exactly;
-//! - latency of `step_within`: p50, p99, p99.9, max; `deadline_misses`: frames over budget.
+//! - latency of `step_within`: p50, p99, p99.9, max; `deadline_misses`: frames over budget;
+//! - `truncated_pairs_per_frame`, and `separated_pairs_per_frame`: mesh pairs answered
+//!   "apart" by a separation kept from an earlier frame (no traversal).
+//!
+//! `--speed F` moves the bodies along the same paths at `F` times the scene's motion per
+//! frame (a faster control loop sees less motion per frame, and kept separations last
+//! longer).
 //!
 //! Writes `DIR/curve.csv` (one row per scene and budget), `DIR/error_vs_time.svg` (distance
 //! error and precision against median frame time) and `DIR/latency.svg` (each budget's
@@ -76,6 +82,10 @@ struct Args {
     /// order buys.
     #[arg(long, default_value = "stages")]
     order: String,
+    /// Motion per frame, as a multiple of the scene's own (`0.1`: the same paths at a tenth
+    /// of the speed, as a faster control loop sees them).
+    #[arg(long, default_value_t = 1.0)]
+    speed: f64,
     /// Print the built-in scenes and exit.
     #[arg(long)]
     list_scenes: bool,
@@ -145,8 +155,9 @@ impl Workload {
     }
 
     /// Moves every mover to its pose at `frame`.
-    fn pose_at(&mut self, frame: usize) {
-        let t = frame as f64;
+    /// Places the movers at frame `frame` of motion at `speed` times the scene's own.
+    fn pose_at(&mut self, frame: usize, speed: f64) {
+        let t = frame as f64 * speed;
         let mut placed: Vec<Pose> = Vec::with_capacity(self.movers.len());
         for m in &self.movers {
             let wobble = DVec3::new(
@@ -346,6 +357,8 @@ struct Row {
     /// Frontier visits and truncated pairs, summed over the frames.
     visits: u64,
     truncated_pairs: u64,
+    /// Mesh pairs answered by a kept separation, summed over frames.
+    separated_pairs: u64,
     latencies_us: Vec<f64>,
     deadline_misses: usize,
 }
@@ -468,7 +481,7 @@ fn compare(row: &mut Row, got: &[PairResult], exact: &[PairResult], w: &Workload
 
 fn run_row(
     w: &mut Workload,
-    frames: usize,
+    (frames, speed): (usize, f64),
     order: RoundOrder,
     (label, budget): &(String, RowBudget),
 ) -> Row {
@@ -484,7 +497,7 @@ fn run_row(
     let mut kept_ws = PipelineWorkspace::default().with_frontier_order(order);
     let (mut exact, mut got) = (FrameResults::default(), FrameResults::default());
     for frame in 0..frames {
-        w.pose_at(frame);
+        w.pose_at(frame, speed);
         step(&w.scene, Query::DISTANCE, &mut exact_ws, &mut exact);
         let started = Instant::now();
         let report: StepReport = match *budget {
@@ -523,6 +536,7 @@ fn run_row(
         row.truncated_frames += usize::from(report.truncated_pairs > 0);
         row.visits += report.frontier.visits;
         row.truncated_pairs += u64::from(report.truncated_pairs);
+        row.separated_pairs += u64::from(report.separated_pairs);
         compare(&mut row, &got.pairs, &exact.pairs, w);
         row.frames += 1;
         w.scene.end_frame();
@@ -532,12 +546,12 @@ fn run_row(
 
 fn csv(scene: &str, rows: &[Row]) -> String {
     let mut out = String::from(
-        "scene,budget_us,frames,missed_collisions,false_positive_pairs,false_positive_max_distance,precision,dist_abs_err_max,dist_rel_err_max,depth_err_max,depth_err_rel_max,normal_err_deg_max,truncated_frames,truncated_pairs_per_frame,visits_per_frame,latency_p50_us,latency_p99_us,latency_p999_us,latency_max_us,deadline_misses\n",
+        "scene,budget_us,frames,missed_collisions,false_positive_pairs,false_positive_max_distance,precision,dist_abs_err_max,dist_rel_err_max,depth_err_max,depth_err_rel_max,normal_err_deg_max,truncated_frames,truncated_pairs_per_frame,visits_per_frame,latency_p50_us,latency_p99_us,latency_p999_us,latency_max_us,deadline_misses,separated_pairs_per_frame\n",
     );
     for r in rows {
         let _ = writeln!(
             out,
-            "{scene},{},{},{},{},{:e},{:.6},{:e},{:e},{:e},{:e},{:.6},{},{:.2},{:.0},{:.1},{:.1},{:.1},{:.1},{}",
+            "{scene},{},{},{},{},{:e},{:.6},{:e},{:e},{:e},{:e},{:.6},{},{:.2},{:.0},{:.1},{:.1},{:.1},{:.1},{},{:.2}",
             r.budget,
             r.frames,
             r.missed_collisions,
@@ -557,6 +571,7 @@ fn csv(scene: &str, rows: &[Row]) -> String {
             r.percentile(0.999),
             r.percentile(1.0),
             r.deadline_misses,
+            r.separated_pairs as f64 / r.frames.max(1) as f64,
         );
     }
     out
@@ -705,7 +720,12 @@ fn main() -> Result<(), Box<dyn Error>> {
     std::fs::create_dir_all(&args.out)?;
     let mut rows = Vec::new();
     for budget in &budgets {
-        rows.push(run_row(&mut workload, args.frames, order, budget));
+        rows.push(run_row(
+            &mut workload,
+            (args.frames, args.speed),
+            order,
+            budget,
+        ));
     }
     let exact_p50 = rows
         .iter()
@@ -719,7 +739,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         args.order
     );
     println!(
-        "{:>12} {:>9} {:>7} {:>6} {:>9} {:>11} {:>10} {:>9} {:>9} {:>9} {:>9} {:>7}",
+        "{:>12} {:>9} {:>7} {:>6} {:>9} {:>11} {:>10} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>7}",
         "budget µs",
         "of exact",
         "missed",
@@ -727,6 +747,8 @@ fn main() -> Result<(), Box<dyn Error>> {
         "precision",
         "dist err m",
         "depth rel",
+        "trunc/fr",
+        "sep/fr",
         "p50 µs",
         "p99 µs",
         "p99.9 µs",
@@ -739,7 +761,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             _ => "-".into(),
         };
         println!(
-            "{:>12} {:>9} {:>7} {:>6} {:>9.3} {:>11.3e} {:>10.3e} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>7}",
+            "{:>12} {:>9} {:>7} {:>6} {:>9.3} {:>11.3e} {:>10.3e} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>7}",
             r.budget,
             share,
             r.missed_collisions,
@@ -748,6 +770,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             r.dist_abs_err_max,
             r.depth_err_rel_max,
             r.truncated_pairs as f64 / r.frames.max(1) as f64,
+            r.separated_pairs as f64 / r.frames.max(1) as f64,
             r.percentile(0.5),
             r.percentile(0.99),
             r.percentile(0.999),

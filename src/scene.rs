@@ -39,8 +39,8 @@ use crate::geometry::mesh::MeshEdges;
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
 use crate::math::{DVec3, Isometry, Pose, conservative_slack};
 use crate::narrow::mesh_mesh::{
-    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, distance_mesh_mesh,
-    rounding_bound, within_distance_mesh_mesh,
+    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity, distance_mesh_mesh,
+    proximity_mesh_mesh, rounding_bound,
 };
 use crate::narrow::toi::{FrameMotion, swept_bounds};
 use std::fmt;
@@ -126,24 +126,24 @@ impl MeshShape {
     }
 
     /// Whether some triangle of this mesh and one of `other` placed at `pose_ab` are within
-    /// `max_distance` ([`within_distance_mesh_mesh`] on the trees
-    /// [`QueryVolume::for_pair`] chooses).
+    /// `max_distance`, with a lower bound of the distance when not ([`proximity_mesh_mesh`]
+    /// on the trees [`QueryVolume::for_pair`] chooses).
     #[must_use]
-    pub fn is_within(
+    pub fn proximity(
         &self,
         other: &Self,
         pose_ab: &Pose,
         max_distance: f64,
         workspace: &mut MeshMeshWorkspace,
-    ) -> bool {
+    ) -> Proximity {
         match QueryVolume::for_pair(self.query_volume, other.query_volume) {
             QueryVolume::Obb => {
                 let (a, b) = (&self.overlap_tree, &other.overlap_tree);
-                within_distance_mesh_mesh(a, b, pose_ab, max_distance, workspace)
+                proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
             }
             QueryVolume::Rss => {
                 let (a, b) = (&self.distance_tree, &other.distance_tree);
-                within_distance_mesh_mesh(a, b, pose_ab, max_distance, workspace)
+                proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
             }
         }
     }
@@ -151,7 +151,7 @@ impl MeshShape {
 
 /// Which of a mesh's two trees distance queries refine it with: the budgeted frontier
 /// ([`MeshPairTrees`](crate::pipeline::MeshPairTrees)) and the exact queries
-/// ([`MeshShape::distance_to`], [`MeshShape::is_within`]).
+/// ([`MeshShape::distance_to`], [`MeshShape::proximity`]).
 ///
 /// Exact queries: on robot-chain (`examples/time_vs_error`, budget `inf`, 300 frames, two
 /// alternating runs), the OBB trees this choice names for the CAD meshes answered a frame
@@ -907,8 +907,8 @@ mod tests {
 
     /// The exact queries refine the trees the pair's volume names (OBBs for two slabs, RSSs
     /// when a ball is in the pair) and answer as the brute force over every triangle pair
-    /// does, with the RSS trees' rounding bound on either path; `is_within` agrees with the
-    /// distance on both sides of the limit.
+    /// does, with the RSS trees' rounding bound on either path; `proximity` agrees with the
+    /// distance on both sides of the limit, and its lower bound when apart is one.
     #[test]
     fn exact_queries_on_either_volume_match_the_brute_force() {
         let slab = MeshShape::new(meshes::subdivided_cuboid(DVec3::new(0.5, 0.3, 0.15), 3));
@@ -939,12 +939,26 @@ mod tests {
                     d.distance
                 );
                 let limit = 0.05;
-                let is_within = a.is_within(b, &pose_ab, limit, &mut workspace);
+                let proximity = a.proximity(b, &pose_ab, limit, &mut workspace);
+                if let Proximity::Apart { lower_bound } = proximity {
+                    assert!(
+                        lower_bound > limit && lower_bound <= truth + rounding,
+                        "{volume:?} case {case}: bound {lower_bound}, truth {truth}"
+                    );
+                }
                 if truth <= limit - rounding {
-                    assert!(is_within, "{volume:?} case {case}: {truth}");
+                    assert_eq!(
+                        proximity,
+                        Proximity::Within,
+                        "{volume:?} case {case}: {truth}"
+                    );
                     within += 1;
                 } else if truth > limit + rounding {
-                    assert!(!is_within, "{volume:?} case {case}: {truth}");
+                    assert_ne!(
+                        proximity,
+                        Proximity::Within,
+                        "{volume:?} case {case}: {truth}"
+                    );
                     beyond += 1;
                 }
             }

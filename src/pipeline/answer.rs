@@ -16,7 +16,7 @@ use crate::bvh::frontier::FrontierAnswer;
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::contact::Manifold;
 use crate::narrow::mesh_mesh::{
-    DistanceCache, MeshMeshWorkspace, contacts_mesh_mesh, intersects_mesh_mesh,
+    DistanceCache, MeshMeshWorkspace, Proximity, contacts_mesh_mesh, intersects_mesh_mesh,
 };
 use crate::scene::{Body, MeshShape, Shape};
 use std::ops::ControlFlow;
@@ -28,6 +28,10 @@ pub(super) struct Answer {
     pub result: PairResult,
     /// Whether the shapes touch or intersect (for a box answer: may touch).
     pub touching: bool,
+    /// When the pair was proven farther apart than its margins: a lower bound of its true
+    /// distance, metres (rounding included), which later frames keep as a
+    /// [`Separation`](super::separation::Separation); `None` otherwise.
+    pub apart_by: Option<f64>,
 }
 
 /// Mesh–mesh scratch of one thread, reused across pairs and frames.
@@ -110,7 +114,11 @@ pub(super) fn direct(
             });
         }
     }
-    Answer { result, touching }
+    Answer {
+        result,
+        touching,
+        apart_by: None,
+    }
 }
 
 /// A one-point manifold from a pair record: its witnesses and normal, `distance` (−depth)
@@ -131,7 +139,9 @@ fn witness_contact(result: &PairResult, distance: f64) -> ContactPoint {
 /// else (`OVERLAP` alone) [`intersects_mesh_mesh`], which stops at the first proof.
 ///
 /// A `CLOSE` pair beyond its margins (and no `DISTANCE` asked) says distance `+∞`: it is
-/// not reported, and it touches nothing. Without a distance, a touching pair's record says distance 0 (intersecting surfaces),
+/// not reported, and it touches nothing; its [`Answer::apart_by`] is the lower bound the
+/// search proved on the way
+/// ([`proximity_mesh_mesh`](crate::narrow::mesh_mesh::proximity_mesh_mesh)). Without a distance, a touching pair's record says distance 0 (intersecting surfaces),
 /// error bound 0, and takes its witnesses and normal from the first contact when contacts
 /// were asked; with `OVERLAP` alone it has none (points and normal all zero).
 pub(super) fn mesh_mesh(
@@ -144,7 +154,6 @@ pub(super) fn mesh_mesh(
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     let pose_ab = Pose::relative(&a.pose, &b.pose);
-    let mut result = empty_record(pair);
     // `CLOSE` without `DISTANCE` needs the distance only of pairs within their margins: a
     // tolerance query, which stops at the first triangle pair close enough, rules the
     // others out (its lower bounds prune far pairs near the roots). Its float distances
@@ -153,7 +162,8 @@ pub(super) fn mesh_mesh(
     let margins = a.margin + b.margin;
     if query.close
         && !query.distance
-        && !ma.is_within(mb, &pose_ab, margins, &mut scratch.traversal)
+        && let Proximity::Apart { lower_bound } =
+            ma.proximity(mb, &pose_ab, margins, &mut scratch.traversal)
         && !((query.overlap || query.contacts)
             && intersects_mesh_mesh(
                 &ma.overlap_tree,
@@ -162,11 +172,7 @@ pub(super) fn mesh_mesh(
                 &mut scratch.traversal,
             ))
     {
-        result.distance = f64::INFINITY;
-        return Answer {
-            result,
-            touching: false,
-        };
+        return apart(pair, Some(lower_bound));
     }
     let known = (query.close || query.distance).then(|| {
         let d = ma.distance_to(mb, &pose_ab, cache, &mut scratch.traversal);
@@ -178,7 +184,7 @@ pub(super) fn mesh_mesh(
         }
     });
     mesh_mesh_tail(
-        result,
+        empty_record(pair),
         (a, ma),
         mb,
         &pose_ab,
@@ -243,7 +249,11 @@ fn mesh_mesh_tail(
             &mut scratch.traversal,
         )
     });
-    Answer { result, touching }
+    Answer {
+        result,
+        touching,
+        apart_by: None,
+    }
 }
 
 /// A mesh pair whose budgeted frontier traversal finished (`frontier` is
@@ -295,12 +305,10 @@ pub(super) fn mesh_mesh_finished(
         if query.distance || grazing {
             return mesh_mesh(pair, (a, ma), (b, mb), query, cache, scratch, contacts);
         }
-        let mut result = empty_record(pair);
-        result.distance = f64::INFINITY;
-        return Answer {
-            result,
-            touching: false,
-        };
+        // The frontier's lower bound may be a triangle distance, which rounding can put
+        // above the truth.
+        let rounding = ma.rounding_with(mb, &pose_ab.to_isometry());
+        return apart(pair, Some(frontier.distance_lower - rounding));
     }
     mesh_mesh_tail(
         empty_record(pair),
@@ -356,7 +364,23 @@ pub(super) fn mesh_mesh_truncated(
     if query.contacts && touching {
         contacts.push(witness_contact(&result, 0.0));
     }
-    Answer { result, touching }
+    Answer {
+        result,
+        touching,
+        apart_by: None,
+    }
+}
+
+/// The answer for a pair beyond its margins under a query that does not ask the distance:
+/// distance `+∞` (never reported), touching nothing; `apart_by` as [`Answer::apart_by`].
+pub(super) fn apart(pair: &CandidatePair, apart_by: Option<f64>) -> Answer {
+    let mut result = empty_record(pair);
+    result.distance = f64::INFINITY;
+    Answer {
+        result,
+        touching: false,
+        apart_by,
+    }
 }
 
 /// A mesh pair's record before anything is known: distance 0, no witnesses, exact.
@@ -477,7 +501,11 @@ pub(super) fn boxes(
     if query.contacts && touching {
         contacts.push(witness_contact(&result, 0.0));
     }
-    Answer { result, touching }
+    Answer {
+        result,
+        touching,
+        apart_by: None,
+    }
 }
 
 /// The normal A→B of two world boxes: along their gap when they are apart, else along the

@@ -16,6 +16,7 @@
 //! | [`contacts_mesh_mesh`] | every intersecting triangle pair, with its intersection segment and a normal | when the sink says so |
 //! | [`distance_mesh_mesh`] | smallest triangle–triangle distance, witnesses, error bound | at distance 0 |
 //! | [`within_distance_mesh_mesh`] | is the distance at most `d`? | at the first pair within `d` |
+//! | [`proximity_mesh_mesh`] | the same, and a lower bound of the distance when not | at the first pair within `d` |
 //!
 //! Meshes are surfaces here: a mesh wholly inside a closed mesh does not intersect it, and
 //! the distance of intersecting meshes is `0.0`, not a penetration depth.
@@ -31,7 +32,9 @@ mod collide;
 mod distance;
 
 pub use collide::{contacts_mesh_mesh, intersects_mesh_mesh};
-pub use distance::{distance_mesh_mesh, rounding_bound, within_distance_mesh_mesh};
+pub use distance::{
+    Proximity, distance_mesh_mesh, proximity_mesh_mesh, rounding_bound, within_distance_mesh_mesh,
+};
 
 use crate::bvh::Bvh;
 use crate::bvh::tandem::RankedPair;
