@@ -21,7 +21,8 @@
 //! 1. every node's volume contains every vertex of every triangle in its subtree (this, not
 //!    "child volume inside parent volume", is what traversal relies on: a fitted child OBB
 //!    may poke out of its parent's box while both enclose the same triangles);
-//! 2. every triangle slot belongs to exactly one leaf, and `triangle_ids` is a permutation;
+//! 2. every triangle slot belongs to exactly one leaf, `triangle_ids` is a permutation and
+//!    `triangle_slots` its inverse;
 //! 3. children come after their parent, in range, adjacent; every node but the root has
 //!    exactly one parent; leaves hold `1 ..= leaf_size` triangles.
 
@@ -93,6 +94,8 @@ pub struct Bvh<B> {
     triangles: Vec<Triangle>,
     /// Leaf slot → index of the triangle in the input.
     triangle_ids: Vec<u32>,
+    /// Index of the triangle in the input → leaf slot: the inverse of `triangle_ids`.
+    triangle_slots: Vec<u32>,
     leaf_size: u32,
 }
 
@@ -150,10 +153,14 @@ impl<B> Bvh<B> {
         self.triangle_ids[slot]
     }
 
-    /// The leaf slot of input triangle `id`, if any (linear search; for tests and tools).
+    /// The leaf slot of input triangle `id`, if the mesh has one (`O(1)`: the frontier
+    /// looks up its seed triangles this way every frame).
     #[must_use]
+    #[inline]
     pub fn slot_of(&self, id: u32) -> Option<usize> {
-        self.triangle_ids.iter().position(|&t| t == id)
+        self.triangle_slots
+            .get(id as usize)
+            .map(|&slot| slot as usize)
     }
 
     /// Number of triangles.

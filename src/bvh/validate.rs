@@ -18,7 +18,8 @@ pub enum BvhError {
     BadLeaf { node: usize, count: usize },
     /// Triangle slot `slot` is owned by no leaf or by several.
     SlotCoverage { slot: usize },
-    /// The slot → triangle map is not a permutation (triangle `id` is missing or repeated).
+    /// The slot → triangle map is not a permutation (triangle `id` is missing or repeated),
+    /// or the triangle → slot map is not its inverse at `id`.
     NotAPermutation { id: usize },
     /// A node's recorded span disagrees with the slots of the leaves beneath it.
     BadSpan { node: usize },
@@ -40,7 +41,12 @@ impl fmt::Display for BvhError {
             Self::SlotCoverage { slot } => {
                 write!(f, "triangle slot {slot} is not in exactly one leaf")
             }
-            Self::NotAPermutation { id } => write!(f, "triangle {id} is missing or repeated"),
+            Self::NotAPermutation { id } => {
+                write!(
+                    f,
+                    "triangle {id} is missing, repeated or mapped to another slot"
+                )
+            }
             Self::BadSpan { node } => {
                 write!(f, "node {node} has a span that disagrees with its leaves")
             }
@@ -69,6 +75,7 @@ impl<B: BoundingVolume> Bvh<B> {
             || n_slots == 0
             || self.spans.len() != n_nodes
             || self.triangle_ids.len() != n_slots
+            || self.triangle_slots.len() != n_slots
         {
             return Err(BvhError::Empty);
         }
@@ -77,6 +84,11 @@ impl<B: BoundingVolume> Bvh<B> {
             let id = id as usize;
             if id >= n_slots || std::mem::replace(&mut seen[id], true) {
                 return Err(BvhError::NotAPermutation { id });
+            }
+        }
+        for (slot, &id) in self.triangle_ids.iter().enumerate() {
+            if self.triangle_slots[id as usize] as usize != slot {
+                return Err(BvhError::NotAPermutation { id: id as usize });
             }
         }
         let mut reached = vec![0u32; n_nodes];
@@ -179,6 +191,14 @@ mod tests {
         bad.triangle_ids[1] = bad.triangle_ids[0];
         let id = bad.triangle_ids[0] as usize;
         assert_eq!(bad.validate(), Err(BvhError::NotAPermutation { id }));
+
+        let mut bad = bvh.clone();
+        bad.triangle_slots.swap(0, 1);
+        assert!(matches!(
+            bad.validate(),
+            Err(BvhError::NotAPermutation { id: 0 | 1 })
+        ));
+        assert_eq!(bvh.slot_of(bvh.triangle_ids[2]), Some(2));
 
         let mut bad = bvh.clone();
         bad.nodes[0].first = 0;

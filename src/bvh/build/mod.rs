@@ -166,7 +166,17 @@ pub(crate) fn fit_topology<B: BoundingVolume>(
         nodes,
         spans: topology.nodes.iter().map(|n| n.span).collect(),
         triangles: ordered,
+        triangle_slots: inverse_permutation(&topology.order),
         triangle_ids: topology.order.clone(),
         leaf_size,
     }
+}
+
+/// The inverse of the permutation `order` of `0..order.len()` (slot → id gives id → slot).
+fn inverse_permutation(order: &[u32]) -> Vec<u32> {
+    let mut inverse = vec![0; order.len()];
+    for (slot, &id) in order.iter().enumerate() {
+        inverse[id as usize] = slot as u32;
+    }
+    inverse
 }
