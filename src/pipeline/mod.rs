@@ -800,13 +800,20 @@ fn mark_separated(scene: &Scene, query: Query, workspace: &mut PipelineWorkspace
     } = workspace;
     separations.retain(|pair, _| candidates.binary_search(pair).is_ok());
     separated.clear();
+    if query.distance || separations.is_empty() {
+        // Nothing to look up (a scene without mesh pairs never gets here with a
+        // separation): one pass of `false`.
+        separated.resize(candidates.len(), false);
+        return;
+    }
     separated.extend(candidates.iter().map(|pair| {
+        let Some(separation) = separations.get(pair) else {
+            return false;
+        };
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        !query.distance
-            && !kept.get(pair).is_some_and(|k| k.fits(scene, pair, query))
-            && separations
-                .get(pair)
-                .and_then(|s| s.lower_bound_now(scene, (a, b)))
+        !kept.get(pair).is_some_and(|k| k.fits(scene, pair, query))
+            && separation
+                .lower_bound_now(scene, (a, b))
                 .is_some_and(|bound| bound > a.margin + b.margin)
     }));
 }
