@@ -72,27 +72,29 @@ pub(super) fn relative_drift(then: &Pose, now: &Pose, reach_a: f64, reach_b: f64
 mod tests {
     use super::*;
     use crate::math::DQuat;
+    use crate::test_support::{TestRng, point_in_cube, rng};
+    use rand::Rng;
 
-    /// A small seeded generator (tests only).
-    struct Lcg(u64);
-    impl Lcg {
-        fn unit(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn vector(&mut self, half: f64) -> DVec3 {
-            DVec3::new(self.unit(), self.unit(), self.unit()) * (2.0 * half) - half
-        }
-        fn pose(&mut self, half: f64, max_angle: f64) -> Pose {
-            let axis = self.vector(1.0).normalize_or(DVec3::Z);
-            Pose::new(
-                self.vector(half),
-                DQuat::from_axis_angle(axis, max_angle * self.unit()),
-            )
-        }
+    /// A pose within `half` of the origin, turned by up to `max_angle` about a random axis.
+    fn pose(rng: &mut TestRng, half: f64, max_angle: f64) -> Pose {
+        let axis = point_in_cube(rng, 1.0).normalize_or(DVec3::Z);
+        let angle = rng.random_range(0.0..max_angle);
+        Pose::new(
+            point_in_cube(rng, half),
+            DQuat::from_axis_angle(axis, angle),
+        )
+    }
+
+    /// A point within `reach` of the origin, on the sphere of that radius half of the time
+    /// (where the bound is reached).
+    fn point_within(rng: &mut TestRng, reach: f64) -> DVec3 {
+        let v = point_in_cube(rng, 1.0).clamp_length_max(1.0);
+        reach
+            * if rng.random_bool(0.5) {
+                v.normalize_or(DVec3::X)
+            } else {
+                v
+            }
     }
 
     /// The distance between any point of A and any point of B (within their reaches)
@@ -100,29 +102,25 @@ mod tests {
     /// bound is not loose: in most cases some sampled point pair shrinks by half of it.
     #[test]
     fn no_two_points_come_closer_than_the_drift_allows() {
-        let mut rng = Lcg(7);
+        let mut rng = rng(7);
         let mut tight = 0;
         for case in 0..3000 {
-            let (reach_a, reach_b) = (2.0 * rng.unit(), 2.0 * rng.unit());
-            let then = rng.pose(3.0, 3.0);
-            let small = case % 2 == 0;
-            let (half, angle) = if small { (0.05, 0.05) } else { (1.0, 3.0) };
-            let now = then.compose(&rng.pose(half, angle));
+            let (reach_a, reach_b) = (rng.random_range(0.0..2.0), rng.random_range(0.0..2.0));
+            let then = pose(&mut rng, 3.0, 3.0);
+            let (half, angle) = if case % 2 == 0 {
+                (0.05, 0.05)
+            } else {
+                (1.0, 3.0)
+            };
+            let now = then.compose(&pose(&mut rng, half, angle));
             let drift = relative_drift(&then, &now, reach_a, reach_b);
             let mut largest: f64 = 0.0;
             for _ in 0..200 {
-                // A point of A (A's frame) and one of B (B's frame), each within its reach;
-                // points on the reach sphere half of the time, where the bound is reached.
-                let mut within = |reach: f64| {
-                    let v = rng.vector(1.0).clamp_length_max(1.0);
-                    reach
-                        * if rng.unit() < 0.5 {
-                            v.normalize_or(DVec3::X)
-                        } else {
-                            v
-                        }
-                };
-                let (x, y) = (within(reach_a), within(reach_b));
+                // A point of A (A's frame) and one of B (B's frame).
+                let (x, y) = (
+                    point_within(&mut rng, reach_a),
+                    point_within(&mut rng, reach_b),
+                );
                 let shrink =
                     (x - then.transform_point(y)).length() - (x - now.transform_point(y)).length();
                 assert!(shrink <= drift, "case {case}: {shrink} beyond {drift}");
@@ -139,9 +137,9 @@ mod tests {
     /// No motion, no drift (to the rounding pad).
     #[test]
     fn a_pair_that_did_not_move_relative_to_each_other_has_no_drift() {
-        let mut rng = Lcg(3);
+        let mut rng = rng(3);
         for _ in 0..100 {
-            let pose = rng.pose(5.0, 3.0);
+            let pose = pose(&mut rng, 5.0, 3.0);
             let drift = relative_drift(&pose, &pose, 1.0, 2.0);
             assert!((0.0..1e-9).contains(&drift), "{drift}");
         }
