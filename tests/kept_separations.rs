@@ -114,10 +114,7 @@ fn frames_answered_from_kept_separations_equal_fresh_frames() {
                 "a fresh workspace has no separation"
             );
             assert!(report.separated_pairs <= report.candidates);
-            if query.distance {
-                assert_eq!(report.separated_pairs, 0, "{query:?} frame {frame}");
-                continue;
-            }
+            scene.end_frame();
             // Every candidate here is a mesh pair: each is answered by reuse, by a kept
             // separation or by a query on its path.
             let traversed = report.paths.mesh_mesh;
@@ -126,10 +123,13 @@ fn frames_answered_from_kept_separations_equal_fresh_frames() {
                 report.candidates,
                 "{query:?} frame {frame}"
             );
+            if query.distance {
+                assert_eq!(report.separated_pairs, 0, "{query:?} frame {frame}");
+                continue;
+            }
             separated_total += report.separated_pairs;
             traversed_total += traversed;
             frames_with_both += usize::from(report.separated_pairs > 0 && traversed > 0);
-            scene.end_frame();
         }
     }
     assert!(

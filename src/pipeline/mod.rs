@@ -841,14 +841,19 @@ fn run_frontier(
         frontier_run,
         ..
     } = workspace;
-    let needed = |pair: &&CandidatePair| {
-        mesh_pair(scene, pair).is_some()
-            && !kept.get(pair).is_some_and(|k| k.fits(scene, pair, query))
-            && candidates
-                .binary_search(pair)
-                .is_ok_and(|slot| !separated[slot])
+    // The mesh pairs no kept answer or separation answers, in candidate order.
+    let needed = || {
+        candidates
+            .iter()
+            .zip(separated.iter())
+            .filter(|&(pair, &apart)| {
+                !apart
+                    && mesh_pair(scene, pair).is_some()
+                    && !kept.get(pair).is_some_and(|k| k.fits(scene, pair, query))
+            })
+            .map(|(pair, _)| pair)
     };
-    if !candidates.iter().any(|pair| needed(&pair)) {
+    if needed().next().is_none() {
         // Nothing to answer: no run (and nothing left to resume later).
         frontier_pairs.clear();
         frontier_answers.clear();
@@ -856,14 +861,11 @@ fn run_frontier(
         return FrontierStats::default();
     }
     let resume = frontier_run.resumes(scene, query, frontier_pairs, candidates)
-        && candidates
-            .iter()
-            .filter(needed)
-            .all(|pair| frontier_pairs.binary_search(pair).is_ok());
+        && needed().all(|pair| frontier_pairs.binary_search(pair).is_ok());
     if !resume {
         frontier_seeds.retain(|pair, _| candidates.binary_search(pair).is_ok());
         frontier_pairs.clear();
-        frontier_pairs.extend(candidates.iter().filter(needed));
+        frontier_pairs.extend(needed());
         frontier_run.scene = scene.uid();
         frontier_run.query = query;
         frontier_run.versions.clear();
