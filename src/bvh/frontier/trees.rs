@@ -9,7 +9,7 @@ use crate::bvh::Bvh;
 use crate::bvh::tandem::descend_a;
 use crate::math::{Isometry, conservative_slack};
 use crate::narrow::distance_triangle_triangle;
-use crate::narrow::mesh_mesh::rounding_bound;
+use crate::narrow::mesh_mesh::{precedes_in_ties, rounding_bound};
 
 /// One mesh pair of the frame.
 #[derive(Debug, Clone, Copy)]
@@ -169,12 +169,13 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
             for sa in x.slots() {
                 let d = distance_triangle_triangle(&ta[sa], &tri_b);
                 tests += 1;
-                if d.distance < *best {
+                let ids = || [self.a.triangle_id(sa), self.b.triangle_id(sb)];
+                if replaces_closest(d.distance, ids, *best, witnesses.as_ref()) {
                     *best = d.distance;
                     *witnesses = Some(FrontierWitnesses {
                         point_a: d.point_a,
                         point_b: d.point_b,
-                        triangles: [self.a.triangle_id(sa), self.b.triangle_id(sb)],
+                        triangles: ids(),
                     });
                 }
             }
@@ -237,6 +238,20 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
     ) -> u64 {
         self.trees().test_leaves(nodes, best, witnesses)
     }
+}
+
+/// Whether a triangle pair at `distance` (its ids from `ids`) replaces the closest found so
+/// far (`best`, named by `witnesses`): closer, or as close and first in
+/// [`precedes_in_ties`]'s order, as in every exact distance query.
+#[inline]
+pub(super) fn replaces_closest(
+    distance: f64,
+    ids: impl Fn() -> [u32; 2],
+    best: f64,
+    witnesses: Option<&FrontierWitnesses>,
+) -> bool {
+    distance < best
+        || (distance == best && witnesses.is_some_and(|w| precedes_in_ties(ids(), w.triangles)))
 }
 
 /// An upper bound of the distance between the geometry bounded by `x` (frame A) and by `y`

@@ -13,6 +13,11 @@ use std::ops::ControlFlow;
 /// The smallest distance between the triangles of `a` and of `b` placed at `pose_ab`, with
 /// witness points in A's frame, by branch and bound over the two trees.
 ///
+/// Of triangle pairs at the same smallest distance (a closest point on an edge or vertex
+/// that several triangles share), the one named first by [`precedes_in_ties`] is reported, so the
+/// witnesses do not depend on the order of the search (nor on the tree type); intersecting
+/// meshes report the first intersecting pair found.
+///
 /// With [`DistanceParams::EXACT`] the distance is the brute-force minimum over all
 /// triangle pairs (to rounding, stated in `error_bound`); looser params let the search stop
 /// once nothing untried can improve the answer by more than the tolerance. `cache` holds the
@@ -54,7 +59,14 @@ pub fn distance_mesh_mesh<B: BoundingVolume>(
             for sb in b.nodes()[lb].slots() {
                 for sa in a.nodes()[la].slots() {
                     let d = pair_distance(sa, sb);
-                    if d.distance < closest.0.distance {
+                    let [ca, cb] = closest.1;
+                    if d.distance < closest.0.distance
+                        || (d.distance == closest.0.distance
+                            && precedes_in_ties(
+                                [a.triangle_id(sa), b.triangle_id(sb)],
+                                [a.triangle_id(ca), b.triangle_id(cb)],
+                            ))
+                    {
                         closest = (d, [sa, sb]);
                     }
                 }
@@ -181,4 +193,106 @@ pub fn rounding_bound<B: BoundingVolume>(a: &Bvh<B>, b: &Bvh<B>, iso: &Isometry)
     conservative_slack(
         reach(a.root_bv()) + reach(b.root_bv()) + iso.translation.abs().max_element(),
     )
+}
+
+/// Whether the triangle pair `x` (triangle ids of A, of B) comes before `y` in the order
+/// that breaks ties between triangle pairs at the same distance: by A's id, then B's.
+/// Every exact distance query breaks ties this way (this one and the budgeted frontier),
+/// so they report the same witnesses.
+#[must_use]
+#[inline]
+pub fn precedes_in_ties(x: [u32; 2], y: [u32; 2]) -> bool {
+    x < y
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bounding::{Obb, Rss};
+    use crate::bvh::BuildParams;
+    use crate::bvh::frontier::{FrontierPair, FrontierWorkspace, Unlimited, query_frontier};
+    use crate::geometry::Triangle;
+    use crate::math::DVec3;
+
+    /// A flat fan of four triangles around the origin, and a triangle whose lowest vertex is
+    /// 1 m above the origin: its closest point is the vertex every fan triangle shares, so
+    /// the four triangle pairs tie exactly.
+    fn tied_fan() -> (Vec<Triangle>, Vec<Triangle>) {
+        let rim = [DVec3::X, DVec3::Y, -DVec3::X, -DVec3::Y];
+        let fan = (0..4)
+            .map(|i| Triangle::new(DVec3::ZERO, rim[i], rim[(i + 1) % 4]))
+            .collect();
+        let above = vec![Triangle::new(
+            DVec3::Z,
+            DVec3::new(0.5, 0.5, 2.0),
+            DVec3::new(-0.5, 0.5, 2.0),
+        )];
+        (fan, above)
+    }
+
+    /// Whichever tied pair a search meets first (here: whichever it is warm-started from),
+    /// every exact distance query reports the one [`precedes_in_ties`] names first, with
+    /// the same witnesses: `distance_mesh_mesh` on box and rectangle-swept-sphere trees,
+    /// and the budgeted frontier seeded with each tied pair.
+    #[test]
+    fn tied_closest_pairs_are_reported_the_same_whatever_the_search_order() {
+        let (fan, above) = tied_fan();
+        let distances: Vec<f64> = fan
+            .iter()
+            .map(|t| crate::narrow::distance_triangle_triangle(t, &above[0]).distance)
+            .collect();
+        assert!(distances.iter().all(|&d| d == 1.0), "{distances:?}");
+        let expected = {
+            let d = crate::narrow::distance_triangle_triangle(&fan[0], &above[0]);
+            (d.point_a, d.point_b, [0, 0])
+        };
+        fn check<B: BoundingVolume>(
+            fan: &[Triangle],
+            above: &[Triangle],
+            expected: (DVec3, DVec3, [u32; 2]),
+        ) {
+            let params = BuildParams::MEDIAN;
+            let (a, b) = (
+                Bvh::<B>::from_triangles(fan, &params),
+                Bvh::<B>::from_triangles(above, &params),
+            );
+            for start in 0..fan.len() {
+                let slot = a.slot_of(start as u32).expect("a triangle of the fan");
+                let mut cache = DistanceCache {
+                    slots: Some([slot as u32, 0]),
+                };
+                let d = distance_mesh_mesh(
+                    &a,
+                    &b,
+                    &Pose::IDENTITY,
+                    &DistanceParams::EXACT,
+                    &mut cache,
+                    &mut MeshMeshWorkspace::new(),
+                );
+                assert_eq!(d.distance, 1.0);
+                assert_eq!(
+                    (d.point_a, d.point_b, d.triangles),
+                    expected,
+                    "from {start}"
+                );
+                let pair = FrontierPair {
+                    a: &a,
+                    b: &b,
+                    pose_ab: Isometry::IDENTITY,
+                    threshold: 2.0,
+                    seed: Some([start as u32, 0]),
+                };
+                let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+                assert!(query_frontier(&[pair], &mut Unlimited, &mut ws, &mut out));
+                let w = out[0].witnesses.expect("within the threshold");
+                assert_eq!(
+                    (w.point_a, w.point_b, w.triangles),
+                    expected,
+                    "seed {start}"
+                );
+            }
+        }
+        check::<Obb>(&fan, &above, expected);
+        check::<Rss>(&fan, &above, expected);
+    }
 }

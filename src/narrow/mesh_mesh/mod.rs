@@ -33,7 +33,8 @@ mod distance;
 
 pub use collide::{contacts_mesh_mesh, intersects_mesh_mesh};
 pub use distance::{
-    Proximity, distance_mesh_mesh, proximity_mesh_mesh, rounding_bound, within_distance_mesh_mesh,
+    Proximity, distance_mesh_mesh, precedes_in_ties, proximity_mesh_mesh, rounding_bound,
+    within_distance_mesh_mesh,
 };
 
 use crate::bvh::Bvh;
