@@ -434,8 +434,10 @@ pub struct PipelineWorkspace {
     frontier_answers: Vec<FrontierAnswer>,
     /// The candidate pairs the frontier answered this frame, in its order.
     frontier_pairs: Vec<CandidatePair>,
-    /// Per mesh–mesh candidate, the triangle ids of the closest triangle pair a budgeted
-    /// frame's frontier found: next frame's first upper bound under `DISTANCE`.
+    /// Per mesh–mesh candidate a budgeted frame's frontier found within its threshold, the
+    /// triangle ids of its closest triangle pair found, kept until it is proven apart:
+    /// next frame's seed ([`crate::bvh::frontier::FrontierPair::seed`]), and first upper
+    /// bound under `DISTANCE`.
     frontier_seeds: HashMap<CandidatePair, [u32; 2]>,
     /// What the frontier last ran over, to resume it next frame.
     frontier_run: FrontierRun,
@@ -605,6 +607,7 @@ pub fn step_within(
         toi_candidates,
         frontier_answers,
         frontier_pairs,
+        frontier_seeds,
         ..
     } = workspace;
     mesh_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
@@ -727,6 +730,7 @@ pub fn step_within(
             match answer.apart_by {
                 Some(bound) => {
                     separations.insert(*pair, Separation::new(scene, (a, b), bound));
+                    frontier_seeds.remove(pair);
                 }
                 None => {
                     separations.remove(pair);
@@ -903,9 +907,18 @@ fn run_frontier(
         },
     );
     frontier.answers(pairs, frontier_answers);
+    // A pair's seed is a proof of closeness (a triangle pair within its threshold), kept
+    // while the pair may be close: the next frame tests it first and, while it holds or
+    // until the undecided pairs are settled, spends nothing more on the pair.
     for (pair, answer) in frontier_pairs.iter().zip(frontier_answers.iter()) {
-        if let Some(w) = answer.witnesses {
-            frontier_seeds.insert(*pair, w.triangles);
+        match answer.witnesses {
+            Some(w) if answer.distance_upper.is_some_and(|d| d <= answer.threshold) => {
+                frontier_seeds.insert(*pair, w.triangles);
+            }
+            _ if !answer.maybe_close => {
+                frontier_seeds.remove(pair);
+            }
+            _ => {}
         }
     }
     let after = *frontier.stats();

@@ -13,13 +13,11 @@
 //! [`FrontierWorkspace::start`] puts one root entry per pair on the frontier (round 1).
 //! A round takes the entries of the frontier in increasing order of their distance lower
 //! bound (ties by pair index, then node of A, then node of B: deterministic), and for each
-//! (unless the stage sets it aside, below):
-//! - a root entry first gets its own bound ([`BoundingVolume::distance_lower_bound_within`](crate::bounding::BoundingVolume::distance_lower_bound_within),
-//!   one *visit*); when it is within the threshold and the pair has no best distance yet
-//!   (no [`FrontierPair::seed`]), a greedy `probe` descends once to a leaf pair and tests
-//!   it, so the rounds prune with a real distance from the start (the warm start of the
-//!   depth-first queries; a touching pair whose probe finds intersecting triangles is then
-//!   exact);
+//! (unless a stage or the deciding phase sets it aside, below):
+//! - a root entry, the first time, gets its own bound ([`BoundingVolume::distance_lower_bound_within`](crate::bounding::BoundingVolume::distance_lower_bound_within),
+//!   one *visit*) and, when it is within the threshold and the pair has a
+//!   [`FrontierPair::seed`], the seed's triangle test (one visit); then, unless the pair
+//!   waits (below), a pair not yet proven close is searched by its *probe* (below);
 //! - an entry whose bound exceeds `threshold` is dropped (that part is proven apart); one
 //!   whose bound is not below the pair's best exact distance so far is dropped too (it
 //!   cannot improve the minimum; no visit);
@@ -36,6 +34,39 @@
 //! truncated answer's lower bound is the tightest the visits made so far give. A root entry
 //! stands at bound `0` until it is processed.
 //!
+//! # The probe
+//! A pair's question has two parts: *is it within the threshold*, and *how close*. A
+//! touching pair's volumes overlap all the way down, so the rounds reach a triangle pair
+//! that proves it close only near the leaves, after visiting most of the overlap. The probe
+//! finds one sooner: a depth-first search from the root entry, each step one entry as the
+//! rounds process it (children dropped by the same rules; the child with the smaller bound
+//! searched first, on a tie the one with the smaller upper bound, which for overlapping
+//! volumes is the deeper overlap). It ends as soon as a triangle pair within the threshold
+//! is found, or after [`PROBE_VISITS`] visits; the entries left on its stack join the next
+//! round, so a probe's visits are never lost: for a pair that is apart, they are part of
+//! the proof. Steps are polled like entries, and a run stopped inside a probe resumes it.
+//!
+//! # Decide first
+//! Only the first part changes which pairs a frame reports, so the undecided pairs are
+//! settled first: while any entry of a pair not proven close is waiting (the *deciding*
+//! phase), the entries of pairs proven close (a triangle pair within the threshold found)
+//! wait in a list of their own, and so do the roots of pairs *expected* close: pairs that
+//! came with a seed that is no longer within the threshold (the seed was last frame's
+//! proof). When no other entry is left, the waiting entries are refined (from the first
+//! stage, below), an expected pair's root starting with its probe. This changes the order
+//! of work only: the answers are read from every waiting entry alike.
+//!
+//! A seed is worth keeping only as a proof: the pipeline keeps a pair's witnesses as its
+//! next seed only when they are within its threshold, and drops it once the pair is proven
+//! apart (a seed of a pair found apart would cost a triangle test every frame for
+//! nothing). Measured on `examples/time_vs_error --scene robot-chain` (counted budgets, 300
+//! frames, a chain of links touching each other and a room): the seeds of touching pairs
+//! still held the next frame in 87–93 % of the frames, and touching pairs had taken 55–69 %
+//! of every budget before; precision of the reported close pairs went 0.67 → 0.83 at 200
+//! visits, 0.85 → 0.94 at 400 and 0.92 → 0.97 at 800. An earlier attempt set aside the
+//! pairs proven close without the probe, while seeds were last frame's closest pair found,
+//! close or not: touching pairs were then hardly ever proven close, and nothing changed.
+//!
 //! # Stages by width
 //! Plain rounds give every pair one more level per round, so a wide pair (a link deep
 //! inside an environment mesh, whose volumes overlap it for many levels) takes most of each
@@ -49,14 +80,12 @@
 //! are settled first and the wide ones still degrade together. A set-aside entry keeps its
 //! bound and depth: the answers read it like any waiting entry.
 //!
-//! Measured (`examples/time_vs_error --scene robot-chain`, 300 frames, three alternating
-//! runs each): precision of the reported close pairs 0.79–0.84 with plain rounds and
-//! 0.914–0.915 in stages at 100 µs, 0.88 and 0.96 at 200 µs, 0.64–0.67 and 0.74–0.78 at
-//! 50 µs. The mesh pile, where the pairs are alike, measured the same either way. Measured
-//! and not kept: setting aside the entries of pairs already proven close (a triangle pair
-//! within the threshold found), to spend the budget on the pairs still open first: no
-//! change (0.83 and 0.82 at 100 µs); nor did any order *within* a round (smallest or largest
-//! bound first, fewest entries per pair first, pair order: 0.81–0.82 at 100 µs).
+//! Measured before the probe and the deciding phase (`examples/time_vs_error --scene
+//! robot-chain`, 300 frames, three alternating runs each): precision of the reported close
+//! pairs 0.79–0.84 with plain rounds and 0.914–0.915 in stages at 100 µs, 0.88 and 0.96 at
+//! 200 µs, 0.64–0.67 and 0.74–0.78 at 50 µs. The mesh pile, where the pairs are alike,
+//! measured the same either way. No order *within* a round changed anything (smallest or
+//! largest bound first, fewest entries per pair first, pair order: 0.81–0.82 at 100 µs).
 //!
 //! The [`Budget`] is polled between entries once at least `poll_every` visits (default
 //! [`DEFAULT_POLL_EVERY`]) were made since the last poll, never inside an entry (so never
@@ -144,7 +173,17 @@ use std::cmp::Ordering;
 use std::time::Instant;
 
 /// Visits between two budget polls unless set with [`FrontierWorkspace::with_poll_every`].
-pub const DEFAULT_POLL_EVERY: u64 = 32;
+///
+/// A poll of a [`Deadline`] reads the clock (about 25 ns); a visit costs 0.1 µs (a volume
+/// bound) to 0.5 µs (a triangle test). Measured with `examples/time_vs_error --scene
+/// robot-chain` (300 frames, two runs each), once probes made a larger share of the visits
+/// triangle tests: polling every 32 visits, 28–41 frames of a 75 µs budget and 103–126 of
+/// a 50 µs one ended past the deadline; every 8, 11 and 45–50, with the same precision.
+pub const DEFAULT_POLL_EVERY: u64 = 8;
+
+/// Most visits of a pair's depth-first probe for a triangle pair within its threshold
+/// (module docs, "The probe").
+pub const PROBE_VISITS: u64 = 64;
 
 /// How much work the frontier may still do, polled between bounded batches of visits.
 pub trait Budget {
@@ -351,6 +390,21 @@ struct PairState {
     root_upper: f64,
     /// Rounding of a triangle distance at this pair's scale.
     rounding: f64,
+    /// Whether the root entry's bound and the seed were computed.
+    root_done: bool,
+    /// Whether the pair came with a seed ([`FrontierPair::seed`]): it is expected close,
+    /// and waits with the decided pairs even when the seed is no longer within the
+    /// threshold.
+    expected_close: bool,
+}
+
+impl PairState {
+    /// Whether the pair is proven within its threshold (a triangle pair within it found):
+    /// only its distance is left to refine.
+    #[inline]
+    fn is_decided_close(&self) -> bool {
+        self.best <= self.threshold
+    }
 }
 
 /// Entries of one pair in a round that the first stage of
@@ -370,6 +424,15 @@ pub struct FrontierWorkspace {
     next: Vec<Entry>,
     /// Entries set aside by the current stage ([`RoundOrder::CheapestPairsFirst`]).
     set_aside: Vec<Entry>,
+    /// While `deciding`: the entries of pairs proven close, and the roots of pairs
+    /// expected close, waiting for the undecided pairs to be settled.
+    later: Vec<Entry>,
+    /// Whether the undecided pairs are still being settled (module docs, "Decide first").
+    deciding: bool,
+    /// The depth-first probe under way: its stack (the last entry is searched next).
+    probe: Vec<Entry>,
+    /// The probe ends once `stats.visits` reaches this.
+    probe_until: u64,
     /// Entries of one pair in a round above which its entries are set aside (`u32::MAX`
     /// for the orders without stages, which set nothing aside).
     cap: u32,
@@ -436,6 +499,10 @@ impl FrontierWorkspace {
             cursor: 0,
             next: Vec::new(),
             set_aside: Vec::new(),
+            later: Vec::new(),
+            deciding: true,
+            probe: Vec::new(),
+            probe_until: 0,
             cap: u32::MAX,
             round_entries: Vec::new(),
             pairs: Vec::new(),
@@ -457,10 +524,10 @@ impl FrontierWorkspace {
         self.current.clear();
         self.next.clear();
         self.set_aside.clear();
-        self.cap = match self.order {
-            RoundOrder::CheapestPairsFirst => FIRST_CAP,
-            _ => u32::MAX,
-        };
+        self.later.clear();
+        self.deciding = true;
+        self.probe.clear();
+        self.cap = self.first_cap();
         self.cursor = 0;
         self.pairs.clear();
         self.stats = FrontierStats::default();
@@ -470,21 +537,16 @@ impl FrontierWorkspace {
             let threshold = p.threshold();
             debug_assert!(threshold >= 0.0, "threshold {threshold} of pair {i}");
             let (root_upper, rounding) = p.root_bounds();
-            let mut state = PairState {
+            self.pairs.push(PairState {
                 threshold,
                 best: f64::INFINITY,
                 witnesses: None,
                 floor: f64::INFINITY,
                 root_upper,
                 rounding,
-            };
-            if let Some((distance, witnesses)) = p.seed_distance() {
-                self.stats.visits += 1;
-                self.stats.triangle_tests += 1;
-                state.best = distance;
-                state.witnesses = Some(witnesses);
-            }
-            self.pairs.push(state);
+                root_done: false,
+                expected_close: false,
+            });
             self.current.push(Entry {
                 bound: 0.0,
                 pair: i as u32,
@@ -502,18 +564,9 @@ impl FrontierWorkspace {
     pub fn run<P: PairTrees, T: Budget + ?Sized>(&mut self, pairs: &[P], budget: &mut T) -> bool {
         debug_assert_eq!(pairs.len(), self.pairs.len(), "pairs differ from start");
         loop {
-            if self.cursor == self.current.len() {
-                if self.next.is_empty() {
-                    if self.set_aside.is_empty() {
-                        return true;
-                    }
-                    // The next stage: the set-aside entries, a wider cap.
-                    std::mem::swap(&mut self.next, &mut self.set_aside);
-                    self.cap = self.cap.saturating_mul(2);
-                }
-                std::mem::swap(&mut self.current, &mut self.next);
-                self.next.clear();
-                self.begin_round();
+            let probing = !self.probe.is_empty();
+            if !probing && self.cursor == self.current.len() && !self.next_round() {
+                return true;
             }
             if self.stats.visits >= self.next_poll {
                 self.stats.polls += 1;
@@ -522,8 +575,18 @@ impl FrontierWorkspace {
                 }
                 self.next_poll = self.stats.visits + self.poll_every;
             }
+            if probing {
+                let entry = self.probe.pop().expect("probing");
+                self.probe_step(&pairs[entry.pair as usize], entry);
+                continue;
+            }
             let entry = self.current[self.cursor];
             self.cursor += 1;
+            let state = &self.pairs[entry.pair as usize];
+            if self.deciding && state.root_done && state.is_decided_close() {
+                self.later.push(entry);
+                continue;
+            }
             if self.cap != u32::MAX && self.round_entries[entry.pair as usize] > self.cap {
                 self.set_aside.push(entry);
                 continue;
@@ -532,10 +595,43 @@ impl FrontierWorkspace {
         }
     }
 
+    /// Begins the next round when the current one is done: the entries created by the
+    /// last; when none, the next stage (the set-aside entries, a wider cap); when none,
+    /// the end of deciding (the waiting decided pairs, from the first cap). Returns `false`
+    /// when nothing is left.
+    fn next_round(&mut self) -> bool {
+        if self.next.is_empty() {
+            if self.set_aside.is_empty() {
+                if self.later.is_empty() {
+                    return false;
+                }
+                // Every undecided pair is settled: the decided ones are refined now.
+                self.deciding = false;
+                std::mem::swap(&mut self.set_aside, &mut self.later);
+                self.cap = self.first_cap();
+            } else {
+                self.cap = self.cap.saturating_mul(2);
+            }
+            std::mem::swap(&mut self.next, &mut self.set_aside);
+        }
+        std::mem::swap(&mut self.current, &mut self.next);
+        self.next.clear();
+        self.begin_round();
+        true
+    }
+
+    /// The cap of a stage's first round (`u32::MAX`: no stages).
+    fn first_cap(&self) -> u32 {
+        match self.order {
+            RoundOrder::CheapestPairsFirst => FIRST_CAP,
+            _ => u32::MAX,
+        }
+    }
+
     /// Whether nothing is left on the frontier (every answer is Exact).
     #[must_use]
     pub fn is_finished(&self) -> bool {
-        self.cursor == self.current.len() && self.next.is_empty() && self.set_aside.is_empty()
+        self.waiting() == 0
     }
 
     /// Counters since [`start`](Self::start).
@@ -553,7 +649,11 @@ impl FrontierWorkspace {
     /// Entries still waiting (live or not).
     #[must_use]
     pub fn waiting(&self) -> usize {
-        self.current.len() - self.cursor + self.next.len() + self.set_aside.len()
+        self.current.len() - self.cursor
+            + self.next.len()
+            + self.set_aside.len()
+            + self.later.len()
+            + self.probe.len()
     }
 
     /// The answer for every pair, in order, into `out` (cleared first); see the
@@ -572,8 +672,12 @@ impl FrontierWorkspace {
             error_bound: s.root_upper,
             threshold: s.threshold,
         }));
-        let waiting = self.current[self.cursor..].iter();
-        for e in waiting.chain(&self.next).chain(&self.set_aside) {
+        let waiting = self.current[self.cursor..].iter().chain(&self.next);
+        for e in waiting
+            .chain(&self.set_aside)
+            .chain(&self.later)
+            .chain(&self.probe)
+        {
             let state = &self.pairs[e.pair as usize];
             if !is_live(e.bound, state) {
                 continue;
@@ -623,13 +727,14 @@ impl FrontierWorkspace {
     }
 
     /// Processes one entry (see the module docs); bounded work: one bound, two child
-    /// bounds or one leaf pair's triangle tests, and for a live root without a best
-    /// distance its [`probe`] (one descent).
+    /// bounds or one leaf pair's triangle tests; a root's first processing adds the seed's
+    /// triangle test, and may begin a probe.
     fn process<P: PairTrees>(&mut self, pair: &P, mut entry: Entry) {
         let state = &mut self.pairs[entry.pair as usize];
         let nodes = [entry.a, entry.b];
         let leaves = pair.are_leaves(nodes);
-        if entry.depth == 0 {
+        if entry.depth == 0 && !state.root_done {
+            state.root_done = true;
             entry.bound = pair.bound(nodes, state.threshold);
             self.stats.visits += 1;
             self.stats.bv_tests += 1;
@@ -637,8 +742,16 @@ impl FrontierWorkspace {
                 state.floor = state.floor.min(entry.bound);
                 return;
             }
-            if state.best.is_infinite() && !leaves {
-                probe(pair, state, &mut self.stats);
+            if let Some((distance, witnesses)) = pair.seed_distance() {
+                self.stats.visits += 1;
+                self.stats.triangle_tests += 1;
+                state.expected_close = true;
+                state.best = distance;
+                state.witnesses = Some(witnesses);
+            }
+            if self.deciding && !leaves && (state.is_decided_close() || state.expected_close) {
+                self.later.push(entry);
+                return;
             }
         }
         if !is_live(entry.bound, state) {
@@ -648,25 +761,77 @@ impl FrontierWorkspace {
             test_leaf_pair(pair, nodes, state, &mut self.stats);
             return;
         }
-        for [ca, cb] in pair.split(nodes) {
-            let limit = state.threshold.min(state.best);
-            let own = pair.bound([ca, cb], limit);
-            self.stats.visits += 1;
-            self.stats.bv_tests += 1;
-            let bound = own.max(entry.bound);
-            if bound > state.threshold {
-                state.floor = state.floor.min(bound);
-            } else if bound < state.best {
-                self.next.push(Entry {
-                    bound,
-                    pair: entry.pair,
-                    a: ca,
-                    b: cb,
-                    depth: entry.depth + 1,
-                });
-            }
+        if entry.depth == 0 && !state.is_decided_close() {
+            // The root of a pair not yet proven close: searched depth first for a proof.
+            self.probe.push(entry);
+            self.probe_until = self.stats.visits + PROBE_VISITS;
+            return;
         }
+        let children = split(pair, state, &mut self.stats, entry);
+        self.next.extend(children.into_iter().flatten());
     }
+
+    /// One step of the probe under way on `entry`, the top of its stack (module docs,
+    /// "The probe"): a leaf pair's triangle tests, or the entry's two children pushed so
+    /// that the one with the smaller bound (on a tie, the smaller upper bound) is searched
+    /// next. Once the pair is proven close or the probe has made [`PROBE_VISITS`] visits,
+    /// the probe ends: this entry and the rest of the stack join the next round.
+    fn probe_step<P: PairTrees>(&mut self, pair: &P, entry: Entry) {
+        let state = &mut self.pairs[entry.pair as usize];
+        if !is_live(entry.bound, state) {
+            return;
+        }
+        if state.is_decided_close() || self.stats.visits >= self.probe_until {
+            self.next.push(entry);
+            self.next.append(&mut self.probe);
+            return;
+        }
+        let nodes = [entry.a, entry.b];
+        if pair.are_leaves(nodes) {
+            test_leaf_pair(pair, nodes, state, &mut self.stats);
+            return;
+        }
+        let [x, y] = split(pair, state, &mut self.stats, entry);
+        // The one searched next goes on top of the stack.
+        let y_first = match (x, y) {
+            (Some(x), Some(y)) if x.bound == y.bound => {
+                pair.upper_bound([y.a, y.b]) < pair.upper_bound([x.a, x.b])
+            }
+            (Some(x), Some(y)) => y.bound < x.bound,
+            _ => false,
+        };
+        let order = if y_first { [x, y] } else { [y, x] };
+        self.probe.extend(order.into_iter().flatten());
+    }
+}
+
+/// The children of `entry` (not a leaf pair) on the side [`PairTrees::split`] chooses, each
+/// with its bound (one visit each; never below its parent's), `None` when dropped: beyond
+/// the threshold (lowering the pair's floor) or unable to beat its best distance.
+fn split<P: PairTrees>(
+    pair: &P,
+    state: &mut PairState,
+    stats: &mut FrontierStats,
+    entry: Entry,
+) -> [Option<Entry>; 2] {
+    let limit = state.threshold.min(state.best);
+    pair.split([entry.a, entry.b]).map(|[a, b]| {
+        stats.visits += 1;
+        stats.bv_tests += 1;
+        let bound = pair.bound([a, b], limit).max(entry.bound);
+        if bound > state.threshold {
+            state.floor = state.floor.min(bound);
+            None
+        } else {
+            (bound < state.best).then_some(Entry {
+                bound,
+                pair: entry.pair,
+                a,
+                b,
+                depth: entry.depth + 1,
+            })
+        }
+    })
 }
 
 /// Tests every triangle pair of the leaf pair `nodes`, one visit each, updating the pair's
@@ -680,35 +845,6 @@ fn test_leaf_pair<P: PairTrees>(
     let tests = pair.test_leaves(nodes, &mut state.best, &mut state.witnesses);
     stats.visits += tests;
     stats.triangle_tests += tests;
-}
-
-/// The greedy probe of a pair with no best distance yet, run when its root entry is found
-/// live: one descent from the roots, always into the child pair with the smaller lower
-/// bound, to a leaf pair whose triangles are all tested (each BV bound and triangle test a
-/// visit). It gives the pair a best distance (a touching pair's intersecting triangles,
-/// most often) that the breadth-first rounds then prune with, as the depth-first queries
-/// prune with their warm start: without it a touching pair stays truncated until the rounds
-/// reach the leaves. Bounded by the trees' depths plus one leaf pair; stops early when both
-/// children are beyond the threshold.
-fn probe<P: PairTrees>(pair: &P, state: &mut PairState, stats: &mut FrontierStats) {
-    let mut nodes = [0, 0];
-    loop {
-        if pair.are_leaves(nodes) {
-            test_leaf_pair(pair, nodes, state, stats);
-            return;
-        }
-        let children = pair.split(nodes);
-        let bounds = children.map(|child| {
-            stats.visits += 1;
-            stats.bv_tests += 1;
-            pair.bound(child, f64::INFINITY)
-        });
-        let pick = usize::from(bounds[1] < bounds[0]);
-        if bounds[pick] > state.threshold {
-            return;
-        }
-        nodes = children[pick];
-    }
 }
 
 /// Runs a fresh frontier over `pairs` under `budget` and writes every pair's answer to
@@ -847,10 +983,10 @@ mod tests {
             assert!(ws.run(&pairs, &mut Unlimited));
             ws.stats().visits
         };
-        // The most one entry costs: a root's bound and its probe (two bounds per level of
-        // one descent, then a leaf pair's 4 × 4 triangle tests), or a bound plus 4 × 4
+        // The most one entry or probe step costs: a root's bound and seed test (and, were
+        // the root a leaf pair, its tests), two child bounds, or a leaf pair's 4 × 4
         // triangle tests (leaf size 4).
-        let entry_cost = 1 + 2 * (a.depth() + b.depth()) as u64 + 16;
+        let entry_cost = 2 + 16;
         for poll_every in [1, 5, 32] {
             for limit in (0..unlimited + 40).step_by(7) {
                 let mut ws = FrontierWorkspace::with_poll_every(poll_every);
@@ -1020,6 +1156,102 @@ mod tests {
             }
         }
         (settled, out)
+    }
+
+    /// Visits after which `done` first holds of the answers, one visit a budget (and
+    /// the final answers).
+    fn visits_until(
+        pairs: &[FrontierPair<'_, Obb>],
+        done: impl Fn(&[FrontierAnswer]) -> bool,
+    ) -> (u64, Vec<FrontierAnswer>) {
+        let mut ws = FrontierWorkspace::with_poll_every(1);
+        ws.start(pairs);
+        let mut out = Vec::new();
+        let mut at = None;
+        for limit in 0.. {
+            let finished = ws.run(pairs, &mut VisitBudget(limit));
+            ws.answers(pairs, &mut out);
+            if at.is_none() && done(&out) {
+                at = Some(ws.stats().visits);
+            }
+            if finished {
+                break;
+            }
+        }
+        (at.expect("holds once every answer is exact"), out)
+    }
+
+    /// The exact answer of one pair on its own (its closest triangles, when within the
+    /// threshold).
+    fn alone(pair: &FrontierPair<'_, Obb>) -> FrontierAnswer {
+        let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+        assert!(query_frontier(&[*pair], &mut Unlimited, &mut ws, &mut out));
+        out[0]
+    }
+
+    /// A pair proven close by its seed, or expected close because it has one (seed no
+    /// longer within the threshold), waits while an undecided pair is settled: that pair
+    /// is answered exactly after its own visits plus the waiting root's bound and seed
+    /// test, where without a seed the touching pair's probe comes first. The final answers
+    /// are each pair's own.
+    #[test]
+    fn pairs_proven_or_expected_close_wait_while_an_undecided_pair_is_settled() {
+        let (a, b, poses) = scene::<Obb>();
+        let [touching, near] = pairs(&a, &b, &[poses[0], poses[1]])
+            .try_into()
+            .expect("two pairs");
+        // The tori a little apart, 0.17 m, beyond a threshold of 0.1 m.
+        let apart = FrontierPair {
+            threshold: 0.1,
+            ..near
+        };
+        assert!(!alone(&apart).maybe_close);
+        let (undecided_alone, _) = visits_until(&[apart], |x| x[0].is_exact());
+        let closest = alone(&touching).witnesses.expect("close").triangles;
+        // A triangle pair of the touching tori farther apart than the threshold.
+        let stale = [0, 0];
+        let stale_distance = distance_triangle_triangle(
+            &a.triangles()[a.slot_of(0).expect("id 0")],
+            &b.triangles()[b.slot_of(0).expect("id 0")].transformed(&touching.pose_ab),
+        )
+        .distance;
+        assert!(stale_distance > touching.threshold, "{stale_distance}");
+        for seed in [closest, stale] {
+            let seeded = FrontierPair {
+                seed: Some(seed),
+                ..touching
+            };
+            let both = [seeded, apart];
+            let (settled, answers) = visits_until(&both, |x| x[1].is_exact());
+            assert_eq!(settled, undecided_alone + 2, "seed {seed:?}");
+            assert_eq!(answers[0].distance_lower, alone(&seeded).distance_lower);
+            assert_eq!(answers[1], alone(&apart), "seed {seed:?}");
+        }
+        let (unseeded, _) = visits_until(&[touching, apart], |x| x[1].is_exact());
+        assert!(
+            unseeded > undecided_alone + 2,
+            "{unseeded} {undecided_alone}"
+        );
+    }
+
+    /// The probe proves touching tori close (a triangle pair within the threshold) within
+    /// its visits, where the rounds alone would first reach a leaf pair much later.
+    #[test]
+    fn the_probe_proves_a_touching_pair_close_within_its_visits() {
+        let (a, b, poses) = scene::<Obb>();
+        let touching = pairs(&a, &b, &poses[..1]);
+        let proven =
+            |x: &[FrontierAnswer]| x[0].distance_upper.is_some_and(|d| d <= x[0].threshold);
+        let (at, answers) = visits_until(&touching, proven);
+        // The root's bound, the probe, and the leaf pair it was testing when it ended.
+        assert!(at <= 1 + PROBE_VISITS + 16, "{at}");
+        assert!(answers[0].is_exact() && answers[0].maybe_close);
+        let total = {
+            let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+            query_frontier(&touching, &mut Unlimited, &mut ws, &mut out);
+            ws.stats().visits
+        };
+        assert!(4 * at < total, "proven after {at} of {total} visits");
     }
 
     /// In stages, a pair that a few levels settle is not kept waiting by a wide one: the

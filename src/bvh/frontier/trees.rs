@@ -25,12 +25,15 @@ pub struct FrontierPair<'a, B> {
     /// only for not beating the pair's best distance so far).
     pub threshold: f64,
     /// A triangle pair to try first (ids into each mesh's own triangle list, as
-    /// [`FrontierWitnesses::triangles`]): typically last frame's closest pair. Its exact
-    /// distance starts the pair's best distance, so entries that cannot beat it are dropped
-    /// from the first round, as the warm start of the depth-first queries does; touching
-    /// pairs whose seed still intersects are exact at once. One visit; `None`, or ids out of
-    /// range, start from nothing. Exact distances do not depend on it (the witnesses of
-    /// tied pairs may); a truncated answer stays conservative, and is usually tighter.
+    /// [`FrontierWitnesses::triangles`]): typically the pair that proved it within the
+    /// threshold last frame. Tested when the root is first processed (one visit), its
+    /// exact distance starts the pair's best distance, so entries that cannot beat it are
+    /// dropped, as the warm start of the depth-first queries does; a seed still within the
+    /// threshold proves the pair close at once. A pair with a seed is *expected close*: it
+    /// waits while undecided pairs are settled even when its seed no longer holds (module
+    /// docs, "Decide first"). `None`, or ids out of range, start from nothing. Exact
+    /// distances do not depend on it (the witnesses of tied pairs may); a truncated answer
+    /// stays conservative, and is usually tighter.
     pub seed: Option<[u32; 2]>,
 }
 
