@@ -1,20 +1,25 @@
-//! Body id maps of the stateful broad phases: [`SlotTable`], id → slot, a plain array while
-//! the ids are small; [`BodyMap`], a hash map with a hash fit for `u32` ids.
+//! Body id maps: [`SlotTable`], id → slot, a plain array while the ids are small;
+//! [`BodyMap`], a hash map with a hash fit for `u32` ids; [`PairMap`], the same for pairs
+//! of ids (the pipeline's per-pair state).
 //!
 //! The standard library's SipHash guards against adversarial keys and costs about 20 ns a
 //! look-up; body ids are chosen by the scene, not by an adversary, and every moved body is
-//! looked up once per frame. One multiply by the golden-ratio constant spreads an id over
-//! the high bits, and folding the high half down reaches the low bits the table indexes by.
+//! looked up once per frame (every candidate pair several times). One multiply by the
+//! golden-ratio constant per id spreads it over the high bits, and folding the high half
+//! down reaches the low bits the table indexes by.
 
 use std::collections::HashMap;
 
-use super::Proxy;
+use super::{CandidatePair, Proxy};
 use std::hash::{BuildHasherDefault, Hasher};
 
 /// Body id → a value (by default its slot).
 pub(crate) type BodyMap<V = u32> = HashMap<u32, V, BuildHasherDefault<IdHasher>>;
 
-/// Multiplicative hash of one `u32` id.
+/// Candidate pair → a value.
+pub(crate) type PairMap<V> = HashMap<CandidatePair, V, BuildHasherDefault<IdHasher>>;
+
+/// Multiplicative hash of `u32` ids (one, or the two of a pair, each folded in turn).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct IdHasher {
     state: u64,

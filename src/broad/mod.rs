@@ -33,6 +33,7 @@
 //! boxes touching at a face, edge or corner pair, and zero-size boxes are points.
 
 mod body_map;
+pub(crate) use body_map::PairMap;
 pub mod brute_force;
 pub mod column_grid;
 #[cfg(test)]

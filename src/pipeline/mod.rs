@@ -137,7 +137,7 @@ pub use frontier_pairs::MeshPairTrees;
 pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{
-    BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, Proxy,
+    BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, PairMap, Proxy,
     SortAndSweep, choose,
 };
 use crate::bvh::frontier::{self, FrontierAnswer, FrontierStats, FrontierWorkspace};
@@ -150,7 +150,6 @@ use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
 use answer::{Answer, MeshScratch};
 use dispatch::{NarrowScratch, Route};
 use separation::Separation;
-use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::Instant;
 pub use workers::{MIN_PARALLEL_MESH_PAIRS, WorkerPool};
@@ -405,11 +404,11 @@ pub struct PipelineWorkspace {
     mesh: MeshScratch,
     /// Closest triangle pair of each mesh–mesh candidate, for the next frame's first bound.
     /// Pairs that stop being candidates are forgotten; a pair that appears inserts once.
-    mesh_caches: HashMap<CandidatePair, DistanceCache>,
+    mesh_caches: PairMap<DistanceCache>,
     /// Last answer of each candidate pair, reused while neither body changes.
-    kept: HashMap<CandidatePair, KeptAnswer>,
+    kept: PairMap<KeptAnswer>,
     /// The last separation proved for each mesh–mesh candidate pair found apart.
-    separations: HashMap<CandidatePair, Separation>,
+    separations: PairMap<Separation>,
     /// Per candidate (same index): whether a kept separation answers it this frame.
     separated: Vec<bool>,
     /// Answers a frame's mesh–mesh pairs in parallel (see [`workers`]).
@@ -438,7 +437,7 @@ pub struct PipelineWorkspace {
     /// triangle ids of its closest triangle pair found, kept until it is proven apart:
     /// next frame's seed ([`crate::bvh::frontier::FrontierPair::seed`]), and first upper
     /// bound under `DISTANCE`.
-    frontier_seeds: HashMap<CandidatePair, [u32; 2]>,
+    frontier_seeds: PairMap<[u32; 2]>,
     /// What the frontier last ran over, to resume it next frame.
     frontier_run: FrontierRun,
 }
