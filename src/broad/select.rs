@@ -7,7 +7,7 @@
 //! keeps the proxy list itself (a dense list with an id → slot map; removal swaps the last
 //! proxy into the freed slot, which the sweep's kept order re-keys for free) and sweeps it in
 //! [`pairs`](BroadPhase::pairs). Every kind reports exactly the pairs of
-//! [`pairs_brute_force`](super::pairs_brute_force) over its bodies, in `(a, b)` order.
+//! [`pairs_brute_force`] over its bodies, in `(a, b)` order.
 //!
 //! [`BroadPhaseStats::measure`] summarises a scene's proxies (body count, fraction moving,
 //! spread of sizes, clustering along the sweep axis) and [`choose`] maps the summary to a
@@ -362,7 +362,7 @@ impl BroadPhase {
 
     /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
     /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
-    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over
+    /// exactly the pairs of [`pairs_brute_force`] over
     /// [`proxies`](Self::proxies) (which the sort-and-sweep kind runs itself up to
     /// [`ALL_PAIRS_MAX`] bodies).
     pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
