@@ -33,7 +33,8 @@
 //!
 //! `--speed F` moves the bodies along the same paths at `F` times the scene's motion per
 //! frame (a faster control loop sees less motion per frame, and kept separations last
-//! longer).
+//! longer). `--workers N` gives the stepping workspace a pool of `N` worker threads, which
+//! the exact rows use for their mesh pairs.
 //!
 //! Writes `DIR/curve.csv` (one row per scene and budget), `DIR/error_vs_time.svg` (distance
 //! error and precision against median frame time) and `DIR/latency.svg` (each budget's
@@ -48,7 +49,7 @@ use proxima::geometry::{Capsule, Cuboid, Sphere, TriMesh};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::pipeline::{
     Budget, Deadline, FrameResults, PairResult, PipelineWorkspace, Query, StepReport, Unlimited,
-    VisitBudget, step, step_within,
+    VisitBudget, WorkerPool, step, step_within,
 };
 use proxima::scene::{
     BodyDesc, BodyId, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape,
@@ -88,6 +89,11 @@ struct Args {
     /// of the speed, as a faster control loop sees them).
     #[arg(long, default_value_t = 1.0)]
     speed: f64,
+    /// Worker threads beside the stepping thread (0: none): the exact (`inf`) rows answer
+    /// their mesh pairs on them too; budgeted frames refine the frontier on the stepping
+    /// thread either way.
+    #[arg(long, default_value_t = 0)]
+    workers: usize,
     /// Print the built-in scenes and exit.
     #[arg(long)]
     list_scenes: bool,
@@ -487,7 +493,7 @@ fn compare(row: &mut Row, got: &[PairResult], exact: &[PairResult], w: &Workload
 fn run_row(
     w: &mut Workload,
     (frames, speed): (usize, f64),
-    order: RoundOrder,
+    (order, pool): (RoundOrder, Option<&Arc<WorkerPool>>),
     (label, budget): &(String, RowBudget),
 ) -> Row {
     let mut row = Row {
@@ -499,7 +505,11 @@ fn run_row(
         ..Row::default()
     };
     let mut exact_ws = PipelineWorkspace::default();
-    let mut kept_ws = PipelineWorkspace::default().with_frontier_order(order);
+    let mut kept_ws = match pool {
+        Some(pool) => PipelineWorkspace::with_workers(Arc::clone(pool)),
+        None => PipelineWorkspace::default(),
+    }
+    .with_frontier_order(order);
     let (mut exact, mut got) = (FrameResults::default(), FrameResults::default());
     for frame in 0..frames {
         w.pose_at(frame, speed);
@@ -733,12 +743,13 @@ fn main() -> Result<(), Box<dyn Error>> {
         _ => return Err("--mesh1 and --mesh2 go together".into()),
     };
     std::fs::create_dir_all(&args.out)?;
+    let pool = (args.workers > 0).then(|| Arc::new(WorkerPool::new(args.workers)));
     let mut rows = Vec::new();
     for budget in &budgets {
         rows.push(run_row(
             &mut workload,
             (args.frames, args.speed),
-            order,
+            (order, pool.as_ref()),
             budget,
         ));
     }
