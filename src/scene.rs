@@ -701,6 +701,13 @@ impl Scene {
         self.shape_boxes[body.shape.0 as usize].reach
     }
 
+    /// The world box of `body`'s shape were the body at `pose` (its
+    /// [`world_bounds`](Body::world_bounds) at its own pose).
+    #[must_use]
+    pub fn bounds_at(&self, body: &Body, pose: &Pose) -> Aabb {
+        self.shape_boxes[body.shape.0 as usize].world(pose)
+    }
+
     /// Like [`Scene::proxies`], but each box covers the body's whole motion over the
     /// current frame ([`swept_bounds`] of [`Scene::frame_motion`], merged with the world
     /// box), grown by its margin: the broad-phase input of time of impact. A body at rest

@@ -140,7 +140,7 @@ fn assert_same_records(records: &[ResultRecord], expected: &FrameResults, frame:
             body_b: want.b,
             index: 0,
             count: u32::from(want.reached),
-            flags: 0,
+            flags: approximate_flag(want.exact),
             distance: want.distance,
             error_bound: want.error_bound,
             point_a: want.point_a.to_array(),
@@ -272,6 +272,13 @@ fn jittered(pose: &Pose, rng: &mut support::TestRng, turn: f64, shift: f64) -> P
         pose.position + support::point_in_cube(rng, shift),
         (turn * pose.rotation).normalize(),
     )
+}
+
+/// `n` poses scattered over the twin scenes' 3.2 m cube, turned at random.
+fn scattered_poses(rng: &mut support::TestRng, n: usize) -> Vec<Pose> {
+    (0..n)
+        .map(|_| Pose::new(support::point_in_cube(rng, 1.6), support::rotation(rng)))
+        .collect()
 }
 
 #[test]
@@ -513,14 +520,7 @@ fn toi_frames_over_shared_memory_match_the_in_process_pipeline_record_for_record
         Query::OVERLAP.union(Query::TOI),
         Query::CLOSE,
     ];
-    let mut poses: Vec<Pose> = (0..oracle.body_count())
-        .map(|_| {
-            Pose::new(
-                support::point_in_cube(&mut rng, 1.6),
-                support::rotation(&mut rng),
-            )
-        })
-        .collect();
+    let mut poses = scattered_poses(&mut rng, oracle.body_count());
     let (mut at_start, mut during, mut toi_frames) = (0, 0, 0);
     for frame in 1..=15u64 {
         let q = queries[(frame as usize - 1) % queries.len()];
@@ -562,6 +562,68 @@ fn toi_frames_over_shared_memory_match_the_in_process_pipeline_record_for_record
     assert!(
         toi_frames == 12 && at_start > 10 && during > 5,
         "TOI frames {toi_frames}, at the start {at_start}, during the motion {during}"
+    );
+}
+
+/// A `TOI` frame with a 1 ns budget: the deadline has passed before the first search, so
+/// every swept candidate comes back unsearched and flagged approximate (`time` 0, `count`
+/// 0, the start boxes' conservative distance), record for record what the in-process
+/// pipeline gives with a deadline already passed, in a frame the header calls `Truncated`.
+#[test]
+fn a_toi_frame_past_its_deadline_reports_its_candidates_unsearched_and_flagged() {
+    use proxima::pipeline::{Deadline, step_within};
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let TwinScenes {
+        scene_id,
+        mut oracle,
+    } = twin_scenes(&client);
+    let link = client.open_scene(scene_id).unwrap();
+    let mut rng = support::rng(89);
+    let mut workspace = PipelineWorkspace::default();
+    let mut expected = FrameResults::default();
+    let mut poses = scattered_poses(&mut rng, oracle.body_count());
+    let records: Vec<_> = (0..poses.len())
+        .map(|i| posed_record(i as u32, &poses[i]))
+        .collect();
+    publish_and_compare(
+        &link,
+        &mut oracle,
+        (&mut workspace, &mut expected),
+        1,
+        Query::CLOSE,
+        &records,
+    );
+    let mut records = Vec::new();
+    for (i, pose) in poses.iter_mut().enumerate() {
+        *pose = jittered(pose, &mut rng, 0.3, 0.35);
+        records.push(posed_record(i as u32, pose));
+        oracle.set_pose(BodyId(i as u32), *pose).unwrap();
+    }
+    link.publish_poses(2, 1, flags(Query::TOI), &records)
+        .unwrap();
+    let report = step_within(
+        &oracle,
+        Query::TOI,
+        &mut Deadline(std::time::Instant::now()),
+        &mut workspace,
+        &mut expected,
+    );
+    oracle.end_frame();
+    assert!(report.truncated_tois > 3, "{report:?}");
+    let result = link
+        .receive_results_for(2, TIMEOUT)
+        .unwrap()
+        .expect("a result frame");
+    let header = result.header();
+    assert_eq!(header.completeness, wire::Completeness::Truncated as u32);
+    assert_eq!((header.deepest_level, header.budget_met), (0, 0));
+    assert_same_records(result.records(), &expected, 2);
+    assert_eq!(result.tois().len(), report.truncated_tois as usize);
+    assert!(
+        result.tois().iter().all(|r| {
+            r.flags == wire::record_flags::APPROXIMATE && r.time == 0.0 && r.count == 0
+        })
     );
 }
 

@@ -13,7 +13,9 @@
 //!   contact, and the oracle finds the pair within its margins plus the tolerance there;
 //!   a pair with a sampled contact is always reported, and both outcomes occur;
 //! - pairs already overlapping at the start report `t = 0`; a body that did not move
-//!   (static or just not posed this frame) against one that did.
+//!   (static or just not posed this frame) against one that did;
+//! - a frame whose deadline has passed reports every candidate unsearched and
+//!   conservatively (box distances against the brute-force distance at the start).
 
 #[path = "support/mod.rs"]
 mod support;
@@ -22,12 +24,16 @@ use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Sphere, Triangle};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::narrow::distance_triangle_triangle;
 use proxima::narrow::toi::FrameMotion;
-use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, TOI_TOLERANCE, step};
+use proxima::pipeline::{
+    Completeness, Deadline, FrameResults, PipelineWorkspace, Query, TOI_TOLERANCE, step,
+    step_within,
+};
 use proxima::scene::{
     BodyDesc, BodyId, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape,
 };
 use rand::Rng;
 use std::sync::Arc;
+use std::time::Instant;
 use support::{TestRng, meshes, point_in_cube, rng, rotation};
 
 /// Oracle steps over the motion.
@@ -558,4 +564,113 @@ fn a_body_at_rest_is_hit_by_a_moving_one() {
         assert_eq!((toi.a, toi.b, toi.time), (w.0, resting.0, 0.0));
         assert!((toi.distance - 0.05).abs() < 1e-9);
     }
+}
+
+/// A frame whose deadline has already passed searches no time of impact: every swept
+/// candidate is reported unsearched (`t = 0`, not reached, not exact) with the bodies'
+/// start boxes for distance, so every pair the unlimited frame reports is there, never
+/// later; each box distance is at most the brute-force distance at the start, and within
+/// its error bound of it. A deadline an hour away gives the unlimited frame's records.
+#[test]
+fn a_passed_deadline_reports_every_toi_candidate_unsearched_and_conservative() {
+    let kinds = kinds();
+    let cored: Vec<Cored> = kinds.iter().map(|(_, s)| Cored::of(s)).collect();
+    let mut rng = rng(317);
+    let (mut hit_pairs, mut extra_pairs, mut checked_distances) = (0, 0, 0);
+    for case in 0..40 {
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let mut motions = Vec::new();
+        for i in 0..8 {
+            let kind = (case + i) % kinds.len();
+            let start = point_in_cube(&mut rng, 1.5);
+            let end = start + point_in_cube(&mut rng, 0.8);
+            let m = motion(&mut rng, start, end, 1.0);
+            let margin = rng.random_range(0.0..0.05);
+            let id = body(
+                &mut scene,
+                kinds[kind].1.clone(),
+                m.start,
+                Motion::Dynamic,
+                margin,
+            );
+            motions.push((id, kind, m));
+        }
+        scene.end_frame();
+        for (id, _, m) in &motions {
+            scene.set_pose(*id, m.end).unwrap();
+        }
+        let mut exact = FrameResults::default();
+        step(
+            &scene,
+            Query::TOI,
+            &mut PipelineWorkspace::default(),
+            &mut exact,
+        );
+        let mut cut = FrameResults::default();
+        let report = step_within(
+            &scene,
+            Query::TOI,
+            &mut Deadline(Instant::now()),
+            &mut PipelineWorkspace::default(),
+            &mut cut,
+        );
+        assert_eq!(report.truncated_tois, report.toi_candidates, "case {case}");
+        assert_eq!(report.completeness, Completeness::Truncated { level: 0 });
+        for want in &exact.tois {
+            let got = cut
+                .tois
+                .iter()
+                .find(|t| (t.a, t.b) == (want.a, want.b))
+                .unwrap_or_else(|| panic!("case {case}: pair {}–{} left out", want.a, want.b));
+            assert!(got.time <= want.time);
+        }
+        for got in &cut.tois {
+            assert!(
+                !got.exact && !got.reached && got.time == 0.0,
+                "case {case}: {got:?}"
+            );
+            let hit = exact.tois.iter().any(|t| (t.a, t.b) == (got.a, got.b));
+            hit_pairs += usize::from(hit);
+            extra_pairs += usize::from(!hit);
+            let start = |id: u32| {
+                let (_, kind, m) = motions.iter().find(|(b, _, _)| b.0 == id).unwrap();
+                (&cored[*kind], m.start)
+            };
+            let ((ca, pa), (cb, pb)) = (start(got.a), start(got.b));
+            let truth = oracle_distance(ca, &pa, cb, &pb);
+            // The oracle is exact while the shapes are apart (a lower bound of 0 once the
+            // cores cross, where only `distance ≤ 0` can be checked).
+            if truth > 0.0 {
+                assert!(
+                    got.distance <= truth + 1e-9,
+                    "case {case}: {got:?} above {truth}"
+                );
+                assert!(
+                    truth <= got.distance + got.error_bound,
+                    "case {case}: {got:?}"
+                );
+                checked_distances += 1;
+            } else {
+                assert!(
+                    got.distance <= 1e-9,
+                    "case {case}: {got:?} for crossing cores"
+                );
+            }
+        }
+        let later = Instant::now() + std::time::Duration::from_secs(3600);
+        let mut unhurried = FrameResults::default();
+        let report = step_within(
+            &scene,
+            Query::TOI,
+            &mut Deadline(later),
+            &mut PipelineWorkspace::default(),
+            &mut unhurried,
+        );
+        assert_eq!(report.truncated_tois, 0);
+        assert_eq!(unhurried.tois, exact.tois, "case {case}");
+    }
+    assert!(
+        hit_pairs > 20 && extra_pairs > 20 && checked_distances > 50,
+        "hits {hit_pairs}, extra {extra_pairs}, distances checked {checked_distances}"
+    );
 }

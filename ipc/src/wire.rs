@@ -84,7 +84,13 @@ pub mod query {
     ///   throughout reports nothing.
     /// - **Record:** `distance`, `point_a`, `point_b` and `normal` (A→B) at the poses of
     ///   `time`, world frame; `count` 1, or 0 when the search stopped at its iteration limit
-    ///   (a long grazing motion; still conservative: no contact before `time`).
+    ///   (a long grazing motion) or at the frame's deadline (still conservative: no contact
+    ///   before `time`).
+    /// - **Deadline:** candidates are searched in order while the frame has time left;
+    ///   those after the deadline are reported unsearched, flagged
+    ///   [`APPROXIMATE`](super::record_flags::APPROXIMATE): `time = 0`, `count` 0, and the
+    ///   bodies' boxes at the start of the motion for distance (a lower bound, within
+    ///   `error_bound`), witnesses and normal.
     pub const TOI: u32 = 1 << 4;
     /// Every flag defined by this protocol version; other bits are rejected.
     pub const ALL: u32 = OVERLAP | CLOSE | DISTANCE | CONTACTS | TOI;
@@ -281,8 +287,13 @@ pub mod record_flags {
     /// frame's deadline (or the pair got the box answer). `distance` is then a lower bound on
     /// the true distance, within `error_bound` of it, and the pair is reported because it
     /// *may* qualify (DESIGN §4). Set on a `Pair` record and on each of its `Contact`
-    /// records; never on `Toi` records (a stopped search says so by `count` 0). A frame
-    /// whose header says `Truncated` has at least one record with it, an `Exact` frame none.
+    /// records, and (since protocol version 6) on a `Toi` record whose search the frame's
+    /// deadline left no time for: `time` 0, `count` 0, `distance` the lower bound the two
+    /// bodies' boxes at the start of the motion give, the pair reported because it may come
+    /// within contact. (A search that stopped, at its limit or at the deadline, says so by
+    /// `count` 0 with an exact record at `time`.) A frame whose header says `Truncated` has
+    /// at least one approximate record or one `Toi` search stopped at the deadline; an
+    /// `Exact` frame neither.
     pub const APPROXIMATE: u32 = 1 << 0;
 }
 
@@ -314,7 +325,8 @@ pub enum RecordKind {
 /// - `Toi`: `body_a < body_b`; `time` the fraction of the frame's motion at first contact;
 ///   `distance`, `point_a`/`point_b`, `normal` (A→B) at the poses of `time`;
 ///   `error_bound` the search tolerance (at `time` the pair is within its margins plus
-///   it); `index` 0; `count` 1, or 0 when the search stopped early (see [`query::TOI`]).
+///   it); `index` 0; `count` 1, or 0 when the search stopped early; with
+///   [`record_flags::APPROXIMATE`], not searched for lack of time (see [`query::TOI`]).
 ///
 /// `time` is 0 in `Pair` and `Contact` records.
 #[derive(Debug, Clone, Copy, Default, PartialEq, ZeroCopySend)]

@@ -279,7 +279,8 @@ fn contact_record(pairs: &[PairResult], c: &ContactPoint) -> ResultRecord {
     }
 }
 
-/// The record of a pair's time of impact (`count` 1 when the search reached contact).
+/// The record of a pair's time of impact (`count` 1 when the search reached contact;
+/// approximate when the deadline came before its search).
 fn toi_record(r: &PairToi) -> ResultRecord {
     ResultRecord {
         kind: RecordKind::Toi as u32,
@@ -287,7 +288,11 @@ fn toi_record(r: &PairToi) -> ResultRecord {
         body_b: r.b,
         index: 0,
         count: u32::from(r.reached),
-        flags: 0,
+        flags: if r.exact {
+            0
+        } else {
+            record_flags::APPROXIMATE
+        },
         distance: r.distance,
         error_bound: r.error_bound,
         point_a: r.point_a.to_array(),

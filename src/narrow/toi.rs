@@ -134,11 +134,14 @@ pub enum ToiOutcome {
     },
     /// No contact during the frame.
     Miss,
-    /// Still apart after `max_iterations` (a bound too loose for the motion); `t` is
-    /// conservative: no contact happened before it.
+    /// Still apart after `max_iterations` (a bound too loose for the motion), or stopped by
+    /// the caller ([`time_of_impact_until`]); `t` is conservative: no contact happened
+    /// before it.
     DidNotConverge {
         /// How far the search safely got.
         t: f64,
+        /// The distance query at `t` (world frame): the pair is still apart there.
+        contact: ShapeDistance,
     },
 }
 
@@ -154,7 +157,30 @@ pub fn time_of_impact(
     motion_b: &FrameMotion,
     reach_b: f64,
     params: &ToiParams,
+    distance: impl FnMut(&Pose, &Pose) -> ShapeDistance,
+) -> ToiOutcome {
+    time_of_impact_until(
+        motion_a,
+        reach_a,
+        motion_b,
+        reach_b,
+        params,
+        distance,
+        || true,
+    )
+}
+
+/// [`time_of_impact`], asking `may_continue` before each distance query after the first:
+/// once it says no (a frame's deadline), the search stops with
+/// [`ToiOutcome::DidNotConverge`] at the time it safely reached.
+pub fn time_of_impact_until(
+    motion_a: &FrameMotion,
+    reach_a: f64,
+    motion_b: &FrameMotion,
+    reach_b: f64,
+    params: &ToiParams,
     mut distance: impl FnMut(&Pose, &Pose) -> ShapeDistance,
+    mut may_continue: impl FnMut() -> bool,
 ) -> ToiOutcome {
     let first = distance(&motion_a.start, &motion_b.start);
     if first.distance <= params.tolerance {
@@ -164,6 +190,9 @@ pub fn time_of_impact(
     let turning = motion_a.angle() * reach_a + motion_b.angle() * reach_b;
     let (mut t, mut contact) = (0.0, first);
     for _ in 0..params.max_iterations {
+        if !may_continue() {
+            break;
+        }
         // Fastest rate at which the distance can shrink: the approach (along the normal
         // for convex shapes) plus the rotations' sweep.
         let approach = if params.convex {
@@ -185,7 +214,7 @@ pub fn time_of_impact(
             return ToiOutcome::Impact { t, contact };
         }
     }
-    ToiOutcome::DidNotConverge { t }
+    ToiOutcome::DidNotConverge { t, contact }
 }
 
 #[cfg(test)]
@@ -264,12 +293,73 @@ mod tests {
                     );
                     misses += 1;
                 }
-                ToiOutcome::DidNotConverge { t } => panic!("case {case}: no convergence at {t}"),
+                ToiOutcome::DidNotConverge { t, .. } => {
+                    panic!("case {case}: no convergence at {t}")
+                }
             }
         }
         assert!(
             hits > 500 && misses > 500 && initial > 50,
             "hits {hits}, misses {misses}, initially touching {initial}"
+        );
+    }
+
+    /// A search stopped by its caller after `k` queries reports how far it safely got,
+    /// with the distance query there: still apart, never past the first contact, and the
+    /// same time a search allowed `k` iterations reaches.
+    #[test]
+    fn a_stopped_search_reports_the_time_it_safely_reached_and_the_query_there() {
+        let mut rng = rng(107);
+        let params = ToiParams::default();
+        let (mut stopped, mut finished) = (0, 0);
+        for case in 0..2_000 {
+            let (ra, rb) = (rng.random_range(0.05..1.0), rng.random_range(0.05..1.0));
+            let (ma, mb) = (
+                FrameMotion {
+                    start: Pose::from_translation(point_in_cube(&mut rng, 3.0)),
+                    end: Pose::from_translation(point_in_cube(&mut rng, 3.0)),
+                },
+                FrameMotion::at_rest(Pose::from_translation(point_in_cube(&mut rng, 3.0))),
+            );
+            let k = rng.random_range(0..6);
+            let mut asked = 0;
+            let outcome =
+                time_of_impact_until(&ma, 0.0, &mb, 0.0, &params, spheres(ra, rb), || {
+                    asked += 1;
+                    asked <= k
+                });
+            let limited = ToiParams {
+                max_iterations: k,
+                ..params
+            };
+            let unstopped = time_of_impact(&ma, 0.0, &mb, 0.0, &params, spheres(ra, rb));
+            let first_contact = match unstopped {
+                ToiOutcome::Impact { t, .. } => t,
+                ToiOutcome::Initially { .. } => 0.0,
+                _ => 1.0,
+            };
+            match outcome {
+                ToiOutcome::DidNotConverge { t, contact } => {
+                    let at_t = spheres(ra, rb)(&ma.pose_at(t), &mb.pose_at(t));
+                    assert_eq!(contact, at_t, "case {case}");
+                    assert!(contact.distance > params.tolerance, "case {case}");
+                    assert!(t <= first_contact, "case {case}: {t} after {first_contact}");
+                    assert_eq!(
+                        time_of_impact(&ma, 0.0, &mb, 0.0, &limited, spheres(ra, rb)),
+                        outcome,
+                        "case {case}"
+                    );
+                    stopped += 1;
+                }
+                other => {
+                    assert_eq!(other, unstopped, "case {case}");
+                    finished += 1;
+                }
+            }
+        }
+        assert!(
+            stopped > 300 && finished > 300,
+            "stopped {stopped}, finished {finished}"
         );
     }
 
@@ -330,7 +420,7 @@ mod tests {
                     misses += 1;
                 }
                 ToiOutcome::Initially { .. } => {}
-                ToiOutcome::DidNotConverge { t } => {
+                ToiOutcome::DidNotConverge { t, .. } => {
                     // Allowed (grazing contact), but must still be conservative.
                     if let Some(truth) = truth {
                         assert!(t <= truth + 1e-4, "case {case}");
@@ -396,7 +486,7 @@ mod tests {
                     misses += 1;
                 }
                 ToiOutcome::Initially { .. } => panic!("case {case}: apart at t = 0"),
-                ToiOutcome::DidNotConverge { t } => {
+                ToiOutcome::DidNotConverge { t, .. } => {
                     assert!(t <= truth.unwrap_or(1.0), "case {case}");
                 }
             }

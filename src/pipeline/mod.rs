@@ -346,6 +346,10 @@ pub struct StepReport {
     /// Mesh–mesh pairs the frontier left unfinished: answered conservatively (see
     /// [`step_within`]); 0 when it did not run.
     pub truncated_pairs: u32,
+    /// Time-of-impact candidates the frame's deadline came before, answered by the start
+    /// boxes ([`PairToi::exact`] `false`); a search the deadline stopped is not counted
+    /// here (it reports `reached = false`) but makes the frame truncated too.
+    pub truncated_tois: u32,
 }
 
 /// Frames between two measurements of a [`BroadPhaseChoice::Auto`] scene's statistics.
@@ -762,12 +766,26 @@ pub fn step_within(
             .extend_from_slice(&results.contacts[first_contact..]);
         report(query, answer, (a, b), first_contact, results);
     }
+    // Time of impact keeps to the frame's deadline too (`toi.rs`, "Under a deadline").
+    let mut toi_clock = PairClock::new(budget.deadline());
+    let mut truncated_tois = 0;
     for pair in toi_candidates.iter() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+        if toi_clock.expired() {
+            truncated_tois += 1;
+            results.tois.push(toi::unsearched(scene, pair, a, b));
+            continue;
+        }
         let shapes = (shape(scene, a), shape(scene, b));
-        if let Some(toi) = toi::pair_toi(scene, pair, (a, shapes.0), (b, shapes.1), narrow) {
+        let searched = toi::pair_toi(scene, pair, (a, shapes.0), (b, shapes.1), narrow, || {
+            !toi_clock.expired()
+        });
+        if let Some(toi) = searched {
             results.tois.push(toi);
         }
+    }
+    if truncated_tois > 0 || toi_clock.expired {
+        completeness = completeness.truncated_at(0);
     }
     StepReport {
         completeness,
@@ -787,6 +805,7 @@ pub fn step_within(
         mid_ns,
         frontier: frontier_stats,
         truncated_pairs,
+        truncated_tois,
     }
 }
 

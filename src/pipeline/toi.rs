@@ -17,14 +17,25 @@
 //!
 //! The record holds the signed distance, witnesses and unit normal (A→B) at the poses of
 //! time `t`, world frame. When the search runs out of iterations (a long grazing motion
-//! against a mesh) the pair is still reported, conservatively, at the time it safely
-//! reached, with `reached = false`: no contact before it, contact after it possible.
+//! against a mesh) or the frame's deadline stops it, the pair is still reported,
+//! conservatively, at the time it safely reached, with `reached = false`: no contact
+//! before it, contact after it possible.
+//!
+//! # Under a deadline
+//! A frame with a deadline ([`step_within`](super::step_within)) searches its candidates
+//! in order while time is left before [`PUBLISH_RESERVE`](super::PUBLISH_RESERVE): a
+//! search that meets that point stops where it is, and each candidate after it gets the
+//! conservative answer of [`unsearched`]: reported at `t = 0`, `reached = false`, `exact =
+//! false`, with the distance between the two shapes' boxes at the start of the motion (a
+//! lower bound) and those boxes' witnesses and normal. No pair that comes within contact
+//! is ever left out, and none is reported later than its first contact.
 
+use super::Query;
 use super::dispatch::{self, NarrowScratch};
 use crate::broad::CandidatePair;
 use crate::math::{DVec3, Pose};
 use crate::narrow::contact::ShapeDistance;
-use crate::narrow::toi::{FrameMotion, ToiOutcome, ToiParams, time_of_impact};
+use crate::narrow::toi::{ToiOutcome, ToiParams, time_of_impact_until};
 use crate::scene::{Body, Scene, Shape};
 
 /// Distance tolerance of the time-of-impact search, metres: at the reported time the pair
@@ -62,19 +73,27 @@ pub struct PairToi {
     pub point_b: DVec3,
     /// Unit normal from A to B at `time`, world frame.
     pub normal: DVec3,
-    /// Whether the pair is within contact at `time`; `false`: the search stopped at its
-    /// iteration limit, no contact before `time`.
+    /// Whether the pair is within contact at `time`; `false`: the search stopped (at its
+    /// iteration limit, or the frame's deadline), no contact before `time`.
     pub reached: bool,
+    /// Whether `distance`, the witnesses and the normal are the exact ones at `time`.
+    /// `false` when the frame's deadline came before the pair's search (a frame with a
+    /// deadline searches its candidates in order while time is left): `time` 0, and the
+    /// record the two shapes' boxes at the start of the motion give, `distance` a lower
+    /// bound of the distance then, within `error_bound` of it.
+    pub exact: bool,
 }
 
 /// The time of impact of candidate `pair` over the current frame's motion, `None` when it
-/// never comes within its margins.
+/// never comes within its margins; the search asks `may_continue` before each distance
+/// query after the first (see [`time_of_impact_until`]).
 pub(super) fn pair_toi(
     scene: &Scene,
     pair: &CandidatePair,
     (a, sa): (&Body, &Shape),
     (b, sb): (&Body, &Shape),
     scratch: &mut NarrowScratch,
+    may_continue: impl FnMut() -> bool,
 ) -> Option<PairToi> {
     let (motion_a, motion_b) = (scene.frame_motion(a), scene.frame_motion(b));
     let margins = a.margin + b.margin;
@@ -100,18 +119,19 @@ pub(super) fn pair_toi(
             normal: pose_a.transform_vector(d.normal),
         }
     };
-    let (time, contact, reached) = match time_of_impact(
+    let (time, contact, reached) = match time_of_impact_until(
         &motion_a,
         scene.reach(a),
         &motion_b,
         scene.reach(b),
         &params,
         &mut gap,
+        may_continue,
     ) {
         ToiOutcome::Miss => return None,
         ToiOutcome::Initially { contact } => (0.0, contact, true),
         ToiOutcome::Impact { t, contact } => (t, contact, true),
-        ToiOutcome::DidNotConverge { t } => (t, at(&motion_a, &motion_b, t, &mut gap), false),
+        ToiOutcome::DidNotConverge { t, contact } => (t, contact, false),
     };
     Some(PairToi {
         a: pair.a,
@@ -123,15 +143,28 @@ pub(super) fn pair_toi(
         point_b: contact.point_b,
         normal: contact.normal,
         reached,
+        exact: true,
     })
 }
 
-/// The query `gap` at time `t` of both motions.
-fn at(
-    motion_a: &FrameMotion,
-    motion_b: &FrameMotion,
-    t: f64,
-    gap: &mut impl FnMut(&Pose, &Pose) -> ShapeDistance,
-) -> ShapeDistance {
-    gap(&motion_a.pose_at(t), &motion_b.pose_at(t))
+/// The conservative time of impact of a candidate the frame's deadline left no time to
+/// search (module docs): `t = 0`, not reached, the two shapes' boxes at the start of the
+/// motion as the record (their distance, a lower bound of the shapes', with the boxes'
+/// diagonals and overlap as error bound, their witnesses and normal).
+pub(super) fn unsearched(scene: &Scene, pair: &CandidatePair, a: &Body, b: &Body) -> PairToi {
+    let start = |body: &Body| scene.bounds_at(body, &scene.frame_motion(body).start);
+    let boxes =
+        super::answer::boxes(pair, &start(a), &start(b), Query::NONE, &mut Vec::new()).result;
+    PairToi {
+        a: pair.a,
+        b: pair.b,
+        time: 0.0,
+        distance: boxes.distance,
+        error_bound: boxes.error_bound,
+        point_a: boxes.point_a,
+        point_b: boxes.point_b,
+        normal: boxes.normal,
+        reached: false,
+        exact: false,
+    }
 }
