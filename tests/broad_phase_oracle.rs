@@ -34,8 +34,8 @@ use std::time::Instant;
 
 use proxima::bounding::{Aabb, BoundingVolume};
 use proxima::broad::{
-    CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, Proxy, SortAndSweep,
-    pairs_brute_force,
+    CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, Proxy, SkinGrid,
+    SortAndSweep, pairs_brute_force,
 };
 use proxima::math::DVec3;
 use rand::Rng;
@@ -91,30 +91,62 @@ macro_rules! stateful_broad_phase {
     )+};
 }
 
-stateful_broad_phase!(IncrementalSap, HashGrid, ColumnGrid);
+stateful_broad_phase!(IncrementalSap, HashGrid, ColumnGrid, SkinGrid);
 
-/// The column grid with a frame's moves gathered and handed over by `update_all`, as the
+/// The broad phases that take a frame's moves as one batch.
+trait UpdateAll: BroadPhase {
+    fn update_all(&mut self, moves: &[(u32, Aabb)]);
+    fn insert_one(&mut self, p: &Proxy);
+    fn remove_one(&mut self, body: u32) -> bool;
+}
+
+macro_rules! update_all {
+    ($($phase:ident),+) => {$(
+        impl UpdateAll for $phase {
+            fn update_all(&mut self, moves: &[(u32, Aabb)]) {
+                $phase::update_all(self, moves);
+            }
+            fn insert_one(&mut self, p: &Proxy) {
+                $phase::insert(self, p.body, p.bounds, p.is_static, p.filter);
+            }
+            fn remove_one(&mut self, body: u32) -> bool {
+                $phase::remove(self, body)
+            }
+        }
+    )+};
+}
+
+update_all!(ColumnGrid, SkinGrid);
+
+/// A broad phase with a frame's moves gathered and handed over by `update_all`, as the
 /// pipeline does: the batch is flushed before any insertion, removal or pair listing.
-struct BatchedColumns {
-    grid: ColumnGrid,
+struct Batched<G> {
+    grid: G,
     moves: Vec<(u32, Aabb)>,
 }
 
-impl BatchedColumns {
+impl<G: UpdateAll> Batched<G> {
+    fn new(grid: G) -> Self {
+        Self {
+            grid,
+            moves: Vec::new(),
+        }
+    }
+
     fn flush(&mut self) {
         self.grid.update_all(&self.moves);
         self.moves.clear();
     }
 }
 
-impl BroadPhase for BatchedColumns {
+impl<G: UpdateAll> BroadPhase for Batched<G> {
     fn insert(&mut self, p: &Proxy) {
         self.flush();
-        self.grid.insert(p.body, p.bounds, p.is_static, p.filter);
+        self.grid.insert_one(p);
     }
     fn remove(&mut self, body: u32) {
         self.flush();
-        assert!(self.grid.remove(body), "{body} was present");
+        assert!(self.grid.remove_one(body), "{body} was present");
     }
     fn update(&mut self, body: u32, bounds: Aabb) {
         self.moves.push((body, bounds));
@@ -529,15 +561,23 @@ fn column_grid_equals_brute_force_after_every_one_of_ten_thousand_frames() {
 #[test]
 fn column_grid_with_batched_moves_equals_brute_force_after_every_one_of_ten_thousand_frames() {
     let start = Instant::now();
-    let counts = run(
-        || {
-            Box::new(BatchedColumns {
-                grid: ColumnGrid::new(),
-                moves: Vec::new(),
-            })
-        },
-        6_400,
-    );
+    let counts = run(|| Box::new(Batched::new(ColumnGrid::new())), 6_400);
     eprintln!("column grid, batched: {counts:?} in {:?}", start.elapsed());
+    assert_scenarios_happened(&counts);
+}
+
+#[test]
+fn skin_grid_equals_brute_force_after_every_one_of_ten_thousand_frames() {
+    let start = Instant::now();
+    let counts = run(|| Box::new(SkinGrid::new()), 6_500);
+    eprintln!("skin grid: {counts:?} in {:?}", start.elapsed());
+    assert_scenarios_happened(&counts);
+}
+
+#[test]
+fn skin_grid_with_batched_moves_equals_brute_force_after_every_one_of_ten_thousand_frames() {
+    let start = Instant::now();
+    let counts = run(|| Box::new(Batched::new(SkinGrid::new())), 6_600);
+    eprintln!("skin grid, batched: {counts:?} in {:?}", start.elapsed());
     assert_scenarios_happened(&counts);
 }

@@ -29,12 +29,13 @@ use support::{TestRng, point_in_cube, rng, rotation};
 
 const FRAMES: u64 = 600;
 
-const CHOICES: [BroadPhaseChoice; 5] = [
+const CHOICES: [BroadPhaseChoice; 6] = [
     BroadPhaseChoice::Auto,
     BroadPhaseChoice::Fixed(BroadPhaseKind::SortAndSweep),
     BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap),
     BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid),
     BroadPhaseChoice::Fixed(BroadPhaseKind::ColumnGrid),
+    BroadPhaseChoice::Fixed(BroadPhaseKind::SkinGrid),
 ];
 
 /// The scene under test and this test's own record of what changed in the current frame.

@@ -233,6 +233,7 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
         BroadPhaseCode::IncrementalSap,
         BroadPhaseCode::HashGrid,
         BroadPhaseCode::ColumnGrid,
+        BroadPhaseCode::SkinGrid,
         BroadPhaseCode::SortAndSweep,
         BroadPhaseCode::Auto,
     ]
@@ -248,7 +249,7 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
         protocol_version: proxima_ipc::PROTOCOL_VERSION,
         command: Command::SetSceneParams as u32,
         scene,
-        broad_phase: 5,
+        broad_phase: 6,
         ..ControlRequest::default()
     };
     let reply = client.request(&bad, &[]).unwrap();
@@ -257,7 +258,7 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
         Some(ErrorCode::MalformedMessage)
     );
     assert!(
-        reply.reason().contains("broad phase 5"),
+        reply.reason().contains("broad phase 6"),
         "{}",
         reply.reason()
     );
@@ -278,8 +279,8 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
         rejected(client.set_broad_phase(scene + 9, BroadPhaseCode::HashGrid)),
         ErrorCode::UnknownScene
     );
-    // Still served: control, and frames (five spheres 0.75 m apart, radius 0.5: four
-    // touching pairs).
+    // Still served: control, and frames (six spheres 0.75 m apart, radius 0.5, one added
+    // under each code: five touching pairs).
     client.add_body(scene, &body(sphere, 10.0)).unwrap();
     let link = client.open_scene(scene).unwrap();
     for frame in 1..=3u64 {
@@ -293,6 +294,6 @@ fn every_broad_phase_code_is_accepted_and_a_bad_one_refused_while_the_scene_keep
             ErrorCode::from_u32(result.header().status),
             Some(ErrorCode::Ok)
         );
-        assert_eq!(result.header().pair_count, 4, "frame {frame}");
+        assert_eq!(result.header().pair_count, 5, "frame {frame}");
     }
 }

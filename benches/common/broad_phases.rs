@@ -3,14 +3,17 @@
 
 use super::parry_broad::{EXACT_CHANGE_MARGIN, ParryBroadPhase, RAPIER_CHANGE_MARGIN};
 use proxima::bounding::Aabb;
-use proxima::broad::{CandidatePair, ColumnGrid, HashGrid, IncrementalSap, Proxy, SortAndSweep};
+use proxima::broad::{
+    CandidatePair, ColumnGrid, HashGrid, IncrementalSap, Proxy, SkinGrid, SortAndSweep,
+};
 
 /// Every broad phase by name, Proxima's first.
-pub const NAMES: [&str; 6] = [
+pub const NAMES: [&str; 7] = [
     "sort_sweep",
     "incremental_sap",
     "hash_grid",
     "column_grid",
+    "skin_grid",
     "parry_bvh",
     "rapier_bvh",
 ];
@@ -26,6 +29,9 @@ pub enum Phase {
     /// Proxima's column grid, a frame's moves handed over as one batch (as the pipeline
     /// does).
     Columns(ColumnGrid),
+    /// Proxima's skin grid (the column grid over skin-grown boxes, with neighbour lists),
+    /// a frame's moves handed over as one batch.
+    Skin(SkinGrid),
     /// rapier's broad phase on parry's BVH; `exact` for the 1 nm change margin.
     Parry { phase: ParryBroadPhase, exact: bool },
 }
@@ -44,6 +50,7 @@ impl Phase {
                 Self::Grid(g)
             }
             "column_grid" => Self::Columns(ColumnGrid::from_proxies(proxies)),
+            "skin_grid" => Self::Skin(SkinGrid::from_proxies(proxies)),
             "parry_bvh" | "rapier_bvh" => {
                 let exact = name == "parry_bvh";
                 let margin = if exact {
@@ -82,6 +89,10 @@ impl Phase {
                 g.pairs(out);
             }
             Self::Columns(c) => {
+                c.update_all(moved);
+                c.pairs(out);
+            }
+            Self::Skin(c) => {
                 c.update_all(moved);
                 c.pairs(out);
             }

@@ -973,6 +973,7 @@ mod tests {
             BroadPhaseCode::IncrementalSap,
             BroadPhaseCode::HashGrid,
             BroadPhaseCode::ColumnGrid,
+            BroadPhaseCode::SkinGrid,
         ] {
             client.set_broad_phase(6, code).unwrap();
             let (header, payload) = responder.next();

@@ -21,7 +21,7 @@ use iceoryx2::service::service_name::{ServiceName, ServiceNameError};
 
 /// The protocol version. A client and a daemon whose versions differ refuse to talk; bump it
 /// on any change to a wire record's layout or meaning.
-pub const PROTOCOL_VERSION: u32 = 6;
+pub const PROTOCOL_VERSION: u32 = 7;
 
 /// The default root prefix of every service name (`<root>/control`, `<root>/<scene>/poses`…).
 pub const DEFAULT_ROOT: &str = "proxima";
@@ -319,7 +319,7 @@ mod tests {
         assert_eq!(count(&|v| wire::Command::from_u32(v).map(|c| c as u32)), 8);
         assert_eq!(
             count(&|v| wire::BroadPhaseCode::from_u32(v).map(|c| c as u32)),
-            5
+            6
         );
         assert_eq!(
             count(&|v| wire::ShapeKindCode::from_u32(v).map(|c| c as u32)),

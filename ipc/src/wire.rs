@@ -491,6 +491,9 @@ pub enum BroadPhaseCode {
     /// Hierarchical grid of columns sorted along one axis: a body that did not move costs
     /// nothing (since protocol version 5).
     ColumnGrid = 4,
+    /// The column grid over boxes grown by a skin, each body's neighbours listed: a body
+    /// that moves within its skin re-tests only those (since protocol version 6).
+    SkinGrid = 5,
 }
 
 impl BroadPhaseCode {
@@ -503,6 +506,7 @@ impl BroadPhaseCode {
             2 => Self::IncrementalSap,
             3 => Self::HashGrid,
             4 => Self::ColumnGrid,
+            5 => Self::SkinGrid,
             _ => return None,
         })
     }

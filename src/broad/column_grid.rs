@@ -89,7 +89,9 @@
 
 use super::body_map::Bodies;
 use super::pair_set::PairSet;
-use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64};
+use super::{
+    CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64, prefetch,
+};
 use crate::bounding::{Aabb, BoundingVolume};
 use crate::math::DVec3;
 
@@ -414,21 +416,6 @@ impl Level {
 /// reads: about the three or four entries a query of a body of the level's own size scans.
 const PREFETCH_LINES: usize = 3;
 
-/// Asks the processor to start loading the cache line holding `p` into its caches. A hint:
-/// no effect on any result, whatever `p` is.
-#[inline(always)]
-fn prefetch(p: *const u8) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch reads nothing the program sees and never faults, whatever the
-    // address (it may be dangling or one past the end); SSE, which it needs, is part of the
-    // x86_64 baseline.
-    unsafe {
-        core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(p.cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = p;
-}
-
 /// The windows a body whose box goes from `old` to `new` (`None`: not present) queries:
 /// their union when they overlap, else each box on its own, as the union of a jump's two
 /// boxes may span the world. A body meeting only the old box is met only in its window, one
@@ -720,6 +707,15 @@ impl ColumnGrid {
         out.extend_from_slice(self.pairs.commit());
     }
 
+    /// Moves the changes of the pair set since the last call (or the last
+    /// [`pairs`](Self::pairs)) to `out`: each pair and whether its boxes now overlap, in
+    /// the order they happened. For a caller that keeps the pairs itself (the
+    /// [`SkinGrid`](super::SkinGrid)); once it is used, [`pairs`](Self::pairs) no longer
+    /// lists the pair set, and [`validate_listing`](Self::validate_listing) is the check.
+    pub(crate) fn take_pair_edits(&mut self, out: &mut Vec<(CandidatePair, bool)>) {
+        self.pairs.take_edits(out);
+    }
+
     /// Checks every invariant: the slot table and id map agree; stored boxes are finite and
     /// not inverted; each body is at the level its box calls for (oversized before the first
     /// rebuild), listed exactly once: in the oversized list, or in its home column with its
@@ -729,6 +725,16 @@ impl ColumnGrid {
     /// # Errors
     /// A description of the first violated invariant.
     pub fn validate(&self) -> Result<(), String> {
+        self.validate_listing()?;
+        self.pairs.check_against_brute_force(&self.bodies.proxies)
+    }
+
+    /// [`validate`](Self::validate) but for the pair set (for a grid whose pair edits are
+    /// taken by its caller).
+    ///
+    /// # Errors
+    /// A description of the first violated invariant.
+    pub(crate) fn validate_listing(&self) -> Result<(), String> {
         self.bodies.check()?;
         let n = self.bodies.len();
         if self.last_move.len() != n {
@@ -786,7 +792,18 @@ impl ColumnGrid {
         if stored != n {
             return Err(format!("{stored} entries stored, {n} bodies"));
         }
-        self.pairs.check_against_brute_force(&self.bodies.proxies)
+        Ok(())
+    }
+
+    /// The reach of the level a box of largest extent `extent` (metres) belongs at: the
+    /// largest extent a box can grow to and stay there; `+∞` for an oversized box (and
+    /// before the first rebuild).
+    pub(crate) fn level_reach(&self, extent: f64) -> f64 {
+        self.levels
+            .iter()
+            .map(|l| l.reach)
+            .find(|&reach| extent <= reach)
+            .unwrap_or(f64::INFINITY)
     }
 
     /// The level a box belongs at: the finest whose reach is at least its largest extent,

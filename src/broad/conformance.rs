@@ -1,7 +1,8 @@
-//! What every stateful broad phase ([`IncrementalSap`], [`HashGrid`], [`ColumnGrid`]) owes,
+//! What every stateful broad phase ([`IncrementalSap`], [`HashGrid`], [`ColumnGrid`],
+//! [`SkinGrid`]) owes,
 //! as generic test bodies that each one's unit tests run with its own constructor and sizes.
 
-use super::{CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap};
+use super::{CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, SkinGrid};
 use crate::bounding::Aabb;
 use crate::math::DVec3;
 use crate::test_support::TestRng;
@@ -45,7 +46,7 @@ macro_rules! stateful {
     )+};
 }
 
-stateful!(IncrementalSap, HashGrid, ColumnGrid);
+stateful!(IncrementalSap, HashGrid, ColumnGrid, SkinGrid);
 
 /// A random box centred in the cube of half-size `spread`: one in `kinds` a point, one in
 /// `kinds` huge (half-extents 2 to 20 m), the rest ordinary (half-extents up to 1 m).

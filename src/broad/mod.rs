@@ -22,9 +22,12 @@
 //! the same stateful API over a hierarchy of 2-D grids of columns, each body listed once,
 //! in the column of its box's low corner, each column sorted along the third axis: a moved
 //! body re-tests the bodies of the 1 to 4 columns around it, each run found by a binary
-//! search, none met twice.
+//! search, none met twice. [`skin_grid`] keeps the column grid over each body's box grown
+//! by a skin, and each body's list of skin neighbours: a body that moves within its skin
+//! re-tests only its listed neighbours, and the grid hears of it only when it leaves the
+//! skin (Verlet lists, fat boxes).
 //!
-//! [`select`] puts the four behind one stateful API ([`BroadPhase`]: insert, update, remove,
+//! [`select`] puts the five behind one stateful API ([`BroadPhase`]: insert, update, remove,
 //! pairs) and chooses among them from measured scene statistics ([`BroadPhaseStats`],
 //! [`choose`]); the pipeline keeps one per scene in sync with the scene's change log, so a
 //! body that did not change is never touched.
@@ -42,6 +45,7 @@ pub mod hash_grid;
 pub mod incremental_sap;
 mod pair_set;
 pub mod select;
+pub mod skin_grid;
 pub mod sort_sweep;
 
 pub use brute_force::pairs_brute_force;
@@ -49,6 +53,7 @@ pub use column_grid::ColumnGrid;
 pub use hash_grid::HashGrid;
 pub use incremental_sap::IncrementalSap;
 pub use select::{BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, choose};
+pub use skin_grid::SkinGrid;
 pub use sort_sweep::SortAndSweep;
 
 use crate::bounding::Aabb;
@@ -141,4 +146,19 @@ fn debug_assert_valid_bounds(bounds: &Aabb) {
 fn floor_to_i64(x: f64) -> i64 {
     let t = x as i64;
     t.saturating_sub(i64::from((t as f64) > x))
+}
+
+/// Asks the processor to start loading the cache line holding `p` into its caches. A hint:
+/// no effect on any result, whatever `p` is.
+#[inline(always)]
+pub(crate) fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads nothing the program sees and never faults, whatever the
+    // address (it may be dangling or one past the end); SSE, which it needs, is part of the
+    // x86_64 baseline.
+    unsafe {
+        core::arch::x86_64::_mm_prefetch::<{ core::arch::x86_64::_MM_HINT_T0 }>(p.cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }

@@ -84,6 +84,14 @@ impl PairSet {
         &self.sorted
     }
 
+    /// Moves the edits logged since the last commit or take to `out` (each pair and
+    /// whether it is now present, in the order they were made), as a caller that keeps the
+    /// set itself wants them; the sorted list is left as it was.
+    pub(crate) fn take_edits(&mut self, out: &mut Vec<(CandidatePair, bool)>) {
+        out.extend(self.log.iter().map(|&(pair, _, present)| (pair, present)));
+        self.log.clear();
+    }
+
     /// Number of pairs, committed first.
     #[cfg(test)]
     pub(crate) fn len(&mut self) -> usize {

@@ -16,8 +16,8 @@
 use super::body_map::BodyMap;
 use super::sort_sweep::widest_spread_axis;
 use super::{
-    CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, Proxy, SortAndSweep,
-    pairs_brute_force,
+    CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, Proxy, SkinGrid,
+    SortAndSweep, pairs_brute_force,
 };
 use crate::bounding::Aabb;
 
@@ -32,15 +32,19 @@ pub enum BroadPhaseKind {
     HashGrid,
     /// Hierarchical grid of sorted columns ([`ColumnGrid`]).
     ColumnGrid,
+    /// The column grid over skin-grown boxes, with each body's neighbours listed
+    /// ([`SkinGrid`]).
+    SkinGrid,
 }
 
 impl BroadPhaseKind {
     /// Every kind.
-    pub const ALL: [Self; 4] = [
+    pub const ALL: [Self; 5] = [
         Self::SortAndSweep,
         Self::IncrementalSap,
         Self::HashGrid,
         Self::ColumnGrid,
+        Self::SkinGrid,
     ];
 }
 
@@ -91,6 +95,8 @@ enum Inner {
     Sap(IncrementalSap),
     Grid(HashGrid),
     Columns(ColumnGrid),
+    /// Boxed: it holds a column grid and its own tables besides.
+    Skin(Box<SkinGrid>),
 }
 
 /// One broad phase of any [`BroadPhaseKind`] behind one stateful API over bodies identified
@@ -116,6 +122,7 @@ impl BroadPhase {
             BroadPhaseKind::IncrementalSap => Inner::Sap(IncrementalSap::new()),
             BroadPhaseKind::HashGrid => Inner::Grid(HashGrid::new()),
             BroadPhaseKind::ColumnGrid => Inner::Columns(ColumnGrid::new()),
+            BroadPhaseKind::SkinGrid => Inner::Skin(Box::new(SkinGrid::new())),
         };
         Self {
             inner,
@@ -128,15 +135,16 @@ impl BroadPhase {
 
     /// A broad phase of kind `kind` holding `proxies` (distinct ids). The incremental sweep
     /// and prune is built at once ([`IncrementalSap::from_proxies`]: endpoints sorted once)
-    /// rather than by `n` insertions of `O(n)` each, and so is the column grid
-    /// ([`ColumnGrid::from_proxies`]: its levels chosen once, from every body); the others
-    /// insert one by one.
+    /// rather than by `n` insertions of `O(n)` each, and so are the column grid
+    /// ([`ColumnGrid::from_proxies`]: its levels chosen once, from every body) and the skin
+    /// grid over it; the others insert one by one.
     #[must_use]
     pub fn from_proxies(kind: BroadPhaseKind, proxies: &[Proxy]) -> Self {
         let mut broad = Self::new(kind);
         broad.inner = match kind {
             BroadPhaseKind::IncrementalSap => Inner::Sap(IncrementalSap::from_proxies(proxies)),
             BroadPhaseKind::ColumnGrid => Inner::Columns(ColumnGrid::from_proxies(proxies)),
+            BroadPhaseKind::SkinGrid => Inner::Skin(Box::new(SkinGrid::from_proxies(proxies))),
             BroadPhaseKind::SortAndSweep | BroadPhaseKind::HashGrid => {
                 for p in proxies {
                     broad.insert(p.body, p.bounds, p.is_static, p.filter);
@@ -166,6 +174,7 @@ impl BroadPhase {
             Inner::Sap(_) => BroadPhaseKind::IncrementalSap,
             Inner::Grid(_) => BroadPhaseKind::HashGrid,
             Inner::Columns(_) => BroadPhaseKind::ColumnGrid,
+            Inner::Skin(_) => BroadPhaseKind::SkinGrid,
         }
     }
 
@@ -195,6 +204,7 @@ impl BroadPhase {
             Inner::Sap(s) => s.proxies(),
             Inner::Grid(g) => g.proxies(),
             Inner::Columns(c) => c.proxies(),
+            Inner::Skin(c) => c.proxies(),
         }
     }
 
@@ -224,6 +234,7 @@ impl BroadPhase {
             Inner::Sap(s) => s.insert(body, bounds, is_static, filter),
             Inner::Grid(g) => g.insert(body, bounds, is_static, filter),
             Inner::Columns(c) => c.insert(body, bounds, is_static, filter),
+            Inner::Skin(c) => c.insert(body, bounds, is_static, filter),
         }
         self.entries.insert(
             body,
@@ -262,6 +273,9 @@ impl BroadPhase {
             Inner::Columns(c) => {
                 c.remove(body);
             }
+            Inner::Skin(c) => {
+                c.remove(body);
+            }
         }
         true
     }
@@ -286,6 +300,7 @@ impl BroadPhase {
             Inner::Sap(s) => s.update(body, bounds),
             Inner::Grid(g) => g.update(body, bounds),
             Inner::Columns(c) => c.update(body, bounds),
+            Inner::Skin(c) => c.update(body, bounds),
         }
     }
 
@@ -324,17 +339,18 @@ impl BroadPhase {
 
     /// [`set`](Self::set) of every proxy in `proxies`, the plain moves (same static flag
     /// and filter) handed over as one batch: [`ColumnGrid::update_all`] reads all their
-    /// records before moving any; the other kinds update one by one.
+    /// records before moving any, [`SkinGrid::update_all`] refiles the bodies that left
+    /// their skins as one batch; the other kinds update one by one.
     ///
     /// # Allocation
     /// None once the batch buffer has grown to the largest batch.
     pub fn set_all(&mut self, proxies: &[Proxy]) {
-        let Inner::Columns(_) = self.inner else {
+        if !matches!(self.inner, Inner::Columns(_) | Inner::Skin(_)) {
             for proxy in proxies {
                 self.set(proxy);
             }
             return;
-        };
+        }
         let mut moves = std::mem::take(&mut self.batch);
         moves.clear();
         for proxy in proxies {
@@ -346,18 +362,24 @@ impl BroadPhase {
                 }
                 _ => {
                     // The batch first: a later move of a replaced body must not undo it.
-                    if let Inner::Columns(c) = &mut self.inner {
-                        c.update_all(&moves);
-                    }
+                    self.update_batch(&moves);
                     moves.clear();
                     self.insert(proxy.body, proxy.bounds, proxy.is_static, proxy.filter);
                 }
             }
         }
-        if let Inner::Columns(c) = &mut self.inner {
-            c.update_all(&moves);
-        }
+        self.update_batch(&moves);
         self.batch = moves;
+    }
+
+    /// Hands `moves` to the kinds that take them as one batch (the others got them one by
+    /// one).
+    fn update_batch(&mut self, moves: &[(u32, Aabb)]) {
+        match &mut self.inner {
+            Inner::Columns(c) => c.update_all(moves),
+            Inner::Skin(c) => c.update_all(moves),
+            Inner::Sweep(_) | Inner::Sap(_) | Inner::Grid(_) => {}
+        }
     }
 
     /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
@@ -378,6 +400,7 @@ impl BroadPhase {
             Inner::Sap(s) => s.pairs(out),
             Inner::Grid(g) => g.pairs(out),
             Inner::Columns(c) => c.pairs(out),
+            Inner::Skin(c) => c.pairs(out),
         }
     }
 
@@ -418,6 +441,7 @@ impl BroadPhase {
             Inner::Sap(s) => s.validate(),
             Inner::Grid(g) => g.validate(),
             Inner::Columns(c) => c.validate(),
+            Inner::Skin(c) => c.validate(),
         }
     }
 }
@@ -488,11 +512,8 @@ fn is_far_move(old: &Aabb, new: &Aabb) -> bool {
 }
 
 /// Above this fraction of bodies changing per frame, the stateless sort and sweep (which
-/// costs the same whatever moved) beats per-body updates at every size measured.
+/// costs the same whatever moved) is chosen.
 pub const MOSTLY_MOVING: f64 = 0.5;
-/// Above this fraction of bodies changing per frame in a scene larger than
-/// [`SAP_MAX_BODIES`], likewise.
-pub const LARGE_SCENE_MOVING: f64 = 0.25;
 /// Above this fraction of far moves among the updates, a scene counts as teleporting.
 pub const TELEPORTING: f64 = 0.01;
 /// Bodies up to which the [`SortAndSweep`] kind tests every pair instead of sweeping: the
@@ -502,75 +523,62 @@ pub const TELEPORTING: f64 = 0.01;
 /// 32 bodies 3,128–4,813 / 1,148–2,173, 64 bodies 8,565–8,830 / 7,523–7,974.
 pub const ALL_PAIRS_MAX: usize = 32;
 
-/// Most bodies for [`IncrementalSap`] on a coherent scene; more go to the [`ColumnGrid`].
-pub const SAP_MAX_BODIES: usize = 1_000;
-
 /// The broad phase a scene with [`BroadPhaseChoice::Auto`] runs, given its statistics:
 ///
 /// 1. more than [`MOSTLY_MOVING`] of the bodies changing per frame: [`SortAndSweep`];
-/// 2. up to [`SAP_MAX_BODIES`] bodies, with at most [`TELEPORTING`] of the updates far
-///    moves: [`IncrementalSap`] (a jump costs it a swap with every endpoint passed);
-/// 3. more than [`LARGE_SCENE_MOVING`] changing per frame: [`SortAndSweep`];
-/// 4. else [`ColumnGrid`] (a jump costs it two queries).
+/// 2. more than [`TELEPORTING`] of the updates far moves: [`ColumnGrid`] (a jump costs it
+///    two queries, and always leaves a skin);
+/// 3. else [`SkinGrid`].
 ///
-/// The [`HashGrid`] is never chosen: the column grid was faster on every measured class
-/// (below); it stays available as a fixed choice.
+/// The [`IncrementalSap`] and the [`HashGrid`] are never chosen: on every measured class
+/// the skin grid or the column grid was faster (below); they stay available as fixed
+/// choices.
 ///
 /// # The measurements behind it
-/// `examples/broad_bench` on this machine (2-core AMD EPYC VM, one core used, nothing else
-/// running), mean µs per frame, every broad phase and rapier's BVH broad phase on parry's
-/// BVH (the faster of its 1 nm and 1 cm change margins: "peer") in lockstep on the same
-/// frames, uniform / clustered / stacked layouts of `common/broad_scenes.rs`, one run
-/// (2026-11-21). Bold: what the rule takes.
+/// `examples/broad_bench` on this machine (2-core AMD EPYC VM, one core used), mean µs per
+/// frame, the broad phases and rapier's BVH broad phase on parry's BVH (its 1 cm change
+/// margin: "peer") in lockstep on the same frames, uniform / clustered / stacked layouts
+/// of `common/broad_scenes.rs`, one run each (2026-11-24, a host running about 1.25×
+/// slower than on 2026-11-21: the peer took 24.6 ms at 100,000 uniform bodies against
+/// 19.8). Bold: what the rule takes.
 ///
-/// | bodies | motion (share moving) | sort & sweep | incremental SAP | hash grid | column grid | peer |
+/// | bodies | motion (share moving) | sort & sweep | incremental SAP | column grid | skin grid | peer |
 /// |---|---|---|---|---|---|---|
-/// | 1,000 | coherent (10 %) | 69 / 46 / 69 | **34 / 22 / 18** | 49 / 45 / 43 | 32 / 17 / 34 | 71 / 41 / 43 |
-/// | 1,000 | coherent (25 %) | 88 / 55 / 98 | **71 / 52 / 46** | 111 / 117 / 124 | 77 / 49 / 89 | 96 / 50 / 55 |
-/// | 1,000 | coherent (all) | **100 / 66 / 144** | 251 / 182 / 249 | 424 / 481 / 652 | 290 / 214 / 463 | 120 / 73 / 87 |
-/// | 1,000 | teleporting (10 %) | 121 / 105 / 93 | 4,490 / 3,638 / 136 | 202 / 190 / 62 | **106 / 55 / 43** | 454 / 205 / 51 |
-/// | 3,000 | coherent (10 %) | 304 / 259 / 272 | 146 / 100 / 102 | 170 / 194 / 173 | **117 / 93 / 92** | 277 / 171 / 122 |
-/// | 10,000 | coherent (5 %) | 1,087 / 1,038 / 852 | 604 / 429 / 468 | 474 / 586 / 507 | **302 / 290 / 303** | 866 / 696 / 473 |
-/// | 10,000 | coherent (10 %) | 1,064 / 1,068 / 926 | 972 / 847 / 883 | 847 / 1,403 / 907 | **519 / 631 / 508** | 1,053 / 963 / 614 |
-/// | 10,000 | coherent (15 %) | 1,107 / 1,039 / 977 | | 1,154 / 1,520 / 965 | **709 / 749 / 527** | 1,205 / 1,022 / 498 |
-/// | 10,000 | coherent (25 %) | 1,111 / 1,087 / 1,107 | | 1,899 / 2,474 / 1,573 | **1,118 / 1,173 / 862** | 1,414 / 1,210 / 595 |
-/// | 10,000 | coherent (50 %) | **1,262 / 1,144 / 1,331** | | 3,610 / 5,199 / 3,257 | 2,141 / 2,317 / 1,709 | 1,755 / 1,572 / 813 |
-/// | 10,000 | coherent (all) | **1,319 / 1,242 / 1,419** | | 6,401 / 10,237 / 6,254 | 3,773 / 4,504 / 3,190 | 1,897 / 1,814 / 1,008 |
-/// | 10,000 | teleporting (10 %) | 1,311 / 1,238 / 1,216 | | 2,411 / 3,110 / 902 | **1,263 / 858 / 504** | 25,859 / 18,015 / 596 |
-/// | 10,000 | teleporting (30 %) | **1,365** / – / **1,333** | | | 3,307 / – / 1,126 | 85,118 / – / 728 |
-/// | 10,000 | teleporting (50 %) | **1,283** / – / **1,440** | | | 4,731 / – / 1,866 | 133,878 / – / 846 |
-/// | 100,000 | coherent (10 %) | 16,736 / 15,872 / 11,174 | | 14,219 / 21,968 / 10,121 | **8,127 / 9,469 / 5,967** | 17,318 / 19,192 / 9,856 |
+/// | 1,000 | coherent (10 %) | 134 / 115 / 139 | 53 / 34 / 40 | 52 / 37 / 60 | **25 / 17 / 9.4** | 121 / 80 / 77 |
+/// | 1,000 | coherent (25 %) | 109 / 101 / 123 | 86 / 70 / 52 | 88 / 79 / 99 | **39 / 32 / 11** | 124 / 92 / 66 |
+/// | 1,000 | coherent (50 %) | 140 / 106 / 154 | 185 / 123 / 141 | 200 / 143 / 249 | **84 / 54 / 20** | 182 / 108 / 94 |
+/// | 1,000 | coherent (all) | **137 / 109 / 193** | | 353 / 317 / 624 | 139 / 98 / 34 | 190 / 128 / 128 |
+/// | 1,000 | teleporting (10 %) | 165 / 143 / 129 | 5,777 / 4,602 / 200 | **159 / 96 / 56** | 291 / 128 / 10 | 595 / 268 / 75 |
+/// | 10,000 | coherent (10 %) | 1,484 / 1,344 / 1,240 | 1,300 / 898 / 1,051 | 629 / 623 / 487 | **425 / 354 / 175** | 1,442 / 1,140 / 763 |
+/// | 10,000 | coherent (25 %) | 1,444 / 1,526 / 1,580 | 2,536 / 2,320 / 3,154 | 1,283 / 1,575 / 1,146 | **787 / 843 / 399** | 1,793 / 1,755 / 1,105 |
+/// | 10,000 | coherent (50 %) | 1,546 / 1,487 / 1,954 | 4,992 / 3,834 / 7,568 | 2,385 / 2,775 / 2,071 | **1,355 / 1,280 / 443** | 2,349 / 2,103 / 1,479 |
+/// | 10,000 | coherent (all) | **1,700 / 1,607 / 2,074** | | 5,003 / 5,482 / 3,961 | 2,896 / 2,427 / 431 | 3,160 / 2,746 / 1,666 |
+/// | 10,000 | teleporting (10 %) | 1,944 / 1,807 / 1,961 | 558,239 / 561,997 / 15,596 | **1,906 / 1,187 / 720** | 3,960 / 1,799 / 258 | 31,479 / 19,927 / 1,209 |
+/// | 100,000 | coherent (10 %) | | | 9,877 / 11,795 / 6,053 | **5,624 / 5,948 / 1,770** | 24,553 / 24,921 / 13,822 |
 ///
-/// (The teleporting 30 % and 50 % rows are from a second run, uniform and stacked only. The
-/// incremental sweep and prune was not run on the larger moving and teleporting scenes: its teleports cost it 0.4 s a frame at 10,000 bodies, and its 25 % and more
-/// moving rows lost to the other kinds at 1,000 and 10,000 in earlier runs.)
-///
-/// The incremental sweep and prune is the fastest on small coherent scenes, stacked dice
-/// above all, but a far move costs it a swap with every endpoint passed and its insertions
-/// are `O(n)`; from 3,000 bodies the column grid beats it on every layout. The column
-/// grid's cost follows the bodies that moved, jumps included; sort and sweep in grid
-/// columns costs the same whatever moved, and wins once more than about a quarter of a
-/// large scene moves (at 25 % the two are even on scattered bodies, and the grid is faster
-/// on stacked dice). Stacked dice with many bodies moving are where parry's BVH (refit and
-/// one self-traversal) beats all four: see issue #6's notes.
+/// The skin grid re-tests a moved body against its few listed neighbours and refiles it in
+/// the column grid only when it leaves its skin: it is the fastest on every coherent class
+/// up to half the bodies moving, 1.6–8× faster than the peer. Sort and sweep costs the same
+/// whatever moved and wins once most bodies move, on scattered bodies; stacked dice, which
+/// move little for their size, keep the skin grid ahead even then (34 and 431 µs against 193
+/// and 2,074), a case the rule, which does not measure how far bodies move for their size,
+/// leaves to sort and sweep. Teleports leave every skin, which costs the skin grid a refiling
+/// each: the column grid takes them, except on the stacked dice, whose "teleports" stay
+/// within 5 cm (not far moves: the rule picks the skin grid there).
 ///
 /// [`BroadPhaseStats::size_spread`] and [`BroadPhaseStats::sweep_overlap_ratio`] are
 /// measured and reported ([`StepReport::broad_stats`](crate::pipeline::StepReport)) but the
 /// rule does not read them: on the measured layouts (tenfold size spread in the clustered
 /// one, stacked dice sharing z ranges) the same kind won on all three layouts of each row
-/// but two (1,000 bodies: 10 % moving, where the column grid edges out the sweep and prune
-/// on scattered bodies; 25 %, on clustered ones), so no threshold on them would pick a
-/// faster kind.
+/// but the all-moving ones (above), so no threshold on them would pick a faster kind.
 #[must_use]
 pub fn choose(stats: &BroadPhaseStats) -> BroadPhaseKind {
     if stats.moving_fraction > MOSTLY_MOVING {
         BroadPhaseKind::SortAndSweep
-    } else if stats.bodies <= SAP_MAX_BODIES && stats.far_move_fraction <= TELEPORTING {
-        BroadPhaseKind::IncrementalSap
-    } else if stats.moving_fraction > LARGE_SCENE_MOVING {
-        BroadPhaseKind::SortAndSweep
-    } else {
+    } else if stats.far_move_fraction > TELEPORTING {
         BroadPhaseKind::ColumnGrid
+    } else {
+        BroadPhaseKind::SkinGrid
     }
 }
 
@@ -859,7 +867,7 @@ mod tests {
 
     #[test]
     fn the_rule_picks_the_measured_fastest_kind_for_each_scene_class() {
-        use BroadPhaseKind::{ColumnGrid as Grid, IncrementalSap as Sap, SortAndSweep as Sweep};
+        use BroadPhaseKind::{ColumnGrid as Grid, SkinGrid as Skin, SortAndSweep as Sweep};
         let stats = |bodies, moving_fraction, far_move_fraction| BroadPhaseStats {
             bodies,
             moving_fraction,
@@ -869,25 +877,20 @@ mod tests {
         };
         let cases = [
             // (bodies, moving, far moves) → kind, as the table in `choose` measured.
-            ((1_000, 0.1, 0.0), Sap),
-            ((1_000, 0.25, 0.0), Sap),
-            ((1_000, 0.5, 0.0), Sap),
-            ((1_001, 0.1, 0.0), Grid),
-            ((3_000, 0.1, 0.0), Grid),
-            ((10_000, 0.05, 0.0), Grid),
-            ((10_000, 0.25, 0.0), Grid),
-            ((10_000, 0.26, 0.0), Sweep),
-            ((100_000, 0.1, 0.0), Grid),
-            ((1_000, 0.1, 1.0), Grid),
+            ((1_000, 0.1, 0.0), Skin),
+            ((1_000, 0.25, 0.0), Skin),
+            ((1_000, 0.5, 0.0), Skin),
+            ((10_000, 0.1, 0.0), Skin),
+            ((10_000, 0.5, 0.0), Skin),
+            ((100_000, 0.1, 0.0), Skin),
+            ((1_000, 0.1, 0.005), Skin),
             ((1_000, 0.1, 0.02), Grid),
-            ((1_000, 0.1, 0.005), Sap),
+            ((10_000, 0.1, 0.5), Grid),
+            ((10_000, 0.5, 1.0), Grid),
+            ((1_000, 0.51, 0.0), Sweep),
             ((1_000, 1.0, 0.0), Sweep),
             ((100_000, 1.0, 1.0), Sweep),
-            ((10_000, 0.1, 0.5), Grid),
-            ((10_000, 0.3, 0.5), Sweep),
-            ((1_000, 0.3, 0.02), Sweep),
-            ((1_000, 0.25, 0.02), Grid),
-            ((0, 0.0, 0.0), Sap),
+            ((0, 0.0, 0.0), Skin),
         ];
         for ((bodies, moving, far), kind) in cases {
             assert_eq!(

@@ -159,7 +159,7 @@ fn broad_phase(code: u32) -> Result<BroadPhaseChoice, Rejection> {
     let code = BroadPhaseCode::from_u32(code).ok_or_else(|| {
         Rejection::new(
             ErrorCode::MalformedMessage,
-            format!("unknown broad phase {code} (0 auto, 1 sort and sweep, 2 incremental SAP, 3 hash grid, 4 column grid)"),
+            format!("unknown broad phase {code} (0 auto, 1 sort and sweep, 2 incremental SAP, 3 hash grid, 4 column grid, 5 skin grid)"),
         )
     })?;
     Ok(match code {
@@ -168,6 +168,7 @@ fn broad_phase(code: u32) -> Result<BroadPhaseChoice, Rejection> {
         BroadPhaseCode::IncrementalSap => BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap),
         BroadPhaseCode::HashGrid => BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid),
         BroadPhaseCode::ColumnGrid => BroadPhaseChoice::Fixed(BroadPhaseKind::ColumnGrid),
+        BroadPhaseCode::SkinGrid => BroadPhaseChoice::Fixed(BroadPhaseKind::SkinGrid),
     })
 }
 
@@ -295,6 +296,7 @@ mod tests {
         assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::Ok);
         assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::UnknownBody);
         for (wire_code, choice) in [
+            (5, BroadPhaseChoice::Fixed(BroadPhaseKind::SkinGrid)),
             (4, BroadPhaseChoice::Fixed(BroadPhaseKind::ColumnGrid)),
             (3, BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid)),
             (2, BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap)),
@@ -477,7 +479,7 @@ mod tests {
             (
                 ControlRequest {
                     scene,
-                    broad_phase: 5,
+                    broad_phase: 6,
                     ..request(Command::SetSceneParams)
                 },
                 vec![],
