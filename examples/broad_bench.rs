@@ -1,4 +1,4 @@
-//! Broad-phase timing per frame: Proxima's three broad phases and rapier's broad phase (on
+//! Broad-phase timing per frame: Proxima's broad phases and rapier's broad phase (on
 //! parry3d-f64's BVH) in lockstep on the same frames of one workload.
 //!
 //! ```text
@@ -15,7 +15,7 @@
 //!   itself, so applying the moves costs it nothing);
 //! - `incremental_sap`, `hash_grid`: `update` of each moved body, then `pairs` (the sorted
 //!   list);
-//! - `column_grid`: `update_all` of the frame's moves, then `pairs`;
+//! - `column_grid`, `skin_grid`: `update_all` of the frame's moves, then `pairs`;
 //! - `parry_bvh` (change margin 1 nm, the exact pair set to within 2 nm) and `rapier_bvh` (rapier's 1 cm
 //!   change margin): rapier's update loop, its pair map kept current; no list produced.
 //!
@@ -66,16 +66,19 @@ struct Args {
     #[arg(long, default_value_t = 100)]
     frames: usize,
     /// Broad phases to run, comma-separated (sort_sweep, incremental_sap, hash_grid,
-    /// column_grid, parry_bvh, rapier_bvh).
+    /// column_grid, skin_grid, parry_bvh, rapier_bvh).
     #[arg(
         long,
-        default_value = "sort_sweep,incremental_sap,hash_grid,column_grid,parry_bvh,rapier_bvh"
+        default_value = "sort_sweep,incremental_sap,hash_grid,column_grid,skin_grid,parry_bvh,rapier_bvh"
     )]
     algos: String,
     /// Check every broad phase's pair set against the others every this many frames
     /// (0: never).
     #[arg(long, default_value_t = 1)]
     check_every: usize,
+    /// Factor on the coherent movers' speeds (3 cm per frame scattered, 5 mm stacked).
+    #[arg(long, default_value_t = 1.0)]
+    speed_scale: f64,
     /// Seed of the layout and the motion.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -136,6 +139,7 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     };
     let mut scene = BroadScene::new(layout, args.bodies, args.moving, motion, args.seed);
+    scene.scale_speed(args.speed_scale);
     let mut runners = Vec::new();
     for name in args.algos.split(',').map(str::trim) {
         match NAMES

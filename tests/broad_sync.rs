@@ -283,8 +283,11 @@ fn kept_broad_phases_answer_like_a_fresh_workspace_and_reread_only_changed_bodie
                         };
                         let mut expected = BroadPhaseStats::measure(&proxies, moved);
                         expected.far_move_fraction = stats.far_move_fraction;
+                        expected.mean_shift = stats.mean_shift;
                         assert_eq!(stats, expected, "{what}");
                         assert!((0.0..=1.0).contains(&stats.far_move_fraction), "{what}");
+                        assert!((0.0..=1.0).contains(&stats.mean_shift), "{what}");
+                        assert!(stats.mean_shift >= stats.far_move_fraction, "{what}");
                         auto_kind = Some(choose(&stats));
                         auto_measured_at = frame;
                     }

@@ -202,6 +202,14 @@ impl BroadScene {
         }
     }
 
+    /// Multiplies every coherent mover's speed by `factor` (the layouts' speeds are in the
+    /// module docs); teleports are unchanged.
+    pub fn scale_speed(&mut self, factor: f64) {
+        for m in &mut self.movers {
+            m.velocity *= factor;
+        }
+    }
+
     /// Number of bodies that move every frame.
     pub fn moving_count(&self) -> usize {
         self.movers.len()

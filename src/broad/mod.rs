@@ -52,7 +52,9 @@ pub use brute_force::pairs_brute_force;
 pub use column_grid::ColumnGrid;
 pub use hash_grid::HashGrid;
 pub use incremental_sap::IncrementalSap;
-pub use select::{BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, choose};
+pub use select::{
+    BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, MoveCounts, choose,
+};
 pub use skin_grid::SkinGrid;
 pub use sort_sweep::SortAndSweep;
 

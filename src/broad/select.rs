@@ -64,18 +64,17 @@ pub enum BroadPhaseChoice {
 struct Entry {
     is_static: bool,
     filter: CollisionFilter,
-    /// Its box, to tell far moves ([`BroadPhase::take_move_counts`]).
+    /// Its box, to measure its moves ([`BroadPhase::take_move_counts`]).
     bounds: Aabb,
     /// Index into [`Sweep::proxies`] (sort and sweep only; 0 otherwise).
     slot: u32,
 }
 
 impl Entry {
-    /// Keeps the body's new box, counting the move and whether it was a far move
-    /// ([`BroadPhase::take_move_counts`]) in `(moves, far_moves)`.
-    fn note_move(&mut self, bounds: Aabb, (moves, far_moves): (&mut u64, &mut u64)) {
-        *moves += 1;
-        *far_moves += u64::from(is_far_move(&self.bounds, &bounds));
+    /// Keeps the body's new box, its move counted in `counts`
+    /// ([`BroadPhase::take_move_counts`]).
+    fn note_move(&mut self, bounds: Aabb, counts: &mut MoveCounts) {
+        counts.add(&self.bounds, &bounds);
         self.bounds = bounds;
     }
 }
@@ -105,10 +104,8 @@ enum Inner {
 pub struct BroadPhase {
     inner: Inner,
     entries: BodyMap<Entry>,
-    /// Updates since the last [`take_move_counts`](Self::take_move_counts), and how many of
-    /// them were far moves.
-    moves: u64,
-    far_moves: u64,
+    /// Updates since the last [`take_move_counts`](Self::take_move_counts).
+    counts: MoveCounts,
     /// [`set_all`](Self::set_all)'s batch of plain moves.
     batch: Vec<(u32, Aabb)>,
 }
@@ -127,8 +124,7 @@ impl BroadPhase {
         Self {
             inner,
             entries: BodyMap::default(),
-            moves: 0,
-            far_moves: 0,
+            counts: MoveCounts::default(),
             batch: Vec::new(),
         }
     }
@@ -311,18 +307,13 @@ impl BroadPhase {
             debug_assert!(false, "update of absent body {body}");
             return None;
         };
-        entry.note_move(bounds, (&mut self.moves, &mut self.far_moves));
+        entry.note_move(bounds, &mut self.counts);
         Some(entry.slot)
     }
 
-    /// Updates since the last call, and how many of them were *far moves*: the box's centre
-    /// moved farther, on some axis, than the box's largest edge (a jump across its own size,
-    /// which a sweep and prune pays for in endpoint swaps with every body passed). Resets
-    /// both counts.
-    pub fn take_move_counts(&mut self) -> (u64, u64) {
-        let counts = (self.moves, self.far_moves);
-        (self.moves, self.far_moves) = (0, 0);
-        counts
+    /// The updates since the last call, measured ([`MoveCounts`]); resets them.
+    pub fn take_move_counts(&mut self) -> MoveCounts {
+        std::mem::take(&mut self.counts)
     }
 
     /// Brings `proxy.body` in line with `proxy`, whatever its state: inserted when absent,
@@ -357,7 +348,7 @@ impl BroadPhase {
             // One look-up: the check that it is a plain move, and the move's record.
             match self.entries.get_mut(&proxy.body) {
                 Some(e) if e.is_static == proxy.is_static && e.filter == proxy.filter => {
-                    e.note_move(proxy.bounds, (&mut self.moves, &mut self.far_moves));
+                    e.note_move(proxy.bounds, &mut self.counts);
                     moves.push((proxy.body, proxy.bounds));
                 }
                 _ => {
@@ -463,10 +454,66 @@ pub struct BroadPhaseStats {
     /// centres spread most, divided by the number of bodies: about the mean number of
     /// neighbours a body's interval meets there, a clustering measure (0 with no bodies).
     pub sweep_overlap_ratio: f64,
-    /// Fraction of the recent updates that were far moves
-    /// ([`BroadPhase::take_move_counts`]); [`measure`](Self::measure) sets 0 (it sees one
-    /// frame's boxes, not their motion) and the caller fills it in from the kept broad phase.
+    /// Fraction of the recent updates that were far moves ([`MoveCounts`]);
+    /// [`measure`](Self::measure) sets 0 (it sees one frame's boxes, not their motion) and
+    /// [`with_moves`](Self::with_moves) fills it in from the kept broad phase.
     pub far_move_fraction: f64,
+    /// Mean relative shift of the recent updates ([`MoveCounts::mean_shift`]); as
+    /// [`far_move_fraction`](Self::far_move_fraction), 0 until
+    /// [`with_moves`](Self::with_moves).
+    pub mean_shift: f64,
+}
+
+/// What a broad phase's updates were like ([`BroadPhase::take_move_counts`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct MoveCounts {
+    /// Updates counted.
+    pub moves: u64,
+    /// How many of them were *far moves*: the box's centre moved farther, on some axis,
+    /// than the box's largest edge (a jump across its own size, which a sweep and prune
+    /// pays for in endpoint swaps with every body passed).
+    pub far_moves: u64,
+    /// Sum over the updates of the *relative shift*: the farthest the centre moved on one
+    /// axis over the box's largest edge, at most 1 (a far move counts 1; so does any move
+    /// of a zero-size box).
+    pub shift_sum: f64,
+}
+
+impl MoveCounts {
+    /// Counts the move of a box from `old` to `new`.
+    fn add(&mut self, old: &Aabb, new: &Aabb) {
+        let shift = (((new.min + new.max) - (old.min + old.max)).abs() * 0.5).max_element();
+        let edge = (old.max - old.min).max_element();
+        self.moves += 1;
+        self.far_moves += u64::from(shift > edge);
+        self.shift_sum += if shift > edge {
+            1.0
+        } else if shift == 0.0 {
+            0.0
+        } else {
+            shift / edge
+        };
+    }
+
+    /// Fraction of the updates that were far moves; 0 with none.
+    #[must_use]
+    pub fn far_fraction(&self) -> f64 {
+        if self.moves == 0 {
+            0.0
+        } else {
+            self.far_moves as f64 / self.moves as f64
+        }
+    }
+
+    /// Mean relative shift per update, in `[0, 1]`; 0 with none.
+    #[must_use]
+    pub fn mean_shift(&self) -> f64 {
+        if self.moves == 0 {
+            0.0
+        } else {
+            self.shift_sum / self.moves as f64
+        }
+    }
 }
 
 impl BroadPhaseStats {
@@ -484,6 +531,7 @@ impl BroadPhaseStats {
                 size_spread: 1.0,
                 sweep_overlap_ratio: 0.0,
                 far_move_fraction: 0.0,
+                mean_shift: 0.0,
             };
         }
         let mut sizes: Vec<f64> = proxies
@@ -501,19 +549,28 @@ impl BroadPhaseStats {
             sweep_overlap_ratio: interval_overlaps(proxies, widest_spread_axis(proxies)) as f64
                 / n as f64,
             far_move_fraction: 0.0,
+            mean_shift: 0.0,
+        }
+    }
+
+    /// These statistics with the motion measures taken from a broad phase's `counts`.
+    #[must_use]
+    pub fn with_moves(self, counts: &MoveCounts) -> Self {
+        Self {
+            far_move_fraction: counts.far_fraction(),
+            mean_shift: counts.mean_shift(),
+            ..self
         }
     }
 }
 
-/// Whether moving a box from `old` to `new` is a far move ([`BroadPhase::take_move_counts`]).
-fn is_far_move(old: &Aabb, new: &Aabb) -> bool {
-    let shift = ((new.min + new.max) - (old.min + old.max)).abs() * 0.5;
-    shift.max_element() > (old.max - old.min).max_element()
-}
-
-/// Above this fraction of bodies changing per frame, the stateless sort and sweep (which
-/// costs the same whatever moved) is chosen.
+/// Above this fraction of bodies changing per frame, moving faster than [`CREEPING`], the
+/// stateless sort and sweep (which costs the same whatever moved) is chosen.
 pub const MOSTLY_MOVING: f64 = 0.5;
+/// Mean relative shift per update ([`MoveCounts::mean_shift`]) up to which bodies count as
+/// creeping: the skin grid keeps them even when most move (measured crossovers in
+/// [`choose`]'s docs).
+pub const CREEPING: f64 = 0.01;
 /// Above this fraction of far moves among the updates, a scene counts as teleporting.
 pub const TELEPORTING: f64 = 0.01;
 /// Bodies up to which the [`SortAndSweep`] kind tests every pair instead of sweeping: the
@@ -525,55 +582,76 @@ pub const ALL_PAIRS_MAX: usize = 32;
 
 /// The broad phase a scene with [`BroadPhaseChoice::Auto`] runs, given its statistics:
 ///
-/// 1. more than [`MOSTLY_MOVING`] of the bodies changing per frame: [`SortAndSweep`];
+/// 1. more than [`MOSTLY_MOVING`] of the bodies changing per frame, and moving more than
+///    [`CREEPING`] for their size ([`BroadPhaseStats::mean_shift`]): [`SortAndSweep`];
 /// 2. more than [`TELEPORTING`] of the updates far moves: [`ColumnGrid`] (a jump costs it
 ///    two queries, and always leaves a skin);
 /// 3. else [`SkinGrid`].
 ///
+/// A teleporting scene (over 1 % far moves, each counted a relative shift of 1) always has
+/// a mean shift over [`CREEPING`], so when most of its bodies move the first line takes it.
 /// The [`IncrementalSap`] and the [`HashGrid`] are never chosen: on every measured class
-/// the skin grid or the column grid was faster (below); they stay available as fixed
-/// choices.
+/// the skin grid, the column grid or sort and sweep was faster (below); they stay
+/// available as fixed choices.
 ///
 /// # The measurements behind it
 /// `examples/broad_bench` on this machine (2-core AMD EPYC VM, one core used), mean µs per
 /// frame, the broad phases and rapier's BVH broad phase on parry's BVH (its 1 cm change
 /// margin: "peer") in lockstep on the same frames, uniform / clustered / stacked layouts
-/// of `common/broad_scenes.rs`, one run each (2026-11-24, a host running about 1.25×
-/// slower than on 2026-11-21: the peer took 24.6 ms at 100,000 uniform bodies against
-/// 19.8). Bold: what the rule takes.
+/// of `common/broad_scenes.rs`, one run per row, on a host running about 1.25× slower
+/// than on 2026-11-21 (the peer took 22–25 ms at 100,000 uniform bodies against 19.8).
+/// Bold: what the rule takes.
+///
+/// First run (2026-11-24, before [`MIN_SKIN`](super::skin_grid::MIN_SKIN) was raised to
+/// 0.1, which changes none of these rows' skins: the bench's full speed is above it, the
+/// dice never leave their first skin, teleports take the largest):
 ///
 /// | bodies | motion (share moving) | sort & sweep | incremental SAP | column grid | skin grid | peer |
 /// |---|---|---|---|---|---|---|
 /// | 1,000 | coherent (10 %) | 134 / 115 / 139 | 53 / 34 / 40 | 52 / 37 / 60 | **25 / 17 / 9.4** | 121 / 80 / 77 |
 /// | 1,000 | coherent (25 %) | 109 / 101 / 123 | 86 / 70 / 52 | 88 / 79 / 99 | **39 / 32 / 11** | 124 / 92 / 66 |
 /// | 1,000 | coherent (50 %) | 140 / 106 / 154 | 185 / 123 / 141 | 200 / 143 / 249 | **84 / 54 / 20** | 182 / 108 / 94 |
-/// | 1,000 | coherent (all) | **137 / 109 / 193** | | 353 / 317 / 624 | 139 / 98 / 34 | 190 / 128 / 128 |
-/// | 1,000 | teleporting (10 %) | 165 / 143 / 129 | 5,777 / 4,602 / 200 | **159 / 96 / 56** | 291 / 128 / 10 | 595 / 268 / 75 |
-/// | 10,000 | coherent (10 %) | 1,484 / 1,344 / 1,240 | 1,300 / 898 / 1,051 | 629 / 623 / 487 | **425 / 354 / 175** | 1,442 / 1,140 / 763 |
+/// | 1,000 | teleporting (10 %) | 165 / 143 / 129 | 5,777 / 4,602 / 200 | **159 / 96** / 56 | 291 / 128 / **10** | 595 / 268 / 75 |
 /// | 10,000 | coherent (25 %) | 1,444 / 1,526 / 1,580 | 2,536 / 2,320 / 3,154 | 1,283 / 1,575 / 1,146 | **787 / 843 / 399** | 1,793 / 1,755 / 1,105 |
 /// | 10,000 | coherent (50 %) | 1,546 / 1,487 / 1,954 | 4,992 / 3,834 / 7,568 | 2,385 / 2,775 / 2,071 | **1,355 / 1,280 / 443** | 2,349 / 2,103 / 1,479 |
-/// | 10,000 | coherent (all) | **1,700 / 1,607 / 2,074** | | 5,003 / 5,482 / 3,961 | 2,896 / 2,427 / 431 | 3,160 / 2,746 / 1,666 |
-/// | 10,000 | teleporting (10 %) | 1,944 / 1,807 / 1,961 | 558,239 / 561,997 / 15,596 | **1,906 / 1,187 / 720** | 3,960 / 1,799 / 258 | 31,479 / 19,927 / 1,209 |
-/// | 100,000 | coherent (10 %) | | | 9,877 / 11,795 / 6,053 | **5,624 / 5,948 / 1,770** | 24,553 / 24,921 / 13,822 |
+/// | 10,000 | teleporting (10 %) | 1,944 / 1,807 / 1,961 | 558,239 / 561,997 / 15,596 | **1,906 / 1,187** / 720 | 3,960 / 1,799 / **258** | 31,479 / 19,927 / 1,209 |
+///
+/// Second run (after it; the bench's speeds, 3 cm a frame scattered and 5 mm stacked, and
+/// a sixth of them, `--speed-scale 0.1667`):
+///
+/// | bodies | motion (share moving, speed) | sort & sweep | column grid | skin grid | peer |
+/// |---|---|---|---|---|---|
+/// | 1,000 | coherent (all, full) | **120 / 71** / 180 | 322 / 223 / 592 | 120 / 67 / **30** | 167 / 89 / 114 |
+/// | 1,000 | coherent (all, a sixth) | 102 / 99 / 183 | 285 / 281 / 603 | **48 / 60 / 32** | 95 / 82 / 89 |
+/// | 10,000 | coherent (10 %, full) | 1,259 / 1,427 / 1,238 | 444 / 676 / 453 | **250 / 410 / 146** | 1,133 / 1,206 / 613 |
+/// | 10,000 | coherent (10 %, a sixth) | 1,237 / 1,205 / 1,322 | 489 / 549 / 470 | **193 / 195 / 148** | 699 / 599 / 555 |
+/// | 10,000 | coherent (all, full) | **1,453 / 1,363** / 1,724 | 4,112 / 4,811 / 3,166 | 2,348 / 1,903 / **288** | 2,460 / 2,130 / 1,099 |
+/// | 10,000 | coherent (all, a sixth) | 1,370 / 1,427 / 1,871 | 4,004 / 5,082 / 3,809 | **746 / 1,246 / 372** | 1,268 / 1,400 / 1,072 |
+/// | 100,000 | coherent (10 %, full) | | 8,725 / 9,997 / 7,628 | **4,813 / 5,276 / 1,923** | 22,035 / 22,886 / 14,663 |
 ///
 /// The skin grid re-tests a moved body against its few listed neighbours and refiles it in
 /// the column grid only when it leaves its skin: it is the fastest on every coherent class
-/// up to half the bodies moving, 1.6–8× faster than the peer. Sort and sweep costs the same
-/// whatever moved and wins once most bodies move, on scattered bodies; stacked dice, which
-/// move little for their size, keep the skin grid ahead even then (34 and 431 µs against 193
-/// and 2,074), a case the rule, which does not measure how far bodies move for their size,
-/// leaves to sort and sweep. Teleports leave every skin, which costs the skin grid a refiling
-/// each: the column grid takes them, except on the stacked dice, whose "teleports" stay
-/// within 5 cm (not far moves: the rule picks the skin grid there).
+/// up to half the bodies moving. Sort and sweep costs the same whatever moved and wins
+/// once most bodies move fast for their size; slow ones stay cheaper in the skin grid.
+/// Where they cross, with all of 10,000 bodies moving (µs, sort and sweep / skin grid, at
+/// 1/6, 1/3, 1/2, 2/3 and all of the bench speed, one run): uniform 1,464 / 750,
+/// 1,527 / 1,023, 1,551 / 1,407, 1,455 / 1,465, 1,773 / 2,949; clustered 1,687 / 1,502,
+/// 1,644 / 1,792, 1,695 / 1,948, 1,420 / 1,609, 1,376 / 1,894. In mean relative shift
+/// (the farthest axis over the largest edge; a random direction's largest component is
+/// about 0.7 of the speed) the uniform bodies cross at about 0.013, the clustered ones,
+/// whose small bodies move far for their size, at about 0.010: [`CREEPING`]. The stacked
+/// dice creep at about 0.004. Teleports leave every skin, which costs the skin grid a
+/// refiling each: the column grid takes them, except on the stacked dice, whose
+/// "teleports" stay within 5 cm (not far moves: the rule picks the skin grid there).
 ///
 /// [`BroadPhaseStats::size_spread`] and [`BroadPhaseStats::sweep_overlap_ratio`] are
 /// measured and reported ([`StepReport::broad_stats`](crate::pipeline::StepReport)) but the
 /// rule does not read them: on the measured layouts (tenfold size spread in the clustered
-/// one, stacked dice sharing z ranges) the same kind won on all three layouts of each row
-/// but the all-moving ones (above), so no threshold on them would pick a faster kind.
+/// one, stacked dice sharing z ranges) the kinds that won did so for how much and how far
+/// the bodies moved, so no threshold on them would pick a faster kind.
 #[must_use]
 pub fn choose(stats: &BroadPhaseStats) -> BroadPhaseKind {
-    if stats.moving_fraction > MOSTLY_MOVING {
+    if stats.moving_fraction > MOSTLY_MOVING && stats.mean_shift > CREEPING {
         BroadPhaseKind::SortAndSweep
     } else if stats.far_move_fraction > TELEPORTING {
         BroadPhaseKind::ColumnGrid
@@ -767,6 +845,7 @@ mod tests {
                 size_spread: 1.0,
                 sweep_overlap_ratio: 0.0,
                 far_move_fraction: 0.0,
+                mean_shift: 0.0,
             }
         );
     }
@@ -868,54 +947,78 @@ mod tests {
     #[test]
     fn the_rule_picks_the_measured_fastest_kind_for_each_scene_class() {
         use BroadPhaseKind::{ColumnGrid as Grid, SkinGrid as Skin, SortAndSweep as Sweep};
-        let stats = |bodies, moving_fraction, far_move_fraction| BroadPhaseStats {
+        let stats = |bodies, moving_fraction, far_move_fraction, mean_shift| BroadPhaseStats {
             bodies,
             moving_fraction,
             size_spread: 3.0,
             sweep_overlap_ratio: 2.0,
             far_move_fraction,
+            mean_shift,
         };
+        // The bench's scattered bodies shift about 0.02 of their size a frame, its stacked
+        // dice 0.004.
         let cases = [
-            // (bodies, moving, far moves) → kind, as the table in `choose` measured.
-            ((1_000, 0.1, 0.0), Skin),
-            ((1_000, 0.25, 0.0), Skin),
-            ((1_000, 0.5, 0.0), Skin),
-            ((10_000, 0.1, 0.0), Skin),
-            ((10_000, 0.5, 0.0), Skin),
-            ((100_000, 0.1, 0.0), Skin),
-            ((1_000, 0.1, 0.005), Skin),
-            ((1_000, 0.1, 0.02), Grid),
-            ((10_000, 0.1, 0.5), Grid),
-            ((10_000, 0.5, 1.0), Grid),
-            ((1_000, 0.51, 0.0), Sweep),
-            ((1_000, 1.0, 0.0), Sweep),
-            ((100_000, 1.0, 1.0), Sweep),
-            ((0, 0.0, 0.0), Skin),
+            // (bodies, moving, far moves, mean shift) → kind, as the table in `choose`
+            // measured.
+            ((1_000, 0.1, 0.0, 0.02), Skin),
+            ((1_000, 0.25, 0.0, 0.02), Skin),
+            ((1_000, 0.5, 0.0, 0.02), Skin),
+            ((10_000, 0.1, 0.0, 0.02), Skin),
+            ((10_000, 0.5, 0.0, 0.02), Skin),
+            ((100_000, 0.1, 0.0, 0.02), Skin),
+            ((1_000, 0.1, 0.005, 0.02), Skin),
+            ((1_000, 0.1, 0.02, 0.03), Grid),
+            ((10_000, 0.1, 0.5, 0.6), Grid),
+            ((10_000, 0.5, 1.0, 1.0), Grid),
+            ((1_000, 0.51, 0.0, 0.02), Sweep),
+            ((1_000, 1.0, 0.0, 0.02), Sweep),
+            ((100_000, 1.0, 1.0, 1.0), Sweep),
+            // Most bodies creeping: the skin grid still.
+            ((10_000, 1.0, 0.0, 0.004), Skin),
+            ((10_000, 1.0, 0.0, CREEPING), Skin),
+            // A scene's first measurement sees no motion.
+            ((10_000, 1.0, 0.0, 0.0), Skin),
+            ((0, 0.0, 0.0, 0.0), Skin),
         ];
-        for ((bodies, moving, far), kind) in cases {
+        for ((bodies, moving, far, shift), kind) in cases {
             assert_eq!(
-                choose(&stats(bodies, moving, far)),
+                choose(&stats(bodies, moving, far, shift)),
                 kind,
-                "{bodies} {moving} {far}"
+                "{bodies} {moving} {far} {shift}"
             );
         }
     }
 
     #[test]
-    fn far_moves_are_jumps_beyond_the_box_size_and_the_counts_reset_when_taken() {
+    fn far_moves_are_jumps_beyond_the_box_size_shifts_are_relative_and_counts_reset() {
         let mut broad = BroadPhase::new(BroadPhaseKind::HashGrid);
         let unit = |x: f64| Aabb::new(DVec3::new(x, 0.0, 0.0), DVec3::new(x + 1.0, 1.0, 1.0));
         broad.insert(0, unit(0.0), false, CollisionFilter::ALL);
-        broad.update(0, unit(0.5)); // half its size: near
-        broad.update(0, unit(1.5)); // exactly its size: near
-        broad.update(0, unit(2.6)); // beyond: far
+        broad.update(0, unit(0.5)); // half its size: near, shift 0.5
+        broad.update(0, unit(1.5)); // exactly its size: near, shift 1
+        broad.update(0, unit(2.6)); // beyond: far, shift counted 1
         broad.set(&Proxy {
             body: 0,
             bounds: unit(-10.0),
             is_static: false,
             filter: CollisionFilter::ALL,
         }); // far, through `set`
-        assert_eq!(broad.take_move_counts(), (4, 2));
-        assert_eq!(broad.take_move_counts(), (0, 0));
+        broad.update(0, unit(-10.0)); // not moved: shift 0
+        let counts = broad.take_move_counts();
+        assert_eq!((counts.moves, counts.far_moves), (5, 2));
+        assert_eq!(counts.shift_sum, 3.5);
+        assert_eq!((counts.far_fraction(), counts.mean_shift()), (0.4, 0.7));
+        assert_eq!(broad.take_move_counts(), MoveCounts::default());
+        assert_eq!(MoveCounts::default().mean_shift(), 0.0);
+        // A point's every move is a full shift; a zero-size box that stays, none.
+        let point = |x: f64| Aabb::new(DVec3::splat(x), DVec3::splat(x));
+        broad.insert(1, point(0.0), false, CollisionFilter::ALL);
+        broad.update(1, point(1e-9));
+        broad.update(1, point(1e-9));
+        let counts = broad.take_move_counts();
+        assert_eq!(
+            (counts.moves, counts.far_moves, counts.shift_sum),
+            (2, 1, 1.0)
+        );
     }
 }

@@ -56,8 +56,10 @@
 //! scene asks for ([`Scene::broad_phase`]): a fixed one, or with
 //! [`BroadPhaseChoice::Auto`] the kind [`choose`] picks from [`BroadPhaseStats`] measured on
 //! the scene at its first frame and again every [`AUTO_REMEASURE_FRAMES`] frames (a
-//! different pick rebuilds the broad phase; the share of far moves comes from the kept broad
-//! phase's counts since the last measurement, [`BroadPhase::take_move_counts`]; the
+//! different pick rebuilds the broad phase; the share of far moves and the mean shift come
+//! from the kept broad phase's counts since the last measurement,
+//! [`BroadPhase::take_move_counts`]: none at the first measurement, which therefore sees
+//! no motion and picks for a scene at rest; the
 //! statistics are in [`StepReport::broad_stats`] on the frames that measured). Each frame it re-reads only the bodies in the
 //! scene's change log ([`Scene::changes_since`]): a body that did not change is never
 //! touched, static bodies included. It rebuilds from every body instead on a scene it was
@@ -915,12 +917,7 @@ fn sync_broad_phase(
                 let moved = changes.map_or(workspace.proxies.len(), <[u32]>::len);
                 let mut stats = BroadPhaseStats::measure(&workspace.proxies, moved);
                 if let Some(broad) = workspace.broad.as_mut() {
-                    let (moves, far) = broad.take_move_counts();
-                    stats.far_move_fraction = if moves == 0 {
-                        0.0
-                    } else {
-                        far as f64 / moves as f64
-                    };
+                    stats = stats.with_moves(&broad.take_move_counts());
                 }
                 *measured = Some(stats);
                 let kind = choose(&stats);
