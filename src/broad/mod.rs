@@ -44,6 +44,7 @@ mod conformance;
 pub mod hash_grid;
 pub mod incremental_sap;
 mod pair_set;
+mod pair_sort;
 pub mod select;
 pub mod skin_grid;
 pub mod sort_sweep;
