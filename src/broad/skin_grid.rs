@@ -30,9 +30,12 @@
 //! that the fat box outgrows the reach of the grid level the true box belongs at (a
 //! bigger box would be filed one level up, where every query of the level below meets
 //! it). A body filed for the first time gets [`FIRST_SKIN`] of its extent, within the same
-//! level room. Each filing's skin is divided by a number between 0.5 and 1.5 drawn from
-//! the body's id and the batch ([`SKIN_SPREAD`]), so that bodies which start moving
-//! together do not all leave their skins in the same frames.
+//! level room. Each refiled skin is divided by a number between 0.5 and 1.5 drawn from the
+//! body's id and the batch ([`SKIN_SPREAD`]), so that bodies which start moving together
+//! do not keep leaving their skins in the same frames. First skins are not spread: a
+//! thicker one would bridge gaps a resting body never crosses (stacked dice 0.23 m apart
+//! gained neighbours across the gap: 241 → 1,000–1,200 µs a frame at 10,000 dice all
+//! moving).
 //!
 //! # Costs (`d` neighbours a body has)
 //! - A move inside the skin: `O(d)` box tests, reading the body's record (fat box and the
@@ -80,8 +83,8 @@ pub const SKIN_FRAMES: f64 = 8.0;
 pub const MIN_SKIN: f64 = 0.1;
 /// See [`MIN_SKIN`].
 pub const MAX_SKIN: f64 = 0.5;
-/// Width of the spread of skin thicknesses: each filing's skin (first or refiled) is
-/// divided by a number drawn uniformly from `[1 − SKIN_SPREAD / 2, 1 + SKIN_SPREAD / 2)`
+/// Width of the spread of skin thicknesses: each refiled skin is divided by a number drawn
+/// uniformly from `[1 − SKIN_SPREAD / 2, 1 + SKIN_SPREAD / 2)`
 /// by a hash of the body's id and the batch (module docs, "The skin"). Dividing, not
 /// multiplying: a body leaves its skin at a rate inversely proportional to its thickness,
 /// so the mean rate of refilings stays what [`SKIN_FRAMES`] asks for.
@@ -90,10 +93,9 @@ pub const MAX_SKIN: f64 = 0.5;
 /// frames, for as long as they keep their speeds. Measured (`examples/broad_bench`,
 /// 100,000 bodies, 10 % moving): without it, frame times swung between 1.0 and 10.5 ms to
 /// the end of a 150-frame run; with it they settle at 3.5–5 ms after the first ten frames.
-/// Four alternating runs of 120 frames, medians of mean / p99 in ms: uniform 3.84 / 8.84
-/// → 3.40 / 5.67, clustered 4.78 / 8.41 → 5.43 / 8.00; multiplying the skin by the drawn
-/// number instead, 4.32 / 6.79 and 4.79 / 7.40. The tail shrinks in every case; the means
-/// moved within this host's run-to-run noise (±20 %).
+/// Four alternating runs of 120 frames on a host drifting ±20 %, medians of mean / p99 in
+/// ms, without and with it: uniform 4.17 / 9.34 → 4.91 / 7.95, clustered 5.60 / 9.11 →
+/// 5.09 / 7.14. The tail shrinks in both; the mean moves either way, within the drift.
 pub const SKIN_SPREAD: f64 = 1.0;
 
 /// The factor [`SKIN_SPREAD`] draws for `body`'s filing in batch `batch`: one over a hash
@@ -132,12 +134,11 @@ struct Record {
 
 impl Record {
     /// A body filed for the first time with box `bounds`, in batch `batch`, in a grid whose
-    /// level for it reaches `reach` metres, its skin multiplied by `factor` (module docs,
-    /// "The skin").
-    fn first(bounds: &Aabb, batch: u32, reach: f64, factor: f64) -> Self {
+    /// level for it reaches `reach` metres (module docs, "The skin").
+    fn first(bounds: &Aabb, batch: u32, reach: f64) -> Self {
         let extent = bounds.extents().max_element();
         Self {
-            fat: bounds.grown(within_room(factor * FIRST_SKIN * extent, extent, reach)),
+            fat: bounds.grown(within_room(FIRST_SKIN * extent, extent, reach)),
             filed_at: batch,
             list: Neighbours::default(),
         }
@@ -279,7 +280,7 @@ impl SkinGrid {
             .map(|p| {
                 debug_assert_valid_bounds(&p.bounds);
                 skin.bodies.push(*p);
-                let record = Record::first(&p.bounds, 0, f64::INFINITY, skin_factor(p.body, 0));
+                let record = Record::first(&p.bounds, 0, f64::INFINITY);
                 let bounds = record.fat;
                 skin.records.push(record);
                 Proxy { bounds, ..*p }
@@ -323,7 +324,7 @@ impl SkinGrid {
         }
         let extent = bounds.extents().max_element();
         let reach = self.grid.level_reach(extent);
-        let record = Record::first(&bounds, self.batch, reach, skin_factor(body, self.batch));
+        let record = Record::first(&bounds, self.batch, reach);
         let fat = record.fat;
         self.bodies.push(Proxy {
             body,
@@ -814,7 +815,7 @@ mod tests {
             // No room at all.
             (0.04, 4, 1.0, 0.0),
         ] {
-            let mut r = Record::first(&unit, 0, f64::INFINITY, 1.0);
+            let mut r = Record::first(&unit, 0, f64::INFINITY);
             assert_eq!(r.fat, unit.grown(FIRST_SKIN));
             let now = moved(step);
             r.refile(&now, batches, reach, 1.0);
@@ -826,7 +827,7 @@ mod tests {
             assert!(encloses(&r.fat, &now));
             assert!(r.fat.extents().max_element() <= reach + 1e-12);
         }
-        let cramped = Record::first(&unit, 0, 1.04, 1.0);
+        let cramped = Record::first(&unit, 0, 1.04);
         assert!((cramped.fat.extents().x - 1.04).abs() < 1e-12);
     }
 }
