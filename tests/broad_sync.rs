@@ -14,6 +14,7 @@
 #[path = "support/mod.rs"]
 mod support;
 
+use proxima::broad::select::CREEPING;
 use proxima::broad::{BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, choose};
 use proxima::geometry::{Capsule, Cuboid, Sphere};
 use proxima::math::{DVec3, Pose};
@@ -413,4 +414,74 @@ fn the_change_log_lists_each_changed_body_once_and_only_real_changes() {
     assert_ne!(copy.uid(), uid);
     assert_eq!(world.scene.changes_since(point), Some(&[][..]));
     assert_eq!(copy.changes_since(point), None);
+}
+
+/// What the automatic choice reads of the motion is measured from the bodies' real moves:
+/// spheres that all slide a set fraction of their box each frame report that fraction as
+/// the mean shift at the next measurement, with no far moves, and the pick follows
+/// [`CREEPING`]: the skin grid for creeping bodies, sort and sweep for fast ones.
+#[test]
+fn the_measured_mean_shift_is_the_bodies_motion_and_the_pick_follows_it() {
+    for (fraction, kind) in [
+        (0.4 * CREEPING, BroadPhaseKind::SkinGrid),
+        (3.0 * CREEPING, BroadPhaseKind::SortAndSweep),
+    ] {
+        let mut scene = Scene::try_new(0.05, SceneLimits::STANDARD).unwrap();
+        let ball = scene
+            .register_shape(Shape::Sphere(Sphere::new(0.5)))
+            .unwrap();
+        let ids: Vec<BodyId> = (0..40)
+            .map(|i| {
+                let at = DVec3::new(f64::from(i % 8) * 1.5, f64::from(i / 8) * 1.5, 0.0);
+                let desc = BodyDesc {
+                    shape: ball,
+                    pose: Pose::new(at, rotation(&mut rng(i as u64))),
+                    motion: Motion::Dynamic,
+                    filter: CollisionFilter::ALL,
+                    margin: Some(0.1),
+                };
+                scene.add_body(&desc).unwrap()
+            })
+            .collect();
+        let edge = {
+            let p = scene.proxy(ids[0]).unwrap();
+            (p.bounds.max - p.bounds.min).max_element()
+        };
+        let step_x = DVec3::X * fraction * edge;
+        let mut workspace = PipelineWorkspace::default();
+        let mut measured = Vec::new();
+        for frame in 0..=AUTO_REMEASURE_FRAMES {
+            if frame > 0 {
+                for &id in &ids {
+                    let pose = scene.body(id).unwrap().pose;
+                    scene
+                        .set_pose(id, Pose::new(pose.position + step_x, pose.rotation))
+                        .unwrap();
+                }
+            }
+            let (_, report) = run(&scene, Query::CLOSE, &mut workspace);
+            if let Some(stats) = report.broad_stats {
+                measured.push((frame, stats, report.broad_kind));
+            }
+            scene.end_frame();
+        }
+        // At the first frame every body is new and no move was counted: a scene at rest.
+        let (first, last) = (measured[0], measured[measured.len() - 1]);
+        assert_eq!((first.0, first.1.mean_shift), (0, 0.0));
+        assert_eq!(first.2, Some(BroadPhaseKind::SkinGrid));
+        assert_eq!(
+            (measured.len(), last.0),
+            (2, AUTO_REMEASURE_FRAMES),
+            "{measured:?}"
+        );
+        let stats = last.1;
+        assert_eq!(stats.moving_fraction, 1.0);
+        assert_eq!(stats.far_move_fraction, 0.0);
+        assert!(
+            (stats.mean_shift - fraction).abs() < 1e-9 * fraction,
+            "{fraction}: measured {}",
+            stats.mean_shift
+        );
+        assert_eq!(last.2, Some(kind), "{fraction}");
+    }
 }
