@@ -9,7 +9,9 @@
 //! changes every 40 frames, and one of each fixed kind on a second scene interleaved with
 //! the first (the workspace must notice the other scene): each answers exactly what a
 //! fresh workspace answers, frame after frame, and re-reads exactly the bodies that
-//! changed (checked against this test's own bookkeeping, not the scene's log).
+//! changed (checked against this test's own bookkeeping, not the scene's log). A second
+//! scene of spheres sliding at set speeds checks the motion statistics the automatic
+//! choice reads, and its pick, against the known motion.
 
 #[path = "support/mod.rs"]
 mod support;
