@@ -128,10 +128,14 @@ struct Slot {
 #[derive(Debug, Clone, Default)]
 pub struct SortAndSweep {
     grid: Grid,
-    /// `(low end on the sweep axis, proxy index)` of every proxy, ascending: kept between
-    /// frames and insertion-sorted (linear when bodies move coherently), so the columns
-    /// filled in this order come out sorted.
-    order: Vec<(f64, u32)>,
+    /// `(slot, proxy index)` of every proxy, ascending by the slot's low end on the sweep
+    /// axis: kept between frames and insertion-sorted (linear when bodies move
+    /// coherently), so the columns filled in this order come out sorted. The whole slot
+    /// rides along, so the filling reads it in order rather than looking it up at random
+    /// (a cache miss per proxy in large scenes; measured with `examples/broad_bench`,
+    /// 100,000 uniform bodies all moving, three alternating runs: 23.1–34.4 →
+    /// 22.5–29.7 ms a frame, each run faster; at 10,000 bodies, and teleporting, alike).
+    order: Vec<(Slot, u32)>,
     /// Start of each column's entries in `entries` (one more than the columns).
     starts: Vec<u32>,
     /// The column entries, grouped by column, each column ascending on the sweep axis.
@@ -347,8 +351,7 @@ impl SortAndSweep {
         // Fill each column from its end backwards, taking the proxies in descending order on
         // the sweep axis: every column comes out ascending, and `starts` ends at the column
         // starts.
-        for &(_, i) in self.order.iter().rev() {
-            let slot = self.slots[i as usize];
+        for &(slot, i) in self.order.iter().rev() {
             if slot.first[0] == u32::MAX {
                 continue;
             }
@@ -385,8 +388,9 @@ impl SortAndSweep {
         if axis != self.order_axis || old == 0 {
             self.order.clear();
             self.order
-                .extend(slots.iter().enumerate().map(|(i, s)| (s.low, i as u32)));
-            self.order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+                .extend(slots.iter().enumerate().map(|(i, &s)| (s, i as u32)));
+            self.order
+                .sort_unstable_by(|a, b| a.0.low.total_cmp(&b.0.low));
             self.order_axis = axis;
             return;
         }
@@ -394,17 +398,18 @@ impl SortAndSweep {
             self.order.retain(|&(_, i)| (i as usize) < n);
         }
         for entry in &mut self.order {
-            entry.0 = slots[entry.1 as usize].low;
+            entry.0 = slots[entry.1 as usize];
         }
         self.order.extend(
             slots
                 .iter()
                 .enumerate()
                 .skip(old)
-                .map(|(i, s)| (s.low, i as u32)),
+                .map(|(i, &s)| (s, i as u32)),
         );
         if !insertion_sort(&mut self.order, MAX_SHIFTS_PER_PROXY * n) {
-            self.order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            self.order
+                .sort_unstable_by(|a, b| a.0.low.total_cmp(&b.0.low));
         }
     }
 
@@ -487,12 +492,12 @@ impl SortAndSweep {
 
 /// Sorts by the first field by insertion, giving up (`false`, order then partly sorted)
 /// once more than `max_shifts` entries have been shifted.
-fn insertion_sort(entries: &mut [(f64, u32)], max_shifts: usize) -> bool {
+fn insertion_sort(entries: &mut [(Slot, u32)], max_shifts: usize) -> bool {
     let mut shifts = 0;
     for i in 1..entries.len() {
         let entry = entries[i];
         let mut j = i;
-        while j > 0 && entries[j - 1].0.total_cmp(&entry.0).is_gt() {
+        while j > 0 && entries[j - 1].0.low.total_cmp(&entry.0.low).is_gt() {
             entries[j] = entries[j - 1];
             j -= 1;
         }
