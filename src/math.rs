@@ -422,6 +422,16 @@ pub fn orthonormal_basis(n: DVec3) -> (DVec3, DVec3) {
     n.any_orthonormal_pair()
 }
 
+/// SplitMix64's finaliser (Steele, Lea, Flood 2014): a bijection of `u64` whose every
+/// output bit depends on every input bit, for hashes and repeatable pseudo-random draws.
+#[must_use]
+#[inline]
+pub(crate) fn splitmix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

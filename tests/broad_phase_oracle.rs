@@ -96,8 +96,6 @@ stateful_broad_phase!(IncrementalSap, HashGrid, ColumnGrid, SkinGrid);
 /// The broad phases that take a frame's moves as one batch.
 trait UpdateAll: BroadPhase {
     fn update_all(&mut self, moves: &[(u32, Aabb)]);
-    fn insert_one(&mut self, p: &Proxy);
-    fn remove_one(&mut self, body: u32) -> bool;
 }
 
 macro_rules! update_all {
@@ -105,12 +103,6 @@ macro_rules! update_all {
         impl UpdateAll for $phase {
             fn update_all(&mut self, moves: &[(u32, Aabb)]) {
                 $phase::update_all(self, moves);
-            }
-            fn insert_one(&mut self, p: &Proxy) {
-                $phase::insert(self, p.body, p.bounds, p.is_static, p.filter);
-            }
-            fn remove_one(&mut self, body: u32) -> bool {
-                $phase::remove(self, body)
             }
         }
     )+};
@@ -142,11 +134,11 @@ impl<G: UpdateAll> Batched<G> {
 impl<G: UpdateAll> BroadPhase for Batched<G> {
     fn insert(&mut self, p: &Proxy) {
         self.flush();
-        self.grid.insert_one(p);
+        self.grid.insert(p);
     }
     fn remove(&mut self, body: u32) {
         self.flush();
-        assert!(self.grid.remove_one(body), "{body} was present");
+        self.grid.remove(body);
     }
     fn update(&mut self, body: u32, bounds: Aabb) {
         self.moves.push((body, bounds));

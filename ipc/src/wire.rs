@@ -492,7 +492,7 @@ pub enum BroadPhaseCode {
     /// nothing (since protocol version 5).
     ColumnGrid = 4,
     /// The column grid over boxes grown by a skin, each body's neighbours listed: a body
-    /// that moves within its skin re-tests only those (since protocol version 6).
+    /// that moves within its skin re-tests only those (since protocol version 7).
     SkinGrid = 5,
 }
 

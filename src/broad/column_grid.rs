@@ -813,20 +813,19 @@ impl ColumnGrid {
     /// largest extent a box can grow to and stay there; `+∞` for an oversized box (and
     /// before the first rebuild).
     pub(crate) fn level_reach(&self, extent: f64) -> f64 {
-        self.levels
-            .iter()
-            .map(|l| l.reach)
-            .find(|&reach| extent <= reach)
-            .unwrap_or(f64::INFINITY)
+        self.level_index(extent)
+            .map_or(f64::INFINITY, |k| self.levels[k].reach)
+    }
+
+    /// The finest level whose reach is at least `extent` (metres), if any.
+    fn level_index(&self, extent: f64) -> Option<usize> {
+        self.levels.iter().position(|l| extent <= l.reach)
     }
 
     /// The level a box belongs at: the finest whose reach is at least its largest extent,
     /// or [`OVERSIZED`] (always, before the first rebuild).
     fn level_for(&self, bounds: &Aabb) -> u8 {
-        let extent = bounds.extents().max_element();
-        self.levels
-            .iter()
-            .position(|l| extent <= l.reach)
+        self.level_index(bounds.extents().max_element())
             .map_or(OVERSIZED, |k| k as u8)
     }
 

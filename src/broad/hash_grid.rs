@@ -172,10 +172,7 @@ impl Hasher for CellHasher {
 
     #[inline]
     fn finish(&self) -> u64 {
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        crate::math::splitmix64(self.state)
     }
 }
 

@@ -486,13 +486,10 @@ impl MoveCounts {
         let edge = (old.max - old.min).max_element();
         self.moves += 1;
         self.far_moves += u64::from(shift > edge);
-        self.shift_sum += if shift > edge {
-            1.0
-        } else if shift == 0.0 {
-            0.0
-        } else {
-            shift / edge
-        };
+        // A far move (a zero-size box's too: `shift / 0` is infinite) counts 1.
+        if shift > 0.0 {
+            self.shift_sum += (shift / edge).min(1.0);
+        }
     }
 
     /// Fraction of the updates that were far moves; 0 with none.

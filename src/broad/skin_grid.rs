@@ -63,6 +63,7 @@ use super::column_grid::ColumnGrid;
 use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds};
 use crate::bounding::{Aabb, BoundingVolume};
+use crate::math::splitmix64;
 use std::collections::BTreeMap;
 
 /// Skin on every side of a box filed for the first time, as a fraction of its largest
@@ -102,10 +103,7 @@ pub const SKIN_SPREAD: f64 = 1.0;
 /// of the two mapped to `[1 − SKIN_SPREAD / 2, 1 + SKIN_SPREAD / 2)`; the same for the same
 /// inputs, so runs are repeatable.
 fn skin_factor(body: u32, batch: u32) -> f64 {
-    let mut x = (u64::from(body) << 32 | u64::from(batch)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    x ^= x >> 29;
-    x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x ^= x >> 32;
+    let x = splitmix64(u64::from(body) << 32 | u64::from(batch));
     let unit = (x >> 11) as f64 / (1u64 << 53) as f64;
     1.0 / (1.0 + SKIN_SPREAD * (unit - 0.5))
 }
@@ -597,9 +595,9 @@ impl SkinGrid {
     }
 }
 
-/// Whether `outer` holds all of `inner` (closed boxes).
+/// Whether `outer` holds all of `inner` (closed boxes): both of its corners.
 fn encloses(outer: &Aabb, inner: &Aabb) -> bool {
-    outer.min.cmple(inner.min).all() && inner.max.cmple(outer.max).all()
+    outer.contains_point(inner.min) && outer.contains_point(inner.max)
 }
 
 #[cfg(test)]

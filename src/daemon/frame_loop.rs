@@ -241,7 +241,7 @@ fn pair_record(r: &PairResult) -> ResultRecord {
         body_b: r.b,
         index: r.first_contact,
         count: r.contact_count,
-        flags: approximate_flag(r),
+        flags: approximate_flag(r.exact),
         distance: r.distance,
         error_bound: r.error_bound,
         point_a: r.point_a.to_array(),
@@ -251,13 +251,9 @@ fn pair_record(r: &PairResult) -> ResultRecord {
     }
 }
 
-/// [`record_flags::APPROXIMATE`] when `r` is not exact.
-fn approximate_flag(r: &PairResult) -> u32 {
-    if r.exact {
-        0
-    } else {
-        record_flags::APPROXIMATE
-    }
+/// [`record_flags::APPROXIMATE`] when a record is not `exact`.
+fn approximate_flag(exact: bool) -> u32 {
+    if exact { 0 } else { record_flags::APPROXIMATE }
 }
 
 /// The record of contact `c`, naming its pair's bodies (from `pairs`).
@@ -269,7 +265,7 @@ fn contact_record(pairs: &[PairResult], c: &ContactPoint) -> ResultRecord {
         body_b: pair.b,
         index: c.pair,
         count: 0,
-        flags: approximate_flag(pair),
+        flags: approximate_flag(pair.exact),
         distance: c.distance,
         error_bound: c.error_bound,
         point_a: c.point_a.to_array(),
@@ -288,11 +284,7 @@ fn toi_record(r: &PairToi) -> ResultRecord {
         body_b: r.b,
         index: 0,
         count: u32::from(r.reached),
-        flags: if r.exact {
-            0
-        } else {
-            record_flags::APPROXIMATE
-        },
+        flags: approximate_flag(r.exact),
         distance: r.distance,
         error_bound: r.error_bound,
         point_a: r.point_a.to_array(),

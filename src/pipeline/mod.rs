@@ -786,7 +786,8 @@ pub fn step_within(
             results.tois.push(toi);
         }
     }
-    if truncated_tois > 0 || toi_clock.expired {
+    // Set once a candidate went unsearched or a search stopped at the deadline.
+    if toi_clock.expired {
         completeness = completeness.truncated_at(0);
     }
     StepReport {
