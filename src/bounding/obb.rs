@@ -319,6 +319,13 @@ impl BoundingVolume for Obb {
 
     /// The face axes first; their gap is returned as soon as it reaches `limit` (the nine
     /// edge axes, each needing a square root, are then skipped).
+    ///
+    /// Measured and not kept (2026-11-24): the gaps along one box's three (orthonormal)
+    /// axes combined as the root of their summed squares, a true bound up to √3 times the
+    /// largest gap for boxes apart along a diagonal. `examples/time_vs_error --scene
+    /// robot-chain` gave the same precision at 150, 250, 350 and 1,000 counted visits
+    /// (0.734, 0.851, 0.903, 0.987) and 0.949 → 0.951 at 500: the node pairs its frontier
+    /// meets near the threshold are apart along one axis.
     fn distance_lower_bound_within(&self, other: &Self, pose_ab: &Isometry, limit: f64) -> f64 {
         let (r, t, slack) = self.relative(other, pose_ab);
         let (a, b) = (self.half_extents.to_array(), other.half_extents.to_array());

@@ -118,6 +118,13 @@ const PREFETCH_FROM_BODIES: usize = 30_000;
 const OVERSIZED: u8 = u8::MAX;
 
 /// A body as its column stores it: its box and slot.
+///
+/// Measured and not kept (2026-11-24): the body's id and filter in the entry too (64
+/// bytes), so that a query logs a pair change without reading the other body's proxy, a
+/// cache miss in a large grid. `examples/broad_bench`, 100,000 bodies, 10 % moving, six
+/// alternating runs, best of each: skin grid uniform 4.00 → 4.17 ms, clustered 4.54 →
+/// 4.32 ms; column grid 6.84 → 7.19 ms and 8.58 → 8.47 ms. The longer scans cost what the
+/// saved reads gain.
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     bounds: Aabb,
