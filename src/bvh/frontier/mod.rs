@@ -145,7 +145,8 @@
 //! slack. With a deadline, three alternating runs each: 0.87–0.90 against 0.84–0.90 at
 //! 75 µs, 0.72–0.85 against 0.83–0.84 at 60 µs, 0.67–0.77 against 0.76–0.79 at 50 µs,
 //! and 9–85 frames of 400 over budget against 3–12. At this scene's motion (links moving
-//! up to 6 cm a frame against 4 cm margins) most of a cut is due again every frame.
+//! up to 6 cm a frame against 4 cm margins) most of a cut is due again every frame. The
+//! code is on the branch `experiment/carried-cuts` (commit b59a2e1).
 //!
 //! # Cost outside visits
 //! Each round is sorted when it begins (`O(n log n)` for its `n` entries, created by at
