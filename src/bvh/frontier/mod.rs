@@ -67,6 +67,17 @@
 //! pairs proven close without the probe, while seeds were last frame's closest pair found,
 //! close or not: touching pairs were then hardly ever proven close, and nothing changed.
 //!
+//! Where the visits go now (2026-11-24, same scene, 250 counted visits a frame, each
+//! pair's answer against the exact one): 38 % to pairs proven apart, 17 % to pairs left
+//! truncated that are apart (the false close pairs), 19 % to pairs proven close and 26 %
+//! to pairs that are close but were not proven so. Measured and not kept, precision at
+//! 150 / 250 / 350 / 500 visits against 0.734 / 0.851 / 0.903 / 0.949: ending a probe at
+//! the first node pair whose volumes are apart, 0.701 / 0.766 / 0.822 / 0.866 (at half
+//! the threshold, 0.733 / 0.785 / 0.829 / 0.887: a probe's visits are part of a proof of
+//! apart too); every root's bound before any probe, 0.738 / 0.848 / 0.902 / 0.949;
+//! [`PROBE_VISITS`] of 16 or 32, at most 0.671 / 0.777 / 0.855 / 0.888; of 128,
+//! 0.744 / 0.845 / 0.897 / 0.956.
+//!
 //! # Stages by width
 //! Plain rounds give every pair one more level per round, so a wide pair (a link deep
 //! inside an environment mesh, whose volumes overlap it for many levels) takes most of each
