@@ -376,40 +376,33 @@ impl SortAndSweep {
     }
 
     /// Brings `order` up to date with `proxies` on the sweep axis: rebuilt and fully sorted
-    /// when the axis changed; otherwise entries past the new proxy count are dropped, new
-    /// indices appended, every entry re-keyed (entries are indices, so a proxy that changed
-    /// place, e.g. by a caller's `swap_remove`, is simply re-keyed) and the order
+    /// when the axis changed; otherwise entries past the new proxy count are dropped, every
+    /// entry's slot read again (entries are indices, so a proxy that changed place, e.g. by
+    /// a caller's `swap_remove`, is simply re-read), new indices appended and the order
     /// insertion-sorted, which is linear when the bodies moved coherently; when that would
     /// take more than [`MAX_SHIFTS_PER_PROXY`] shifts per proxy (teleports), a full sort.
     fn refresh_order(&mut self, n: usize) {
-        let axis = self.grid.axis;
-        let old = self.order.len();
         let slots = &self.slots;
-        if axis != self.order_axis || old == 0 {
+        let rebuild = self.grid.axis != self.order_axis || self.order.is_empty();
+        if rebuild {
             self.order.clear();
-            self.order
-                .extend(slots.iter().enumerate().map(|(i, &s)| (s, i as u32)));
-            self.order
-                .sort_unstable_by(|a, b| a.0.low.total_cmp(&b.0.low));
-            self.order_axis = axis;
-            return;
-        }
-        if n < old {
+            self.order_axis = self.grid.axis;
+        } else {
             self.order.retain(|&(_, i)| (i as usize) < n);
+            for entry in &mut self.order {
+                entry.0 = slots[entry.1 as usize];
+            }
         }
-        for entry in &mut self.order {
-            entry.0 = slots[entry.1 as usize];
-        }
+        let kept = self.order.len();
         self.order.extend(
             slots
                 .iter()
                 .enumerate()
-                .skip(old)
+                .skip(kept)
                 .map(|(i, &s)| (s, i as u32)),
         );
-        if !insertion_sort(&mut self.order, MAX_SHIFTS_PER_PROXY * n) {
-            self.order
-                .sort_unstable_by(|a, b| a.0.low.total_cmp(&b.0.low));
+        if rebuild || !insertion_sort(&mut self.order, MAX_SHIFTS_PER_PROXY * n) {
+            self.order.sort_unstable_by(by_low_end);
         }
     }
 
@@ -490,14 +483,20 @@ impl SortAndSweep {
     }
 }
 
-/// Sorts by the first field by insertion, giving up (`false`, order then partly sorted)
-/// once more than `max_shifts` entries have been shifted.
+/// The order of `order`'s entries: by their slot's low end on the sweep axis.
+#[inline]
+fn by_low_end(a: &(Slot, u32), b: &(Slot, u32)) -> std::cmp::Ordering {
+    a.0.low.total_cmp(&b.0.low)
+}
+
+/// Sorts [`by_low_end`] by insertion, giving up (`false`, order then partly sorted) once
+/// more than `max_shifts` entries have been shifted.
 fn insertion_sort(entries: &mut [(Slot, u32)], max_shifts: usize) -> bool {
     let mut shifts = 0;
     for i in 1..entries.len() {
         let entry = entries[i];
         let mut j = i;
-        while j > 0 && entries[j - 1].0.low.total_cmp(&entry.0.low).is_gt() {
+        while j > 0 && by_low_end(&entries[j - 1], &entry).is_gt() {
             entries[j] = entries[j - 1];
             j -= 1;
         }
