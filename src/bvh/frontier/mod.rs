@@ -52,9 +52,11 @@
 //! phase), the entries of pairs proven close (a triangle pair within the threshold found)
 //! wait in a list of their own, and so do the roots of pairs *expected* close: pairs that
 //! came with a seed that is no longer within the threshold (the seed was last frame's
-//! proof). When no other entry is left, the waiting entries are refined (from the first
-//! stage, below), an expected pair's root starting with its probe. This changes the order
-//! of work only: the answers are read from every waiting entry alike.
+//! proof). An expected pair is still undecided, so it waits only until the stages (below)
+//! reach a cap of [`EXPECTED_JOIN_CAP`]: its root then joins that stage, starting with its
+//! probe. When no other entry is left, the waiting entries are refined (from the first
+//! stage), an expected pair's root that has not joined starting with its probe. This
+//! changes the order of work only: the answers are read from every waiting entry alike.
 //!
 //! A seed is worth keeping only as a proof: the pipeline keeps a pair's witnesses as its
 //! next seed only when they are within its threshold, and drops it once the pair is proven
@@ -77,6 +79,31 @@
 //! measured worse at small budgets (precision at 150 / 250 / 350 / 500 visits: `k` = 1,
 //! 0.678 / 0.794 / 0.887 / 0.940; 2, 0.694 / 0.830 / 0.901 / 0.948; 3, 0.705 / 0.844 /
 //! 0.912 / 0.948): the stale seeds of pairs still close then cost probes.
+//!
+//! Nor did a seed's age tell them apart: of 1,951 stale seeds (same scene, 300 frames),
+//! 21 % belonged to pairs then apart, 5–15 % while the seed was within 10 times the
+//! threshold and 31 % beyond it, 9–16 % while under 20 frames old and 33 % older (a seed
+//! is renewed only by a proof, so a touching pair that waits keeps an old one). Taking a
+//! pair as expected close only while its seed is under 1, 2 or 4 frames old measured
+//! worse (0.691 / 0.826 / 0.897 / 0.943 for 1). Those pairs are not nearly touching: the
+//! false close pairs were a median 0.11 m beyond their threshold, and 340 of the 397
+//! stale-seeded ones had their root's bound and seed test only, the budget spent before
+//! the deciding phase ended. Unlimited, such a pair is proven apart in a median of 29
+//! visits, an undecided pair left false in 262. Hence [`EXPECTED_JOIN_CAP`]: the waiting
+//! roots join once the stages turn to the wide pairs. Counted visits (400 frames, 200 /
+//! 300 / 400 / 600 / 1,200 a frame): 0.810 / 0.879 / 0.934 / 0.957 / 0.992 waiting to the
+//! end, 0.815 / 0.901 / 0.936 / 0.954 / 0.989 joining at a cap of 8 (at 4, 0.861 at 250
+//! visits against 0.868 at 8; at 16, 0.867; at 32, 0.851). With deadlines (three
+//! alternating runs of 400 frames, exact frames 233–263 µs at the median): 0.901–0.917
+//! against 0.867–0.892 at 75 µs, 0.840–0.859 against 0.818–0.852 at 60 µs, 0.731–0.783
+//! against 0.763–0.799 at 50 µs. On the mesh pile (200 frames,
+//! 600 / 800 / 1,200 / 1,600 visits): 0.963 / 0.973 / 0.982 / 0.987 against 0.951 /
+//! 0.966 / 0.989 / 0.994. Measured and not kept besides: expected roots joining the first
+//! stage without a probe and waiting once set aside (0.713 / 0.805 / 0.896 / 0.937 at
+//! 150 / 250 / 350 / 500 visits: pairs then proven close less often keep staler seeds);
+//! after the deciding phase, the expected roots before the proven pairs' entries (0.736 /
+//! 0.837 / 0.904 / 0.953); renewing a waiting pair's seed from the closest triangle pair
+//! its visits found (0.735 / 0.837 / 0.903 / 0.950).
 //!
 //! Also measured and not kept, precision at 150 / 250 / 350 / 500 visits against
 //! 0.734 / 0.851 / 0.903 / 0.949: ending a probe at the first node pair whose volumes are
@@ -454,6 +481,11 @@ impl PairState {
 /// (0.73–0.79 against 0.68–0.73 for 4 and 4).
 pub const FIRST_CAP: u32 = 2;
 
+/// The stage cap at which the roots of pairs expected close stop waiting for the deciding
+/// phase to end and join it (module docs, "Decide first"). Measured on robot-chain and the
+/// mesh pile with 4, 8, 16 and 32 (module docs).
+pub const EXPECTED_JOIN_CAP: u32 = 8;
+
 /// Scratch space and state of the frontier; keep one per thread and reuse it every frame.
 #[derive(Debug, Clone)]
 pub struct FrontierWorkspace {
@@ -651,6 +683,9 @@ impl FrontierWorkspace {
                 self.cap = self.first_cap();
             } else {
                 self.cap = self.cap.saturating_mul(2);
+                if self.deciding && self.cap == EXPECTED_JOIN_CAP {
+                    self.join_expected();
+                }
             }
             std::mem::swap(&mut self.next, &mut self.set_aside);
         }
@@ -658,6 +693,16 @@ impl FrontierWorkspace {
         self.next.clear();
         self.begin_round();
         true
+    }
+
+    /// Moves the waiting roots of pairs expected close (the waiting entries of pairs not
+    /// proven close) to the stage about to begin; the proven pairs' entries keep waiting.
+    fn join_expected(&mut self) {
+        let pairs = &self.pairs;
+        let undecided = |e: &Entry| !pairs[e.pair as usize].is_decided_close();
+        self.set_aside
+            .extend(self.later.iter().filter(|e| undecided(e)));
+        self.later.retain(|e| !undecided(e));
     }
 
     /// The cap of a stage's first round (`u32::MAX`: no stages).
@@ -1272,6 +1317,58 @@ mod tests {
             unseeded > undecided_alone + 2,
             "{unseeded} {undecided_alone}"
         );
+    }
+
+    /// A pair expected close waits only until the stages reach [`EXPECTED_JOIN_CAP`]: beside
+    /// a wide undecided pair (a small torus inside a large one, in its plane, apart all
+    /// around the ring by a little more than the threshold), the touching pair with a stale seed is proven close before the
+    /// wide pair is settled, where it would otherwise wait for it. The final answers are
+    /// each pair's own.
+    #[test]
+    fn an_expected_pair_joins_the_deciding_phase_once_the_stages_reach_the_join_cap() {
+        let (a, b, poses) = scene::<Obb>();
+        let params = BuildParams::BINNED_SAH.with_leaf_size(4);
+        let inner = Bvh::from_mesh(&TriMesh::torus(0.5, 0.15, 16, 8), &params);
+        let wide = FrontierPair {
+            a: &a,
+            b: &inner,
+            pose_ab: Isometry::IDENTITY,
+            threshold: 0.02,
+            seed: None,
+        };
+        let wide_alone = alone(&wide);
+        assert!(!wide_alone.maybe_close);
+        let widest = {
+            let (mut ws, mut out) = (FrontierWorkspace::new(), Vec::new());
+            query_frontier(&[wide], &mut Unlimited, &mut ws, &mut out);
+            ws.entries_per_round().iter().copied().max()
+        };
+        assert!(
+            widest > Some(u64::from(EXPECTED_JOIN_CAP)),
+            "widest round {widest:?}"
+        );
+        let touching = FrontierPair {
+            seed: Some([0, 0]),
+            ..pairs(&a, &b, &poses[..1])[0]
+        };
+        let stale = alone(&FrontierPair {
+            seed: None,
+            ..touching
+        });
+        assert!(stale.maybe_close);
+        let both = [touching, wide];
+        let proven =
+            |x: &[FrontierAnswer]| x[0].distance_upper.is_some_and(|d| d <= x[0].threshold);
+        let (first_visit, _) = visits_until(&both, |x| x[0].distance_upper.is_some());
+        let (proven_at, _) = visits_until(&both, proven);
+        let (settled, answers) = visits_until(&both, |x| x[1].is_exact());
+        assert_eq!(first_visit, 2, "the root's bound and the stale seed's test");
+        assert!(
+            proven_at < settled,
+            "proven at {proven_at}, settled at {settled}"
+        );
+        assert_eq!(answers[0].distance_lower, alone(&touching).distance_lower);
+        assert_eq!(answers[1], wide_alone);
     }
 
     /// The probe proves touching tori close (a triangle pair within the threshold) within
