@@ -42,9 +42,9 @@
 //! rounds process it (children dropped by the same rules; the child with the smaller bound
 //! searched first, on a tie the one with the smaller upper bound, which for overlapping
 //! volumes is the deeper overlap). It ends as soon as a triangle pair within the threshold
-//! is found, or after [`PROBE_VISITS`] visits; the entries left on its stack join the next
-//! round, so a probe's visits are never lost: for a pair that is apart, they are part of
-//! the proof. Steps are polled like entries, and a run stopped inside a probe resumes it.
+//! is found, or after [`PROBE_VISITS`] visits ([`EXPECTED_PROBE_VISITS`] for a pair
+//! expected close, below); the entries left on its stack join the next round, so a
+//! probe's visits are never lost: for a pair that is apart, they are part of the proof. Steps are polled like entries, and a run stopped inside a probe resumes it.
 //!
 //! # Decide first
 //! Only the first part changes which pairs a frame reports, so the undecided pairs are
@@ -251,6 +251,18 @@ pub const DEFAULT_POLL_EVERY: u64 = 8;
 /// Most visits of a pair's depth-first probe for a triangle pair within its threshold
 /// (module docs, "The probe").
 pub const PROBE_VISITS: u64 = 64;
+
+/// Most visits of the probe of a pair expected close (module docs, "Decide first"): most
+/// such pairs are still close, and one proven close waits, then passes its proof on as
+/// next frame's seed. Measured with counted visits, against [`PROBE_VISITS`] for these
+/// probes too: `examples/time_vs_error --scene robot-chain` (400 frames) at 200 / 250 /
+/// 300 / 400 / 600 visits, 0.815 / 0.864 / 0.901 / 0.936 / 0.954 → 0.813 / 0.865 /
+/// 0.905 / 0.943 / 0.964 (128: 0.815 / 0.866 / 0.907 / 0.942; 512 and unbounded as 256;
+/// 32: 0.782 / 0.821 / 0.874 / 0.918); the mesh pile (200 frames) at 400 / 800 / 1,200 /
+/// 1,600 visits, 0.925 / 0.966 / 0.989 / 0.994 → 0.932 / 0.975 / 0.993 / 0.999. Longer
+/// probes for the other pairs measured worse (128: 0.807 / 0.841 / 0.877 / 0.933 on
+/// robot-chain at 200–400 visits).
+pub const EXPECTED_PROBE_VISITS: u64 = 256;
 
 /// How much work the frontier may still do, polled between bounded batches of visits.
 pub trait Budget {
@@ -849,7 +861,12 @@ impl FrontierWorkspace {
         if entry.depth == 0 && !state.is_decided_close() {
             // The root of a pair not yet proven close: searched depth first for a proof.
             self.probe.push(entry);
-            self.probe_until = self.stats.visits + PROBE_VISITS;
+            self.probe_until = self.stats.visits
+                + if state.expected_close {
+                    EXPECTED_PROBE_VISITS
+                } else {
+                    PROBE_VISITS
+                };
             return;
         }
         let children = split(pair, state, &mut self.stats, entry);
@@ -859,8 +876,9 @@ impl FrontierWorkspace {
     /// One step of the probe under way on `entry`, the top of its stack (module docs,
     /// "The probe"): a leaf pair's triangle tests, or the entry's two children pushed so
     /// that the one with the smaller bound (on a tie, the smaller upper bound) is searched
-    /// next. Once the pair is proven close or the probe has made [`PROBE_VISITS`] visits,
-    /// the probe ends: this entry and the rest of the stack join the next round.
+    /// next. Once the pair is proven close or the probe has made its visits
+    /// ([`PROBE_VISITS`], [`EXPECTED_PROBE_VISITS`] for a pair expected close), the probe
+    /// ends: this entry and the rest of the stack join the next round.
     fn probe_step<P: PairTrees>(&mut self, pair: &P, entry: Entry) {
         let state = &mut self.pairs[entry.pair as usize];
         if !is_live(entry.bound, state) {
