@@ -103,7 +103,14 @@
 //! 150 / 250 / 350 / 500 visits: pairs then proven close less often keep staler seeds);
 //! after the deciding phase, the expected roots before the proven pairs' entries (0.736 /
 //! 0.837 / 0.904 / 0.953); renewing a waiting pair's seed from the closest triangle pair
-//! its visits found (0.735 / 0.837 / 0.903 / 0.950).
+//! its visits found (0.735 / 0.837 / 0.903 / 0.950). With the join and
+//! [`EXPECTED_PROBE_VISITS`] in place, the false close pairs left at 300 visits were
+//! mostly still stale-seeded ones that a few visits would settle (148 of 384, a median
+//! 19–25 visits each unlimited, given 3–15 before the budget ran out); giving them the
+//! first stages without a probe, waiting once set aside until the join, with a probe from
+//! their first entry then, measured worse again (0.719 / 0.770 / 0.806 / 0.828 / 0.909 /
+//! 0.944 against 0.747 / 0.813 / 0.865 / 0.905 / 0.943 / 0.964 at 150 / 200 / 250 / 300 /
+//! 400 / 600 visits).
 //!
 //! Also measured and not kept, precision at 150 / 250 / 350 / 500 visits against
 //! 0.734 / 0.851 / 0.903 / 0.949: ending a probe at the first node pair whose volumes are
