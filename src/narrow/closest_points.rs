@@ -33,61 +33,127 @@ use crate::math::DVec3;
 #[must_use]
 #[inline]
 pub(crate) fn closest_point_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
-    debug_assert!(p.is_finite() && a.is_finite() && b.is_finite() && c.is_finite());
-    let (ab, bc, ca) = (
-        (b - a).length_squared(),
-        (c - b).length_squared(),
-        (a - c).length_squared(),
-    );
-    let (o, e, w) = if ab >= bc && ab >= ca {
-        (a, b, c)
-    } else if bc >= ca {
-        (b, c, a)
-    } else {
-        (c, a, b)
-    };
-    let len2 = ab.max(bc).max(ca);
-    if len2 == 0.0 {
-        // All three vertices coincide.
-        return a;
-    }
-    let len = len2.sqrt();
-    let u = (e - o) / len;
-    let ow = w - o;
-    let xw = ow.dot(u);
-    // NOTE: the second Gram–Schmidt pass is needed: the first leaves a component along `u`
-    // of `eps |w − o|`, which is large relative to a small `t` (a needle or a sliver) and
-    // would skew the frame, adding `x (u · v)` to every `y`.
-    let across = ow - u * xw;
-    let across = across - u * across.dot(u);
-    let t = across.length();
-    // NOTE: the first pass errs by about `4 eps |w − o|`; a smaller `t` is rounding
-    // (possibly along `u`, for exactly collinear input) and gives no direction. The
-    // triangle is then within that of its longest edge, which spans it.
-    if t <= 8.0 * f64::EPSILON * ow.length() {
-        return closest_point_segment(p, o, e);
-    }
-    let v = across / t;
-    let d = p - o;
-    let (x, y) = (d.dot(u), d.dot(v));
-    // Inner sides of the 2-D triangle (0, 0) → (len, 0) → (xw, t), counter-clockwise.
-    let inner_oe = y >= 0.0;
-    let inner_ew = (xw - len) * y - t * (x - len) >= 0.0;
-    let inner_wo = t * (x - xw) - xw * (y - t) >= 0.0;
-    if inner_oe && inner_ew && inner_wo {
-        let m = u.cross(v);
-        return p - m * d.dot(m);
-    }
-    let mut best = None::<DVec3>;
-    for (inner, x0, x1) in [(inner_oe, o, e), (inner_ew, e, w), (inner_wo, w, o)] {
-        if !inner {
-            let q = closest_point_segment(p, x0, x1);
-            if best.is_none_or(|b| q.distance_squared(p) < b.distance_squared(p)) {
-                best = Some(q);
-            }
+    HingeFrame::new(a, b, c).closest_point(p)
+}
+
+/// A triangle described in the frame of its longest edge, as
+/// [`closest_point_triangle`] describes it: built once, then queried for many points
+/// (triangle–triangle distance asks for three), each answer the same as
+/// [`closest_point_triangle`]'s.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum HingeFrame {
+    /// All three vertices coincide.
+    Point(DVec3),
+    /// Thinner than rounding: the triangle is within that of its longest edge `o → e`,
+    /// which spans it.
+    Edge(DVec3, DVec3),
+    /// The 2-D triangle `(0, 0), (len, 0), (xw, t)` of the plane through `o` spanned by
+    /// the unit vectors `u` (along the hinge `o → e`) and `v` (across it, towards `w`).
+    Face {
+        o: DVec3,
+        e: DVec3,
+        w: DVec3,
+        u: DVec3,
+        v: DVec3,
+        len: f64,
+        xw: f64,
+        t: f64,
+    },
+}
+
+impl HingeFrame {
+    /// The frame of the closed triangle `a, b, c`.
+    #[must_use]
+    #[inline]
+    pub(crate) fn new(a: DVec3, b: DVec3, c: DVec3) -> Self {
+        debug_assert!(a.is_finite() && b.is_finite() && c.is_finite());
+        let (ab, bc, ca) = (
+            (b - a).length_squared(),
+            (c - b).length_squared(),
+            (a - c).length_squared(),
+        );
+        let (o, e, w) = if ab >= bc && ab >= ca {
+            (a, b, c)
+        } else if bc >= ca {
+            (b, c, a)
+        } else {
+            (c, a, b)
+        };
+        let len2 = ab.max(bc).max(ca);
+        if len2 == 0.0 {
+            return Self::Point(a);
+        }
+        let len = len2.sqrt();
+        let u = (e - o) / len;
+        let ow = w - o;
+        let xw = ow.dot(u);
+        // NOTE: the second Gram–Schmidt pass is needed: the first leaves a component along
+        // `u` of `eps |w − o|`, which is large relative to a small `t` (a needle or a
+        // sliver) and would skew the frame, adding `x (u · v)` to every `y`.
+        let across = ow - u * xw;
+        let across = across - u * across.dot(u);
+        let t = across.length();
+        // NOTE: the first pass errs by about `4 eps |w − o|`; a smaller `t` is rounding
+        // (possibly along `u`, for exactly collinear input) and gives no direction. The
+        // triangle is then within that of its longest edge, which spans it.
+        if t <= 8.0 * f64::EPSILON * ow.length() {
+            return Self::Edge(o, e);
+        }
+        Self::Face {
+            o,
+            e,
+            w,
+            u,
+            v: across / t,
+            len,
+            xw,
+            t,
         }
     }
-    best.unwrap_or(p)
+
+    /// The point of the triangle closest to `p` (same frame as the triangle).
+    #[must_use]
+    #[inline(always)]
+    pub(crate) fn closest_point(&self, p: DVec3) -> DVec3 {
+        debug_assert!(p.is_finite());
+        let &Self::Face {
+            o,
+            e,
+            w,
+            u,
+            v,
+            len,
+            xw,
+            t,
+        } = self
+        else {
+            return match *self {
+                Self::Point(a) => a,
+                Self::Edge(o, e) => closest_point_segment(p, o, e),
+                Self::Face { .. } => unreachable!("matched above"),
+            };
+        };
+        let d = p - o;
+        let (x, y) = (d.dot(u), d.dot(v));
+        // Inner sides of the 2-D triangle (0, 0) → (len, 0) → (xw, t), counter-clockwise.
+        let inner_oe = y >= 0.0;
+        let inner_ew = (xw - len) * y - t * (x - len) >= 0.0;
+        let inner_wo = t * (x - xw) - xw * (y - t) >= 0.0;
+        if inner_oe && inner_ew && inner_wo {
+            let m = u.cross(v);
+            return p - m * d.dot(m);
+        }
+        let mut best = None::<DVec3>;
+        for (inner, x0, x1) in [(inner_oe, o, e), (inner_ew, e, w), (inner_wo, w, o)] {
+            if !inner {
+                let q = closest_point_segment(p, x0, x1);
+                if best.is_none_or(|b| q.distance_squared(p) < b.distance_squared(p)) {
+                    best = Some(q);
+                }
+            }
+        }
+        best.unwrap_or(p)
+    }
 }
 
 /// The point of the closed segment `a, b` closest to `p`.
@@ -108,7 +174,7 @@ pub(crate) fn closest_point_segment(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
 /// the points are projected on each other's segment alternately (clamped), which handles
 /// the end-point regions and, with `n = 0`, parallel and zero-length segments.
 #[must_use]
-#[inline]
+#[inline(always)]
 pub(crate) fn closest_points_segment_segment(
     p: DVec3,
     q: DVec3,

@@ -153,7 +153,9 @@ fn near_miss_at_large_offset_is_decided_exactly() {
 fn segment_triangle_distance_by_search(p: DVec3, q: DVec3, t: &Triangle) -> f64 {
     let f = |s: f64| {
         let x = p + (q - p) * s;
-        x.distance(super::closest_point_triangle(x, t.a, t.b, t.c))
+        x.distance(crate::narrow::closest_points::closest_point_triangle(
+            x, t.a, t.b, t.c,
+        ))
     };
     let ratio = (5f64.sqrt() - 1.0) / 2.0;
     let (mut lo, mut hi) = (0.0, 1.0);
@@ -216,7 +218,9 @@ fn distances_to_sliver_triangles_match_a_line_search_oracle() {
             } else {
                 (d.point_a, d.point_b)
             };
-            let on_a = pa.distance(super::closest_point_triangle(pa, a.a, a.b, a.c));
+            let on_a = pa.distance(crate::narrow::closest_points::closest_point_triangle(
+                pa, a.a, a.b, a.c,
+            ));
             let on_b = pb.distance(crate::narrow::closest_points::closest_point_segment(
                 pb, p, q,
             ));
