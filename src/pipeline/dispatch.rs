@@ -109,6 +109,16 @@ pub(super) fn route<'s>(a: &'s Shape, b: &'s Shape) -> Route<'s> {
     }
 }
 
+/// Whether the pair's exact answer costs about what the conservative answer of its world
+/// boxes costs: a sphere against a sphere, capsule or cuboid, whose closed forms take
+/// 2.5–14 ns (`benches/narrow_phase.rs`, README). Such a pair is answered exactly even once
+/// the frame's deadline is near ([`super::PUBLISH_RESERVE`]): its box answer would save
+/// nothing and, for a sphere whose box corners lie outside it, often report it close.
+pub(super) fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
+    use Shape::{Capsule as C, Cuboid as B, Sphere as S};
+    matches!((a, b), (S(_), S(_) | C(_) | B(_)) | (C(_) | B(_), S(_)))
+}
+
 /// The signed distance of `a` and `b` placed by `pose_ab`, A's frame (see the module docs
 /// for the query each pair gets), exact when it is at most `limit` metres; above the limit
 /// the answer may be only an upper bound (`distance > limit`, possibly `+∞`): a convex

@@ -542,10 +542,12 @@ pub fn step(
 /// wall-clock deadline too: once it is within [`PUBLISH_RESERVE`] (checked every few
 /// pairs), each remaining one gets the conservative answer of its margin-grown world boxes
 /// (distance between the boxes, their diagonals as error bound, "may touch" when they
-/// touch: level 0), counted in [`StepReport::truncated_pairs`]. Counted budgets leave them
-/// exact. Not yet budgeted: the broad phase, the exact contacts of finished touching mesh
-/// pairs and time of impact run to completion whatever the budget (the frontier's reserve
-/// is for them). The worker pool is not used for a budgeted frontier (one thread).
+/// touch: level 0), counted in [`StepReport::truncated_pairs`], except a sphere against a
+/// sphere, capsule or cuboid, whose closed form costs no more than that and stays exact.
+/// Counted budgets leave them exact. Not yet budgeted: the broad phase, the exact contacts
+/// of finished touching mesh pairs and time of impact run to completion whatever the
+/// budget (the frontier's reserve is for them). The worker pool is not used for a
+/// budgeted frontier (one thread).
 ///
 /// # Allocation
 /// As [`step`], plus, with a limited budget, one list of the frame's frontier pairs (it
@@ -680,7 +682,9 @@ pub fn step_within(
                 separated_pairs += 1;
                 answer::apart(pair, None)
             }
-            (Route::Direct, _) if pair_clock.expired() => {
+            (Route::Direct, _)
+                if !dispatch::exact_costs_no_more_than_boxes(sa, sb) && pair_clock.expired() =>
+            {
                 truncated_pairs += 1;
                 let bounds = |body: &Body| body.world_bounds.grown(body.margin);
                 answer::boxes(pair, &bounds(a), &bounds(b), query, contacts)
