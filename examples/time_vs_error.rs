@@ -781,16 +781,8 @@ fn main() -> Result<(), Box<dyn Error>> {
     };
     std::fs::create_dir_all(&args.out)?;
     let pool = (args.workers > 0).then(|| Arc::new(WorkerPool::new(args.workers)));
-    let exact = if args.oracle_inline {
-        Vec::new()
-    } else {
-        exact_frames(&mut workload, args.frames, args.speed)
-    };
-    let oracle = if args.oracle_inline {
-        Oracle::Inline
-    } else {
-        Oracle::Before(&exact)
-    };
+    let exact = (!args.oracle_inline).then(|| exact_frames(&mut workload, args.frames, args.speed));
+    let oracle = exact.as_deref().map_or(Oracle::Inline, Oracle::Before);
     let mut rows = Vec::new();
     for budget in &budgets {
         rows.push(run_row(

@@ -116,43 +116,42 @@ impl HingeFrame {
     #[inline(always)]
     pub(crate) fn closest_point(&self, p: DVec3) -> DVec3 {
         debug_assert!(p.is_finite());
-        let &Self::Face {
-            o,
-            e,
-            w,
-            u,
-            v,
-            len,
-            xw,
-            t,
-        } = self
-        else {
-            return match *self {
-                Self::Point(a) => a,
-                Self::Edge(o, e) => closest_point_segment(p, o, e),
-                Self::Face { .. } => unreachable!("matched above"),
-            };
-        };
-        let d = p - o;
-        let (x, y) = (d.dot(u), d.dot(v));
-        // Inner sides of the 2-D triangle (0, 0) → (len, 0) → (xw, t), counter-clockwise.
-        let inner_oe = y >= 0.0;
-        let inner_ew = (xw - len) * y - t * (x - len) >= 0.0;
-        let inner_wo = t * (x - xw) - xw * (y - t) >= 0.0;
-        if inner_oe && inner_ew && inner_wo {
-            let m = u.cross(v);
-            return p - m * d.dot(m);
-        }
-        let mut best = None::<DVec3>;
-        for (inner, x0, x1) in [(inner_oe, o, e), (inner_ew, e, w), (inner_wo, w, o)] {
-            if !inner {
-                let q = closest_point_segment(p, x0, x1);
-                if best.is_none_or(|b| q.distance_squared(p) < b.distance_squared(p)) {
-                    best = Some(q);
+        match *self {
+            Self::Point(a) => a,
+            Self::Edge(o, e) => closest_point_segment(p, o, e),
+            Self::Face {
+                o,
+                e,
+                w,
+                u,
+                v,
+                len,
+                xw,
+                t,
+            } => {
+                let d = p - o;
+                let (x, y) = (d.dot(u), d.dot(v));
+                // Inner sides of the 2-D triangle (0, 0) → (len, 0) → (xw, t),
+                // counter-clockwise.
+                let inner_oe = y >= 0.0;
+                let inner_ew = (xw - len) * y - t * (x - len) >= 0.0;
+                let inner_wo = t * (x - xw) - xw * (y - t) >= 0.0;
+                if inner_oe && inner_ew && inner_wo {
+                    let m = u.cross(v);
+                    return p - m * d.dot(m);
                 }
+                let mut best = None::<DVec3>;
+                for (inner, x0, x1) in [(inner_oe, o, e), (inner_ew, e, w), (inner_wo, w, o)] {
+                    if !inner {
+                        let q = closest_point_segment(p, x0, x1);
+                        if best.is_none_or(|b| q.distance_squared(p) < b.distance_squared(p)) {
+                            best = Some(q);
+                        }
+                    }
+                }
+                best.unwrap_or(p)
             }
         }
-        best.unwrap_or(p)
     }
 }
 

@@ -44,7 +44,8 @@
 //! volumes is the deeper overlap). It ends as soon as a triangle pair within the threshold
 //! is found, or after [`PROBE_VISITS`] visits ([`EXPECTED_PROBE_VISITS`] for a pair
 //! expected close, below); the entries left on its stack join the next round, so a
-//! probe's visits are never lost: for a pair that is apart, they are part of the proof. Steps are polled like entries, and a run stopped inside a probe resumes it.
+//! probe's visits are never lost: for a pair that is apart, they are part of the proof.
+//! Steps are polled like entries, and a run stopped inside a probe resumes it.
 //!
 //! # Decide first
 //! Only the first part changes which pairs a frame reports, so the undecided pairs are
@@ -504,6 +505,14 @@ pub const FIRST_CAP: u32 = 2;
 /// phase to end and join it (module docs, "Decide first"). Measured on robot-chain and the
 /// mesh pile with 4, 8, 16 and 32 (module docs).
 pub const EXPECTED_JOIN_CAP: u32 = 8;
+
+// The stage caps are `FIRST_CAP · 2ᵏ`, and the join happens when one equals
+// `EXPECTED_JOIN_CAP` (`FrontierWorkspace::next_round`): it must be one of them.
+const _: () = assert!(
+    EXPECTED_JOIN_CAP > FIRST_CAP
+        && EXPECTED_JOIN_CAP.is_multiple_of(FIRST_CAP)
+        && (EXPECTED_JOIN_CAP / FIRST_CAP).is_power_of_two()
+);
 
 /// Scratch space and state of the frontier; keep one per thread and reuse it every frame.
 #[derive(Debug, Clone)]
@@ -1346,9 +1355,9 @@ mod tests {
 
     /// A pair expected close waits only until the stages reach [`EXPECTED_JOIN_CAP`]: beside
     /// a wide undecided pair (a small torus inside a large one, in its plane, apart all
-    /// around the ring by a little more than the threshold), the touching pair with a stale seed is proven close before the
-    /// wide pair is settled, where it would otherwise wait for it. The final answers are
-    /// each pair's own.
+    /// around the ring by a little more than the threshold), the touching pair with a
+    /// stale seed is proven close before the wide pair is settled, where it would otherwise
+    /// wait for it. The final answers are each pair's own.
     #[test]
     fn an_expected_pair_joins_the_deciding_phase_once_the_stages_reach_the_join_cap() {
         let (a, b, poses) = scene::<Obb>();
@@ -1376,11 +1385,8 @@ mod tests {
             seed: Some([0, 0]),
             ..pairs(&a, &b, &poses[..1])[0]
         };
-        let stale = alone(&FrontierPair {
-            seed: None,
-            ..touching
-        });
-        assert!(stale.maybe_close);
+        let (seed_distance, _) = touching.seed_distance().expect("a seed");
+        assert!(seed_distance > touching.threshold, "{seed_distance}");
         let both = [touching, wide];
         let proven =
             |x: &[FrontierAnswer]| x[0].distance_upper.is_some_and(|d| d <= x[0].threshold);
@@ -1388,6 +1394,7 @@ mod tests {
         let (proven_at, _) = visits_until(&both, proven);
         let (settled, answers) = visits_until(&both, |x| x[1].is_exact());
         assert_eq!(first_visit, 2, "the root's bound and the stale seed's test");
+        assert!(proven_at > first_visit, "proven by its probe, not its seed");
         assert!(
             proven_at < settled,
             "proven at {proven_at}, settled at {settled}"
