@@ -21,7 +21,7 @@ mod support;
 use proxima::geometry::{Capsule, Cuboid, Sphere, Triangle};
 use proxima::math::{DMat3, DQuat, DVec3, Isometry, Pose};
 use proxima::narrow::pairs::*;
-use proxima::narrow::{Manifold, ShapeDistance, distance_triangle_triangle};
+use proxima::narrow::{DistanceBound, Manifold, ShapeDistance, distance_triangle_triangle};
 use rand::Rng;
 use support::{TestRng, rng, rotation};
 
@@ -574,6 +574,105 @@ fn capsule_triangle_matches_the_oracles() {
 #[test]
 fn cuboid_triangle_matches_the_oracles() {
     run_pair(2, 3, 4000, 9);
+}
+
+fn distance_bound(a: &Shape, b: &Shape, pose: &Isometry, enough: f64) -> DistanceBound {
+    use Shape::*;
+    match (a, b) {
+        (Capsule(a), Capsule(b)) => distance_bound_capsule_capsule(a, b, pose, enough),
+        (Capsule(a), Cuboid(b)) => distance_bound_capsule_cuboid(a, b, pose, enough),
+        (Cuboid(a), Cuboid(b)) => distance_bound_cuboid_cuboid(a, b, pose, enough),
+        _ => unreachable!("no bound for this pair"),
+    }
+}
+
+/// The separating-axis bounds against the oracles: the true signed distance lies between
+/// them; B's witness is on B's surface and A's across the axis; a bound that says the pair
+/// is beyond `enough` is right; with no limit and cores overlapping (by more than rounding)
+/// in a pair with a solid box, the bounds meet at the depth oracle; two capsules whose
+/// segments are apart get the exact distance. Both outcomes of each claim occur.
+fn run_bounds(rank_a: u8, rank_b: u8, cases: usize, seed: u64) {
+    let mut r = rng(seed);
+    let (mut beyond, mut not_proven, mut met, mut apart_bounded) = (0, 0, 0, 0);
+    for case in 0..cases {
+        let a = random_shape(&mut r, rank_a);
+        let b = random_shape(&mut r, rank_b);
+        let pose = random_pose(&mut r, &a, &b);
+        let enough = if r.random_bool(0.5) {
+            f64::INFINITY
+        } else {
+            uniform(&mut r, 0.0, 0.5)
+        };
+        let bound = distance_bound(&a, &b, &pose, enough);
+        let tol = tolerance(&a, &b, &pose);
+        let (want, cores_meet) = match separated_distance(&a, &b, &pose) {
+            Some(d) => (d, false),
+            None => (-depth_oracle(&a, &b, &pose), true),
+        };
+        let ctx =
+            format!("case {case}: {a:?} {b:?} {pose:?} ({enough}) -> {bound:?}, oracle {want}");
+        assert!(
+            bound.lower <= want + tol && want - tol <= bound.upper,
+            "{ctx}"
+        );
+        assert!((bound.normal.length() - 1.0).abs() < 1e-12, "{ctx}");
+        let residual = bound.point_b - bound.point_a - bound.normal * bound.lower;
+        assert!(residual.length() <= tol, "{ctx}: residual {residual}");
+        let on_b = pose.inverse().transform_point(bound.point_b);
+        assert!(
+            b.sdf(on_b).abs() <= tol,
+            "{ctx}: point_b off B by {}",
+            b.sdf(on_b)
+        );
+        if want > enough + tol {
+            if bound.lower > enough {
+                beyond += 1;
+            } else {
+                not_proven += 1;
+            }
+        }
+        let radii = a.radius() + b.radius();
+        if enough.is_infinite() && cores_meet && want < -radii - tol && b.solid_box() {
+            assert!(
+                (bound.lower - want).abs() <= tol && bound.upper - bound.lower <= tol,
+                "{ctx}: the bounds should meet at the depth"
+            );
+            met += 1;
+        }
+        if want > 0.0 && bound.lower > 0.0 {
+            apart_bounded += 1;
+        }
+        if rank_b == 1 && !cores_meet {
+            // Two capsules whose segments are apart: the segments' closest points, exact.
+            assert!(bound.upper - bound.lower <= tol, "{ctx}: not tight");
+        }
+    }
+    eprintln!(
+        "bounds {rank_a}-{rank_b}: {cases} cases, {beyond} proven beyond the limit, \
+         {not_proven} beyond but not proven, {met} exact depths, {apart_bounded} apart with a \
+         positive lower bound"
+    );
+    // Only the box pairs' axes can leave a pair beyond the limit unproven.
+    assert!(
+        beyond > cases / 20 && (rank_b == 1 || not_proven > 0) && apart_bounded > cases / 20,
+        "beyond {beyond}, not proven {not_proven}, apart bounded {apart_bounded}"
+    );
+    assert!(rank_b < 2 || met > cases / 50, "exact depths {met}");
+}
+
+#[test]
+fn capsule_capsule_distance_bounds_hold_the_oracle_between_them() {
+    run_bounds(1, 1, 3000, 11);
+}
+
+#[test]
+fn capsule_cuboid_distance_bounds_hold_the_oracle_between_them() {
+    run_bounds(1, 2, 3000, 12);
+}
+
+#[test]
+fn cuboid_cuboid_distance_bounds_hold_the_oracle_between_them() {
+    run_bounds(2, 2, 3000, 13);
 }
 
 const ALL_PAIRS: [(u8, u8); 9] = [

@@ -71,6 +71,7 @@ fn total(reports: &[StepReport]) -> PathCounts {
         .fold(PathCounts::default(), |t, r| PathCounts {
             closed_form: t.closed_form + r.paths.closed_form,
             gjk: t.gjk + r.paths.gjk,
+            separating_axes: t.separating_axes + r.paths.separating_axes,
             epa: t.epa + r.paths.epa,
             convex_mesh: t.convex_mesh + r.paths.convex_mesh,
             mesh_mesh: t.mesh_mesh + r.paths.mesh_mesh,

@@ -49,6 +49,69 @@ impl ShapeDistance {
     }
 }
 
+/// Bounds on the signed distance between two shapes from a test cheaper than the exact
+/// query (the separating axes alone, no closest features), A's frame: what a pair gets
+/// when there is no time for its exact answer, or all a query needs to know it is beyond
+/// its limit.
+///
+/// - `lower ≤ exact signed distance ≤ upper`, rounding included.
+/// - `normal` is the unit axis A→B that gave `lower`: the shapes' projections on it are
+///   `lower` apart (overlapping by `−lower` when negative).
+/// - `point_a` and `point_b` lie on the two shapes' supporting planes across that axis,
+///   `point_b − point_a = lower · normal` as in a [`ShapeDistance`], and at least one of
+///   them lies on its shape's surface (the query takes B's point farthest along `−normal`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DistanceBound {
+    /// Lower bound on the signed distance, metres.
+    pub lower: f64,
+    /// Upper bound on the signed distance, metres.
+    pub upper: f64,
+    /// Unit axis from A to B, A's frame.
+    pub normal: DVec3,
+    /// On A's supporting plane, A's frame.
+    pub point_a: DVec3,
+    /// On B's supporting plane, A's frame.
+    pub point_b: DVec3,
+}
+
+impl DistanceBound {
+    /// The bounds `lower` and `upper` (raised to `lower` when below it) along the unit axis
+    /// `normal`, with B's witness `point_b` and A's across the axis from it.
+    #[must_use]
+    pub fn new(lower: f64, upper: f64, normal: DVec3, point_b: DVec3) -> Self {
+        Self {
+            lower,
+            upper: upper.max(lower),
+            normal,
+            point_a: point_b - normal * lower,
+            point_b,
+        }
+    }
+
+    /// The same bounds seen from B (see [`ShapeDistance::flipped`]).
+    #[must_use]
+    pub fn flipped(&self, pose_ba: &crate::math::Isometry) -> Self {
+        Self {
+            lower: self.lower,
+            upper: self.upper,
+            normal: pose_ba.transform_vector(-self.normal),
+            point_a: pose_ba.transform_point(self.point_b),
+            point_b: pose_ba.transform_point(self.point_a),
+        }
+    }
+
+    /// The bounds as a [`ShapeDistance`] at the lower bound (its witnesses and normal).
+    #[must_use]
+    pub fn at_lower(&self) -> ShapeDistance {
+        ShapeDistance {
+            distance: self.lower,
+            point_a: self.point_a,
+            point_b: self.point_b,
+            normal: self.normal,
+        }
+    }
+}
+
 /// One point of a contact manifold, A's frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ManifoldPoint {

@@ -38,12 +38,13 @@ pub mod toi;
 mod triangle_overlap;
 pub mod triangle_triangle;
 
-pub use contact::{MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+pub use contact::{DistanceBound, MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
 pub use convex_manifold::{ContactFeatures, manifold_convex_convex};
 pub use gjk::{
     GjkCache, GjkOutcome, GjkParams, GjkResult, Rounded, gjk_distance, signed_distance_convex,
 };
 pub use pairs::{
+    distance_bound_capsule_capsule, distance_bound_capsule_cuboid, distance_bound_cuboid_cuboid,
     distance_capsule_capsule, distance_capsule_cuboid, distance_capsule_triangle,
     distance_cuboid_cuboid, distance_cuboid_triangle, distance_sphere_capsule,
     distance_sphere_cuboid, distance_sphere_sphere, distance_sphere_triangle,

@@ -1,7 +1,9 @@
 //! The answer for one candidate pair, doing only what the frame's [`Query`] asks:
 //! mesh–mesh by exact BVH queries (warm starts, contact sets), every other pair through the
-//! [`dispatch`](super::dispatch)er; the conservative box answer remains only as the worker
-//! pool's fallback when answering a pair panicked (a bug, never client input).
+//! [`dispatch`](super::dispatch)er. Conservative answers ([`conservative`]: separating-axis
+//! bounds, or world boxes) go to pairs left no time for their exact one, and the box answer
+//! is also the worker pool's fallback when answering a pair panicked (a bug, never client
+//! input).
 //!
 //! Each function returns the pair's [`Answer`] and, when the query asks for contacts and the
 //! pair touches, appends its manifold (at most [`MAX_CONTACTS_PER_PAIR`] points) to
@@ -456,6 +458,66 @@ fn mesh_manifold(
             distance: 0.0,
             error_bound: conservative_slack(point.abs().max_element()),
         });
+    }
+}
+
+/// The conservative answer of a pair left no time for its exact one (not a mesh–mesh pair):
+/// the separating axes' bounds ([`dispatch::distance_bound`]) for capsules and cuboids among
+/// themselves, else their margin-grown world boxes' answer ([`boxes`]).
+///
+/// From the axes: the distance is their lower bound less the rounding of the relative pose
+/// (a pair is reported close whenever the truth may be), the error bound reaches their
+/// upper bound, the normal is their axis. It may touch when the lower bound is `≤ 0`; its
+/// contact (when asked) is one point at that bound. Where the axes meet the depth (cores
+/// overlapping, a box in the pair) the answer is the exact one's to rounding, but without
+/// its witnesses or manifold, so it stays marked inexact.
+pub(super) fn conservative(
+    pair: &CandidatePair,
+    (a, sa): (&Body, &Shape),
+    (b, sb): (&Body, &Shape),
+    query: Query,
+    scratch: &mut NarrowScratch,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    let pose_ab = Pose::relative(&a.pose, &b.pose);
+    // Without DISTANCE a pair beyond its margins is not reported: the axes may stop there.
+    let enough = if query.distance {
+        f64::INFINITY
+    } else {
+        a.margin + b.margin
+    };
+    let Some(bound) = dispatch::distance_bound(sa, sb, &pose_ab.to_isometry(), enough) else {
+        let grown = |body: &Body| body.world_bounds.grown(body.margin);
+        return boxes(pair, &grown(a), &grown(b), query, contacts);
+    };
+    scratch.paths.separating_axes += 1;
+    let (point_a, point_b) = (
+        a.pose.transform_point(bound.point_a),
+        a.pose.transform_point(bound.point_b),
+    );
+    let slack = conservative_slack(
+        a.pose.position.abs().max_element() + b.pose.position.abs().max_element(),
+    );
+    let result = PairResult {
+        a: pair.a,
+        b: pair.b,
+        distance: bound.lower - slack,
+        error_bound: bound.upper - bound.lower + 2.0 * slack,
+        point_a,
+        point_b,
+        normal: a.pose.transform_vector(bound.normal),
+        exact: false,
+        first_contact: 0,
+        contact_count: 0,
+    };
+    let touching = result.distance <= 0.0;
+    if query.contacts && touching {
+        contacts.push(witness_contact(&result, result.distance));
+    }
+    Answer {
+        result,
+        touching,
+        apart_by: None,
     }
 }
 

@@ -21,12 +21,11 @@
 use super::mesh_contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 use crate::geometry::{Segment, SupportMap};
 use crate::math::{DVec3, Isometry, Pose};
-use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
+use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, ShapeDistance};
 use crate::narrow::convex_manifold::{ContactFeatures, manifold_convex_convex};
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
 use crate::narrow::gjk::{
-    EpaWorkspace, GjkCache, GjkOutcome, GjkParams, POINT, Rounded, gjk_distance,
-    signed_distance_convex,
+    EpaWorkspace, GjkCache, GjkParams, POINT, Rounded, signed_distance_convex,
 };
 use crate::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
 use crate::narrow::pairs;
@@ -49,9 +48,12 @@ pub(super) const GJK: GjkParams = GjkParams {
 pub struct PathCounts {
     /// Closed forms: sphere, capsule and cuboid among themselves.
     pub closed_form: u32,
-    /// GJK runs: convex pairs without a closed form, and the early-out of capsule and
-    /// cuboid pairs that proves them beyond the reporting limit.
+    /// GJK runs: convex pairs without a closed form.
     pub gjk: u32,
+    /// Separating-axis bounds alone ([`DistanceBound`]): the early-out that proves capsule
+    /// and cuboid pairs beyond the reporting limit, and those pairs' conservative answer
+    /// once the frame's deadline is near.
+    pub separating_axes: u32,
     /// EPA runs: GJK found the cores overlapping.
     pub epa: u32,
     /// Walks of a mesh's BVH for a convex shape against the mesh.
@@ -119,10 +121,35 @@ pub(super) fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
     matches!((a, b), (S(_), S(_) | C(_) | B(_)) | (C(_) | B(_), S(_)))
 }
 
+/// Bounds on the signed distance of `a` and `b` placed by `pose_ab`, A's frame, from the
+/// separating axes alone (no closest features; [`DistanceBound`]), for the pairs that have
+/// them: capsules and cuboids among themselves. The test may stop once the lower bound
+/// exceeds `enough` metres. `None` for every other pair (sphere pairs answer exactly for
+/// about the same cost; the others have no such test).
+pub(super) fn distance_bound(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    enough: f64,
+) -> Option<DistanceBound> {
+    use Shape::{Capsule as C, Cuboid as B};
+    match (a, b) {
+        (C(x), C(y)) => Some(pairs::distance_bound_capsule_capsule(x, y, pose_ab, enough)),
+        (C(x), B(y)) => Some(pairs::distance_bound_capsule_cuboid(x, y, pose_ab, enough)),
+        (B(x), B(y)) => Some(pairs::distance_bound_cuboid_cuboid(x, y, pose_ab, enough)),
+        (B(_), C(_)) => {
+            let pose_ba = pose_ab.inverse();
+            distance_bound(b, a, &pose_ba, enough).map(|d| d.flipped(pose_ab))
+        }
+        _ => None,
+    }
+}
+
 /// The signed distance of `a` and `b` placed by `pose_ab`, A's frame (see the module docs
 /// for the query each pair gets), exact when it is at most `limit` metres; above the limit
-/// the answer may be only an upper bound (`distance > limit`, possibly `+∞`): a convex
-/// shape's walk of a mesh then stops early. Mesh–mesh pairs get a cold exact distance
+/// the answer may be only a bound (`distance > limit` holds, the value is not exact): a
+/// lower bound from the separating axes of capsule and cuboid pairs ([`beyond`]), or an
+/// upper bound, possibly `+∞`, from a convex shape's walk of a mesh stopped early. Mesh–mesh pairs get a cold exact distance
 /// here; the pipeline sends them down [`Route::MeshMesh`] instead.
 pub(super) fn distance(
     a: &Shape,
@@ -227,14 +254,10 @@ pub(super) fn manifold(
     }
 }
 
-/// Relative accuracy of GJK's distance when it reports the shapes apart (its default
-/// relative tolerance, with room for rounding).
-const GJK_RELATIVE_ERROR: f64 = 1e-9;
-
-/// GJK's answer when it proves the shapes farther apart than `limit` (a pair that will not
-/// be reported, so the exact closed form need not run: GJK costs a fraction of the
-/// closed forms' feature search when they are apart); `None` when they may be within it.
-/// Its distance is then exact to GJK's tolerance, above the limit as [`distance`] allows.
+/// The separating axes' answer when they prove the shapes farther apart than `limit` (a
+/// pair that will not be reported, so the exact closed form need not run: the axes cost a
+/// fraction of its feature search); `None` when they may be within it. Its distance is then
+/// a lower bound above the limit, as [`distance`] allows.
 fn beyond(
     a: &Shape,
     b: &Shape,
@@ -245,29 +268,9 @@ fn beyond(
     if !limit.is_finite() {
         return None;
     }
-    let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_of(a), core_of(b)) else {
-        return None;
-    };
-    paths.gjk += 1;
-    let g = gjk_distance(
-        core_a.support_map(),
-        core_b.support_map(),
-        pose_ab,
-        &GJK,
-        &mut GjkCache::default(),
-    );
-    let distance = g.distance - radius_a - radius_b;
-    let scale = g.point_a.abs().max_element() + g.point_b.abs().max_element() + g.distance;
-    let certain = distance - GJK_RELATIVE_ERROR * scale > limit;
-    (g.outcome == GjkOutcome::Separated && certain).then(|| {
-        let normal = g.normal();
-        ShapeDistance {
-            distance,
-            point_a: g.point_a + normal * radius_a,
-            point_b: g.point_b - normal * radius_b,
-            normal,
-        }
-    })
+    let bound = distance_bound(a, b, pose_ab, limit)?;
+    paths.separating_axes += 1;
+    (bound.lower > limit).then(|| bound.at_lower())
 }
 
 /// The answer of B against A turned into A against B: points swapped, normal reversed,

@@ -540,10 +540,12 @@ pub fn step(
 ///
 /// The pairs outside the frontier (closed forms, GJK/EPA, convex–mesh walks) keep to a
 /// wall-clock deadline too: once it is within [`PUBLISH_RESERVE`] (checked every few
-/// pairs), each remaining one gets the conservative answer of its margin-grown world boxes
-/// (distance between the boxes, their diagonals as error bound, "may touch" when they
-/// touch: level 0), counted in [`StepReport::truncated_pairs`], except a sphere against a
-/// sphere, capsule or cuboid, whose closed form costs no more than that and stays exact.
+/// pairs), each remaining one gets a conservative answer (level 0), counted in
+/// [`StepReport::truncated_pairs`]: capsules and cuboids among themselves their separating
+/// axes' bounds (a lower bound as distance, exact depth when their cores overlap, tens of
+/// nanoseconds), the others their margin-grown world boxes' answer (distance between the
+/// boxes, their diagonals as error bound, "may touch" when they touch). A sphere against a
+/// sphere, capsule or cuboid stays exact: its closed form costs no more than a box answer.
 /// Counted budgets leave them exact. Not yet budgeted: the broad phase, the exact contacts
 /// of finished touching mesh pairs and time of impact run to completion whatever the
 /// budget (the frontier's reserve is for them). The worker pool is not used for a
@@ -686,8 +688,7 @@ pub fn step_within(
                 if !dispatch::exact_costs_no_more_than_boxes(sa, sb) && pair_clock.expired() =>
             {
                 truncated_pairs += 1;
-                let bounds = |body: &Body| body.world_bounds.grown(body.margin);
-                answer::boxes(pair, &bounds(a), &bounds(b), query, contacts)
+                answer::conservative(pair, (a, sa), (b, sb), query, narrow, contacts)
             }
             (Route::Direct, _) => {
                 answer::direct(pair, (a, sa), (b, sb), query, narrow, manifold, contacts)

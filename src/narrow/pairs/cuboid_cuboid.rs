@@ -16,10 +16,10 @@
 
 use super::clip;
 use super::core::{AXIS_RELATIVE, Core};
-use super::query::{self, Axis, FEATURE_RELATIVE};
+use super::query::{self, Axis, BOUND_ULPS, FEATURE_RELATIVE};
 use crate::geometry::Cuboid;
 use crate::math::{DMat3, DVec3, Isometry};
-use crate::narrow::contact::{Manifold, ShapeDistance};
+use crate::narrow::contact::{DistanceBound, Manifold, ShapeDistance};
 
 /// Exact signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's), with
 /// witnesses and unit normal A→B, all in A's frame, as [`crate::narrow::contact`] states;
@@ -33,6 +33,21 @@ pub fn distance_cuboid_cuboid(a: &Cuboid, b: &Cuboid, pose_ab: &Isometry) -> Sha
         let (core_a, core_b) = cores(a, b, pose_ab);
         query::distance_with_axis(&core_a, &core_b, axis)
     })
+}
+
+/// Bounds on the signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's)
+/// from the separating-axis test alone, A's frame, as [`DistanceBound`] states; the test
+/// may stop once the lower bound exceeds `enough` metres (`f64::INFINITY`: never).
+#[must_use]
+pub fn distance_bound_cuboid_cuboid(
+    a: &Cuboid,
+    b: &Cuboid,
+    pose_ab: &Isometry,
+    enough: f64,
+) -> DistanceBound {
+    let boxes = Boxes::new(a, b, pose_ab);
+    let axis = boxes.best_axis_or_first_above(enough);
+    boxes.bound(&axis, axis.separation <= enough)
 }
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4
@@ -78,8 +93,10 @@ struct Boxes {
     abs_r: DMat3,
     /// B's half extents' reach along A's axes, `|r| hb`.
     reach_b: DVec3,
-    /// [`FEATURE_RELATIVE`] times the largest corner coordinate, metres: the tolerance of
-    /// support features and of rounding-sized gaps, as the shared engine's.
+    /// The largest corner coordinate, metres.
+    scale: f64,
+    /// [`FEATURE_RELATIVE`] times `scale`: the tolerance of support features and of
+    /// rounding-sized gaps, as the shared engine's.
     tiny: f64,
 }
 
@@ -98,6 +115,7 @@ impl Boxes {
             r,
             abs_r,
             reach_b,
+            scale,
             tiny: FEATURE_RELATIVE * scale,
         }
     }
@@ -182,6 +200,24 @@ impl Boxes {
             }
         }
         best
+    }
+
+    /// The shared engine's [`query::bound`] on half extents: A's corner farthest along the
+    /// axis and B's farthest against it are sign patterns, a closest point a clamp.
+    fn bound(&self, axis: &Axis, complete: bool) -> DistanceBound {
+        let slack = BOUND_ULPS * f64::EPSILON * self.scale;
+        let n = axis.normal;
+        let lower = axis.separation - slack;
+        let to_b = |p: DVec3| self.r.transpose() * (p - self.t);
+        let from_b = |q: DVec3| self.t + self.r * q;
+        let upper = if complete && axis.separation <= 0.0 {
+            lower + 2.0 * slack
+        } else {
+            let on_b = from_b(to_b(n.signum() * self.ha).clamp(-self.hb, self.hb));
+            on_b.clamp(-self.ha, self.ha).distance(on_b) + slack
+        };
+        let point_b = from_b(-(self.r.transpose() * n).signum() * self.hb);
+        DistanceBound::new(lower, upper, n, point_b)
     }
 
     /// The signed distance given the best axis, or any axis the boxes are apart on; `shared`

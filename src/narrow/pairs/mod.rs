@@ -38,10 +38,16 @@ mod sphere_cuboid;
 mod sphere_sphere;
 mod sphere_triangle;
 
-pub use capsule_capsule::{distance_capsule_capsule, manifold_capsule_capsule};
-pub use capsule_cuboid::{distance_capsule_cuboid, manifold_capsule_cuboid};
+pub use capsule_capsule::{
+    distance_bound_capsule_capsule, distance_capsule_capsule, manifold_capsule_capsule,
+};
+pub use capsule_cuboid::{
+    distance_bound_capsule_cuboid, distance_capsule_cuboid, manifold_capsule_cuboid,
+};
 pub use capsule_triangle::{distance_capsule_triangle, manifold_capsule_triangle};
-pub use cuboid_cuboid::{distance_cuboid_cuboid, manifold_cuboid_cuboid};
+pub use cuboid_cuboid::{
+    distance_bound_cuboid_cuboid, distance_cuboid_cuboid, manifold_cuboid_cuboid,
+};
 pub use cuboid_triangle::{distance_cuboid_triangle, manifold_cuboid_triangle};
 pub use sphere_capsule::{distance_sphere_capsule, manifold_sphere_capsule};
 pub use sphere_cuboid::{distance_sphere_cuboid, manifold_sphere_cuboid};
