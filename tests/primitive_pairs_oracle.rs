@@ -579,7 +579,7 @@ fn cuboid_triangle_matches_the_oracles() {
 fn distance_bound(a: &Shape, b: &Shape, pose: &Isometry, enough: f64) -> DistanceBound {
     use Shape::*;
     match (a, b) {
-        (Capsule(a), Capsule(b)) => distance_bound_capsule_capsule(a, b, pose, enough),
+        (Capsule(a), Capsule(b)) => distance_bound_capsule_capsule(a, b, pose),
         (Capsule(a), Cuboid(b)) => distance_bound_capsule_cuboid(a, b, pose, enough),
         (Cuboid(a), Cuboid(b)) => distance_bound_cuboid_cuboid(a, b, pose, enough),
         _ => unreachable!("no bound for this pair"),

@@ -6,7 +6,7 @@
 //! zero-length ones a fixed axis crossed with the direction. Manifold: 2 points for parallel
 //! overlapping cores ([`super::clip`]), else 1.
 
-use super::core::Core;
+use super::core::{AXIS_RELATIVE, Core};
 use super::query::FEATURE_RELATIVE;
 use super::{clip, query};
 use crate::geometry::Capsule;
@@ -19,37 +19,26 @@ use crate::narrow::contact::{DistanceBound, Manifold, ShapeDistance};
 /// negative: minus the penetration depth. Never NaN, degenerate sizes included.
 #[must_use]
 pub fn distance_capsule_capsule(a: &Capsule, b: &Capsule, pose_ab: &Isometry) -> ShapeDistance {
-    let segments = Segments::new(a, b, pose_ab);
-    if let Some(d) = segments.apart() {
-        return d;
-    }
-    query::distance(
-        &Core::capsule(a, &Isometry::IDENTITY),
-        &Core::capsule(b, pose_ab),
-    )
+    Segments::new(a, b, pose_ab).distance(a, b, pose_ab)
 }
 
-/// Bounds on the signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's)
-/// from the separating-axis test alone, A's frame, as [`DistanceBound`] states; the test
-/// may stop once the lower bound exceeds `enough` metres (`f64::INFINITY`: never).
+/// Bounds on the signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's),
+/// A's frame, as [`DistanceBound`] states: the exact answer, a rounding allowance either
+/// side. For two capsules the closed form costs what a separating-axis test would (the
+/// segments' closest points), so the bounds are exact and need no limit to stop at.
 #[must_use]
 pub fn distance_bound_capsule_capsule(
     a: &Capsule,
     b: &Capsule,
     pose_ab: &Isometry,
-    enough: f64,
 ) -> DistanceBound {
     let segments = Segments::new(a, b, pose_ab);
-    if let Some(d) = segments.apart() {
-        // Exact: both bounds at the distance, a rounding allowance apart.
-        let slack = query::BOUND_ULPS * f64::EPSILON * segments.scale;
-        return DistanceBound::new(d.distance - slack, d.distance + slack, d.normal, d.point_b);
-    }
-    query::distance_bound(
-        &Core::capsule(a, &Isometry::IDENTITY),
-        &Core::capsule(b, pose_ab),
-        enough,
-    )
+    let d = segments.distance(a, b, pose_ab);
+    // Rounding, plus what the shared engine's skip of near-parallel axes may change in a
+    // depth when the segments meet.
+    let slack = query::BOUND_ULPS * f64::EPSILON * segments.scale
+        + AXIS_RELATIVE * 2.0 * (a.half_height + b.half_height);
+    DistanceBound::new(d.distance - slack, d.distance + slack, d.normal, d.point_b)
 }
 
 /// The two core segments in A's frame, with their radii.
@@ -74,6 +63,16 @@ impl Segments {
             radii: (a.radius, b.radius),
             scale,
         }
+    }
+
+    /// The exact signed distance: [`Self::apart`], else the shared engine's.
+    fn distance(&self, a: &Capsule, b: &Capsule, pose_ab: &Isometry) -> ShapeDistance {
+        self.apart().unwrap_or_else(|| {
+            query::distance(
+                &Core::capsule(a, &Isometry::IDENTITY),
+                &Core::capsule(b, pose_ab),
+            )
+        })
     }
 
     /// The exact answer when the segments are apart by more than rounding: their closest

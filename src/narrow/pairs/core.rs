@@ -210,20 +210,6 @@ impl Core {
             })
     }
 
-    /// A vertex of the core farthest along `n` (any one of them on a tie).
-    #[must_use]
-    pub fn support_point(&self, n: DVec3) -> DVec3 {
-        if let Kind::Box { center, axes, half } = self.kind {
-            let signs = (axes.transpose() * n).signum();
-            return center + axes * (signs * half);
-        }
-        self.vertices()
-            .iter()
-            .copied()
-            .reduce(|best, v| if v.dot(n) > best.dot(n) { v } else { best })
-            .unwrap_or(DVec3::ZERO)
-    }
-
     /// The support feature along `n`: the vertices within `tol` of the maximum of `x · n`,
     /// as a convex polygon in cyclic order (1 to 4 points).
     #[must_use]

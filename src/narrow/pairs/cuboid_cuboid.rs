@@ -211,7 +211,9 @@ impl Boxes {
         let to_b = |p: DVec3| self.r.transpose() * (p - self.t);
         let from_b = |q: DVec3| self.t + self.r * q;
         let upper = if complete && axis.separation <= 0.0 {
-            lower + 2.0 * slack
+            // The skipped near-parallel cross axes may change the depth by as much.
+            let skipped = AXIS_RELATIVE * 2.0 * (self.ha.max_element() + self.hb.max_element());
+            lower + 2.0 * slack + skipped
         } else {
             let on_b = from_b(to_b(n.signum() * self.ha).clamp(-self.hb, self.hb));
             on_b.clamp(-self.ha, self.ha).distance(on_b) + slack

@@ -34,7 +34,9 @@
 use super::core::{AXIS_RELATIVE, Core, Kind, Polygon};
 use crate::math::DVec3;
 use crate::narrow::closest_points::closest_points_segment_segment;
-use crate::narrow::contact::{DistanceBound, ShapeDistance};
+#[cfg(doc)]
+use crate::narrow::contact::DistanceBound;
+use crate::narrow::contact::ShapeDistance;
 
 /// Relative size (times the coordinate scale) under which a core gap is treated as zero
 /// for choosing a normal, and within which vertices count as one support feature.
@@ -136,46 +138,9 @@ pub(super) fn best_axis_or_first_above(a: &Core, b: &Core, enough: f64) -> Axis 
     best
 }
 
-/// Rounding allowance of [`bound`]'s lower bound, in ulps of the cores' coordinate scale
-/// (as the pipeline's error bound of exact answers).
+/// Rounding allowance of the separating-axis distance bounds ([`DistanceBound`]), in ulps
+/// of the pair's coordinate scale (as the pipeline's error bound of exact answers).
 pub(super) const BOUND_ULPS: f64 = 64.0;
-
-/// Bounds on the signed distance of two placed cores' shapes from the separating-axis test
-/// alone, A's frame (see [`DistanceBound`]); `enough` (metres) is the lower bound beyond
-/// which the test may stop (`f64::INFINITY`: the best axis). No closest features: for a
-/// caller that needs only to know the shapes are beyond a limit, or a conservative answer
-/// when time is short.
-#[must_use]
-pub(super) fn distance_bound(a: &Core, b: &Core, enough: f64) -> DistanceBound {
-    let stop = enough + a.radius + b.radius;
-    let axis = best_axis_or_first_above(a, b, stop);
-    bound(a, b, &axis, axis.separation <= stop)
-}
-
-/// [`DistanceBound`] of two placed cores' shapes from one separating axis, `complete` when
-/// it is the best over the complete axis set (module docs, step 1).
-///
-/// - Lower: the separation along any unit axis, less both radii, is at most the signed
-///   distance (the shapes are convex: the signed distance is the largest such separation
-///   over all axes), less a rounding allowance.
-/// - Upper: the distance between any point of each core, less both radii: the pair a step
-///   of alternating projection finds from A's support point. When the axis is the best of
-///   the complete set and the cores overlap, its separation *is* the depth (exactly what
-///   [`distance`] answers), and the bounds meet to rounding.
-#[must_use]
-pub(super) fn bound(a: &Core, b: &Core, axis: &Axis, complete: bool) -> DistanceBound {
-    let slack = BOUND_ULPS * f64::EPSILON * a.scale().max(b.scale());
-    let (n, radii) = (axis.normal, a.radius + b.radius);
-    let lower = axis.separation - radii - slack;
-    let upper = if complete && axis.separation <= 0.0 {
-        lower + 2.0 * slack
-    } else {
-        let on_b = b.closest_point(a.support_point(n));
-        a.closest_point(on_b).distance(on_b) - radii + slack
-    };
-    let point_b = b.support_point(-n) - n * b.radius;
-    DistanceBound::new(lower, upper, n, point_b)
-}
 
 /// The closest of the point pairs offered so far.
 struct BestPair {
