@@ -50,7 +50,8 @@ impl ShapeDistance {
 }
 
 /// Bounds on the signed distance between two shapes from a test cheaper than the exact
-/// query (the separating axes alone, no closest features), A's frame: what a pair gets
+/// query (the separating axes; closest features only where they cost no more), A's frame:
+/// what a pair gets
 /// when there is no time for its exact answer, or all a query needs to know it is beyond
 /// its limit.
 ///

@@ -462,11 +462,12 @@ fn mesh_manifold(
 }
 
 /// The conservative answer of a pair left no time for its exact one (not a mesh–mesh pair):
-/// the separating axes' bounds ([`dispatch::distance_bound`]) for capsules and cuboids among
-/// themselves, else their margin-grown world boxes' answer ([`boxes`]).
+/// the bounds of [`dispatch::distance_bound`] for capsules and cuboids among themselves
+/// (exact to rounding for a capsule apart from the other core), else their margin-grown
+/// world boxes' answer ([`boxes`]).
 ///
-/// From the axes: the distance is their lower bound less the rounding of the relative pose
-/// (a pair is reported close whenever the truth may be), the error bound reaches their
+/// From the bounds: the distance is their lower bound less the rounding of the relative
+/// pose (a pair is reported close whenever the truth may be), the error bound reaches their
 /// upper bound, the normal is their axis. It may touch when the lower bound is `≤ 0`; its
 /// contact (when asked) is one point at that bound. Where the axes meet the depth (cores
 /// overlapping, a box in the pair) the answer is the exact one's to rounding, but without

@@ -50,8 +50,8 @@ pub struct PathCounts {
     pub closed_form: u32,
     /// GJK runs: convex pairs without a closed form.
     pub gjk: u32,
-    /// Distance bounds ([`DistanceBound`]): the early-out that proves capsule–cuboid and
-    /// cuboid–cuboid pairs beyond the reporting limit by their separating axes, and the
+    /// Distance bounds ([`DistanceBound`]): the early-out that proves cuboid–cuboid pairs
+    /// beyond the reporting limit by their separating axes, and the
     /// conservative answer of capsule and cuboid pairs once the frame's deadline is near.
     pub separating_axes: u32,
     /// EPA runs: GJK found the cores overlapping.
@@ -121,12 +121,13 @@ pub(super) fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
     matches!((a, b), (S(_), S(_) | C(_) | B(_)) | (C(_) | B(_), S(_)))
 }
 
-/// Bounds on the signed distance of `a` and `b` placed by `pose_ab`, A's frame, from the
-/// separating axes alone (no closest features; [`DistanceBound`]), for the pairs that have
-/// them: capsules and cuboids among themselves (two capsules: their exact answer, as cheap).
-/// The test may stop once the lower bound
-/// exceeds `enough` metres. `None` for every other pair (sphere pairs answer exactly for
-/// about the same cost; the others have no such test).
+/// Bounds on the signed distance of `a` and `b` placed by `pose_ab`, A's frame, cheaper
+/// than the exact query ([`DistanceBound`]), for the pairs that have them: capsules and
+/// cuboids among themselves. A capsule's are its exact answer while its segment is apart
+/// from the other core (as cheap as the separating axes); two boxes' come from the axes,
+/// which may stop once the lower bound exceeds `enough` metres. `None` for every other
+/// pair (sphere pairs answer exactly for about the same cost; the others have no such
+/// test).
 pub(super) fn distance_bound(
     a: &Shape,
     b: &Shape,
@@ -136,7 +137,7 @@ pub(super) fn distance_bound(
     use Shape::{Capsule as C, Cuboid as B};
     match (a, b) {
         (C(x), C(y)) => Some(pairs::distance_bound_capsule_capsule(x, y, pose_ab)),
-        (C(x), B(y)) => Some(pairs::distance_bound_capsule_cuboid(x, y, pose_ab, enough)),
+        (C(x), B(y)) => Some(pairs::distance_bound_capsule_cuboid(x, y, pose_ab)),
         (B(x), B(y)) => Some(pairs::distance_bound_cuboid_cuboid(x, y, pose_ab, enough)),
         (B(_), C(_)) => {
             let pose_ba = pose_ab.inverse();
@@ -149,8 +150,7 @@ pub(super) fn distance_bound(
 /// The signed distance of `a` and `b` placed by `pose_ab`, A's frame (see the module docs
 /// for the query each pair gets), exact when it is at most `limit` metres; above the limit
 /// the answer may be only a bound (`distance > limit` holds, the value is not exact): a
-/// lower bound from the separating axes of capsule–cuboid and cuboid–cuboid pairs
-/// ([`beyond`]), or an upper bound, possibly `+∞`, from a convex shape's walk of a mesh
+/// lower bound from the separating axes of cuboid–cuboid pairs ([`beyond`]), or an upper bound, possibly `+∞`, from a convex shape's walk of a mesh
 /// stopped early. Mesh–mesh pairs get a cold exact distance here; the pipeline sends them
 /// down [`Route::MeshMesh`] instead.
 pub(super) fn distance(
@@ -176,15 +176,15 @@ pub(super) fn distance(
             paths.closed_form += 1;
             pairs::distance_sphere_cuboid(x, y, &iso)
         }
+        // No early-out for a capsule: its closed form costs what the separating axes would.
         (C(x), C(y)) => {
-            // No early-out: the closed form costs what the separating axes would.
             paths.closed_form += 1;
             pairs::distance_capsule_capsule(x, y, &iso)
         }
-        (C(x), B(y)) => beyond(a, b, &iso, limit, paths).unwrap_or_else(|| {
+        (C(x), B(y)) => {
             paths.closed_form += 1;
             pairs::distance_capsule_cuboid(x, y, &iso)
-        }),
+        }
         (B(x), B(y)) => beyond(a, b, &iso, limit, paths).unwrap_or_else(|| {
             paths.closed_form += 1;
             pairs::distance_cuboid_cuboid(x, y, &iso)
