@@ -14,6 +14,7 @@
 //! | query | Proxima (`proxima`, and for the convex hulls `proxima-accelerated`, `proxima-warm`) | parry (`parry`) |
 //! |---|---|---|
 //! | `sphere_sphere`, `sphere_capsule`, `capsule_capsule`, `sphere_cuboid`, `capsule_cuboid`, `cuboid_cuboid` | the closed-form `proxima::narrow::distance_X_Y`: signed distance, witnesses and normal under the contact contract, for both cases | `separated`: `query::distance`; `penetrating`: `query::contact` with prediction 0 (depth, points, normal), each parry's dedicated pair routine where it has one, GJK/EPA otherwise |
+//! | `capsule_capsule`, `capsule_cuboid`, `cuboid_cuboid` (`proxima-bound`) | `distance_bound_X_Y` (no limit): the bounds the pipeline answers with past a frame's deadline, on the same poses; checked to hold the exact distance before timing | — (parry has no bound query; its exact query is the comparison) |
 //! | `cuboid_cuboid_manifold` | [`manifold_cuboid_cuboid`]: up to 4 points, clipped faces (empty when apart) | `PersistentQueryDispatcher::contact_manifold_convex_convex` with prediction 0 into one reused `ContactManifold` (no contact reuse between unrelated poses: each is a fresh manifold computation, as `contact_manifolds` would do on a new pair) |
 //! | `convex_distance/hullN` (separated poses) | [`gjk_distance`] on [`ConvexPolyhedron`] hulls of `N` = 8, 64, 512, 4,096 random points on the unit sphere: `proxima` plain GJK, `proxima-accelerated` with `GjkParams { accelerated: true, .. }`, `proxima-warm` plain with a [`GjkCache`] per pose kept across laps (the best case of frame-to-frame coherence); other runs use a fresh cache | `query::distance` on `ConvexPolyhedron::from_convex_hull` of the same points (GJK) |
 //! | `convex_depth/hullN` (penetrating poses) | [`signed_distance_convex`] (GJK, then EPA on penetration), same three variants, one [`EpaWorkspace`] per bench | `query::contact` with prediction 0 (GJK, then EPA) |
@@ -46,10 +47,11 @@ use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Sphere};
 use proxima::math::{DVec3, Isometry, Pose};
 use proxima::narrow::gjk::EpaWorkspace;
 use proxima::narrow::{
-    GjkCache, GjkParams, Manifold, Rounded, ShapeDistance, distance_capsule_capsule,
-    distance_capsule_cuboid, distance_cuboid_cuboid, distance_sphere_capsule,
-    distance_sphere_cuboid, distance_sphere_sphere, gjk_distance, manifold_cuboid_cuboid,
-    signed_distance_convex,
+    DistanceBound, GjkCache, GjkParams, Manifold, Rounded, ShapeDistance,
+    distance_bound_capsule_capsule, distance_bound_capsule_cuboid, distance_bound_cuboid_cuboid,
+    distance_capsule_capsule, distance_capsule_cuboid, distance_cuboid_cuboid,
+    distance_sphere_capsule, distance_sphere_cuboid, distance_sphere_sphere, gjk_distance,
+    manifold_cuboid_cuboid, signed_distance_convex,
 };
 use rand::Rng;
 use std::hint::black_box;
@@ -151,13 +153,22 @@ fn bench_pair(
     query: &str,
     reach: f64,
     proxima: impl Fn(&Isometry) -> ShapeDistance,
-    parry_a: &dyn ParryShape,
-    parry_b: &dyn ParryShape,
+    bound: Option<&dyn Fn(&Isometry) -> DistanceBound>,
+    (parry_a, parry_b): (&dyn ParryShape, &dyn ParryShape),
 ) {
     let cases = sorted_poses(rng, reach, |pose| proxima(pose).distance);
     let mut group = c.benchmark_group(format!("narrow_phase/{query}"));
     for case in &cases {
         let apart = case.name == "separated";
+        if let Some(bound) = bound {
+            check_bounds(query, case, &proxima, bound);
+            cycle_bench(
+                &mut group,
+                BenchmarkId::new("proxima-bound", case.name),
+                &case.proxima,
+                |_, pose| bound(pose).lower,
+            );
+        }
         let worst = case
             .proxima
             .iter()
@@ -184,6 +195,33 @@ fn bench_pair(
     group.finish();
 }
 
+/// Checks that `bound` holds `proxima`'s exact distance between its bounds on every pose of
+/// `case` (to 1 nm), and prints the widest gap between them.
+///
+/// # Panics
+/// When a bound misses the exact distance.
+fn check_bounds(
+    query: &str,
+    case: &Poses,
+    proxima: &impl Fn(&Isometry) -> ShapeDistance,
+    bound: &dyn Fn(&Isometry) -> DistanceBound,
+) {
+    let mut widest = 0.0f64;
+    for pose in &case.proxima {
+        let (exact, b) = (proxima(pose).distance, bound(pose));
+        assert!(
+            b.lower <= exact + 1e-9 && exact <= b.upper + 1e-9,
+            "{query}/{}: {b:?} misses {exact}",
+            case.name
+        );
+        widest = widest.max(b.upper - b.lower);
+    }
+    eprintln!(
+        "narrow_phase/{query}/{}: bounds hold the exact distance, widest gap {widest:e} m",
+        case.name
+    );
+}
+
 fn closed_form_pairs(c: &mut Criterion, rng: &mut TestRng) {
     let sphere = Sphere::new(0.5);
     let capsule = Capsule::new(0.6, 0.3);
@@ -203,8 +241,8 @@ fn closed_form_pairs(c: &mut Criterion, rng: &mut TestRng) {
         "sphere_sphere",
         2.0,
         |p| distance_sphere_sphere(black_box(&sphere), black_box(&sphere), p),
-        &p_sphere,
-        &p_sphere,
+        None,
+        (&p_sphere, &p_sphere),
     );
     bench_pair(
         c,
@@ -212,8 +250,8 @@ fn closed_form_pairs(c: &mut Criterion, rng: &mut TestRng) {
         "sphere_capsule",
         2.5,
         |p| distance_sphere_capsule(black_box(&sphere), black_box(&capsule), p),
-        &p_sphere,
-        &p_capsule,
+        None,
+        (&p_sphere, &p_capsule),
     );
     bench_pair(
         c,
@@ -221,8 +259,10 @@ fn closed_form_pairs(c: &mut Criterion, rng: &mut TestRng) {
         "capsule_capsule",
         3.0,
         |p| distance_capsule_capsule(black_box(&capsule), black_box(&capsule), p),
-        &p_capsule,
-        &p_capsule,
+        Some(&|p: &Isometry| {
+            distance_bound_capsule_capsule(black_box(&capsule), black_box(&capsule), p)
+        }),
+        (&p_capsule, &p_capsule),
     );
     bench_pair(
         c,
@@ -230,8 +270,8 @@ fn closed_form_pairs(c: &mut Criterion, rng: &mut TestRng) {
         "sphere_cuboid",
         2.5,
         |p| distance_sphere_cuboid(black_box(&sphere), black_box(&box_a), p),
-        &p_sphere,
-        &p_box_a,
+        None,
+        (&p_sphere, &p_box_a),
     );
     bench_pair(
         c,
@@ -239,8 +279,10 @@ fn closed_form_pairs(c: &mut Criterion, rng: &mut TestRng) {
         "capsule_cuboid",
         3.0,
         |p| distance_capsule_cuboid(black_box(&capsule), black_box(&box_a), p),
-        &p_capsule,
-        &p_box_a,
+        Some(&|p: &Isometry| {
+            distance_bound_capsule_cuboid(black_box(&capsule), black_box(&box_a), p)
+        }),
+        (&p_capsule, &p_box_a),
     );
     bench_pair(
         c,
@@ -248,8 +290,10 @@ fn closed_form_pairs(c: &mut Criterion, rng: &mut TestRng) {
         "cuboid_cuboid",
         2.5,
         |p| distance_cuboid_cuboid(black_box(&box_a), black_box(&box_b), p),
-        &p_box_a,
-        &p_box_b,
+        Some(&|p: &Isometry| {
+            distance_bound_cuboid_cuboid(black_box(&box_a), black_box(&box_b), p, f64::INFINITY)
+        }),
+        (&p_box_a, &p_box_b),
     );
     cuboid_manifolds(c, rng, (&box_a, &box_b), (&p_box_a, &p_box_b));
 }
