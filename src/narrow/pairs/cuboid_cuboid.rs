@@ -1,7 +1,8 @@
 //! Cuboid–cuboid: the 15-axis separating-axis test (3 + 3 faces, 9 edge × edge) gives the
 //! exact penetration depth; apart, the exact distance is the best of the 16 corner-to-box
 //! clamps and the support edges along the cross axes the boxes are apart on
-//! ([`super::query`], step 2).
+//! ([`super::query`], step 2). The edges are tried only when the best corner pair does not
+//! separate the boxes at its own distance (which proves it the closest pair).
 //!
 //! Gottschalk, Lin, Manocha, *OBBTree* (1996); Ericson §4.4.1. Near-parallel edge pairs
 //! (`|e_a × e_b| ≤ 1e-12`) are skipped, which can change a depth by at most `1e-12` × extent.
@@ -270,6 +271,11 @@ impl Boxes {
         if best_b.0 < best.0 {
             best = (best_b.0, r * best_b.1 + t, r * best_b.2 + t);
         }
+        if self.separates_at(best.1, best.2) {
+            // PERF: the corner pair is the closest pair, no edge pair need be tried (most
+            // apart poses: `narrow_phase` cuboid_cuboid separated 323 → 198 ns).
+            return Some((best.1, best.2));
+        }
         for i in 0..3 {
             for j in 0..3 {
                 let Some(axis) = self.cross(i, j) else {
@@ -301,6 +307,23 @@ impl Boxes {
             }
         }
         Some((best.1, best.2))
+    }
+}
+
+impl Boxes {
+    /// Whether the boxes are apart along `on_b − on_a` by that pair's own distance (to
+    /// [`BOUND_ULPS`] of the scale): then no pair of points is closer, since the distance is
+    /// at least the separation along any axis, and `(on_a, on_b)` is the closest pair.
+    fn separates_at(&self, on_a: DVec3, on_b: DVec3) -> bool {
+        let gap = on_b - on_a;
+        let length = gap.length();
+        if length <= self.tiny {
+            return false;
+        }
+        let u = gap / length;
+        let reach_b = (self.r.transpose() * u).abs().dot(self.hb);
+        let separation = self.t.dot(u) - u.abs().dot(self.ha) - reach_b;
+        separation >= length - BOUND_ULPS * f64::EPSILON * self.scale
     }
 }
 
