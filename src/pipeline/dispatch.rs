@@ -125,7 +125,8 @@ pub(super) fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
 /// than the exact query ([`DistanceBound`]), for the pairs that have them: capsules and
 /// cuboids among themselves. A capsule's are its exact answer while its segment is apart
 /// from the other core (as cheap as the separating axes); two boxes' come from the axes,
-/// which may stop once the lower bound exceeds `enough` metres. `None` for every other
+/// which may stop once the lower bound exceeds `enough` metres, and are exact when the
+/// axes find the boxes apart but not beyond it. `None` for every other
 /// pair (sphere pairs answer exactly for about the same cost; the others have no such
 /// test).
 pub(super) fn distance_bound(
@@ -150,7 +151,7 @@ pub(super) fn distance_bound(
 /// The signed distance of `a` and `b` placed by `pose_ab`, A's frame (see the module docs
 /// for the query each pair gets), exact when it is at most `limit` metres; above the limit
 /// the answer may be only a bound (`distance > limit` holds, the value is not exact): a
-/// lower bound from the separating axes of cuboid–cuboid pairs ([`beyond`]), or an upper bound, possibly `+∞`, from a convex shape's walk of a mesh
+/// lower bound from the separating axes of cuboid–cuboid pairs, or an upper bound, possibly `+∞`, from a convex shape's walk of a mesh
 /// stopped early. Mesh–mesh pairs get a cold exact distance here; the pipeline sends them
 /// down [`Route::MeshMesh`] instead.
 pub(super) fn distance(
@@ -185,10 +186,15 @@ pub(super) fn distance(
             paths.closed_form += 1;
             pairs::distance_capsule_cuboid(x, y, &iso)
         }
-        (B(x), B(y)) => beyond(a, b, &iso, limit, paths).unwrap_or_else(|| {
-            paths.closed_form += 1;
-            pairs::distance_cuboid_cuboid(x, y, &iso)
-        }),
+        (B(x), B(y)) => {
+            let (d, beyond_limit) = pairs::distance_cuboid_cuboid_within(x, y, &iso, limit);
+            if beyond_limit {
+                paths.separating_axes += 1;
+            } else {
+                paths.closed_form += 1;
+            }
+            d
+        }
         (C(_), S(_)) | (B(_), S(_) | C(_)) => {
             flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso)
         }
@@ -255,25 +261,6 @@ pub(super) fn manifold(
         }
         (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, d, scratch, out),
     }
-}
-
-/// The separating axes' answer when they prove the shapes farther apart than `limit` (a
-/// pair that will not be reported, so the exact closed form need not run: the axes cost a
-/// fraction of its feature search); `None` when they may be within it. Its distance is then
-/// a lower bound above the limit, as [`distance`] allows.
-fn beyond(
-    a: &Shape,
-    b: &Shape,
-    pose_ab: &Isometry,
-    limit: f64,
-    paths: &mut PathCounts,
-) -> Option<ShapeDistance> {
-    if !limit.is_finite() {
-        return None;
-    }
-    let bound = distance_bound(a, b, pose_ab, limit)?;
-    paths.separating_axes += 1;
-    (bound.lower > limit).then(|| bound.at_lower())
 }
 
 /// The answer of B against A turned into A against B: points swapped, normal reversed,

@@ -27,18 +27,48 @@ use crate::narrow::contact::{DistanceBound, Manifold, ShapeDistance};
 /// negative: minus the penetration depth. Never NaN, degenerate sizes included.
 #[must_use]
 pub fn distance_cuboid_cuboid(a: &Cuboid, b: &Cuboid, pose_ab: &Isometry) -> ShapeDistance {
+    distance_cuboid_cuboid_within(a, b, pose_ab, f64::INFINITY).0
+}
+
+/// [`distance_cuboid_cuboid`] when it is at most `limit` metres; above the limit the answer
+/// may be the separating axes' lower bound instead (`distance > limit` holds, the value is
+/// not exact), which the second field then says (`true`). PERF: the first axis the boxes
+/// are apart on decides, in the one pass the exact answer needs anyway.
+#[must_use]
+pub(crate) fn distance_cuboid_cuboid_within(
+    a: &Cuboid,
+    b: &Cuboid,
+    pose_ab: &Isometry,
+    limit: f64,
+) -> (ShapeDistance, bool) {
     let boxes = Boxes::new(a, b, pose_ab);
     // Apart along any axis is enough to go to the closest pair; overlapping needs the best.
     let axis = boxes.best_axis_or_first_above(0.0);
-    boxes.distance(&axis, |axis| {
+    if axis.separation > limit {
+        return (boxes.bound(&axis, false).at_lower(), true);
+    }
+    (exact(&boxes, &axis, (a, b, pose_ab)), false)
+}
+
+/// [`Boxes::distance`] with the shared engine on the boxes' cores behind it.
+fn exact(
+    boxes: &Boxes,
+    axis: &Axis,
+    (a, b, pose_ab): (&Cuboid, &Cuboid, &Isometry),
+) -> ShapeDistance {
+    boxes.distance(axis, |axis| {
         let (core_a, core_b) = cores(a, b, pose_ab);
         query::distance_with_axis(&core_a, &core_b, axis)
     })
 }
 
-/// Bounds on the signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's)
-/// from the separating-axis test alone, A's frame, as [`DistanceBound`] states; the test
-/// may stop once the lower bound exceeds `enough` metres (`f64::INFINITY`: never).
+/// Bounds on the signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's),
+/// A's frame, as [`DistanceBound`] states. The separating-axis test stops at the first
+/// axis the boxes are apart on: apart by more than `enough` metres there, the bounds are
+/// that separation and an upper bound; apart by less, their exact distance, a rounding
+/// allowance either side (the exact answer costs what the apart case of
+/// [`distance_cuboid_cuboid`] costs, and settles a pair the axes leave undecided).
+/// Overlapping boxes get the axes' depth.
 #[must_use]
 pub fn distance_bound_cuboid_cuboid(
     a: &Cuboid,
@@ -47,8 +77,15 @@ pub fn distance_bound_cuboid_cuboid(
     enough: f64,
 ) -> DistanceBound {
     let boxes = Boxes::new(a, b, pose_ab);
-    let axis = boxes.best_axis_or_first_above(enough);
-    boxes.bound(&axis, axis.separation <= enough)
+    // The first axis the boxes are apart on: beyond `enough`, that is all the bounds need;
+    // within it, the exact distance is what another axis could add, and more.
+    let axis = boxes.best_axis_or_first_above(0.0);
+    if axis.separation > 0.0 && axis.separation <= enough {
+        let d = exact(&boxes, &axis, (a, b, pose_ab));
+        let slack = BOUND_ULPS * f64::EPSILON * boxes.scale;
+        return DistanceBound::new(d.distance - slack, d.distance + slack, d.normal, d.point_b);
+    }
+    boxes.bound(&axis, axis.separation <= 0.0)
 }
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4

@@ -45,6 +45,7 @@ pub use capsule_cuboid::{
     distance_bound_capsule_cuboid, distance_capsule_cuboid, manifold_capsule_cuboid,
 };
 pub use capsule_triangle::{distance_capsule_triangle, manifold_capsule_triangle};
+pub(crate) use cuboid_cuboid::distance_cuboid_cuboid_within;
 pub use cuboid_cuboid::{
     distance_bound_cuboid_cuboid, distance_cuboid_cuboid, manifold_cuboid_cuboid,
 };
