@@ -125,7 +125,7 @@ const SCENES: [(&str, &str); 3] = [
     ),
     (
         "primitives",
-        "150 spheres, capsules and boxes: no meshes, so no BVH; exact while time lasts, the pairs left at the deadline answered by their boxes",
+        "150 spheres, capsules and boxes: no meshes, so no BVH; exact while time lasts; the capsule and box pairs left at the deadline get their distance bounds (exact where apart within their margins)",
     ),
 ];
 

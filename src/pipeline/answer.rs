@@ -464,8 +464,7 @@ fn mesh_manifold(
 /// The conservative answer of a pair left no time for its exact one (not a mesh–mesh pair):
 /// the bounds of [`dispatch::distance_bound`] for capsules and cuboids among themselves
 /// (exact to rounding for a capsule apart from the other core, and for two boxes apart
-/// but within `enough`), else their margin-grown
-/// world boxes' answer ([`boxes`]).
+/// but within `enough`), else their margin-grown world boxes' answer ([`boxes`]).
 ///
 /// From the bounds: the distance is their lower bound less the rounding of the relative
 /// pose (a pair is reported close whenever the truth may be), the error bound reaches their

@@ -51,8 +51,8 @@ pub struct PathCounts {
     /// GJK runs: convex pairs without a closed form.
     pub gjk: u32,
     /// Distance bounds ([`DistanceBound`]): the early-out that proves cuboid–cuboid pairs
-    /// beyond the reporting limit by their separating axes, and the
-    /// conservative answer of capsule and cuboid pairs once the frame's deadline is near.
+    /// beyond the reporting limit by their separating axes, and the conservative answer of
+    /// capsule and cuboid pairs once the frame's deadline is near.
     pub separating_axes: u32,
     /// EPA runs: GJK found the cores overlapping.
     pub epa: u32,
@@ -126,9 +126,8 @@ pub(super) fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
 /// cuboids among themselves. A capsule's are its exact answer while its segment is apart
 /// from the other core (as cheap as the separating axes); two boxes' come from the axes,
 /// which may stop once the lower bound exceeds `enough` metres, and are exact when the
-/// axes find the boxes apart but not beyond it. `None` for every other
-/// pair (sphere pairs answer exactly for about the same cost; the others have no such
-/// test).
+/// axes find the boxes apart but not beyond it. `None` for every other pair (sphere pairs
+/// answer exactly for about the same cost; the others have no such test).
 pub(super) fn distance_bound(
     a: &Shape,
     b: &Shape,
@@ -151,9 +150,9 @@ pub(super) fn distance_bound(
 /// The signed distance of `a` and `b` placed by `pose_ab`, A's frame (see the module docs
 /// for the query each pair gets), exact when it is at most `limit` metres; above the limit
 /// the answer may be only a bound (`distance > limit` holds, the value is not exact): a
-/// lower bound from the separating axes of cuboid–cuboid pairs, or an upper bound, possibly `+∞`, from a convex shape's walk of a mesh
-/// stopped early. Mesh–mesh pairs get a cold exact distance here; the pipeline sends them
-/// down [`Route::MeshMesh`] instead.
+/// lower bound from the separating axes of cuboid–cuboid pairs, or an upper bound,
+/// possibly `+∞`, from a convex shape's walk of a mesh stopped early. Mesh–mesh pairs get a
+/// cold exact distance here; the pipeline sends them down [`Route::MeshMesh`] instead.
 pub(super) fn distance(
     a: &Shape,
     b: &Shape,

@@ -548,10 +548,11 @@ pub fn step(
 /// wall-clock deadline too: once it is within [`PUBLISH_RESERVE`] (checked every few
 /// pairs), each remaining one gets a conservative answer (level 0), counted in
 /// [`StepReport::truncated_pairs`]: capsules and cuboids among themselves their
-/// [`DistanceBound`](crate::narrow::contact::DistanceBound)s (a capsule apart from the
-/// other core its exact distance, two boxes a lower bound from their separating axes, exact
-/// depth where the cores overlap; tens of nanoseconds), the others their margin-grown world boxes' answer (distance between the
-/// boxes, their diagonals as error bound, "may touch" when they touch). A sphere against a
+/// [`DistanceBound`](crate::narrow::contact::DistanceBound)s (exact distances where the
+/// separating axes find them apart within their margins, a lower bound from the axes
+/// beyond them, exact depth where the cores overlap; tens to hundreds of nanoseconds), the
+/// others their margin-grown world boxes' answer (distance between the boxes, their
+/// diagonals as error bound, "may touch" when they touch). A sphere against a
 /// sphere, capsule or cuboid stays exact: its closed form costs no more than a box answer.
 /// Counted budgets leave them exact. Not yet budgeted: the broad phase, the exact contacts
 /// of finished touching mesh pairs and time of impact run to completion whatever the

@@ -52,8 +52,8 @@ pub fn distance_bound_capsule_cuboid(a: &Capsule, b: &Cuboid, pose_ab: &Isometry
 }
 
 /// The capsule's core segment in the box's frame, where each separating axis costs a few
-/// products. PERF: a quarter of the shared engine's cost on placed cores (4,096 near
-/// pairs: 266–271 → 87 ns a bound).
+/// products. PERF: the axes cost a quarter of the shared engine's on placed cores (4,096
+/// near pairs: 266–271 → 87 ns a bound).
 #[derive(Debug, Clone, Copy)]
 struct InBox {
     /// The segment's end points, box frame.
@@ -184,7 +184,7 @@ impl InBox {
     /// are then complete, so their least overlap is the cores' penetration depth); `None`
     /// otherwise (the shared engine then decides). The witnesses are the closest points of
     /// the segment moved out along the axis by that overlap, where the cores touch, moved
-    /// back. PERF: a fifth of the shared engine's cost (96 against 468 ns a pair,
+    /// back. PERF: a quarter of the shared engine's cost (129 against 558 ns a pair,
     /// `narrow_phase` penetrating poses), which searches the features as well.
     fn overlapping(&self, pose_ab: &Isometry) -> Option<ShapeDistance> {
         let axis = self.best_axis();

@@ -345,9 +345,7 @@ impl Boxes {
         }
         Some((best.1, best.2))
     }
-}
 
-impl Boxes {
     /// Whether the boxes are apart along `on_b − on_a` by that pair's own distance (to
     /// [`BOUND_ULPS`] of the scale): then no pair of points is closer, since the distance is
     /// at least the separation along any axis, and `(on_a, on_b)` is the closest pair.
