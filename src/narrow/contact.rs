@@ -51,9 +51,8 @@ impl ShapeDistance {
 
 /// Bounds on the signed distance between two shapes from a test cheaper than the exact
 /// query (the separating axes; closest features only where they cost no more), A's frame:
-/// what a pair gets
-/// when there is no time for its exact answer, or all a query needs to know it is beyond
-/// its limit.
+/// what a pair gets when there is no time for its exact answer, or all a query needs to
+/// know it is beyond its limit.
 ///
 /// - `lower ≤ exact signed distance ≤ upper`, rounding included.
 /// - `normal` is the unit axis A→B that gave `lower`: the shapes' projections on it are
@@ -87,6 +86,12 @@ impl DistanceBound {
             point_a: point_b - normal * lower,
             point_b,
         }
+    }
+
+    /// An exact answer `d` as bounds, `slack` metres (its rounding) either side.
+    #[must_use]
+    pub fn exact(d: &ShapeDistance, slack: f64) -> Self {
+        Self::new(d.distance - slack, d.distance + slack, d.normal, d.point_b)
     }
 
     /// The same bounds seen from B (see [`ShapeDistance::flipped`]).

@@ -16,7 +16,7 @@ use crate::bounding::Aabb;
 use crate::broad::CandidatePair;
 use crate::bvh::frontier::FrontierAnswer;
 use crate::math::{DVec3, Pose, conservative_slack};
-use crate::narrow::contact::Manifold;
+use crate::narrow::contact::{Manifold, ShapeDistance};
 use crate::narrow::mesh_mesh::{
     DistanceCache, MeshMeshWorkspace, Proximity, contacts_mesh_mesh, intersects_mesh_mesh,
 };
@@ -75,32 +75,15 @@ pub(super) fn direct(
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     let pose_ab = Pose::relative(&a.pose, &b.pose);
-    // Without DISTANCE, nothing beyond the margins is reported (and touching is within
-    // them): the query may stop at that limit.
-    let limit = if query.distance {
-        f64::INFINITY
-    } else {
-        a.margin + b.margin
-    };
-    let d = dispatch::distance(sa, sb, &pose_ab, limit, scratch);
+    let d = dispatch::distance(sa, sb, &pose_ab, reporting_limit(query, a, b), scratch);
     let scale = d
         .point_a
         .abs()
         .max_element()
         .max(d.point_b.abs().max_element())
         + a.pose.position.abs().max_element();
-    let result = PairResult {
-        a: pair.a,
-        b: pair.b,
-        distance: d.distance,
-        error_bound: 1e-10 * d.distance.abs() + 64.0 * f64::EPSILON * scale,
-        point_a: a.pose.transform_point(d.point_a),
-        point_b: a.pose.transform_point(d.point_b),
-        normal: a.pose.transform_vector(d.normal),
-        exact: true,
-        first_contact: 0,
-        contact_count: 0,
-    };
+    let error_bound = 1e-10 * d.distance.abs() + 64.0 * f64::EPSILON * scale;
+    let result = in_world(pair, a, &d, error_bound, true);
     let touching = d.distance <= 0.0;
     if query.contacts && touching {
         dispatch::manifold(sa, sb, &pose_ab, &d, scratch, manifold);
@@ -120,6 +103,39 @@ pub(super) fn direct(
         result,
         touching,
         apart_by: None,
+    }
+}
+
+/// How far apart a pair's answer must be exact, metres: without `DISTANCE` nothing beyond
+/// the margins is reported (and touching is within them), so a query may stop there.
+fn reporting_limit(query: Query, a: &Body, b: &Body) -> f64 {
+    if query.distance {
+        f64::INFINITY
+    } else {
+        a.margin + b.margin
+    }
+}
+
+/// The record of `pair` from its answer `d` in A's frame, mapped to world frame by A's
+/// pose, with `error_bound` and whether it is `exact`.
+fn in_world(
+    pair: &CandidatePair,
+    a: &Body,
+    d: &ShapeDistance,
+    error_bound: f64,
+    exact: bool,
+) -> PairResult {
+    PairResult {
+        a: pair.a,
+        b: pair.b,
+        distance: d.distance,
+        error_bound,
+        point_a: a.pose.transform_point(d.point_a),
+        point_b: a.pose.transform_point(d.point_b),
+        normal: a.pose.transform_vector(d.normal),
+        exact,
+        first_contact: 0,
+        contact_count: 0,
     }
 }
 
@@ -480,37 +496,22 @@ pub(super) fn conservative(
     scratch: &mut NarrowScratch,
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
-    let pose_ab = Pose::relative(&a.pose, &b.pose);
-    // Without DISTANCE a pair beyond its margins is not reported: the axes may stop there.
-    let enough = if query.distance {
-        f64::INFINITY
-    } else {
-        a.margin + b.margin
-    };
-    let Some(bound) = dispatch::distance_bound(sa, sb, &pose_ab.to_isometry(), enough) else {
+    let pose_ab = Pose::relative(&a.pose, &b.pose).to_isometry();
+    let enough = reporting_limit(query, a, b);
+    let Some(bound) = dispatch::distance_bound(sa, sb, &pose_ab, enough) else {
         let grown = |body: &Body| body.world_bounds.grown(body.margin);
         return boxes(pair, &grown(a), &grown(b), query, contacts);
     };
     scratch.paths.separating_axes += 1;
-    let (point_a, point_b) = (
-        a.pose.transform_point(bound.point_a),
-        a.pose.transform_point(bound.point_b),
-    );
     let slack = conservative_slack(
         a.pose.position.abs().max_element() + b.pose.position.abs().max_element(),
     );
-    let result = PairResult {
-        a: pair.a,
-        b: pair.b,
+    let at_lower = ShapeDistance {
         distance: bound.lower - slack,
-        error_bound: bound.upper - bound.lower + 2.0 * slack,
-        point_a,
-        point_b,
-        normal: a.pose.transform_vector(bound.normal),
-        exact: false,
-        first_contact: 0,
-        contact_count: 0,
+        ..bound.at_lower()
     };
+    let error_bound = bound.upper - bound.lower + 2.0 * slack;
+    let result = in_world(pair, a, &at_lower, error_bound, false);
     let touching = result.distance <= 0.0;
     if query.contacts && touching {
         contacts.push(witness_contact(&result, result.distance));

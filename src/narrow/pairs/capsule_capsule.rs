@@ -38,7 +38,7 @@ pub fn distance_bound_capsule_capsule(
     // depth when the segments meet.
     let slack = query::BOUND_ULPS * f64::EPSILON * segments.scale
         + AXIS_RELATIVE * 2.0 * (a.half_height + b.half_height);
-    DistanceBound::new(d.distance - slack, d.distance + slack, d.normal, d.point_b)
+    DistanceBound::exact(&d, slack)
 }
 
 /// The two core segments in A's frame, with their radii.

@@ -6,8 +6,9 @@
 //! comes first, in closed form: it proves the cores apart in the common case (the shapes
 //! touch through the radius) and is then the answer. Cores that meet get their depth from
 //! the separating axes, exact for a solid box; the shared engine of [`super::query`] answers
-//! what is left (a flat box whose core meets the segment, cores touching to rounding). Manifold: up to 2 points (segment clipped against a box face), 1 for an edge
-//! or corner contact ([`super::clip`]).
+//! what is left (a flat box whose core meets the segment, cores touching to rounding).
+//! Manifold: up to 2 points (segment clipped against a box face), 1 for an edge or corner
+//! contact ([`super::clip`]).
 
 use super::core::{AXIS_RELATIVE, Core};
 use super::query::FEATURE_RELATIVE;
@@ -43,10 +44,7 @@ pub fn distance_capsule_cuboid(a: &Capsule, b: &Cuboid, pose_ab: &Isometry) -> S
 pub fn distance_bound_capsule_cuboid(a: &Capsule, b: &Cuboid, pose_ab: &Isometry) -> DistanceBound {
     let placed = InBox::new(a, b, pose_ab);
     match placed.apart(pose_ab) {
-        Some(d) => {
-            let slack = placed.slack();
-            DistanceBound::new(d.distance - slack, d.distance + slack, d.normal, d.point_b)
-        }
+        Some(d) => DistanceBound::exact(&d, placed.slack()),
         None => placed.bound_from_axes(pose_ab),
     }
 }
@@ -156,7 +154,8 @@ impl InBox {
     }
 
     /// The exact answer, A's frame, when the cores are apart by more than rounding; `None`
-    /// when they meet or nearly do (the shared engine then finds the depth and its normal).
+    /// when they meet or nearly do ([`Self::overlapping`] or the shared engine then finds
+    /// the depth and its normal).
     ///
     /// The squared distance from the segment's point `p(t) = p₀ + t·d` to the box is convex
     /// and differentiable in `t`, with slope `2 d · (p(t) − clamp(p(t)))`: continuous,
@@ -165,8 +164,7 @@ impl InBox {
     /// exactly by linear interpolation between the two crossing parameters around the sign
     /// change. PERF: no feature enumeration, no branches on the box's features.
     fn apart(&self, pose_ab: &Isometry) -> Option<ShapeDistance> {
-        let t = self.closest_parameter();
-        let on_segment = self.p0 + (self.p1 - self.p0) * t;
+        let on_segment = self.closest_point();
         let on_box = on_segment.clamp(-self.half, self.half);
         let gap = on_segment.distance(on_box);
         (gap > FEATURE_RELATIVE * self.scale()).then(|| {
@@ -197,8 +195,7 @@ impl InBox {
             p1: self.p1 + out,
             ..*self
         };
-        let t = touching.closest_parameter();
-        let on_touching = touching.p0 + (touching.p1 - touching.p0) * t;
+        let on_touching = touching.closest_point();
         let on_box = on_touching.clamp(-self.half, self.half);
         let normal = -axis.away;
         Some(ShapeDistance {
@@ -207,6 +204,11 @@ impl InBox {
             point_b: pose_ab.transform_point(on_box),
             normal: pose_ab.transform_vector(normal),
         })
+    }
+
+    /// A point of the segment closest to the box (see [`Self::apart`]), box frame.
+    fn closest_point(&self) -> DVec3 {
+        self.p0 + (self.p1 - self.p0) * self.closest_parameter()
     }
 
     /// The segment parameter in `[0, 1]` of a point closest to the box (see [`Self::apart`]).

@@ -45,7 +45,7 @@ pub(crate) fn distance_cuboid_cuboid_within(
     // Apart along any axis is enough to go to the closest pair; overlapping needs the best.
     let axis = boxes.best_axis_or_first_above(0.0);
     if axis.separation > limit {
-        return (boxes.bound(&axis, false).at_lower(), true);
+        return (boxes.bound(&axis).at_lower(), true);
     }
     (exact(&boxes, &axis, (a, b, pose_ab)), false)
 }
@@ -81,11 +81,9 @@ pub fn distance_bound_cuboid_cuboid(
     // within it, the exact distance is what another axis could add, and more.
     let axis = boxes.best_axis_or_first_above(0.0);
     if axis.separation > 0.0 && axis.separation <= enough {
-        let d = exact(&boxes, &axis, (a, b, pose_ab));
-        let slack = BOUND_ULPS * f64::EPSILON * boxes.scale;
-        return DistanceBound::new(d.distance - slack, d.distance + slack, d.normal, d.point_b);
+        return DistanceBound::exact(&exact(&boxes, &axis, (a, b, pose_ab)), boxes.slack());
     }
-    boxes.bound(&axis, axis.separation <= 0.0)
+    boxes.bound(&axis)
 }
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4
@@ -240,15 +238,23 @@ impl Boxes {
         best
     }
 
-    /// The shared engine's [`query::bound`] on half extents: A's corner farthest along the
-    /// axis and B's farthest against it are sign patterns, a closest point a clamp.
-    fn bound(&self, axis: &Axis, complete: bool) -> DistanceBound {
-        let slack = BOUND_ULPS * f64::EPSILON * self.scale;
+    /// The rounding allowance of a bound, metres.
+    fn slack(&self) -> f64 {
+        BOUND_ULPS * f64::EPSILON * self.scale
+    }
+
+    /// The bounds from `axis`, as [`Self::best_axis_or_first_above`] gives it: the best of
+    /// the 15 when the boxes overlap (the test then ran to the end), so the lower bound is
+    /// the depth and the upper one meets it; else an axis they are apart on, with an upper
+    /// bound from one step of alternating projection. A's corner farthest along the axis
+    /// and B's farthest against it are sign patterns, a closest point a clamp.
+    fn bound(&self, axis: &Axis) -> DistanceBound {
+        let slack = self.slack();
         let n = axis.normal;
         let lower = axis.separation - slack;
         let to_b = |p: DVec3| self.r.transpose() * (p - self.t);
         let from_b = |q: DVec3| self.t + self.r * q;
-        let upper = if complete && axis.separation <= 0.0 {
+        let upper = if axis.separation <= 0.0 {
             // The skipped near-parallel cross axes may change the depth by as much.
             let skipped = AXIS_RELATIVE * 2.0 * (self.ha.max_element() + self.hb.max_element());
             lower + 2.0 * slack + skipped
@@ -358,7 +364,7 @@ impl Boxes {
         let u = gap / length;
         let reach_b = (self.r.transpose() * u).abs().dot(self.hb);
         let separation = self.t.dot(u) - u.abs().dot(self.ha) - reach_b;
-        separation >= length - BOUND_ULPS * f64::EPSILON * self.scale
+        separation >= length - self.slack()
     }
 }
 
