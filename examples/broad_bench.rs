@@ -25,6 +25,11 @@
 //!
 //! Prints, per broad phase: mean and p99 µs per frame, pairs per frame, and the ratio of
 //! rapier's mean (the faster of its two settings) to this one's.
+//!
+//! Like `proximad`, the process allocates through [`HugePageAlloc`], so that large tables
+//! sit on transparent huge pages where the kernel allows; `--small-pages` turns that off.
+//!
+//! [`HugePageAlloc`]: proxima::huge_pages::HugePageAlloc
 
 // Shared with benches/broad_phase.rs, which uses the items this one does not.
 #[allow(dead_code)]
@@ -46,6 +51,11 @@ use proxima::bounding::Aabb;
 use proxima::broad::CandidatePair;
 use std::process::ExitCode;
 use std::time::Instant;
+
+/// Large tables on transparent huge pages, as in `proximad` (`--small-pages` turns the
+/// advice off).
+#[global_allocator]
+static ALLOC: proxima::huge_pages::HugePageAlloc = proxima::huge_pages::HugePageAlloc;
 
 #[derive(Parser, Debug)]
 #[command(about = "Broad-phase time per frame, Proxima against rapier/parry, same frames")]
@@ -82,6 +92,10 @@ struct Args {
     /// Seed of the layout and the motion.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Leave every table on the 4 KiB pages the system gives (no huge-page advice), to
+    /// measure what the advice buys.
+    #[arg(long)]
+    small_pages: bool,
 }
 
 /// One broad phase under test with its timings.
@@ -131,6 +145,7 @@ impl Runner {
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    proxima::huge_pages::set_advising(!args.small_pages);
     let (Some(layout), Some(motion)) = (
         Layout::from_name(&args.scene),
         Motion::from_name(&args.motion),

@@ -51,3 +51,6 @@ pub mod pipeline;
 
 // The daemon's service loop and wire conversion (the only user of `proxima-ipc`).
 pub mod daemon;
+
+// Outside the data flow: a global allocator for binaries with large scenes.
+pub mod huge_pages;

@@ -13,6 +13,10 @@ use std::error::Error;
 use std::path::PathBuf;
 use std::time::Duration;
 
+/// Large scenes' tables on transparent huge pages ([`proxima::huge_pages`]).
+#[global_allocator]
+static ALLOC: proxima::huge_pages::HugePageAlloc = proxima::huge_pages::HugePageAlloc;
+
 /// Proxima's collision co-processor: serves scenes over iceoryx2 shared memory.
 ///
 /// Settings come from the defaults, then `--config FILE` (TOML), then the flags given.
