@@ -31,7 +31,7 @@ pub enum Phase {
     Columns(ColumnGrid),
     /// Proxima's skin grid (the column grid over skin-grown boxes, with neighbour lists),
     /// a frame's moves handed over as one batch.
-    Skin(SkinGrid),
+    Skin(Box<SkinGrid>),
     /// rapier's broad phase on parry's BVH; `exact` for the 1 nm change margin.
     Parry { phase: ParryBroadPhase, exact: bool },
 }
@@ -50,7 +50,7 @@ impl Phase {
                 Self::Grid(g)
             }
             "column_grid" => Self::Columns(ColumnGrid::from_proxies(proxies)),
-            "skin_grid" => Self::Skin(SkinGrid::from_proxies(proxies)),
+            "skin_grid" => Self::Skin(Box::new(SkinGrid::from_proxies(proxies))),
             "parry_bvh" | "rapier_bvh" => {
                 let exact = name == "parry_bvh";
                 let margin = if exact {

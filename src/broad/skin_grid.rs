@@ -14,10 +14,10 @@
 //! - The grid holds each body's *fat box*: its box when last filed, grown on every side by
 //!   its *skin*. Its pairs (fat boxes overlapping) are the *skin neighbours*; each body
 //!   keeps the list of its own, each entry with whether the two true boxes overlap now.
-//! - A moved body whose box is still inside its fat box only re-tests its neighbours'
-//!   true boxes against its new one, and logs the pairs whose overlap changed. One that
-//!   left it is filed again under a new fat box (a column grid move, whose pair changes
-//!   add and remove neighbours), then re-tests its neighbours the same way.
+//! - A moved body whose box is still inside its fat box re-tests only the neighbours its
+//!   travel has made due (below, "Travel budgets"), and logs the pairs whose overlap
+//!   changed. One that left it is filed again under a new fat box (a column grid move,
+//!   whose pair changes add and remove neighbours), then re-tests all its neighbours.
 //! - The pairs reported are the neighbours whose true boxes overlap: exactly the pairs of
 //!   [`pairs_brute_force`](super::pairs_brute_force), since every true box lies inside its
 //!   fat box, so two overlapping true boxes have overlapping fat boxes.
@@ -37,14 +37,35 @@
 //! gained neighbours across the gap: 241 → 1,000–1,200 µs a frame at 10,000 dice all
 //! moving).
 //!
+//! # Travel budgets
+//! Two boxes keep their relation (overlapping or apart) while their corners move less, in
+//! total, than the pair's *room*: for overlapping boxes the least overlap of their
+//! intervals over the axes, for separate ones the widest gap on an axis. So each pair
+//! gives its room, as a budget, to one of its two bodies, the *holder*: its entry records
+//! the holder's *travel* (the running sum of the largest change of a
+//! corner coordinate per move) at which the budget runs out, and the other side's entry
+//! is always due. A move adds to the body's travel and re-tests only the entries it has
+//! made due; a re-test gives the whole room to the body re-testing, and writes the twin
+//! entry only when the overlap changed or the twin held the budget. A body moving among
+//! resting ones therefore reads its own record and, for the few pairs due, its
+//! neighbours' boxes, and nothing else of theirs; when both bodies move, the budget
+//! passes back and forth. Travel and budgets are `f32`, rounded towards re-testing, with
+//! a relative allowance (`BUDGET_ROUNDING`) for the roundings before.
+//!
+//! Measured (`examples/broad_bench`, 10 % moving, eight alternating runs of 100 frames,
+//! medians of the means): 100,000 uniform bodies 4.73 → 4.24 ms a frame (about 2.5
+//! neighbours listed per move, 0.7 due); 100,000 clustered 4.74 → 4.87 ms, within the
+//! drift; 10,000 uniform 199 → 197 µs. A budget of half the room on both sides, which
+//! re-tests write to both lists, measured no faster than re-testing every neighbour.
+//!
 //! # Costs (`d` neighbours a body has)
-//! - A move inside the skin: `O(d)` box tests, reading the body's record (fat box and the
-//!   first neighbours side by side) and its neighbours' boxes; in a batch of a large grid
-//!   those are prefetched a few moves ahead, in both passes (the first, which tells the
-//!   moves out of the skin, reads each record and writes each proxy; the second re-tests).
-//!   Measured (`examples/broad_bench`, 100,000 bodies, 10 % moving, six alternating runs,
-//!   medians): the first pass's prefetch took uniform from 5.17 to 4.12 ms a frame,
-//!   clustered from 6.31 to 5.19.
+//! - A move inside the skin: `O(d)` budget checks on the body's record (fat box and the
+//!   first neighbours side by side), and a box test for each pair due, reading the
+//!   neighbour's box; in a batch of a large grid the records are prefetched a few moves
+//!   ahead, and each re-test waits in a queue of `RETEST_AHEAD` while what it reads is
+//!   fetched. Measured before the budgets (`examples/broad_bench`, 100,000 bodies, 10 %
+//!   moving, six alternating runs, medians): the records' prefetch took uniform from 5.17
+//!   to 4.12 ms a frame, clustered from 6.31 to 5.19.
 //! - A move out of it: a column grid move (module docs of [`ColumnGrid`]) of the fat box,
 //!   plus constant work per neighbour gained or lost (each entry knows its twin).
 //! - Teleports leave the skin every time: the column grid alone is the better choice then.
@@ -55,6 +76,8 @@
 //! - The neighbour lists are symmetric, and hold exactly the pairs of overlapping fat
 //!   boxes that may pair, each once per side; an entry's overlap flag says whether the
 //!   true boxes overlap.
+//! - Of the two entries of a pair exactly one holds its budget, the other is always due,
+//!   and what the holder may still travel fits in the pair's room now.
 //! - The pair set is exactly the flagged neighbours: the brute-force pairs of the true
 //!   boxes.
 
@@ -64,7 +87,7 @@ use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds};
 use crate::bounding::{Aabb, BoundingVolume};
 use crate::math::splitmix64;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 
 /// Skin on every side of a box filed for the first time, as a fraction of its largest
 /// extent.
@@ -111,12 +134,18 @@ fn skin_factor(body: u32, batch: u32) -> f64 {
 /// A body's neighbour: another body whose fat box overlaps its own. Each pair is listed
 /// on both sides, each entry knowing where its twin is, so that a body with thousands of
 /// neighbours (a floor under a field of dice) updates or drops one in constant time.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Neighbour {
     /// The neighbour's slot.
     slot: u32,
     /// Where the twin entry is in the neighbour's list.
     twin: u32,
+    /// The owner's [`Record::travel`] from which the pair is due a re-test when the owner
+    /// moves (module docs, "Travel budgets"); `−∞` on the side that does not hold the
+    /// pair's budget: any move re-tests.
+    due_at: f32,
+    /// Whether this side holds the pair's budget (exactly one of the twins does).
+    holds: bool,
     /// Whether the two true boxes overlap (the pair is in the pair set).
     overlaps: bool,
 }
@@ -127,6 +156,10 @@ struct Record {
     fat: Aabb,
     /// The batch the box was last filed in.
     filed_at: u32,
+    /// How far the body's box has travelled (metres, rounded up): the sum over its moves of
+    /// the largest change of a corner coordinate. Set back to 0 now and then, its entries'
+    /// [`Neighbour::due_at`] with it (module docs, "Travel budgets").
+    travel: f32,
     list: Neighbours,
 }
 
@@ -138,6 +171,7 @@ impl Record {
         Self {
             fat: grown_within(bounds, FIRST_SKIN * extent, reach),
             filed_at: batch,
+            travel: 0.0,
             list: Neighbours::default(),
         }
     }
@@ -154,6 +188,18 @@ impl Record {
             (factor * SKIN_FRAMES * moved / batches).clamp(MIN_SKIN * extent, MAX_SKIN * extent);
         self.fat = grown_within(bounds, wanted, reach);
         self.filed_at = batch;
+        // Its neighbours are all re-tested after the refiling, which sets their budgets.
+        self.travel = 0.0;
+    }
+
+    /// Sets the travel back to 0, every entry's budget with it (rounded down).
+    fn rebase(&mut self) {
+        let travel = f64::from(self.travel);
+        for i in 0..self.list.len() {
+            let entry = &mut self.list[i];
+            entry.due_at = ((f64::from(entry.due_at) - travel) as f32).next_down();
+        }
+        self.travel = 0.0;
     }
 }
 
@@ -192,6 +238,15 @@ const PREFETCH_AHEAD: usize = 4;
 /// Fewest bodies for which a batch's retests prefetch (below, the records and boxes stay
 /// in the caches).
 const PREFETCH_FROM_BODIES: usize = 30_000;
+
+/// Re-tests a batch keeps waiting while what they read is fetched, in grids large enough
+/// to prefetch (module docs, "Costs").
+const RETEST_AHEAD: usize = 8;
+
+/// A body's travel is set back to 0 once it exceeds this many extents of its fat box, so
+/// that the `f32` travel and budgets keep their precision (a body jittering inside its
+/// skin forever).
+const REBASE_AFTER_EXTENTS: f32 = 1024.0;
 
 /// Entries a neighbour list holds in place before it spills to the heap.
 const INLINE: usize = 4;
@@ -232,6 +287,12 @@ impl Neighbours {
             self.spill.pop();
         }
         self.len -= 1;
+    }
+
+    /// Where entry `i` sits in memory, for a prefetch: found without reading the spill
+    /// list's header when in place; the record's start otherwise.
+    fn entry_address(&self, i: usize) -> *const Neighbour {
+        self.inline.as_ptr().wrapping_add(i.min(INLINE - 1))
     }
 
     fn iter(&self) -> impl Iterator<Item = &Neighbour> {
@@ -280,8 +341,10 @@ pub struct SkinGrid {
     /// Scratch: a batch's moves out of the skin, and the grid's pair edits.
     refiled: Vec<(u32, Aabb)>,
     edits: Vec<(CandidatePair, bool)>,
-    /// Scratch: the slots a batch moved.
-    moved: Vec<u32>,
+    /// Scratch: the slots a batch refiled.
+    refiled_slots: Vec<u32>,
+    /// Scratch: pair re-tests waiting while what they read is fetched, as `(slot, entry)`.
+    pending: VecDeque<(u32, u32)>,
     /// Batches of moves so far ([`update_all`](Self::update_all) calls), the clock the
     /// skins are sized by.
     batch: u32,
@@ -398,7 +461,7 @@ impl SkinGrid {
     /// None once the scratch buffers and the neighbour lists have grown to their peaks.
     pub fn update_all(&mut self, moves: &[(u32, Aabb)]) {
         self.refiled.clear();
-        self.moved.clear();
+        self.refiled_slots.clear();
         self.batch = self.batch.wrapping_add(1);
         let prefetching = self.bodies.len() >= PREFETCH_FROM_BODIES;
         for (k, &(body, bounds)) in moves.iter().enumerate() {
@@ -410,25 +473,33 @@ impl SkinGrid {
                 debug_assert!(false, "update of absent body {body}");
                 continue;
             };
-            self.bodies.proxies[slot].bounds = bounds;
-            self.moved.push(slot as u32);
+            let old = std::mem::replace(&mut self.bodies.proxies[slot].bounds, bounds);
             let record = &mut self.records[slot];
-            if !encloses(&record.fat, &bounds) {
+            record.travel = travelled(record.travel, &old, &bounds);
+            if encloses(&record.fat, &bounds) {
+                self.queue_due(slot, prefetching);
+            } else {
                 let reach = self.grid.level_reach(bounds.extents().max_element());
                 record.refile(&bounds, self.batch, reach, skin_factor(body, self.batch));
                 self.refiled.push((body, record.fat));
+                self.refiled_slots.push(slot as u32);
             }
         }
-        if !self.refiled.is_empty() {
-            self.grid.update_all(&self.refiled);
-            self.apply_grid_edits();
+        self.run_retests(0);
+        if self.refiled.is_empty() {
+            return;
         }
-        for k in 0..self.moved.len() {
-            if prefetching {
-                self.prefetch_retest(k);
+        self.grid.update_all(&self.refiled);
+        self.apply_grid_edits();
+        // A refiled body re-tests every neighbour: its list changed, and its travel
+        // started again from 0.
+        for k in 0..self.refiled_slots.len() {
+            let slot = self.refiled_slots[k] as usize;
+            for i in 0..self.records[slot].list.len() {
+                self.queue_retest(slot, i, prefetching);
             }
-            self.retest(self.moved[k] as usize);
         }
+        self.run_retests(0);
     }
 
     /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
@@ -483,11 +554,27 @@ impl SkinGrid {
                 ))?;
                 let other = &self.records[e.slot as usize].list;
                 let twin = (e.twin < other.len).then(|| other[e.twin as usize]);
-                if twin.is_none_or(|t| t.slot as usize != slot || t.overlaps != e.overlaps) {
+                if twin.is_none_or(|t| {
+                    t.slot as usize != slot || t.overlaps != e.overlaps || t.holds == e.holds
+                }) {
                     return Err(format!("{}–{}: the twin entry is wrong", p.body, q.body));
                 }
                 if e.overlaps != p.bounds.intersects(&q.bounds) {
                     return Err(format!("{}–{} overlap flag stale", p.body, q.body));
+                }
+                // What the two may still travel without a re-test must fit in the room
+                // the pair has now (module docs, "Travel budgets"); the side without the
+                // budget re-tests on any move.
+                let left = |entry: &Neighbour, owner: usize| {
+                    f64::from(entry.due_at) - f64::from(self.records[owner].travel)
+                };
+                let (_, room) = relation(&p.bounds, &q.bounds);
+                let both = left(e, slot) + left(&other[e.twin as usize], e.slot as usize);
+                if both > room * (1.0 + 1e-9) || (!e.holds && e.due_at != f32::NEG_INFINITY) {
+                    return Err(format!(
+                        "{}–{}: budgets of {both} m left, {room} m of room",
+                        p.body, q.body
+                    ));
                 }
                 *listed.entry(CandidatePair::of(p.body, q.body)).or_insert(0) += 1;
             }
@@ -513,18 +600,31 @@ impl SkinGrid {
                 continue;
             };
             if present {
-                let overlaps = self.bodies.proxies[a]
-                    .bounds
-                    .intersects(&self.bodies.proxies[b].bounds);
+                let (overlaps, room) = relation(
+                    &self.bodies.proxies[a].bounds,
+                    &self.bodies.proxies[b].bounds,
+                );
                 let (at_a, at_b) = (self.records[a].list.len(), self.records[b].list.len());
+                // The budget goes to a body refiled in this batch: the one that moves.
+                let a_holds = self.records[a].filed_at == self.batch
+                    || self.records[b].filed_at != self.batch;
+                let (due_a, due_b) = if a_holds {
+                    (due_at(self.records[a].travel, room), f32::NEG_INFINITY)
+                } else {
+                    (f32::NEG_INFINITY, due_at(self.records[b].travel, room))
+                };
                 self.records[a].list.push(Neighbour {
                     slot: b as u32,
                     twin: at_b as u32,
+                    due_at: due_a,
+                    holds: a_holds,
                     overlaps,
                 });
                 self.records[b].list.push(Neighbour {
                     slot: a as u32,
                     twin: at_a as u32,
+                    due_at: due_b,
+                    holds: !a_holds,
                     overlaps,
                 });
                 if overlaps {
@@ -560,48 +660,95 @@ impl SkinGrid {
     /// body's record (its fat box) and its proxy.
     fn prefetch_move(&self, moves: &[(u32, Aabb)], k: usize) {
         if let Some(slot) = moves.get(k).and_then(|&(body, _)| self.bodies.slot(body)) {
-            super::prefetch(&raw const self.records[slot]);
+            let record = (&raw const self.records[slot]).cast::<u8>();
+            for line in (0..size_of::<Record>())
+                .step_by(64)
+                .chain([size_of::<Record>() - 1])
+            {
+                super::prefetch(record.wrapping_add(line));
+            }
             super::prefetch(&raw const self.bodies.proxies[slot]);
         }
     }
 
-    /// Starts loading what the retests [`PREFETCH_AHEAD`] and twice that many moves after
-    /// the `k`-th of the batch read: the later one's record, the nearer one's neighbours'
-    /// boxes.
-    fn prefetch_retest(&self, k: usize) {
-        if let Some(&far) = self.moved.get(k + 2 * PREFETCH_AHEAD) {
-            super::prefetch(&raw const self.records[far as usize]);
+    /// Queues the re-test of every entry of `slot`'s list that its travel has made due
+    /// (module docs, "Travel budgets"), first setting its travel back to 0 if it has grown
+    /// past [`REBASE_AFTER_EXTENTS`] fat-box extents.
+    fn queue_due(&mut self, slot: usize, prefetching: bool) {
+        let record = &mut self.records[slot];
+        let extent = record.fat.extents().max_element() as f32;
+        if record.travel > REBASE_AFTER_EXTENTS * extent {
+            record.rebase();
         }
-        if let Some(&near) = self.moved.get(k + PREFETCH_AHEAD) {
-            for e in self.records[near as usize].list.iter() {
-                super::prefetch(&raw const self.bodies.proxies[e.slot as usize]);
+        let travel = record.travel;
+        for i in 0..record.list.len() {
+            if self.records[slot].list[i].due_at <= travel {
+                self.queue_retest(slot, i, prefetching);
             }
         }
     }
 
-    /// Re-tests slot `slot`'s true box against its neighbours' and logs every pair whose
-    /// overlap changed.
-    fn retest(&mut self, slot: usize) {
-        let p = self.bodies.proxies[slot];
-        for i in 0..self.records[slot].list.len() {
+    /// Queues the re-test of entry `i` of `slot`'s list, starting to fetch what it reads
+    /// (the neighbour's box and its twin entry) when `prefetching`, and runs the re-tests
+    /// queued [`RETEST_AHEAD`] re-tests before (all of them when not prefetching).
+    fn queue_retest(&mut self, slot: usize, i: usize, prefetching: bool) {
+        if prefetching {
             let Neighbour {
-                slot: other,
-                twin,
-                overlaps,
+                slot: other, twin, ..
             } = self.records[slot].list[i];
-            let q = &self.bodies.proxies[other as usize];
-            let now = p.bounds.intersects(&q.bounds);
-            if now == overlaps {
-                continue;
-            }
+            super::prefetch(&raw const self.bodies.proxies[other as usize]);
+            super::prefetch(
+                self.records[other as usize]
+                    .list
+                    .entry_address(twin as usize),
+            );
+        }
+        self.pending.push_back((slot as u32, i as u32));
+        self.run_retests(if prefetching { RETEST_AHEAD } else { 0 });
+    }
+
+    /// Runs the queued re-tests, oldest first, until at most `left` wait.
+    fn run_retests(&mut self, left: usize) {
+        while self.pending.len() > left {
+            let Some((slot, i)) = self.pending.pop_front() else {
+                break;
+            };
+            self.retest(slot as usize, i as usize);
+        }
+    }
+
+    /// Re-tests entry `i` of `slot`'s list against the two true boxes as they are now:
+    /// logs the pair if its overlap changed, and gives this side the pair's whole budget.
+    /// The twin entry is written only when the overlap changed or it held the budget, so a
+    /// body moving among resting ones reads its neighbours' boxes and nothing more of
+    /// theirs.
+    fn retest(&mut self, slot: usize, i: usize) {
+        let Neighbour {
+            slot: other,
+            twin,
+            holds,
+            overlaps,
+            ..
+        } = self.records[slot].list[i];
+        let (p, q) = (
+            &self.bodies.proxies[slot],
+            &self.bodies.proxies[other as usize],
+        );
+        let (now, room) = relation(&p.bounds, &q.bounds);
+        if now != overlaps {
             let pair = CandidatePair::of(p.body, q.body);
-            self.records[slot].list[i].overlaps = now;
-            self.records[other as usize].list[twin as usize].overlaps = now;
             if now {
                 self.pairs.insert(pair);
             } else {
                 self.pairs.remove(pair);
             }
+        }
+        let due = due_at(self.records[slot].travel, room);
+        let entry = &mut self.records[slot].list[i];
+        (entry.overlaps, entry.due_at, entry.holds) = (now, due, true);
+        if now != overlaps || !holds {
+            let entry = &mut self.records[other as usize].list[twin as usize];
+            (entry.overlaps, entry.due_at, entry.holds) = (now, f32::NEG_INFINITY, false);
         }
     }
 
@@ -623,6 +770,42 @@ impl SkinGrid {
 /// Whether `outer` holds all of `inner` (closed boxes): both of its corners.
 fn encloses(outer: &Aabb, inner: &Aabb) -> bool {
     outer.contains_point(inner.min) && outer.contains_point(inner.max)
+}
+
+/// Relative allowance for rounding in the travel budgets: far more than the few roundings
+/// of a coordinate difference, a sum and a conversion to `f32` (module docs, "Travel
+/// budgets").
+const BUDGET_ROUNDING: f64 = 1e-6;
+
+/// Whether boxes `a` and `b` overlap (touching counts, as [`Aabb::intersects`]), and their
+/// *room* (metres, `≥ 0`): how far their corner coordinates may move in total, the two
+/// together, before that can change. For overlapping boxes, the least overlap of their
+/// intervals over the three axes (moving that far keeps them touching); for separate
+/// ones, the widest gap between them on an axis (they stay apart while they move less).
+fn relation(a: &Aabb, b: &Aabb) -> (bool, f64) {
+    // Per axis, ≥ 0 exactly when the intervals meet (a difference of doubles is exact in
+    // sign); its magnitude is the overlap or the gap.
+    let slack = (b.max - a.min).min(a.max - b.min).min_element();
+    debug_assert_eq!(slack >= 0.0, a.intersects(b));
+    (slack >= 0.0, slack.abs())
+}
+
+/// The [`Neighbour::due_at`] of the entry holding a pair's budget, its owner having
+/// travelled `travel` when the pair is tested with room `room`: the room ahead, rounded
+/// down (module docs, "Travel budgets"). With no room it is below `travel`: any move
+/// re-tests.
+fn due_at(travel: f32, room: f64) -> f32 {
+    ((f64::from(travel) + room * (1.0 - BUDGET_ROUNDING)) as f32).next_down()
+}
+
+/// A body's [`Record::travel`] after its box moved from `old` to `new`: `travel` plus the
+/// largest change of a corner coordinate, rounded up.
+fn travelled(travel: f32, old: &Aabb, new: &Aabb) -> f32 {
+    let step = (new.min - old.min)
+        .abs()
+        .max((new.max - old.max).abs())
+        .max_element();
+    ((f64::from(travel) + step * (1.0 + BUDGET_ROUNDING)) as f32).next_up()
 }
 
 #[cfg(test)]
@@ -653,6 +836,44 @@ mod tests {
             })),
         };
         Aabb::new(c - h, c + h)
+    }
+
+    /// A body stepping away from a resting neighbour and back into it: its entry is
+    /// re-tested only when its travel has spent the pair's room (some steps skip the test,
+    /// some do it), and the pair is reported exactly while the boxes overlap (validated
+    /// against brute force every step).
+    #[test]
+    fn a_moving_body_retests_a_resting_neighbour_only_when_its_budget_runs_out() {
+        let unit = Aabb::new(DVec3::ZERO, DVec3::ONE);
+        let at = |x: f64| Aabb::new(unit.min + DVec3::X * x, unit.max + DVec3::X * x);
+        let mut skin = SkinGrid::new();
+        skin.insert(1, at(0.0), false, CollisionFilter::ALL);
+        skin.insert(2, at(1.05), true, CollisionFilter::ALL);
+        let (mut skipped, mut retested, mut reported) = (0, 0, 0);
+        let path = (0..=8)
+            .chain((-2..=14).rev())
+            .map(|k| 0.04 - 0.01 * f64::from(k));
+        for x in path {
+            let slot = skin.bodies.slot(1).expect("present");
+            let before = skin.records[slot].list.iter().next().map(|e| e.due_at);
+            skin.update(1, at(x));
+            skin.validate().expect("valid");
+            let after = skin.records[slot].list.iter().next().map(|e| e.due_at);
+            match (before, after) {
+                (Some(b), Some(a)) if a == b => skipped += 1,
+                (Some(_), Some(_)) => retested += 1,
+                _ => {}
+            }
+            let mut pairs = Vec::new();
+            skin.pairs(&mut pairs);
+            assert_eq!(!pairs.is_empty(), at(x).intersects(&at(1.05)), "at x = {x}");
+            reported += usize::from(!pairs.is_empty());
+        }
+        assert!(
+            skipped > 3 && retested > 3,
+            "{skipped} skipped, {retested} re-tested"
+        );
+        assert!(reported > 0, "the boxes never met");
     }
 
     /// A skin asked to fill (or overfill) its room gives a fat box no wider than the reach,
