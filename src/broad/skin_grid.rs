@@ -23,19 +23,30 @@
 //!   fat box, so two overlapping true boxes have overlapping fat boxes.
 //!
 //! # The skin
-//! A thick skin means few refilings but more neighbours to re-test; the right thickness
-//! depends on how fast the body moves, so each refiling sizes it anew: enough for
-//! [`SKIN_FRAMES`] batches at the speed the body's centre moved since it was last filed,
-//! at least [`MIN_SKIN`] and at most [`MAX_SKIN`] of its largest extent, and never so much
-//! that the fat box outgrows the reach of the grid level the true box belongs at (a
-//! bigger box would be filed one level up, where every query of the level below meets
-//! it). A body filed for the first time gets [`FIRST_SKIN`] of its extent, within the same
-//! level room. Each refiled skin is divided by a number between 0.5 and 1.5 drawn from the
-//! body's id and the batch ([`SKIN_SPREAD`]), so that bodies which start moving together
-//! do not keep leaving their skins in the same frames. First skins are not spread: a
-//! thicker one would bridge gaps a resting body never crosses (stacked dice 0.23 m apart
-//! gained neighbours across the gap: 241 → 1,000–1,200 µs a frame at 10,000 dice all
-//! moving).
+//! A thick skin means few refilings but more neighbours; a skin where the body is not
+//! going is wasted. So each refiling sizes the skin anew, per axis and side, from the
+//! velocity of the body's centre since it was last filed: *ahead* of the motion along an
+//! axis, as far as that velocity goes in [`SKIN_FRAMES`] batches plus the skin behind, at
+//! least [`MIN_SKIN`] of its largest extent; *behind* it, and on an axis it does not move
+//! along, [`BACK_SKIN`]; the two together at most twice [`MAX_SKIN`]. Never so much that
+//! the fat box outgrows the reach of the grid level the true box belongs at (a bigger box
+//! would be filed one level up, where every query of the level below meets it): an axis
+//! without the room shares it in proportion. A body filed for the first time gets
+//! [`FIRST_SKIN`] of its extent on every side, within the same level room. Each refiling's
+//! [`SKIN_FRAMES`] is divided by a number between 0.5 and 1.5 drawn from the body's id and
+//! the batch ([`SKIN_SPREAD`]), so that bodies which start moving together do not keep
+//! leaving their skins in the same frames. First skins are not spread: a thicker one
+//! would bridge gaps a resting body never crosses (stacked dice 0.23 m apart gained
+//! neighbours across the gap: 241 → 1,000–1,200 µs a frame at 10,000 dice all moving).
+//!
+//! Measured against a skin of the same thickness on every side (`max(MIN_SKIN,
+//! SKIN_FRAMES` × the largest speed along an axis`)`, at most `MAX_SKIN`), with
+//! `examples/broad_bench`, 10 % moving, five alternating runs, medians of the means:
+//! 100,000 uniform bodies 4.86 → 3.45 ms a frame, clustered 6.27 → 5.13, stacked dice
+//! 1.10 → 1.19 (within the drift; they turn back every few frames); 10,000 uniform 196 →
+//! 169 µs. Growing `MIN_SKIN` on every side as well, and the motion's reach on top of it
+//! ahead, measured 3.92 ms uniform and 1.36 ms stacked in the same runs: wider boxes
+//! bridge more gaps.
 //!
 //! # Travel budgets
 //! Two boxes keep their relation (overlapping or apart) while their corners move less, in
@@ -86,29 +97,33 @@ use super::column_grid::ColumnGrid;
 use super::pair_set::PairSet;
 use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds};
 use crate::bounding::{Aabb, BoundingVolume};
-use crate::math::splitmix64;
+use crate::math::{DVec3, splitmix64};
 use std::collections::{BTreeMap, VecDeque};
 
 /// Skin on every side of a box filed for the first time, as a fraction of its largest
 /// extent.
 pub const FIRST_SKIN: f64 = 0.1;
-/// Frames a refiled box's skin is sized to last, at the speed the body moved since it was
-/// last filed.
+/// Frames a refiled box's skin reaches ahead of its motion, at the velocity the body
+/// moved at since it was last filed (module docs, "The skin").
 pub const SKIN_FRAMES: f64 = 8.0;
-/// Smallest and largest skin of a refiled box, as fractions of its largest extent.
+/// Smallest skin ahead of a refiled box's motion, as a fraction of its largest extent.
 ///
-/// The smallest is the first filing's: a slow body is better served by a skin many
-/// frames thick, as a refiling (a column-grid query over the fat box) costs as much as
-/// re-testing dozens of neighbours. Measured (`examples/broad_bench`, 10,000 bodies all
-/// moving at a sixth of the bench speed, 5 mm a frame, medians of three alternating runs):
-/// 0.02 → 0.1 took the uniform layout from 904 to 778 µs a frame and the clustered one
-/// from 1,357 to 958; 0.2 was slower again (804 uniform); the 10 %-moving classes at
-/// full speed, whose skins are above either floor, alike.
+/// A slow body is better served by a skin many frames thick, as a refiling (a column-grid
+/// query over the fat box) costs as much as re-testing dozens of neighbours. Measured
+/// with symmetric skins (`examples/broad_bench`, 10,000 bodies all moving at a sixth of
+/// the bench speed, 5 mm a frame, medians of three alternating runs): 0.02 → 0.1 took the
+/// uniform layout from 904 to 778 µs a frame and the clustered one from 1,357 to 958; 0.2
+/// was slower again (804 uniform). With skins ahead of the motion, 0.05 measured the same
+/// as 0.1 (100,000 uniform bodies, 10 % moving, five alternating runs).
 pub const MIN_SKIN: f64 = 0.1;
-/// See [`MIN_SKIN`].
+/// Skin behind a refiled box's motion, and on the axes it does not move along, as a
+/// fraction of its largest extent: room to turn back or drift sideways.
+pub const BACK_SKIN: f64 = 0.05;
+/// Largest growth of a refiled box along an axis, as a fraction of its largest extent on
+/// either side: its skin behind and ahead together are at most twice this.
 pub const MAX_SKIN: f64 = 0.5;
-/// Width of the spread of skin thicknesses: each refiled skin is divided by a number drawn
-/// uniformly from `[1 − SKIN_SPREAD / 2, 1 + SKIN_SPREAD / 2)`
+/// Width of the spread of skin thicknesses: each refiling's [`SKIN_FRAMES`] is divided by
+/// a number drawn uniformly from `[1 − SKIN_SPREAD / 2, 1 + SKIN_SPREAD / 2)`
 /// by a hash of the body's id and the batch (module docs, "The skin"). Dividing, not
 /// multiplying: a body leaves its skin at a rate inversely proportional to its thickness,
 /// so the mean rate of refilings stays what [`SKIN_FRAMES`] asks for.
@@ -156,6 +171,8 @@ struct Record {
     fat: Aabb,
     /// The batch the box was last filed in.
     filed_at: u32,
+    /// The centre of the true box when last filed (metres).
+    filed_centre: DVec3,
     /// How far the body's box has travelled (metres, rounded up): the sum over its moves of
     /// the largest change of a corner coordinate. Set back to 0 now and then, its entries'
     /// [`Neighbour::due_at`] with it (module docs, "Travel budgets").
@@ -167,27 +184,35 @@ impl Record {
     /// A body filed for the first time with box `bounds`, in batch `batch`, in a grid whose
     /// level for it reaches `reach` metres (module docs, "The skin").
     fn first(bounds: &Aabb, batch: u32, reach: f64) -> Self {
-        let extent = bounds.extents().max_element();
+        let skin = DVec3::splat(FIRST_SKIN * bounds.extents().max_element());
         Self {
-            fat: grown_within(bounds, FIRST_SKIN * extent, reach),
+            fat: grown_within(bounds, skin, skin, reach),
             filed_at: batch,
+            filed_centre: bounds.center(),
             travel: 0.0,
             list: Neighbours::default(),
         }
     }
 
-    /// Files the body again with box `bounds` in batch `batch`: the skin sized to last
-    /// `factor` × [`SKIN_FRAMES`] batches at the speed its centre moved since the last
-    /// filing, within [`MIN_SKIN`] and [`MAX_SKIN`] of its largest extent and the room
-    /// below `reach` (module docs, "The skin").
+    /// Files the body again with box `bounds` in batch `batch`: the skin reaches ahead of
+    /// the body's motion as far as it would go in `factor` × [`SKIN_FRAMES`] batches at the
+    /// velocity of its centre since the last filing, within the room below `reach`
+    /// (module docs, "The skin").
     fn refile(&mut self, bounds: &Aabb, batch: u32, reach: f64, factor: f64) {
-        let moved = (bounds.center() - self.fat.center()).abs().max_element();
+        let centre = bounds.center();
         let batches = f64::from(batch.wrapping_sub(self.filed_at).max(1));
+        let ahead = (centre - self.filed_centre) * (factor * SKIN_FRAMES / batches);
         let extent = bounds.extents().max_element();
-        let wanted =
-            (factor * SKIN_FRAMES * moved / batches).clamp(MIN_SKIN * extent, MAX_SKIN * extent);
-        self.fat = grown_within(bounds, wanted, reach);
+        let back = BACK_SKIN * extent;
+        let front = (DVec3::splat(back) + ahead.abs()).clamp(
+            DVec3::splat(MIN_SKIN * extent),
+            DVec3::splat(2.0 * MAX_SKIN * extent - back),
+        );
+        let below = DVec3::select(ahead.cmplt(DVec3::ZERO), front, DVec3::splat(back));
+        let above = DVec3::select(ahead.cmpgt(DVec3::ZERO), front, DVec3::splat(back));
+        self.fat = grown_within(bounds, below, above, reach);
         self.filed_at = batch;
+        self.filed_centre = centre;
         // Its neighbours are all re-tested after the refiling, which sets their budgets.
         self.travel = 0.0;
     }
@@ -203,32 +228,40 @@ impl Record {
     }
 }
 
-/// `bounds` grown by `skin`, the skin cut to what keeps the grown box's largest extent,
-/// as computed, within `reach` (at least that of `bounds`).
+/// `bounds` grown by `below` under its low corner and `above` over its high one (per
+/// axis, metres, `≥ 0`), the growth cut to what keeps each axis's extent of the grown box,
+/// as computed, within `reach` (at least that of `bounds`): an axis with too little room
+/// is grown in proportion on its two sides.
 ///
-/// The cut to half the room is not enough on its own: the grown box's corners and its
-/// extent are rounded, and a box whose skin fills its room exactly came out a few ulps wider
-/// than `reach`. The column grid then filed it one level up, where every query of its own
-/// level meets it: measured (`examples/broad_bench`, 100,000 uniform bodies, 10 % moving),
-/// 580 bodies had leaked to a level of 4 columns after 50 frames, and a refiling met 54
-/// candidates instead of 21. So the extent is checked as the grid computes it, and the
-/// skin cut by the excess until it fits (once, in practice; no skin at all fits, as
+/// The cut to the room is not enough on its own: the grown box's corners and its extent
+/// are rounded, and a box whose skin fills its room exactly came out a few ulps wider than
+/// `reach`. The column grid then filed it one level up, where every query of its own level
+/// meets it: measured (`examples/broad_bench`, 100,000 uniform bodies, 10 % moving), 580
+/// bodies had leaked to a level of 4 columns after 50 frames, and a refiling met 54
+/// candidates instead of 21. So the extents are checked as the grid computes them, and the
+/// growth cut by the excess until it fits (once, in practice; no growth at all fits, as
 /// `bounds` does).
-fn grown_within(bounds: &Aabb, skin: f64, reach: f64) -> Aabb {
+fn grown_within(bounds: &Aabb, below: DVec3, above: DVec3, reach: f64) -> Aabb {
     debug_assert!(bounds.extents().max_element() <= reach);
-    let mut skin = skin.min(0.5 * (reach - bounds.extents().max_element()));
+    let room = DVec3::splat(reach) - bounds.extents();
+    let total = below + above;
+    let share = DVec3::select(total.cmpgt(room), room / total, DVec3::ONE);
+    let (mut below, mut above) = (below * share, above * share);
     // A cut smaller than the corners' rounding may change nothing: cut at least that.
-    let magnitude = bounds.min.abs().max(bounds.max.abs()).max_element() + skin;
+    let magnitude = bounds.min.abs().max(bounds.max.abs()).max_element() + total.max_element();
     for _ in 0..4 {
-        if skin <= 0.0 {
-            break;
-        }
-        let fat = bounds.grown(skin);
-        let excess = fat.extents().max_element() - reach;
-        if excess <= 0.0 {
+        let fat = Aabb::new(bounds.min - below, bounds.max + above);
+        let excess = fat.extents() - DVec3::splat(reach);
+        if excess.cmple(DVec3::ZERO).all() {
             return fat;
         }
-        skin -= excess.max(4.0 * f64::EPSILON * magnitude);
+        let cut = DVec3::select(
+            excess.cmpgt(DVec3::ZERO),
+            excess.max(DVec3::splat(4.0 * f64::EPSILON * magnitude)),
+            DVec3::ZERO,
+        );
+        below = (below - cut).max(DVec3::ZERO);
+        above = (above - cut).max(DVec3::ZERO);
     }
     *bounds
 }
@@ -893,7 +926,7 @@ mod tests {
             let reach = extent * rng.random_range(1.0..2.0);
             let room = 0.5 * (reach - extent);
             let skin = room * rng.random_range(0.9..1.5);
-            let fat = grown_within(&bounds, skin, reach);
+            let fat = grown_within(&bounds, DVec3::splat(skin), DVec3::splat(skin), reach);
             assert!(fat.extents().max_element() <= reach, "case {case}");
             assert!(encloses(&fat, &bounds), "case {case}");
             let wanted = skin.min(room);
@@ -1076,34 +1109,51 @@ mod tests {
         assert!(bins.iter().all(|&n| (450..750).contains(&n)), "{bins:?}");
     }
 
-    /// A refiled skin lasts the asked number of batches at the body's speed, within its
-    /// bounds, and a fat box never outgrows the reach of its true box's level.
+    /// A refiled skin reaches ahead of the body's motion as far as it moved in the asked
+    /// number of batches, plus the skin behind, at least the smallest skin ahead and at
+    /// most the largest growth, with the skin behind on the other side and on the axes it
+    /// does not move along; within the room of its true box's level (shared in proportion
+    /// on an axis without enough). The fat box encloses the box and never outgrows the
+    /// reach.
     #[test]
-    fn a_refiled_skin_follows_the_speed_within_its_bounds_and_the_level_room() {
+    fn a_refiled_skin_reaches_ahead_of_the_motion_within_its_bounds_and_the_level_room() {
         let unit = Aabb::new(DVec3::ZERO, DVec3::ONE);
         let moved = |d: f64| Aabb::new(unit.min + DVec3::X * d, unit.max + DVec3::X * d);
-        for (step, batches, reach, skin) in [
-            // 2 cm a batch for 4 batches: 8 batches' worth.
-            (0.08, 4, f64::INFINITY, 0.16),
-            // Barely moving: the smallest skin; racing: the largest.
-            (1e-6, 1, f64::INFINITY, MIN_SKIN),
-            (10.0, 1, f64::INFINITY, MAX_SKIN),
-            // The level reaches 1.1 m: 5 cm of room on each side.
-            (0.04, 4, 1.1, 0.05),
+        let back = BACK_SKIN;
+        let fit = 0.1 / (back + 0.08 + back); // the share that fits in 0.1 m of room
+        // (step along x, batches, reach) → (below on x, above on x, each side on y and z).
+        for ((step, batches, reach), (below, above, side)) in [
+            // 2 cm a batch: 8 batches' worth, 16 cm, ahead; backwards, behind.
+            ((0.08, 4, f64::INFINITY), (back, back + 0.16, back)),
+            ((-0.08, 4, f64::INFINITY), (back + 0.16, back, back)),
+            // Barely moving: the smallest skin ahead; racing: the largest growth.
+            ((1e-6, 1, f64::INFINITY), (back, MIN_SKIN, back)),
+            (
+                (10.0, 1, f64::INFINITY),
+                (back, 2.0 * MAX_SKIN - back, back),
+            ),
+            // The level reaches 1.1 m: 10 cm of room on each axis.
+            ((0.04, 4, 1.1), (back * fit, (back + 0.08) * fit, back)),
             // No room at all.
-            (0.04, 4, 1.0, 0.0),
+            ((0.04, 4, 1.0), (0.0, 0.0, 0.0)),
         ] {
             let mut r = Record::first(&unit, 0, f64::INFINITY);
             assert_eq!(r.fat, unit.grown(FIRST_SKIN));
             let now = moved(step);
             r.refile(&now, batches, reach, 1.0);
-            let got = (r.fat.extents().x - now.extents().x) / 2.0;
-            assert!(
-                (got - skin).abs() < 1e-12,
-                "{step} {batches} {reach}: {got}"
-            );
+            let got_below = now.min - r.fat.min;
+            let got_above = r.fat.max - now.max;
+            let expected = [below, above, side, side, side, side];
+            let got = [got_below.x, got_above.x, got_below.y, got_above.y];
+            let got = got.into_iter().chain([got_below.z, got_above.z]);
+            for (g, e) in got.zip(expected) {
+                assert!(
+                    (g - e).abs() < 1e-12,
+                    "{step} {batches} {reach}: {g} for {e}"
+                );
+            }
             assert!(encloses(&r.fat, &now));
-            assert!(r.fat.extents().max_element() <= reach + 1e-12);
+            assert!(r.fat.extents().max_element() <= reach);
         }
         let cramped = Record::first(&unit, 0, 1.04);
         assert!((cramped.fat.extents().x - 1.04).abs() < 1e-12);
