@@ -52,22 +52,32 @@
 //! Two boxes keep their relation (overlapping or apart) while their corners move less, in
 //! total, than the pair's *room*: for overlapping boxes the least overlap of their
 //! intervals over the axes, for separate ones the widest gap on an axis. So each pair
-//! gives its room, as a budget, to one of its two bodies, the *holder*: its entry records
-//! the holder's *travel* (the running sum of the largest change of a
-//! corner coordinate per move) at which the budget runs out, and the other side's entry
-//! is always due. A move adds to the body's travel and re-tests only the entries it has
-//! made due; a re-test gives the whole room to the body re-testing, and writes the twin
-//! entry only when the overlap changed or the twin held the budget. A body moving among
-//! resting ones therefore reads its own record and, for the few pairs due, its
-//! neighbours' boxes, and nothing else of theirs; when both bodies move, the budget
-//! passes back and forth. Travel and budgets are `f32`, rounded towards re-testing, with
-//! a relative allowance (`BUDGET_ROUNDING`) for the roundings before.
+//! shares its room, as a budget, between its two bodies: each entry records the *travel*
+//! of its owner (the running sum of the largest change of a corner coordinate per move) at
+//! which its share runs out. A move adds to the body's travel and re-tests only the
+//! entries it has made due. The shares follow who moves:
+//! - a pair whose bodies rest but for one gives it the *whole* room, and the resting side
+//!   is always due: a re-test by the mover renews its own entry only, and writes the twin
+//!   only when the overlap changed. A body moving among resting ones therefore reads its
+//!   own record and, for the few pairs due, its neighbours' boxes, and nothing else of
+//!   theirs;
+//! - when the other side moves (it is always due), its re-test splits the room, *half*
+//!   each, writing both entries; so does every re-test of a pair split so.
 //!
-//! Measured (`examples/broad_bench`, 10 % moving, eight alternating runs of 100 frames,
-//! medians of the means): 100,000 uniform bodies 4.73 → 4.24 ms a frame (about 2.5
-//! neighbours listed per move, 0.7 due); 100,000 clustered 4.74 → 4.87 ms, within the
-//! drift; 10,000 uniform 199 → 197 µs. A budget of half the room on both sides, which
-//! re-tests write to both lists, measured no faster than re-testing every neighbour.
+//! A new pair gives the whole room to a body refiled in the batch (the mover). Travel and
+//! budgets are `f32`, rounded towards re-testing, with a relative allowance
+//! (`BUDGET_ROUNDING`) for the roundings before.
+//!
+//! Measured (`examples/broad_bench`, alternating runs of 100 frames, medians of the
+//! means), against re-testing every neighbour on every move: 100,000 uniform bodies, 10 %
+//! moving, 4.73 → 4.24 ms a frame (eight runs; about 2.5 neighbours listed per move, 0.7
+//! due); clustered 4.74 → 4.87 ms, within the drift; 10,000 uniform bodies all moving at a
+//! sixth of the speed, 696 → 497 µs, and at full speed 2,052 → 1,732 (three runs each,
+//! with the skins of "The skin" in both). Without the halves (the whole room to the latest
+//! re-tester, the other side always due) the all-moving rows measured 956 and 2,093: both
+//! sides re-tested every pair every move, writing the twin each time. Halves on both sides
+//! for every pair measured no faster than re-testing every neighbour, as every re-test
+//! writes both lists.
 //!
 //! # Costs (`d` neighbours a body has)
 //! - A move inside the skin: `O(d)` budget checks on the body's record (fat box and the
@@ -87,8 +97,8 @@
 //! - The neighbour lists are symmetric, and hold exactly the pairs of overlapping fat
 //!   boxes that may pair, each once per side; an entry's overlap flag says whether the
 //!   true boxes overlap.
-//! - Of the two entries of a pair exactly one holds its budget, the other is always due,
-//!   and what the holder may still travel fits in the pair's room now.
+//! - The two entries of a pair share its budget as whole and none (the latter always
+//!   due) or half each, and what the two may still travel fits in the pair's room now.
 //! - The pair set is exactly the flagged neighbours: the brute-force pairs of the true
 //!   boxes.
 
@@ -159,10 +169,43 @@ struct Neighbour {
     /// moves (module docs, "Travel budgets"); `−∞` on the side that does not hold the
     /// pair's budget: any move re-tests.
     due_at: f32,
-    /// Whether this side holds the pair's budget (exactly one of the twins does).
-    holds: bool,
+    /// This side's share of the pair's budget: the twins hold `Whole` and `None`, or
+    /// `Half` each.
+    share: Share,
     /// Whether the two true boxes overlap (the pair is in the pair set).
     overlaps: bool,
+}
+
+/// A side's share of a pair's budget (module docs, "Travel budgets").
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+enum Share {
+    /// Always due: the twin holds the whole budget.
+    #[default]
+    None,
+    /// Half the room; the twin holds the other half.
+    Half,
+    /// The whole room; the twin is always due.
+    Whole,
+}
+
+impl Share {
+    /// The twin's share.
+    fn twin(self) -> Self {
+        match self {
+            Self::None => Self::Whole,
+            Self::Half => Self::Half,
+            Self::Whole => Self::None,
+        }
+    }
+
+    /// The fraction of the room this share lets its side travel.
+    fn fraction(self) -> f64 {
+        match self {
+            Self::None => 0.0,
+            Self::Half => 0.5,
+            Self::Whole => 1.0,
+        }
+    }
 }
 
 /// What a body keeps besides its true box: its fat box and its neighbours.
@@ -588,7 +631,7 @@ impl SkinGrid {
                 let other = &self.records[e.slot as usize].list;
                 let twin = (e.twin < other.len).then(|| other[e.twin as usize]);
                 if twin.is_none_or(|t| {
-                    t.slot as usize != slot || t.overlaps != e.overlaps || t.holds == e.holds
+                    t.slot as usize != slot || t.overlaps != e.overlaps || t.share != e.share.twin()
                 }) {
                     return Err(format!("{}–{}: the twin entry is wrong", p.body, q.body));
                 }
@@ -603,7 +646,9 @@ impl SkinGrid {
                 };
                 let (_, room) = relation(&p.bounds, &q.bounds);
                 let both = left(e, slot) + left(&other[e.twin as usize], e.slot as usize);
-                if both > room * (1.0 + 1e-9) || (!e.holds && e.due_at != f32::NEG_INFINITY) {
+                if both > room * (1.0 + 1e-9)
+                    || (e.share == Share::None && e.due_at != f32::NEG_INFINITY)
+                {
                     return Err(format!(
                         "{}–{}: budgets of {both} m left, {room} m of room",
                         p.body, q.body
@@ -641,23 +686,23 @@ impl SkinGrid {
                 // The budget goes to a body refiled in this batch: the one that moves.
                 let a_holds = self.records[a].filed_at == self.batch
                     || self.records[b].filed_at != self.batch;
-                let (due_a, due_b) = if a_holds {
-                    (due_at(self.records[a].travel, room), f32::NEG_INFINITY)
-                } else {
-                    (f32::NEG_INFINITY, due_at(self.records[b].travel, room))
-                };
+                let share_a = if a_holds { Share::Whole } else { Share::None };
+                let (due_a, due_b) = (
+                    due_at(self.records[a].travel, room, share_a),
+                    due_at(self.records[b].travel, room, share_a.twin()),
+                );
                 self.records[a].list.push(Neighbour {
                     slot: b as u32,
                     twin: at_b as u32,
                     due_at: due_a,
-                    holds: a_holds,
+                    share: share_a,
                     overlaps,
                 });
                 self.records[b].list.push(Neighbour {
                     slot: a as u32,
                     twin: at_a as u32,
                     due_at: due_b,
-                    holds: !a_holds,
+                    share: share_a.twin(),
                     overlaps,
                 });
                 if overlaps {
@@ -750,16 +795,16 @@ impl SkinGrid {
         }
     }
 
-    /// Re-tests entry `i` of `slot`'s list against the two true boxes as they are now:
-    /// logs the pair if its overlap changed, and gives this side the pair's whole budget.
-    /// The twin entry is written only when the overlap changed or it held the budget, so a
-    /// body moving among resting ones reads its neighbours' boxes and nothing more of
-    /// theirs.
+    /// Re-tests entry `i` of `slot`'s list against the two true boxes as they are now,
+    /// logs the pair if its overlap changed, and renews the budget (module docs, "Travel
+    /// budgets"): a side holding the whole of it keeps it, and writes the twin entry only
+    /// when the overlap changed; a side that moved while the twin held all or half of it
+    /// splits it, half each, writing the twin.
     fn retest(&mut self, slot: usize, i: usize) {
         let Neighbour {
             slot: other,
             twin,
-            holds,
+            share,
             overlaps,
             ..
         } = self.records[slot].list[i];
@@ -776,12 +821,19 @@ impl SkinGrid {
                 self.pairs.remove(pair);
             }
         }
-        let due = due_at(self.records[slot].travel, room);
+        let share = if share == Share::Whole {
+            share
+        } else {
+            Share::Half
+        };
+        let due = due_at(self.records[slot].travel, room, share);
         let entry = &mut self.records[slot].list[i];
-        (entry.overlaps, entry.due_at, entry.holds) = (now, due, true);
-        if now != overlaps || !holds {
-            let entry = &mut self.records[other as usize].list[twin as usize];
-            (entry.overlaps, entry.due_at, entry.holds) = (now, f32::NEG_INFINITY, false);
+        (entry.overlaps, entry.due_at, entry.share) = (now, due, share);
+        if now != overlaps || share == Share::Half {
+            let other = &mut self.records[other as usize];
+            let due = due_at(other.travel, room, share.twin());
+            let entry = &mut other.list[twin as usize];
+            (entry.overlaps, entry.due_at, entry.share) = (now, due, share.twin());
         }
     }
 
@@ -823,12 +875,16 @@ fn relation(a: &Aabb, b: &Aabb) -> (bool, f64) {
     (slack >= 0.0, slack.abs())
 }
 
-/// The [`Neighbour::due_at`] of the entry holding a pair's budget, its owner having
-/// travelled `travel` when the pair is tested with room `room`: the room ahead, rounded
-/// down (module docs, "Travel budgets"). With no room it is below `travel`: any move
-/// re-tests.
-fn due_at(travel: f32, room: f64) -> f32 {
-    ((f64::from(travel) + room * (1.0 - BUDGET_ROUNDING)) as f32).next_down()
+/// The [`Neighbour::due_at`] of an entry with share `share` of a pair's budget, its
+/// owner having travelled `travel` when the pair is tested with room `room`: that share of
+/// the room ahead, rounded down (module docs, "Travel budgets"); `−∞` for no share. With
+/// no room it is below `travel`: any move re-tests.
+fn due_at(travel: f32, room: f64, share: Share) -> f32 {
+    if share == Share::None {
+        return f32::NEG_INFINITY;
+    }
+    let ahead = room * share.fraction() * (1.0 - BUDGET_ROUNDING);
+    ((f64::from(travel) + ahead) as f32).next_down()
 }
 
 /// A body's [`Record::travel`] after its box moved from `old` to `new`: `travel` plus the
@@ -907,6 +963,37 @@ mod tests {
             "{skipped} skipped, {retested} re-tested"
         );
         assert!(reported > 0, "the boxes never met");
+    }
+
+    /// Two bodies stepping in turn towards each other and apart: the pair's budget is
+    /// split once both move, and the pair is reported exactly while the boxes overlap
+    /// (validated against brute force, shares and budgets included, every step).
+    #[test]
+    fn two_moving_neighbours_split_the_budget_and_stay_exact() {
+        let unit = Aabb::new(DVec3::ZERO, DVec3::ONE);
+        let at = |x: f64| Aabb::new(unit.min + DVec3::X * x, unit.max + DVec3::X * x);
+        let mut skin = SkinGrid::new();
+        skin.insert(1, at(0.0), false, CollisionFilter::ALL);
+        skin.insert(2, at(1.06), false, CollisionFilter::ALL);
+        let (mut halves, mut met, mut apart) = (0, 0, 0);
+        for step in 0..40 {
+            // Closing in for 10 steps of 6 mm a side, then parting, and again.
+            let phase = f64::from(step % 20);
+            let offset = 0.006 * if phase < 10.0 { phase } else { 20.0 - phase };
+            let (x1, x2) = (offset, 1.06 - offset);
+            skin.update_all(&[(1, at(x1))]);
+            skin.update_all(&[(2, at(x2))]);
+            skin.validate().expect("valid");
+            let slot = skin.bodies.slot(1).expect("present");
+            let shares = skin.records[slot].list.iter().map(|e| e.share);
+            halves += shares.filter(|&s| s == Share::Half).count();
+            let mut pairs = Vec::new();
+            skin.pairs(&mut pairs);
+            let overlap = at(x1).intersects(&at(x2));
+            assert_eq!(!pairs.is_empty(), overlap, "step {step}");
+            (met, apart) = (met + usize::from(overlap), apart + usize::from(!overlap));
+        }
+        assert!(halves > 0 && met > 0 && apart > 0, "{halves} {met} {apart}");
     }
 
     /// A skin asked to fill (or overfill) its room gives a fat box no wider than the reach,
