@@ -626,6 +626,19 @@ pub const ALL_PAIRS_MAX: usize = 32;
 /// | 10,000 | coherent (all, a sixth) | 1,370 / 1,427 / 1,871 | 4,004 / 5,082 / 3,809 | **746 / 1,246 / 372** | 1,268 / 1,400 / 1,072 |
 /// | 100,000 | coherent (10 %, full) | | 8,725 / 9,997 / 7,628 | **4,813 / 5,276 / 1,923** | 22,035 / 22,886 / 14,663 |
 ///
+/// Third run (2026-11-24, later: the skin grid's skins reaching ahead of the motion, its
+/// travel budgets, and the bench on transparent huge pages like `proximad`):
+///
+/// | bodies | motion (share moving, speed) | sort & sweep | column grid | skin grid | peer |
+/// |---|---|---|---|---|---|
+/// | 1,000 | coherent (10 %, full) | 122 / 86 / 113 | 51 / 28 / 52 | **22 / 13 / 11** | 123 / 69 / 68 |
+/// | 10,000 | coherent (10 %, full) | 1,439 / 1,378 / 1,116 | 745 / 793 / 501 | **518 / 484 / 219** | 1,586 / 1,339 / 752 |
+/// | 10,000 | coherent (10 %, a sixth) | 1,147 / 1,212 / 1,097 | 507 / 641 / 537 | **216 / 272 / 203** | 751 / 732 / 770 |
+/// | 10,000 | coherent (all, full) | **1,464 / 1,611** / 1,924 | 4,745 / 6,199 / 4,285 | 2,129 / 2,836 / **481** | 2,787 / 3,054 / 1,641 |
+/// | 10,000 | coherent (all, a sixth) | 1,318 / 1,435 / 1,524 | 4,346 / 5,719 / 3,218 | **863 / 1,297 / 297** | 1,519 / 1,635 / 902 |
+/// | 10,000 | teleporting (10 %) | 2,040 / 1,717 / 1,936 | **1,857 / 1,099** / 801 | 3,826 / 1,618 / **403** | 35,495 / 22,078 / 1,396 |
+/// | 100,000 | coherent (10 %, full) | 20,355 / 18,460 / 16,691 | 9,316 / 9,448 / 6,573 | **3,856 / 4,260 / 1,659** | 22,879 / 21,740 / 16,350 |
+///
 /// The skin grid re-tests a moved body against its few listed neighbours and refiles it in
 /// the column grid only when it leaves its skin: it is the fastest on every coherent class
 /// up to half the bodies moving. Sort and sweep costs the same whatever moved and wins
