@@ -203,15 +203,6 @@ impl Share {
             Self::Whole => Self::None,
         }
     }
-
-    /// The fraction of the room this share lets its side travel.
-    fn fraction(self) -> f64 {
-        match self {
-            Self::None => 0.0,
-            Self::Half => 0.5,
-            Self::Whole => 1.0,
-        }
-    }
 }
 
 /// What a body keeps besides its true box: its fat box and its neighbours.
@@ -640,11 +631,11 @@ impl SkinGrid {
                 ))?;
                 let other = &self.records[e.slot as usize].list;
                 let twin = (e.twin < other.len).then(|| other[e.twin as usize]);
-                if twin.is_none_or(|t| {
-                    t.slot as usize != slot || t.overlaps != e.overlaps || t.share != e.share.twin()
-                }) {
+                let Some(twin) = twin.filter(|t| {
+                    t.slot as usize == slot && t.overlaps == e.overlaps && t.share == e.share.twin()
+                }) else {
                     return Err(format!("{}–{}: the twin entry is wrong", p.body, q.body));
-                }
+                };
                 if e.overlaps != p.bounds.intersects(&q.bounds) {
                     return Err(format!("{}–{} overlap flag stale", p.body, q.body));
                 }
@@ -655,7 +646,7 @@ impl SkinGrid {
                     f64::from(entry.due_at) - f64::from(self.records[owner].travel)
                 };
                 let (_, room) = relation(&p.bounds, &q.bounds);
-                let both = left(e, slot) + left(&other[e.twin as usize], e.slot as usize);
+                let both = left(e, slot) + left(&twin, e.slot as usize);
                 if both > room * (1.0 + 1e-9)
                     || (e.share == Share::None && e.due_at != f32::NEG_INFINITY)
                 {
@@ -693,7 +684,8 @@ impl SkinGrid {
                     &self.bodies.proxies[b].bounds,
                 );
                 let (at_a, at_b) = (self.records[a].list.len(), self.records[b].list.len());
-                // The budget goes to a body refiled in this batch: the one that moves.
+                // The budget goes to a body refiled in this batch: it re-tests all its
+                // neighbours next, keeping a whole budget without writing the twin.
                 let a_holds = self.records[a].filed_at == self.batch
                     || self.records[b].filed_at != self.batch;
                 let share_a = if a_holds { Share::Whole } else { Share::None };
@@ -899,10 +891,12 @@ fn relation(a: &Aabb, b: &Aabb) -> (bool, f64) {
 /// the room ahead, rounded down (module docs, "Travel budgets"); `−∞` for no share. With
 /// no room it is below `travel`: any move re-tests.
 fn due_at(travel: f32, room: f64, share: Share) -> f32 {
-    if share == Share::None {
-        return f32::NEG_INFINITY;
-    }
-    let ahead = room * share.fraction() * (1.0 - BUDGET_ROUNDING);
+    let fraction = match share {
+        Share::None => return f32::NEG_INFINITY,
+        Share::Half => 0.5,
+        Share::Whole => 1.0,
+    };
+    let ahead = room * fraction * (1.0 - BUDGET_ROUNDING);
     ((f64::from(travel) + ahead) as f32).next_down()
 }
 
@@ -952,8 +946,7 @@ mod tests {
     /// against brute force every step).
     #[test]
     fn a_moving_body_retests_a_resting_neighbour_only_when_its_budget_runs_out() {
-        let unit = Aabb::new(DVec3::ZERO, DVec3::ONE);
-        let at = |x: f64| Aabb::new(unit.min + DVec3::X * x, unit.max + DVec3::X * x);
+        let at = unit_cube_at;
         let mut skin = SkinGrid::new();
         skin.insert(1, at(0.0), false, CollisionFilter::ALL);
         skin.insert(2, at(1.05), true, CollisionFilter::ALL);
@@ -972,10 +965,9 @@ mod tests {
                 (Some(_), Some(_)) => retested += 1,
                 _ => {}
             }
-            let mut pairs = Vec::new();
-            skin.pairs(&mut pairs);
-            assert_eq!(!pairs.is_empty(), at(x).intersects(&at(1.05)), "at x = {x}");
-            reported += usize::from(!pairs.is_empty());
+            let reported_now = reports_a_pair(&mut skin);
+            assert_eq!(reported_now, at(x).intersects(&at(1.05)), "at x = {x}");
+            reported += usize::from(reported_now);
         }
         assert!(
             skipped > 3 && retested > 3,
@@ -989,8 +981,7 @@ mod tests {
     /// (validated against brute force, shares and budgets included, every step).
     #[test]
     fn two_moving_neighbours_split_the_budget_and_stay_exact() {
-        let unit = Aabb::new(DVec3::ZERO, DVec3::ONE);
-        let at = |x: f64| Aabb::new(unit.min + DVec3::X * x, unit.max + DVec3::X * x);
+        let at = unit_cube_at;
         let mut skin = SkinGrid::new();
         skin.insert(1, at(0.0), false, CollisionFilter::ALL);
         skin.insert(2, at(1.06), false, CollisionFilter::ALL);
@@ -1006,10 +997,8 @@ mod tests {
             let slot = skin.bodies.slot(1).expect("present");
             let shares = skin.records[slot].list.iter().map(|e| e.share);
             halves += shares.filter(|&s| s == Share::Half).count();
-            let mut pairs = Vec::new();
-            skin.pairs(&mut pairs);
             let overlap = at(x1).intersects(&at(x2));
-            assert_eq!(!pairs.is_empty(), overlap, "step {step}");
+            assert_eq!(reports_a_pair(&mut skin), overlap, "step {step}");
             (met, apart) = (met + usize::from(overlap), apart + usize::from(!overlap));
         }
         assert!(halves > 0 && met > 0 && apart > 0, "{halves} {met} {apart}");
@@ -1047,6 +1036,18 @@ mod tests {
             cut > 100,
             "the plain half-room skin overflowed only {cut} times"
         );
+    }
+
+    /// The unit cube moved `x` metres along x.
+    fn unit_cube_at(x: f64) -> Aabb {
+        Aabb::new(DVec3::X * x, DVec3::ONE + DVec3::X * x)
+    }
+
+    /// Whether `skin` reports any pair.
+    fn reports_a_pair(skin: &mut SkinGrid) -> bool {
+        let mut pairs = Vec::new();
+        skin.pairs(&mut pairs);
+        !pairs.is_empty()
     }
 
     #[test]
@@ -1223,8 +1224,7 @@ mod tests {
     /// reach.
     #[test]
     fn a_refiled_skin_reaches_ahead_of_the_motion_within_its_bounds_and_the_level_room() {
-        let unit = Aabb::new(DVec3::ZERO, DVec3::ONE);
-        let moved = |d: f64| Aabb::new(unit.min + DVec3::X * d, unit.max + DVec3::X * d);
+        let (unit, moved) = (unit_cube_at(0.0), unit_cube_at);
         let back = BACK_SKIN;
         let fit = 0.1 / (back + 0.08 + back); // the share that fits in 0.1 m of room
         // (step along x, batches, reach) → (below on x, above on x, each side on y and z).
