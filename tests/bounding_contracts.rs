@@ -185,6 +185,21 @@ fn check_distance_bound_and_outcomes<B: BoundingVolume>(seed: u64) {
             "{} case {case}: bound within {limit} is {within} (full {bound}, true {truth})",
             B::NAME
         );
+        // The two-volume form (a node's two children against one node) is the single form
+        // twice, bit for bit.
+        assert_eq!(
+            B::distance_lower_bounds_within([&bv_a, &bv_a], &bv_b, &pose_ab, limit),
+            [within; 2],
+            "{} case {case}: the pair form differs from the single one",
+            B::NAME
+        );
+        // Seen from B (the frontier's split of B's node): a bound of the same distance.
+        let reverse = bv_b.distance_lower_bound(&bv_a, &pose_ab.inverse());
+        assert!(
+            reverse <= truth,
+            "{} case {case}: bound from B's side {reverse} exceeds the true distance {truth}",
+            B::NAME
+        );
         let overlaps = bv_a.overlaps(&bv_b, &pose_ab);
         let moved = bv_b.transformed(&pose_ab);
         if overlaps != bv_a.intersects(&moved) {

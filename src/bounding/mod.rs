@@ -123,6 +123,21 @@ pub trait BoundingVolume: Copy + std::fmt::Debug + Send + Sync + 'static {
         self.distance_lower_bound(other, pose_ab)
     }
 
+    /// [`distance_lower_bound_within`](Self::distance_lower_bound_within) of each volume of
+    /// `pair` (frame A) against the one `other` (frame B): the two children of a node pair
+    /// split on one side. Types whose bound first moves `other` into frame A (OBB) move it
+    /// once for both.
+    #[must_use]
+    #[inline]
+    fn distance_lower_bounds_within(
+        pair: [&Self; 2],
+        other: &Self,
+        pose_ab: &Isometry,
+        limit: f64,
+    ) -> [f64; 2] {
+        pair.map(|x| x.distance_lower_bound_within(other, pose_ab, limit))
+    }
+
     /// Whether `point` (same frame) lies inside or on the volume. Exact up to rounding; no
     /// slack is added here (fits add it).
     #[must_use]

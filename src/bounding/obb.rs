@@ -171,19 +171,29 @@ impl Obb {
         best
     }
 
-    /// `R = Aᵀ·R_ab·B` (rows), `t` = B's centre in A's box frame, and the slack for the
-    /// magnitudes involved.
+    /// `self` (frame B) placed in frame A by `pose_ab`, unpadded, with the magnitude its
+    /// placing rounds at: the first half of [`relative_to`](Self::relative_to), done once
+    /// when one box is tested against several ([`BoundingVolume::distance_lower_bounds_within`]).
     #[inline]
-    fn relative(&self, other: &Self, pose_ab: &Isometry) -> ([[f64; 3]; 3], [f64; 3], f64) {
+    fn placed(&self, pose_ab: &Isometry) -> PlacedObb {
+        PlacedObb {
+            center: pose_ab.rotation * self.center + pose_ab.translation,
+            axes: pose_ab.rotation * self.axes,
+            half_extents: self.half_extents,
+            scale: self.center.abs().max_element()
+                + pose_ab.translation.abs().max_element()
+                + self.half_extents.element_sum(),
+        }
+    }
+
+    /// `R = Aᵀ·R_ab·B` (rows), `t` = B's centre in A's box frame, and the slack for the
+    /// magnitudes involved, with B already placed in A's frame.
+    #[inline]
+    fn relative_to(&self, other: &PlacedObb) -> ([[f64; 3]; 3], [f64; 3], f64) {
         let to_a = self.axes.transpose();
-        let r = to_a * (pose_ab.rotation * other.axes);
-        let d = pose_ab.rotation * other.center + pose_ab.translation - self.center;
-        let t = to_a * d;
-        let scale = self.center.abs().max_element()
-            + other.center.abs().max_element()
-            + pose_ab.translation.abs().max_element()
-            + self.half_extents.element_sum()
-            + other.half_extents.element_sum();
+        let r = to_a * other.axes;
+        let t = to_a * (other.center - self.center);
+        let scale = self.center.abs().max_element() + self.half_extents.element_sum() + other.scale;
         let c = r.to_cols_array_2d();
         let rows = [
             [c[0][0], c[1][0], c[2][0]],
@@ -192,6 +202,63 @@ impl Obb {
         ];
         (rows, t.to_array(), conservative_slack(scale))
     }
+
+    /// The distance bound of [`BoundingVolume::distance_lower_bound_within`] against a box
+    /// already placed in `self`'s frame.
+    fn distance_lower_bound_to(&self, other: &PlacedObb, limit: f64) -> f64 {
+        let (r, t, slack) = self.relative_to(other);
+        let (a, b) = (self.half_extents.to_array(), other.half_extents.to_array());
+        let abs = r.map(|row| row.map(|x| x.abs() + tolerance::SAT_PARALLEL));
+        let mut best = 0.0f64;
+        for i in 0..3 {
+            let rb = b[0] * abs[i][0] + b[1] * abs[i][1] + b[2] * abs[i][2];
+            let gap = t[i].abs() - a[i] - rb - slack;
+            if gap > best {
+                best = gap;
+            }
+        }
+        for j in 0..3 {
+            let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
+            let ra = a[0] * abs[0][j] + a[1] * abs[1][j] + a[2] * abs[2][j];
+            let gap = tj.abs() - ra - b[j] - slack;
+            if gap > best {
+                best = gap;
+            }
+        }
+        if best >= limit {
+            return best;
+        }
+        for i in 0..3 {
+            let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+            for j in 0..3 {
+                let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+                let lhs = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
+                let ra = a[i1] * abs[i2][j] + a[i2] * abs[i1][j];
+                let rb = b[j1] * abs[i][j2] + b[j2] * abs[i][j1];
+                let gap = lhs - ra - rb - slack;
+                // |e_i × B_j|², computed from the two entries it is made of.
+                let length_squared = r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j];
+                if gap > 0.0
+                    && length_squared > MIN_EDGE_AXIS_SQUARED
+                    && gap * gap > best * best * length_squared
+                {
+                    best = gap / length_squared.sqrt();
+                }
+            }
+        }
+        best
+    }
+}
+
+/// A box of frame B placed in frame A ([`Obb::placed`]): its centre and axes moved, not
+/// padded; `scale` is the magnitude the move rounds at (B's centre, the translation and
+/// the half extents), which the tests' slack covers.
+#[derive(Debug, Clone, Copy)]
+struct PlacedObb {
+    center: DVec3,
+    axes: DMat3,
+    half_extents: DVec3,
+    scale: f64,
 }
 
 /// Distinct normals of the largest facets, at most [`MAX_FACET_NORMALS`].
@@ -282,7 +349,7 @@ impl BoundingVolume for Obb {
 
     #[inline]
     fn overlaps(&self, other: &Self, pose_ab: &Isometry) -> bool {
-        let (r, t, slack) = self.relative(other, pose_ab);
+        let (r, t, slack) = self.relative_to(&other.placed(pose_ab));
         let (a, b) = (self.half_extents.to_array(), other.half_extents.to_array());
         let abs = r.map(|row| row.map(|x| x.abs() + tolerance::SAT_PARALLEL));
         for i in 0..3 {
@@ -327,47 +394,19 @@ impl BoundingVolume for Obb {
     /// (0.734, 0.851, 0.903, 0.987) and 0.949 → 0.951 at 500: the node pairs its frontier
     /// meets near the threshold are apart along one axis.
     fn distance_lower_bound_within(&self, other: &Self, pose_ab: &Isometry, limit: f64) -> f64 {
-        let (r, t, slack) = self.relative(other, pose_ab);
-        let (a, b) = (self.half_extents.to_array(), other.half_extents.to_array());
-        let abs = r.map(|row| row.map(|x| x.abs() + tolerance::SAT_PARALLEL));
-        let mut best = 0.0f64;
-        for i in 0..3 {
-            let rb = b[0] * abs[i][0] + b[1] * abs[i][1] + b[2] * abs[i][2];
-            let gap = t[i].abs() - a[i] - rb - slack;
-            if gap > best {
-                best = gap;
-            }
-        }
-        for j in 0..3 {
-            let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
-            let ra = a[0] * abs[0][j] + a[1] * abs[1][j] + a[2] * abs[2][j];
-            let gap = tj.abs() - ra - b[j] - slack;
-            if gap > best {
-                best = gap;
-            }
-        }
-        if best >= limit {
-            return best;
-        }
-        for i in 0..3 {
-            let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
-            for j in 0..3 {
-                let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
-                let lhs = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
-                let ra = a[i1] * abs[i2][j] + a[i2] * abs[i1][j];
-                let rb = b[j1] * abs[i][j2] + b[j2] * abs[i][j1];
-                let gap = lhs - ra - rb - slack;
-                // |e_i × B_j|², computed from the two entries it is made of.
-                let length_squared = r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j];
-                if gap > 0.0
-                    && length_squared > MIN_EDGE_AXIS_SQUARED
-                    && gap * gap > best * best * length_squared
-                {
-                    best = gap / length_squared.sqrt();
-                }
-            }
-        }
-        best
+        self.distance_lower_bound_to(&other.placed(pose_ab), limit)
+    }
+
+    /// `other` is placed in frame A once, for both: half of the work of a bound.
+    #[inline]
+    fn distance_lower_bounds_within(
+        pair: [&Self; 2],
+        other: &Self,
+        pose_ab: &Isometry,
+        limit: f64,
+    ) -> [f64; 2] {
+        let placed = other.placed(pose_ab);
+        pair.map(|x| x.distance_lower_bound_to(&placed, limit))
     }
 
     #[inline]
@@ -624,6 +663,32 @@ mod tests {
             assert!((d1 - d2).abs() <= 1e-9 * scale, "case {case}: {d1} vs {d2}");
         }
         assert_eq!(mismatches, 0);
+    }
+
+    /// The frontier bounds a split of B's node from B's side (`pose_ab` inverted): the same
+    /// 15 separating axes, so the same bound to rounding, at every scale and offset.
+    #[test]
+    fn the_bound_is_the_same_seen_from_either_box() {
+        let mut rng = rng(27);
+        let mut positive = 0;
+        for case in 0..3000 {
+            let (center, scale) = (CENTERS[case % 4], SCALES[case % 5]);
+            let a = random_obb(&mut rng, center, scale);
+            let b = random_obb(&mut rng, 0.0, scale);
+            let mut pose = isometry(&mut rng, 2.0 * scale);
+            pose.translation += DVec3::splat(center);
+            let (forward, reverse) = (
+                a.distance_lower_bound(&b, &pose),
+                b.distance_lower_bound(&a, &pose.inverse()),
+            );
+            let magnitude = center.abs() + scale;
+            assert!(
+                (forward - reverse).abs() <= 1e-9 * magnitude,
+                "case {case}: {forward} from A, {reverse} from B"
+            );
+            positive += usize::from(forward > 0.0);
+        }
+        assert!((300..2700).contains(&positive), "{positive} of 3000 apart");
     }
 
     #[test]

@@ -244,3 +244,61 @@ fn distances_to_sliver_triangles_match_a_line_search_oracle() {
         "{touching} touching, {apart} apart"
     );
 }
+
+/// The thresholded distance against the exact one, over random pairs near each other and
+/// random limits: `Exact` is [`distance_triangle_triangle`] bit for bit, beyond the limit
+/// or `0`; `Within` is a pair of points of the two triangles within the limit, so never
+/// below the exact distance; both outcomes occur, and `Within` also for intersecting pairs.
+#[test]
+fn the_thresholded_distance_is_exact_beyond_the_limit_and_a_point_pair_within_it() {
+    use crate::narrow::closest_points::closest_point_triangle;
+    use crate::test_support::{point_in_cube, rng};
+    use rand::Rng;
+    let mut r = rng(0x7e_5a01);
+    let (mut within, mut exact, mut within_intersecting) = (0, 0, 0);
+    for case in 0..5000 {
+        let triangle = |r: &mut crate::test_support::TestRng, centre: DVec3| {
+            Triangle::new(
+                centre + point_in_cube(r, 1.0),
+                centre + point_in_cube(r, 1.0),
+                centre + point_in_cube(r, 1.0),
+            )
+        };
+        let a = triangle(&mut r, DVec3::ZERO);
+        let offset = point_in_cube(&mut r, 2.0);
+        let b = triangle(&mut r, offset);
+        let full = distance_triangle_triangle(&a, &b);
+        let limit = r.random_range(0.0..2.0);
+        match distance_triangle_triangle_within(&a, &b, limit) {
+            Thresholded::Exact(d) => {
+                assert_eq!(d, full, "case {case}");
+                // Beyond the limit, or intersecting through the interiors (no feature
+                // pair is within the limit, yet the triangles meet).
+                assert!(
+                    d.distance > limit || d.distance == 0.0,
+                    "case {case}: {} ≤ {limit}",
+                    d.distance
+                );
+                exact += 1;
+            }
+            Thresholded::Within(d) => {
+                let on =
+                    |p: DVec3, t: &Triangle| p.distance(closest_point_triangle(p, t.a, t.b, t.c));
+                assert!(
+                    d.distance <= limit * (1.0 + 1e-15)
+                        && d.distance >= full.distance
+                        && (d.point_a.distance(d.point_b) - d.distance).abs() <= 1e-12
+                        && on(d.point_a, &a) <= 1e-12
+                        && on(d.point_b, &b) <= 1e-12,
+                    "case {case}: {d:?} within {limit}, exact {full:?}"
+                );
+                within += 1;
+                within_intersecting += usize::from(full.distance == 0.0);
+            }
+        }
+    }
+    assert!(
+        within > 500 && exact > 500 && within_intersecting > 50,
+        "{within} within ({within_intersecting} intersecting), {exact} exact"
+    );
+}

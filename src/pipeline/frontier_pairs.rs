@@ -79,7 +79,7 @@ impl PairTrees for MeshPairTrees {
     }
 
     fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
-        on_trees!(self, t => t.seed_distance(self.seed))
+        on_trees!(self, t => t.seed_distance(self.seed, self.threshold))
     }
 
     #[inline]
@@ -97,8 +97,8 @@ impl PairTrees for MeshPairTrees {
     }
 
     #[inline]
-    fn split(&self, nodes: [u32; 2]) -> [[u32; 2]; 2] {
-        on_trees!(self, t => t.split(nodes))
+    fn split(&self, nodes: [u32; 2], limit: f64) -> [([u32; 2], f64); 2] {
+        on_trees!(self, t => t.split(nodes, limit))
     }
 
     fn test_leaves(

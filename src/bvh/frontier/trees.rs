@@ -8,8 +8,8 @@ use crate::bounding::BoundingVolume;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::descend_a;
 use crate::math::{Isometry, conservative_slack};
-use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::{precedes_in_ties, rounding_bound};
+use crate::narrow::{Thresholded, distance_triangle_triangle, distance_triangle_triangle_within};
 
 /// One mesh pair of the frame.
 #[derive(Debug, Clone, Copy)]
@@ -27,9 +27,11 @@ pub struct FrontierPair<'a, B> {
     /// A triangle pair to try first (ids into each mesh's own triangle list, as
     /// [`FrontierWitnesses::triangles`]): typically the pair that proved it within the
     /// threshold last frame. Tested when the root is first processed (one visit), its
-    /// exact distance starts the pair's best distance, so entries that cannot beat it are
+    /// distance starts the pair's best distance, so entries that cannot beat it are
     /// dropped, as the warm start of the depth-first queries does; a seed still within the
-    /// threshold proves the pair close at once. A pair with a seed is *expected close*: it
+    /// threshold proves the pair close at once (the test stops at the first pair of points
+    /// within it, whose distance stands in for the exact one until the traversal reaches
+    /// the seed's leaf pair). A pair with a seed is *expected close*: it
     /// waits while undecided pairs are settled even when its seed no longer holds (module
     /// docs, "Decide first"). `None`, or ids out of range, start from nothing. Exact
     /// distances do not depend on it (the witnesses of tied pairs may); a truncated answer
@@ -58,7 +60,9 @@ pub trait PairTrees {
     fn root_bounds(&self) -> (f64, f64);
 
     /// The seed triangle pair's distance and witnesses (one triangle test), when the pair
-    /// has a seed naming triangles of both meshes.
+    /// has a seed naming triangles of both meshes: exact, or, when a pair of points of the
+    /// two triangles within the threshold is found first, those points' distance (an upper
+    /// bound; [`distance_triangle_triangle_within`]).
     fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)>;
 
     /// A lower bound of the distance between the two nodes' triangles, metres
@@ -72,8 +76,9 @@ pub trait PairTrees {
     /// Whether both nodes are leaves.
     fn are_leaves(&self, nodes: [u32; 2]) -> bool;
 
-    /// The two child node pairs, splitting the side [`descend_a`] chooses.
-    fn split(&self, nodes: [u32; 2]) -> [[u32; 2]; 2];
+    /// The two child node pairs, splitting the side [`descend_a`] chooses, each with its
+    /// [`bound`](Self::bound) within `limit` (the node kept is placed once for both).
+    fn split(&self, nodes: [u32; 2], limit: f64) -> [([u32; 2], f64); 2];
 
     /// Tests every triangle pair of the leaf pair `nodes`, lowering `best` (metres) and
     /// replacing `witnesses` on each strictly closer pair; returns the number of tests.
@@ -108,13 +113,19 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
         )
     }
 
-    /// See [`PairTrees::seed_distance`]; `seed` names a triangle of each mesh.
+    /// See [`PairTrees::seed_distance`]; `seed` names a triangle of each mesh, `threshold`
+    /// is the pair's.
     #[must_use]
-    pub fn seed_distance(&self, seed: Option<[u32; 2]>) -> Option<(f64, FrontierWitnesses)> {
+    pub fn seed_distance(
+        &self,
+        seed: Option<[u32; 2]>,
+        threshold: f64,
+    ) -> Option<(f64, FrontierWitnesses)> {
         let [ia, ib] = seed?;
         let (sa, sb) = (self.a.slot_of(ia)?, self.b.slot_of(ib)?);
         let tri_b = self.b.triangles()[sb].transformed(self.pose_ab);
-        let d = distance_triangle_triangle(&self.a.triangles()[sa], &tri_b);
+        let (Thresholded::Within(d) | Thresholded::Exact(d)) =
+            distance_triangle_triangle_within(&self.a.triangles()[sa], &tri_b, threshold);
         Some((
             d.distance,
             FrontierWitnesses {
@@ -153,15 +164,23 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
         self.a.nodes()[a as usize].is_leaf() && self.b.nodes()[b as usize].is_leaf()
     }
 
-    /// See [`PairTrees::split`].
+    /// See [`PairTrees::split`]. A split of B's node bounds its children against A's node
+    /// in B's frame: the same separating axes, so the same bound up to rounding.
     #[inline]
     #[must_use]
-    pub fn split(&self, [a, b]: [u32; 2]) -> [[u32; 2]; 2] {
+    pub fn split(&self, [a, b]: [u32; 2], limit: f64) -> [([u32; 2], f64); 2] {
         let (x, y) = (&self.a.nodes()[a as usize], &self.b.nodes()[b as usize]);
         if descend_a(x, y) {
-            x.children().map(|c| [c as u32, b])
+            let children = x.children();
+            let [c0, c1] = children.map(|c| &self.a.nodes()[c].bv);
+            let bounds = B::distance_lower_bounds_within([c0, c1], &y.bv, self.pose_ab, limit);
+            [0, 1].map(|k| ([children[k] as u32, b], bounds[k]))
         } else {
-            y.children().map(|c| [a, c as u32])
+            let children = y.children();
+            let [c0, c1] = children.map(|c| &self.b.nodes()[c].bv);
+            let pose_ba = self.pose_ab.inverse();
+            let bounds = B::distance_lower_bounds_within([c0, c1], &x.bv, &pose_ba, limit);
+            [0, 1].map(|k| ([a, children[k] as u32], bounds[k]))
         }
     }
 
@@ -219,7 +238,7 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
     }
 
     fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
-        self.trees().seed_distance(self.seed)
+        self.trees().seed_distance(self.seed, self.threshold)
     }
 
     #[inline]
@@ -237,8 +256,8 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
     }
 
     #[inline]
-    fn split(&self, nodes: [u32; 2]) -> [[u32; 2]; 2] {
-        self.trees().split(nodes)
+    fn split(&self, nodes: [u32; 2], limit: f64) -> [([u32; 2], f64); 2] {
+        self.trees().split(nodes, limit)
     }
 
     fn test_leaves(
