@@ -22,7 +22,7 @@ pub struct MeshScene {
 }
 
 /// The shared data directory (`../shared/data` next to the package root).
-fn data_dir() -> &'static Path {
+pub fn data_dir() -> &'static Path {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"))
 }
 
