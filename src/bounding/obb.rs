@@ -17,7 +17,8 @@
 //! lower bound. The 9 edge axes are kept because they pay: over 20,000 random separated
 //! pairs they raised the bound by more than 1% in about half the cases (the 6 face axes
 //! alone gave 92% of it on average), and a gap is normalised (one square root) only when
-//! it beats the best so far, so they cost about the edge part of the overlap test.
+//! it beats the best so far, so they cost about the edge part of the overlap test. They
+//! are skipped when the face axes already show a deep overlap ([`DEEP_FACE_OVERLAP`]).
 //!
 //! Citation: S. Gottschalk, M. C. Lin, D. Manocha, "OBBTree: A Hierarchical Structure for
 //! Rapid Interference Detection", SIGGRAPH 1996; Gottschalk's thesis (2000) §4 for the
@@ -209,23 +210,26 @@ impl Obb {
         let (r, t, slack) = self.relative_to(other);
         let (a, b) = (self.half_extents.to_array(), other.half_extents.to_array());
         let abs = r.map(|row| row.map(|x| x.abs() + tolerance::SAT_PARALLEL));
-        let mut best = 0.0f64;
+        // The largest face-axis gap, negative while the boxes overlap along all six.
+        let mut faces = f64::NEG_INFINITY;
         for i in 0..3 {
             let rb = b[0] * abs[i][0] + b[1] * abs[i][1] + b[2] * abs[i][2];
-            let gap = t[i].abs() - a[i] - rb - slack;
-            if gap > best {
-                best = gap;
-            }
+            faces = faces.max(t[i].abs() - a[i] - rb - slack);
         }
         for j in 0..3 {
             let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
             let ra = a[0] * abs[0][j] + a[1] * abs[1][j] + a[2] * abs[2][j];
-            let gap = tj.abs() - ra - b[j] - slack;
-            if gap > best {
-                best = gap;
-            }
+            faces = faces.max(tj.abs() - ra - b[j] - slack);
         }
-        if best >= limit {
+        let mut best = faces.max(0.0);
+        if best >= limit
+            || -faces
+                >= DEEP_FACE_OVERLAP
+                    * self
+                        .half_extents
+                        .max_element()
+                        .min(other.half_extents.max_element())
+        {
             return best;
         }
         for i in 0..3 {
@@ -442,6 +446,18 @@ impl BoundingVolume for Obb {
         2.0 * self.half_extents.length()
     }
 }
+
+/// Overlap along every face axis, as a fraction of the smaller box's largest half extent,
+/// beyond which the distance bound does not try the edge axes (the bound stays a bound,
+/// only looser where an edge axis would have separated such boxes).
+///
+/// Measured on `benches/frontier.rs`'s scene (128 frames at 250 visits): of the bounds
+/// whose face axes all overlap, the edge axes separated 476 pairs; the overlap was at
+/// least half the extent for 4 of them and for 8,024 of the 17,318 that stayed
+/// overlapping (at a fifth: 88 and 12,900). Cost per visit 89.8 → 87.0 ns (medians of
+/// five alternating runs), the same precision at every counted budget on robot-chain, and
+/// 0.7 % more visits for the exact answers.
+const DEEP_FACE_OVERLAP: f64 = 0.5;
 
 /// Edge axes shorter than this (squared; edges parallel to within 1e-6 rad) are skipped by
 /// the distance bound: a face axis bounds that direction as well, and dividing by the
