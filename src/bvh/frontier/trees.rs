@@ -165,7 +165,8 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
     }
 
     /// See [`PairTrees::split`]. A split of B's node bounds its children against A's node
-    /// in B's frame: the same separating axes, so the same bound up to rounding.
+    /// in B's frame (through the inverse pose): a bound of the same distance, and for OBBs
+    /// the same 15 separating axes, so the same bound up to rounding.
     #[inline]
     #[must_use]
     pub fn split(&self, [a, b]: [u32; 2], limit: f64) -> [([u32; 2], f64); 2] {
