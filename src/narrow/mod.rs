@@ -53,6 +53,6 @@ pub use pairs::{
     manifold_sphere_cuboid, manifold_sphere_sphere, manifold_sphere_triangle,
 };
 pub use triangle_triangle::{
-    Thresholded, TriangleDistance, distance_triangle_triangle, distance_triangle_triangle_within,
-    intersection_segment_triangle_triangle, intersects_triangle_triangle,
+    TriangleDistance, distance_triangle_triangle, intersection_segment_triangle_triangle,
+    intersects_triangle_triangle,
 };

@@ -113,50 +113,8 @@ pub fn intersection_segment_triangle_triangle(
 /// Never allocates.
 #[must_use]
 pub fn distance_triangle_triangle(a: &Triangle, b: &Triangle) -> TriangleDistance {
-    distance_from_features(
-        a,
-        b,
-        closest_feature_pair(&a.vertices(), &b.vertices(), -1.0),
-    )
-}
-
-/// Two triangles' distance as far as a question with a threshold needs it: a pair of
-/// points, one on each triangle, at most `limit` metres apart (to the rounding of a square
-/// root; an upper bound of the distance), when the search finds one; otherwise the exact
-/// [`distance_triangle_triangle`]. The first of the 15 feature pairs within `limit` ends
-/// the search, so a pair well within the threshold costs a few of them.
-///
-/// May give `Within` for intersecting triangles whose distance is `0`: the points are
-/// then a pair of the triangles within `limit`, not a common point.
-#[must_use]
-pub fn distance_triangle_triangle_within(a: &Triangle, b: &Triangle, limit: f64) -> Thresholded {
-    let stop_within = limit * limit;
-    let closest = closest_feature_pair(&a.vertices(), &b.vertices(), stop_within);
-    if closest.distance_squared <= stop_within {
-        Thresholded::Within(TriangleDistance {
-            distance: closest.distance_squared.sqrt(),
-            point_a: closest.point_a,
-            point_b: closest.point_b,
-        })
-    } else {
-        Thresholded::Exact(distance_from_features(a, b, closest))
-    }
-}
-
-/// What [`distance_triangle_triangle_within`] found.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Thresholded {
-    /// A point pair within the limit: its distance is an upper bound of the triangles'.
-    Within(TriangleDistance),
-    /// No feature pair within the limit: the exact distance and its witnesses, beyond the
-    /// limit or `0` (triangles that meet through their interiors).
-    Exact(TriangleDistance),
-}
-
-/// The distance from the closest of the 15 feature pairs (all of them searched): theirs
-/// when a plane separates the triangles, else `0` at a common point when they meet.
-fn distance_from_features(a: &Triangle, b: &Triangle, closest: Closest) -> TriangleDistance {
     let (va, vb) = (a.vertices(), b.vertices());
+    let closest = closest_feature_pair(&va, &vb);
     // PERF(benches/mesh_pair.rs, distance): most pairs a distance query meets are far
     // apart; a separating plane through the closest feature pair proves them disjoint
     // without the exact overlap test.
@@ -186,20 +144,14 @@ fn distance_from_features(a: &Triangle, b: &Triangle, closest: Closest) -> Trian
 /// parallel edges stray along them, and the distances were off by up to 5.5e-9 of the
 /// coordinates (allowed: 8 ulps). Certified on all six vertices instead, it passed and
 /// gained nothing measurable.
-///
-/// The search ends at the first pair whose squared distance is at most `stop_within`
-/// (negative: never), which is then returned.
 #[inline]
-fn closest_feature_pair(va: &[DVec3; 3], vb: &[DVec3; 3], stop_within: f64) -> Closest {
+fn closest_feature_pair(va: &[DVec3; 3], vb: &[DVec3; 3]) -> Closest {
     let mut best = Closest::new(va[0], vb[0]);
     for i in 0..3 {
         let (p, q) = (va[i], va[(i + 1) % 3]);
         for j in 0..3 {
             let (x, y) = closest_points_segment_segment(p, q, vb[j], vb[(j + 1) % 3]);
             best.offer(x, y);
-            if best.distance_squared <= stop_within {
-                return best;
-            }
         }
     }
     // PERF: each triangle's hinge frame is built once for the other's three vertices, and
@@ -211,15 +163,9 @@ fn closest_feature_pair(va: &[DVec3; 3], vb: &[DVec3; 3], stop_within: f64) -> C
     );
     for p in *va {
         best.offer(p, frame_b.closest_point(p));
-        if best.distance_squared <= stop_within {
-            return best;
-        }
     }
     for q in *vb {
         best.offer(frame_a.closest_point(q), q);
-        if best.distance_squared <= stop_within {
-            return best;
-        }
     }
     best
 }

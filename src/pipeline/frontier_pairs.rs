@@ -79,7 +79,7 @@ impl PairTrees for MeshPairTrees {
     }
 
     fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
-        on_trees!(self, t => t.seed_distance(self.seed, self.threshold))
+        on_trees!(self, t => t.seed_distance(self.seed))
     }
 
     #[inline]

@@ -16,16 +16,13 @@
 //! (unless a stage or the deciding phase sets it aside, below):
 //! - a root entry, the first time, gets its own bound ([`BoundingVolume::distance_lower_bound_within`](crate::bounding::BoundingVolume::distance_lower_bound_within),
 //!   one *visit*) and, when it is within the threshold and the pair has a
-//!   [`FrontierPair::seed`], the seed's triangle test (one visit; it stops at the first
-//!   pair of points within the threshold, whose distance then stands in for the seed's:
-//!   [`distance_triangle_triangle_within`](crate::narrow::distance_triangle_triangle_within));
-//!   then, unless the pair
+//!   [`FrontierPair::seed`], the seed's triangle test (one visit); then, unless the pair
 //!   waits (below), a pair not yet proven close is searched by its *probe* (below);
 //! - an entry whose bound exceeds `threshold` is dropped (that part is proven apart); one
-//!   whose bound is not below the pair's best distance so far is dropped too (it cannot
-//!   improve the minimum; no visit);
+//!   whose bound is not below the pair's best exact distance so far is dropped too (it
+//!   cannot improve the minimum; no visit);
 //! - an entry of two leaves runs [`distance_triangle_triangle`](crate::narrow::distance_triangle_triangle) on each triangle pair (one
-//!   visit each), updating the pair's best distance and its witnesses;
+//!   visit each), updating the pair's best exact distance and its witnesses;
 //! - any other entry is replaced by its children on the side chosen by
 //!   [`descend_a`](crate::bvh::tandem::descend_a): each child's bound is computed (one visit)
 //!   and the child joins the *next* round unless it is dropped by the rules above. A
@@ -153,15 +150,12 @@
 //!
 //! # The answers ([`FrontierAnswer`])
 //! A pair's *live* entries are its entries still waiting whose bound is at most `threshold`
-//! and below its best distance. Write `best` for the smallest distance of a point pair
-//! found on a triangle pair so far (`+∞` when none): an exact triangle-pair distance, or
-//! the seed's point pair within the threshold, an upper bound of its triangles' distance;
-//! `floor` for the smallest bound of its entries dropped for exceeding `threshold`, `live`
-//! for the smallest bound of its live entries.
+//! and below its best exact distance. Write `best` for the smallest triangle-pair distance
+//! computed so far (`+∞` when none), `floor` for the smallest bound of its entries dropped
+//! for exceeding `threshold`, `live` for the smallest bound of its live entries.
 //! - **Exact** when it has no live entry. If `best ≤ threshold`, `best` *is* the minimum
 //!   over all triangle pairs (every triangle pair lies under a dropped entry, a tested leaf
-//!   pair or an entry that could not beat `best`; a seed's leaf pair closer than its point
-//!   pair has a bound below `best`, so it was tested too): `maybe_close`, `distance_lower =
+//!   pair or an entry that could not beat `best`): `maybe_close`, `distance_lower =
 //!   distance_upper = best`, witnesses of that pair, `error_bound` = rounding. Otherwise
 //!   the pair is proven apart: `!maybe_close`, `distance_lower = min(floor, best) >
 //!   threshold`.
@@ -474,8 +468,7 @@ fn entry_order(x: &Entry, y: &Entry) -> Ordering {
 #[derive(Debug, Clone, Copy)]
 struct PairState {
     threshold: f64,
-    /// Smallest distance of a point pair found on a triangle pair (module docs, "The
-    /// answers"), `+∞` when none.
+    /// Smallest triangle-pair distance computed, `+∞` when none.
     best: f64,
     witnesses: Option<FrontierWitnesses>,
     /// Smallest bound of the entries dropped for exceeding the threshold, `+∞` when none.

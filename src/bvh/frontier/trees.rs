@@ -8,8 +8,8 @@ use crate::bounding::BoundingVolume;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::descend_a;
 use crate::math::{Isometry, conservative_slack};
+use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::{precedes_in_ties, rounding_bound};
-use crate::narrow::{Thresholded, distance_triangle_triangle, distance_triangle_triangle_within};
 
 /// One mesh pair of the frame.
 #[derive(Debug, Clone, Copy)]
@@ -27,11 +27,9 @@ pub struct FrontierPair<'a, B> {
     /// A triangle pair to try first (ids into each mesh's own triangle list, as
     /// [`FrontierWitnesses::triangles`]): typically the pair that proved it within the
     /// threshold last frame. Tested when the root is first processed (one visit), its
-    /// distance starts the pair's best distance, so entries that cannot beat it are
+    /// exact distance starts the pair's best distance, so entries that cannot beat it are
     /// dropped, as the warm start of the depth-first queries does; a seed still within the
-    /// threshold proves the pair close at once (the test stops at the first pair of points
-    /// within it, whose distance stands in for the exact one until the traversal reaches
-    /// the seed's leaf pair). A pair with a seed is *expected close*: it
+    /// threshold proves the pair close at once. A pair with a seed is *expected close*: it
     /// waits while undecided pairs are settled even when its seed no longer holds (module
     /// docs, "Decide first"). `None`, or ids out of range, start from nothing. Exact
     /// distances do not depend on it (the witnesses of tied pairs may); a truncated answer
@@ -60,9 +58,7 @@ pub trait PairTrees {
     fn root_bounds(&self) -> (f64, f64);
 
     /// The seed triangle pair's distance and witnesses (one triangle test), when the pair
-    /// has a seed naming triangles of both meshes: exact, or, when a pair of points of the
-    /// two triangles within the threshold is found first, those points' distance (an upper
-    /// bound; [`distance_triangle_triangle_within`]).
+    /// has a seed naming triangles of both meshes.
     fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)>;
 
     /// A lower bound of the distance between the two nodes' triangles, metres
@@ -113,19 +109,13 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
         )
     }
 
-    /// See [`PairTrees::seed_distance`]; `seed` names a triangle of each mesh, `threshold`
-    /// is the pair's.
+    /// See [`PairTrees::seed_distance`]; `seed` names a triangle of each mesh.
     #[must_use]
-    pub fn seed_distance(
-        &self,
-        seed: Option<[u32; 2]>,
-        threshold: f64,
-    ) -> Option<(f64, FrontierWitnesses)> {
+    pub fn seed_distance(&self, seed: Option<[u32; 2]>) -> Option<(f64, FrontierWitnesses)> {
         let [ia, ib] = seed?;
         let (sa, sb) = (self.a.slot_of(ia)?, self.b.slot_of(ib)?);
         let tri_b = self.b.triangles()[sb].transformed(self.pose_ab);
-        let (Thresholded::Within(d) | Thresholded::Exact(d)) =
-            distance_triangle_triangle_within(&self.a.triangles()[sa], &tri_b, threshold);
+        let d = distance_triangle_triangle(&self.a.triangles()[sa], &tri_b);
         Some((
             d.distance,
             FrontierWitnesses {
@@ -239,7 +229,7 @@ impl<B: BoundingVolume> PairTrees for FrontierPair<'_, B> {
     }
 
     fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)> {
-        self.trees().seed_distance(self.seed, self.threshold)
+        self.trees().seed_distance(self.seed)
     }
 
     #[inline]
