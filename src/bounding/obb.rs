@@ -173,7 +173,7 @@ impl Obb {
     }
 
     /// `self` (frame B) placed in frame A by `pose_ab`, unpadded, with the magnitude its
-    /// placing rounds at: the first half of [`relative_to`](Self::relative_to), done once
+    /// placing rounds at: the first half of [`SeparatingAxes::new`], done once
     /// when one box is tested against several ([`BoundingVolume::distance_lower_bounds_within`]).
     #[inline]
     fn placed(&self, pose_ab: &Isometry) -> PlacedObb {
@@ -187,61 +187,30 @@ impl Obb {
         }
     }
 
-    /// `R = Aᵀ·R_ab·B` (rows), `t` = B's centre in A's box frame, and the slack for the
-    /// magnitudes involved, with B already placed in A's frame.
-    #[inline]
-    fn relative_to(&self, other: &PlacedObb) -> ([[f64; 3]; 3], [f64; 3], f64) {
-        let to_a = self.axes.transpose();
-        let r = to_a * other.axes;
-        let t = to_a * (other.center - self.center);
-        let scale = self.center.abs().max_element() + self.half_extents.element_sum() + other.scale;
-        let c = r.to_cols_array_2d();
-        let rows = [
-            [c[0][0], c[1][0], c[2][0]],
-            [c[0][1], c[1][1], c[2][1]],
-            [c[0][2], c[1][2], c[2][2]],
-        ];
-        (rows, t.to_array(), conservative_slack(scale))
-    }
-
     /// The distance bound of [`BoundingVolume::distance_lower_bound_within`] against a box
     /// already placed in `self`'s frame.
     fn distance_lower_bound_to(&self, other: &PlacedObb, limit: f64) -> f64 {
-        let (r, t, slack) = self.relative_to(other);
-        let (a, b) = (self.half_extents.to_array(), other.half_extents.to_array());
-        let abs = r.map(|row| row.map(|x| x.abs() + tolerance::SAT_PARALLEL));
+        let axes = SeparatingAxes::new(self, other);
         // The largest face-axis gap, negative while the boxes overlap along all six.
-        let mut faces = f64::NEG_INFINITY;
-        for i in 0..3 {
-            let rb = b[0] * abs[i][0] + b[1] * abs[i][1] + b[2] * abs[i][2];
-            faces = faces.max(t[i].abs() - a[i] - rb - slack);
-        }
-        for j in 0..3 {
-            let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
-            let ra = a[0] * abs[0][j] + a[1] * abs[1][j] + a[2] * abs[2][j];
-            faces = faces.max(tj.abs() - ra - b[j] - slack);
-        }
+        let faces = (0..3)
+            .map(|i| axes.face_of_a(i))
+            .chain((0..3).map(|j| axes.face_of_b(j)))
+            .fold(f64::NEG_INFINITY, |most, (extent, reach)| {
+                most.max(extent - reach - axes.slack)
+            });
         let mut best = faces.max(0.0);
-        if best >= limit
-            || -faces
-                >= DEEP_FACE_OVERLAP
-                    * self
-                        .half_extents
-                        .max_element()
-                        .min(other.half_extents.max_element())
-        {
+        let smaller = self
+            .half_extents
+            .max_element()
+            .min(other.half_extents.max_element());
+        if best >= limit || -faces >= DEEP_FACE_OVERLAP * smaller {
             return best;
         }
         for i in 0..3 {
-            let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
             for j in 0..3 {
-                let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
-                let lhs = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
-                let ra = a[i1] * abs[i2][j] + a[i2] * abs[i1][j];
-                let rb = b[j1] * abs[i][j2] + b[j2] * abs[i][j1];
-                let gap = lhs - ra - rb - slack;
-                // |e_i × B_j|², computed from the two entries it is made of.
-                let length_squared = r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j];
+                let (extent, reach) = axes.edge(i, j);
+                let gap = extent - reach - axes.slack;
+                let length_squared = axes.edge_length_squared(i, j);
                 if gap > 0.0
                     && length_squared > MIN_EDGE_AXIS_SQUARED
                     && gap * gap > best * best * length_squared
@@ -251,6 +220,91 @@ impl Obb {
             }
         }
         best
+    }
+}
+
+/// The 15 separating axes of two boxes (Gottschalk), B placed in A's frame: along each,
+/// the extent of the centres' offset and the two boxes' summed reach, unnormalised. The
+/// boxes are apart along an axis when the extent exceeds the reach plus `slack`.
+struct SeparatingAxes {
+    /// `R = Aᵀ·R_ab·B`, by rows.
+    r: [[f64; 3]; 3],
+    /// `|R|` plus [`tolerance::SAT_PARALLEL`], so near-parallel edges never separate falsely.
+    abs: [[f64; 3]; 3],
+    /// B's centre in A's box frame.
+    t: [f64; 3],
+    /// Half extents of A, of B.
+    a: [f64; 3],
+    b: [f64; 3],
+    /// Covers the rounding at the magnitudes involved.
+    slack: f64,
+}
+
+impl SeparatingAxes {
+    #[inline]
+    fn new(box_a: &Obb, placed_b: &PlacedObb) -> Self {
+        let to_a = box_a.axes.transpose();
+        let c = (to_a * placed_b.axes).to_cols_array_2d();
+        let r = [
+            [c[0][0], c[1][0], c[2][0]],
+            [c[0][1], c[1][1], c[2][1]],
+            [c[0][2], c[1][2], c[2][2]],
+        ];
+        let scale =
+            box_a.center.abs().max_element() + box_a.half_extents.element_sum() + placed_b.scale;
+        Self {
+            r,
+            abs: r.map(|row| row.map(|x| x.abs() + tolerance::SAT_PARALLEL)),
+            t: (to_a * (placed_b.center - box_a.center)).to_array(),
+            a: box_a.half_extents.to_array(),
+            b: placed_b.half_extents.to_array(),
+            slack: conservative_slack(scale),
+        }
+    }
+
+    /// A's face axis `i`: (extent, reach).
+    #[inline]
+    fn face_of_a(&self, i: usize) -> (f64, f64) {
+        let (abs, b) = (&self.abs, &self.b);
+        let rb = b[0] * abs[i][0] + b[1] * abs[i][1] + b[2] * abs[i][2];
+        (self.t[i].abs(), self.a[i] + rb)
+    }
+
+    /// B's face axis `j`: (extent, reach).
+    #[inline]
+    fn face_of_b(&self, j: usize) -> (f64, f64) {
+        let (r, abs, t, a) = (&self.r, &self.abs, &self.t, &self.a);
+        let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
+        let ra = a[0] * abs[0][j] + a[1] * abs[1][j] + a[2] * abs[2][j];
+        (tj.abs(), ra + self.b[j])
+    }
+
+    /// The edge axis `A_i × B_j`: (extent, reach), both scaled by the axis's length.
+    #[inline]
+    fn edge(&self, i: usize, j: usize) -> (f64, f64) {
+        let (r, abs, t, a, b) = (&self.r, &self.abs, &self.t, &self.a, &self.b);
+        let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
+        let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
+        let extent = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
+        let ra = a[i1] * abs[i2][j] + a[i2] * abs[i1][j];
+        let rb = b[j1] * abs[i][j2] + b[j2] * abs[i][j1];
+        (extent, ra + rb)
+    }
+
+    /// `|A_i × B_j|²`, computed from the two entries of `R` it is made of.
+    #[inline]
+    fn edge_length_squared(&self, i: usize, j: usize) -> f64 {
+        let (r, i1, i2) = (&self.r, (i + 1) % 3, (i + 2) % 3);
+        r[i1][j] * r[i1][j] + r[i2][j] * r[i2][j]
+    }
+
+    /// Whether some axis separates the boxes (each test exits early).
+    #[inline]
+    fn any_separates(&self) -> bool {
+        let apart = |(extent, reach): (f64, f64)| extent > reach + self.slack;
+        (0..3).any(|i| apart(self.face_of_a(i)))
+            || (0..3).any(|j| apart(self.face_of_b(j)))
+            || (0..9).any(|k| apart(self.edge(k / 3, k % 3)))
     }
 }
 
@@ -353,35 +407,7 @@ impl BoundingVolume for Obb {
 
     #[inline]
     fn overlaps(&self, other: &Self, pose_ab: &Isometry) -> bool {
-        let (r, t, slack) = self.relative_to(&other.placed(pose_ab));
-        let (a, b) = (self.half_extents.to_array(), other.half_extents.to_array());
-        let abs = r.map(|row| row.map(|x| x.abs() + tolerance::SAT_PARALLEL));
-        for i in 0..3 {
-            let rb = b[0] * abs[i][0] + b[1] * abs[i][1] + b[2] * abs[i][2];
-            if t[i].abs() > a[i] + rb + slack {
-                return false;
-            }
-        }
-        for j in 0..3 {
-            let tj = t[0] * r[0][j] + t[1] * r[1][j] + t[2] * r[2][j];
-            let ra = a[0] * abs[0][j] + a[1] * abs[1][j] + a[2] * abs[2][j];
-            if tj.abs() > ra + b[j] + slack {
-                return false;
-            }
-        }
-        for i in 0..3 {
-            let (i1, i2) = ((i + 1) % 3, (i + 2) % 3);
-            for j in 0..3 {
-                let (j1, j2) = ((j + 1) % 3, (j + 2) % 3);
-                let lhs = (t[i2] * r[i1][j] - t[i1] * r[i2][j]).abs();
-                let ra = a[i1] * abs[i2][j] + a[i2] * abs[i1][j];
-                let rb = b[j1] * abs[i][j2] + b[j2] * abs[i][j1];
-                if lhs > ra + rb + slack {
-                    return false;
-                }
-            }
-        }
-        true
+        !SeparatingAxes::new(self, &other.placed(pose_ab)).any_separates()
     }
 
     fn distance_lower_bound(&self, other: &Self, pose_ab: &Isometry) -> f64 {

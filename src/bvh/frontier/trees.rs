@@ -161,18 +161,24 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
     #[must_use]
     pub fn split(&self, [a, b]: [u32; 2], limit: f64) -> [([u32; 2], f64); 2] {
         let (x, y) = (&self.a.nodes()[a as usize], &self.b.nodes()[b as usize]);
-        if descend_a(x, y) {
-            let children = x.children();
-            let [c0, c1] = children.map(|c| &self.a.nodes()[c].bv);
-            let bounds = B::distance_lower_bounds_within([c0, c1], &y.bv, self.pose_ab, limit);
-            [0, 1].map(|k| ([children[k] as u32, b], bounds[k]))
+        let split_a = descend_a(x, y);
+        let inverse;
+        let (tree, kept, children, pose) = if split_a {
+            (self.a, &y.bv, x.children(), self.pose_ab)
         } else {
-            let children = y.children();
-            let [c0, c1] = children.map(|c| &self.b.nodes()[c].bv);
-            let pose_ba = self.pose_ab.inverse();
-            let bounds = B::distance_lower_bounds_within([c0, c1], &x.bv, &pose_ba, limit);
-            [0, 1].map(|k| ([a, children[k] as u32], bounds[k]))
-        }
+            inverse = self.pose_ab.inverse();
+            (self.b, &x.bv, y.children(), &inverse)
+        };
+        let bounds = B::distance_lower_bounds_within(
+            children.map(|c| &tree.nodes()[c].bv),
+            kept,
+            pose,
+            limit,
+        );
+        [0, 1].map(|k| {
+            let c = children[k] as u32;
+            (if split_a { [c, b] } else { [a, c] }, bounds[k])
+        })
     }
 
     /// See [`PairTrees::test_leaves`].
