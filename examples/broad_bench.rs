@@ -23,6 +23,12 @@
 //! and `parry_bvh`'s map to the same set, every `--check-every` frames (not timed); a
 //! mismatch stops the run.
 //!
+//! `--one-at-a-time` runs each broad phase through all the frames before the next starts,
+//! on the same frames (the workload regenerated from the seed), so no other broad phase's
+//! work evicts its tables between its frames: at 100,000 bodies the peer's 11–13 ms frame
+//! reads far more memory than a whole cache, and in lockstep every phase starts its frames
+//! cold. The pair sets are then compared by a fingerprint per checked frame.
+//!
 //! Prints, per broad phase: mean and p99 µs per frame, pairs per frame, and the ratio of
 //! rapier's mean (the faster of its two settings) to this one's.
 //!
@@ -92,6 +98,10 @@ struct Args {
     /// Seed of the layout and the motion.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Each broad phase through all the frames in turn (same frames), instead of all of
+    /// them in lockstep, frame by frame.
+    #[arg(long)]
+    one_at_a_time: bool,
     /// Leave every table on the 4 KiB pages the system gives (no huge-page advice), to
     /// measure what the advice buys.
     #[arg(long)]
@@ -153,59 +163,47 @@ fn main() -> ExitCode {
         eprintln!("--scene is uniform|clustered|stack, --motion is coherent|teleport");
         return ExitCode::FAILURE;
     };
-    let mut scene = BroadScene::new(layout, args.bodies, args.moving, motion, args.seed);
-    scene.scale_speed(args.speed_scale);
-    let mut runners = Vec::new();
+    let new_scene = || {
+        let mut scene = BroadScene::new(layout, args.bodies, args.moving, motion, args.seed);
+        scene.scale_speed(args.speed_scale);
+        scene
+    };
+    let mut names = Vec::new();
     for name in args.algos.split(',').map(str::trim) {
-        match NAMES
-            .into_iter()
-            .find(|&a| a == name)
-            .and_then(|a| Runner::new(a, &scene))
-        {
-            Some(r) => runners.push(r),
+        match NAMES.into_iter().find(|&a| a == name) {
+            Some(a) => names.push(a),
             None => {
                 eprintln!("unknown broad phase {name:?}");
                 return ExitCode::FAILURE;
             }
         }
     }
+    let scene = new_scene();
     println!(
-        "scene {} ({} motion): {} bodies, {} moving per frame, {} frames",
+        "scene {} ({} motion): {} bodies, {} moving per frame, {} frames{}",
         layout.name(),
         motion.name(),
         scene.proxies.len(),
         scene.moving_count(),
-        args.frames
+        args.frames,
+        if args.one_at_a_time {
+            ", one broad phase at a time"
+        } else {
+            ""
+        }
     );
-    let mut moved = Vec::new();
-    for frame in 0..args.frames {
-        scene.next_frame(&mut moved);
-        let n = runners.len();
-        for k in 0..n {
-            runners[(frame + k) % n].frame(&scene, &moved);
+    let outcome = if args.one_at_a_time {
+        one_at_a_time(&names, new_scene, &args)
+    } else {
+        lockstep(&names, scene, &args)
+    };
+    let runners = match outcome {
+        Ok(runners) => runners,
+        Err(message) => {
+            eprintln!("{message}");
+            return ExitCode::FAILURE;
         }
-        if args.check_every > 0 && frame % args.check_every == 0 {
-            let mut reference: Option<(&str, Vec<CandidatePair>)> = None;
-            for r in &runners {
-                let Some(pairs) = r.phase.exact_pairs(&r.out) else {
-                    continue;
-                };
-                match &reference {
-                    None => reference = Some((r.name, pairs)),
-                    Some((name, expected)) if *expected != pairs => {
-                        eprintln!(
-                            "frame {frame}: {} has {} pairs, {name} has {}: the pair sets differ",
-                            r.name,
-                            pairs.len(),
-                            expected.len()
-                        );
-                        return ExitCode::FAILURE;
-                    }
-                    Some(_) => {}
-                }
-            }
-        }
-    }
+    };
     let peer_mean = runners
         .iter()
         .filter(|r| r.phase.is_peer())
@@ -231,4 +229,104 @@ fn main() -> ExitCode {
         );
     }
     ExitCode::SUCCESS
+}
+
+/// Loads a runner for each name (all known) on `scene`.
+fn runners(names: &[&'static str], scene: &BroadScene) -> Vec<Runner> {
+    names
+        .iter()
+        .filter_map(|&name| Runner::new(name, scene))
+        .collect()
+}
+
+/// Every broad phase on each frame in turn, the order rotating; the pair sets compared
+/// every `--check-every` frames.
+fn lockstep(
+    names: &[&'static str],
+    mut scene: BroadScene,
+    args: &Args,
+) -> Result<Vec<Runner>, String> {
+    let mut runners = runners(names, &scene);
+    let mut moved = Vec::new();
+    for frame in 0..args.frames {
+        scene.next_frame(&mut moved);
+        let n = runners.len();
+        for k in 0..n {
+            runners[(frame + k) % n].frame(&scene, &moved);
+        }
+        if args.check_every > 0 && frame % args.check_every == 0 {
+            let mut reference: Option<(&str, Vec<CandidatePair>)> = None;
+            for r in &runners {
+                let Some(pairs) = r.phase.exact_pairs(&r.out) else {
+                    continue;
+                };
+                match &reference {
+                    None => reference = Some((r.name, pairs)),
+                    Some((name, expected)) if *expected != pairs => {
+                        return Err(format!(
+                            "frame {frame}: {} has {} pairs, {name} has {}: the pair sets differ",
+                            r.name,
+                            pairs.len(),
+                            expected.len()
+                        ));
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+    }
+    Ok(runners)
+}
+
+/// Each broad phase through all the frames before the next one is loaded, on the same
+/// frames (`new_scene` regenerates the workload); the pair sets compared by a fingerprint
+/// of every `--check-every`th frame's sorted pairs.
+fn one_at_a_time(
+    names: &[&'static str],
+    new_scene: impl Fn() -> BroadScene,
+    args: &Args,
+) -> Result<Vec<Runner>, String> {
+    let mut done = Vec::new();
+    let mut reference: Option<(&str, Vec<u64>)> = None;
+    let mut moved = Vec::new();
+    for &name in names {
+        let mut scene = new_scene();
+        let mut runner = runners(&[name], &scene).remove(0);
+        let mut fingerprints = Vec::new();
+        for frame in 0..args.frames {
+            scene.next_frame(&mut moved);
+            runner.frame(&scene, &moved);
+            if args.check_every > 0
+                && frame % args.check_every == 0
+                && let Some(pairs) = runner.phase.exact_pairs(&runner.out)
+            {
+                fingerprints.push(fingerprint(&pairs));
+            }
+        }
+        if !fingerprints.is_empty() {
+            match &reference {
+                None => reference = Some((name, fingerprints)),
+                Some((first, expected)) => {
+                    if let Some(k) = (0..expected.len()).find(|&k| expected[k] != fingerprints[k]) {
+                        return Err(format!(
+                            "checked frame {}: {name} and {first} report different pair sets",
+                            k * args.check_every
+                        ));
+                    }
+                }
+            }
+        }
+        done.push(runner);
+    }
+    Ok(done)
+}
+
+/// A hash of a sorted pair list (FNV-1a over the ids).
+fn fingerprint(pairs: &[CandidatePair]) -> u64 {
+    pairs
+        .iter()
+        .flat_map(|p| [p.a, p.b])
+        .fold(0xcbf2_9ce4_8422_2325, |h, id| {
+            (h ^ u64::from(id)).wrapping_mul(0x0100_0000_01b3)
+        })
 }
