@@ -231,12 +231,9 @@ fn main() -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// Loads a runner for each name (all known) on `scene`.
-fn runners(names: &[&'static str], scene: &BroadScene) -> Vec<Runner> {
-    names
-        .iter()
-        .filter_map(|&name| Runner::new(name, scene))
-        .collect()
+/// The runner of `name`, one of [`NAMES`] (checked in `main`), loaded with `scene`.
+fn runner(name: &'static str, scene: &BroadScene) -> Runner {
+    Runner::new(name, scene).expect("names are checked against NAMES")
 }
 
 /// Every broad phase on each frame in turn, the order rotating; the pair sets compared
@@ -246,7 +243,7 @@ fn lockstep(
     mut scene: BroadScene,
     args: &Args,
 ) -> Result<Vec<Runner>, String> {
-    let mut runners = runners(names, &scene);
+    let mut runners: Vec<Runner> = names.iter().map(|&name| runner(name, &scene)).collect();
     let mut moved = Vec::new();
     for frame in 0..args.frames {
         scene.next_frame(&mut moved);
@@ -291,7 +288,7 @@ fn one_at_a_time(
     let mut moved = Vec::new();
     for &name in names {
         let mut scene = new_scene();
-        let mut runner = runners(&[name], &scene).remove(0);
+        let mut runner = runner(name, &scene);
         let mut fingerprints = Vec::new();
         for frame in 0..args.frames {
             scene.next_frame(&mut moved);
@@ -307,7 +304,8 @@ fn one_at_a_time(
             match &reference {
                 None => reference = Some((name, fingerprints)),
                 Some((first, expected)) => {
-                    if let Some(k) = (0..expected.len()).find(|&k| expected[k] != fingerprints[k]) {
+                    let differ = expected.iter().zip(&fingerprints).position(|(e, f)| e != f);
+                    if let Some(k) = differ {
                         return Err(format!(
                             "checked frame {}: {name} and {first} report different pair sets",
                             k * args.check_every

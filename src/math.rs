@@ -397,20 +397,26 @@ pub fn f32_rounding_slack(magnitude: f32) -> f32 {
     16.0 * f32::EPSILON * magnitude + f32::MIN_POSITIVE
 }
 
-/// Rounds `x` down to the nearest f32 (never above `x`), for lower interval ends.
+/// An f32 at or below `x`, for lower interval ends: the nearest f32 (within half an ulp,
+/// 2⁻²⁴ relative) lowered by a relative 2⁻²² and the smallest normal, so at most about
+/// 3·2⁻²⁴ of `|x|` below it. Beyond f32's range, `±f32::MAX` or below.
+///
+/// Not the largest such f32: that needs a test of the nearest rounding's direction,
+/// which is random and mispredicted half the time. Measured in the sort and sweep's
+/// per-frame rounding of 10,000 boxes (`examples/broad_bench`, all moving): with the
+/// test, 27 % of the frame; without, 4 %.
 #[must_use]
 #[inline]
 pub fn f32_round_down(x: f64) -> f32 {
-    let y = x as f32;
-    if f64::from(y) > x { y.next_down() } else { y }
+    let y = (x as f32).clamp(-f32::MAX, f32::MAX);
+    y - (y.abs() * (2.0 * f32::EPSILON) + f32::MIN_POSITIVE)
 }
 
-/// Rounds `x` up to the nearest f32 (never below `x`), for upper interval ends and radii.
+/// An f32 at or above `x`, for upper interval ends and radii (as [`f32_round_down`]).
 #[must_use]
 #[inline]
 pub fn f32_round_up(x: f64) -> f32 {
-    let y = x as f32;
-    if f64::from(y) < x { y.next_up() } else { y }
+    -f32_round_down(-x)
 }
 
 /// An orthonormal basis `(u, v)` completing the unit vector `n` to a right-handed frame
@@ -550,11 +556,49 @@ mod tests {
         );
     }
 
+    /// The rounded ends bracket the value at every magnitude, within a few f32 ulps inside
+    /// f32's normal range, over values that round to nearest in both directions.
     #[test]
-    fn f32_rounding_brackets_the_value() {
-        for x in [0.1, -0.1, 1e-30, 3.0, 1e7 + 0.3, -123.456789, 0.0] {
-            assert!(f64::from(f32_round_down(x)) <= x, "{x}");
-            assert!(f64::from(f32_round_up(x)) >= x, "{x}");
+    fn f32_rounding_brackets_the_value_at_any_magnitude() {
+        use rand::Rng;
+        let mut rng = crate::test_support::rng(41);
+        let mut both = [0usize; 2];
+        let special = [
+            0.1,
+            -0.1,
+            1e-30,
+            3.0,
+            1e7 + 0.3,
+            -123.456789,
+            0.0,
+            -0.0,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+            1e-40,
+            -1e-40,
+            f64::from(f32::MAX),
+            -f64::from(f32::MAX),
+            1e39,
+            -1e39,
+            1e300,
+            -1e300,
+        ];
+        let random = (0..20_000).map(|_| {
+            let magnitude = 10f64.powf(rng.random_range(-12.0..12.0));
+            magnitude * rng.random_range(-1.0..1.0)
+        });
+        for x in special.into_iter().chain(random) {
+            let (below, above) = (f32_round_down(x), f32_round_up(x));
+            assert!(
+                f64::from(below) <= x && x <= f64::from(above),
+                "{x}: {below} {above}"
+            );
+            if x.abs() > 1e-30 && x.abs() < 1e30 {
+                assert!(f64::from(above) - f64::from(below) <= 1e-6 * x.abs(), "{x}");
+            }
+            // Which side of `x` the nearest f32 falls on: both must occur.
+            both[usize::from(f64::from(x as f32) > x)] += 1;
         }
+        assert!(both[0] > 1_000 && both[1] > 1_000, "{both:?}");
     }
 }

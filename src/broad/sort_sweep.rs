@@ -17,15 +17,16 @@
 //!
 //! # One frame
 //! 1. The sweep axis `s` (largest variance of the centres) and the column axes `u`, `v`.
-//! 2. The column edge `c`: [`COLUMN_EDGE_PER_BOX`] times the 75th percentile of the boxes' larger extent on `u`,
-//!    `v`, raised until the grid over the boxes (their span measured every frame) has at
-//!    most [`MAX_COLUMNS_PER_PROXY`] × `n` columns (so tiny far-apart boxes do not make a
-//!    huge empty grid); boxes wider than [`BIG_COLUMNS`] columns on `u` or `v` are *big*:
-//!    tested against every proxy instead. The axis and the percentile are measured again
-//!    every [`RESHAPE_FRAMES`] frames, or when the proxy count changes: a stale one only
-//!    costs time, as any grid lists every box in every column it meets (measured, 10,000
-//!    bodies all moving, three alternating runs: 1,415–1,530 → 1,355–1,365 µs a frame
-//!    uniform, 1,420–1,532 → 1,310–1,347 clustered).
+//! 2. The column edge `c`: [`COLUMN_EDGE_PER_BOX`] times the 75th percentile of the
+//!    boxes' larger extent on `u`, `v`, raised until the grid over the boxes (their span
+//!    measured every frame) has at most [`MAX_COLUMNS_PER_PROXY`] × `n` columns (so tiny
+//!    far-apart boxes do not make a huge empty grid); boxes wider than [`BIG_COLUMNS`]
+//!    columns on `u` or `v` are *big*: tested against every proxy instead. The axis and
+//!    the percentile are measured again every [`RESHAPE_FRAMES`] frames, or when the
+//!    proxy count changes: a stale one only costs time, as any grid lists every box in
+//!    every column it meets (measured, 10,000 bodies all moving, three alternating runs:
+//!    1,415–1,530 → 1,355–1,365 µs a frame uniform, 1,420–1,532 → 1,310–1,347
+//!    clustered).
 //! 3. The kept order of the proxies by their low end on `s` is brought up to date by
 //!    insertion sort (linear for coherent motion; a full sort past
 //!    [`MAX_SHIFTS_PER_PROXY`] shifts per proxy). Every other box is listed in each column
@@ -60,6 +61,7 @@
 use super::pair_sort::sort_pairs;
 use super::{CandidatePair, Proxy};
 use crate::bounding::{Aabb, BoundingVolume};
+use crate::math::{f32_round_down, f32_round_up};
 
 /// Column edge over the 75th percentile of the boxes' larger extent on the column axes.
 ///
@@ -130,30 +132,13 @@ type RoundedBox = [f32; 6];
 #[inline]
 fn rounded_box(b: &Aabb, grid: &Grid) -> RoundedBox {
     [
-        f32_below(b.min[grid.axis]),
-        f32_above(b.max[grid.axis]),
-        f32_below(b.min[grid.u]),
-        f32_above(b.max[grid.u]),
-        f32_below(b.min[grid.v]),
-        f32_above(b.max[grid.v]),
+        f32_round_down(b.min[grid.axis]),
+        f32_round_up(b.max[grid.axis]),
+        f32_round_down(b.min[grid.u]),
+        f32_round_up(b.max[grid.u]),
+        f32_round_down(b.min[grid.v]),
+        f32_round_up(b.max[grid.v]),
     ]
-}
-
-/// An `f32` at or below `x`, without a branch: the nearest `f32` (within half an ulp,
-/// 2⁻²⁴ relative) lowered by a relative 2⁻²² and the smallest normal. Not the largest
-/// such `f32` ([`f32_round_down`](crate::math::f32_round_down) is, but its test of the
-/// rounding's direction mispredicts half the time: 27 % of a frame of 10,000 boxes).
-/// Beyond `f32`'s range, `±f32::MAX` or below.
-#[inline]
-fn f32_below(x: f64) -> f32 {
-    let y = (x as f32).clamp(-f32::MAX, f32::MAX);
-    y - (y.abs() * (2.0 * f32::EPSILON) + f32::MIN_POSITIVE)
-}
-
-/// An `f32` at or above `x`, without a branch (as [`f32_below`]).
-#[inline]
-fn f32_above(x: f64) -> f32 {
-    -f32_below(-x)
 }
 
 /// Whether two rounded boxes overlap on the column axes (touching counts): never false
@@ -708,44 +693,6 @@ mod tests {
             total_pairs > 1_000 && unpaired > 1_000 && kept > 500,
             "pairs {total_pairs}, unpaired boxes {unpaired}, frames on a kept shape {kept}"
         );
-    }
-
-    #[test]
-    fn rounded_ends_never_cross_the_exact_value_at_any_magnitude() {
-        let mut rng = rng(41);
-        let mut both = [0usize; 2];
-        let special = [
-            0.0,
-            -0.0,
-            f64::MIN_POSITIVE,
-            -f64::MIN_POSITIVE,
-            1e-40,
-            -1e-40,
-            f64::from(f32::MAX),
-            -f64::from(f32::MAX),
-            1e39,
-            -1e39,
-            1e300,
-            -1e300,
-        ];
-        let random = (0..20_000).map(|_| {
-            let magnitude = 10f64.powf(rng.random_range(-12.0..12.0));
-            magnitude * rng.random_range(-1.0..1.0)
-        });
-        for x in special.into_iter().chain(random) {
-            let (below, above) = (f32_below(x), f32_above(x));
-            assert!(
-                f64::from(below) <= x && x <= f64::from(above),
-                "{x}: {below} {above}"
-            );
-            // Not much wider than the nearest rounding, inside f32's normal range.
-            if x.abs() > 1e-30 && x.abs() < 1e30 {
-                assert!(f64::from(above) - f64::from(below) <= 1e-6 * x.abs(), "{x}");
-            }
-            // Both sides of the nearest `f32` occur.
-            both[usize::from(f64::from(x as f32) > x)] += 1;
-        }
-        assert!(both[0] > 1_000 && both[1] > 1_000, "{both:?}");
     }
 
     #[test]
