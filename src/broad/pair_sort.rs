@@ -13,6 +13,7 @@
 //! [`SortAndSweep`]: super::SortAndSweep
 
 use super::CandidatePair;
+use super::radix::radix_sort;
 
 /// Fewest pairs the radix sort is used for; fewer go to `sort_unstable`, whose compares
 /// cost less than the radix passes' 256-entry tables then.
@@ -34,32 +35,7 @@ pub(crate) fn sort_pairs(pairs: &mut Vec<CandidatePair>, scratch: &mut Vec<Candi
         pairs.sort_unstable();
         return;
     }
-    let mut counts = [[0u32; 256]; 8];
-    for pair in pairs.iter() {
-        let k = key(pair);
-        for (byte, table) in counts.iter_mut().enumerate() {
-            table[((k >> (8 * byte)) & 0xff) as usize] += 1;
-        }
-    }
-    scratch.clear();
-    scratch.resize(pairs.len(), CandidatePair { a: 0, b: 0 });
-    let n = pairs.len() as u32;
-    for (byte, table) in counts.iter_mut().enumerate() {
-        // Every key has the same byte here: the pass would move nothing.
-        if table.contains(&n) {
-            continue;
-        }
-        let mut start = 0;
-        for count in table.iter_mut() {
-            (start, *count) = (start + *count, start);
-        }
-        for pair in pairs.iter() {
-            let digit = ((key(pair) >> (8 * byte)) & 0xff) as usize;
-            scratch[table[digit] as usize] = *pair;
-            table[digit] += 1;
-        }
-        std::mem::swap(pairs, scratch);
-    }
+    radix_sort::<_, 8>(pairs, scratch, key);
 }
 
 #[cfg(test)]

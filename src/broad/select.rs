@@ -90,7 +90,8 @@ struct Sweep {
 
 #[derive(Debug, Clone)]
 enum Inner {
-    Sweep(Sweep),
+    /// Boxed, as `Skin`: its scratch is a dozen vectors.
+    Sweep(Box<Sweep>),
     Sap(IncrementalSap),
     Grid(HashGrid),
     Columns(ColumnGrid),
@@ -115,7 +116,7 @@ impl BroadPhase {
     #[must_use]
     pub fn new(kind: BroadPhaseKind) -> Self {
         let inner = match kind {
-            BroadPhaseKind::SortAndSweep => Inner::Sweep(Sweep::default()),
+            BroadPhaseKind::SortAndSweep => Inner::Sweep(Box::default()),
             BroadPhaseKind::IncrementalSap => Inner::Sap(IncrementalSap::new()),
             BroadPhaseKind::HashGrid => Inner::Grid(HashGrid::new()),
             BroadPhaseKind::ColumnGrid => Inner::Columns(ColumnGrid::new()),

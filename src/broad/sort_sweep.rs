@@ -28,8 +28,9 @@
 //!    1,415–1,530 → 1,355–1,365 µs a frame uniform, 1,420–1,532 → 1,310–1,347
 //!    clustered).
 //! 3. The kept order of the proxies by their low end on `s` is brought up to date by
-//!    insertion sort (linear for coherent motion; a full sort past
-//!    [`MAX_SHIFTS_PER_PROXY`] shifts per proxy). Every other box is listed in each column
+//!    insertion sort while few proxies change places, by a radix sort of the keys when
+//!    many do (`key_sort.rs`, whose docs give the rule and its measurements). Every other
+//!    box is listed in each column
 //!    its `u`, `v` extent meets (1 to 4 mostly), by a counting sort on the column filled in
 //!    that order, so each column comes out sorted by low end with no sort of its own.
 //! 4. Each column is swept: entry `i` meets the entries after it whose low end is at most
@@ -69,10 +70,11 @@
 //! `n log n` work with the fallback), `e` column entries, `t` interval tests in the
 //! columns and `k` pairs; no allocation once the scratch has grown.
 
+use super::key_sort::KeySort;
 use super::pair_sort::sort_pairs;
 use super::{CandidatePair, Proxy};
 use crate::bounding::{Aabb, BoundingVolume};
-use crate::math::{f32_round_down, f32_round_up};
+use crate::math::{DVec3, f32_round_down, f32_round_up};
 
 /// Column edge over the 75th percentile of the boxes' larger extent on the column axes.
 ///
@@ -90,9 +92,6 @@ pub const COLUMN_EDGE_PER_BOX: f64 = 4.0;
 pub const MAX_COLUMNS_PER_PROXY: usize = 4;
 /// A box spanning more columns than this on a column axis is tested against every proxy.
 pub const BIG_COLUMNS: u64 = 4;
-/// Insertion sort of the kept order gives way to a full sort beyond this many shifts per
-/// proxy (teleports): coherent frames shift each proxy by a few places at most.
-pub const MAX_SHIFTS_PER_PROXY: usize = 8;
 /// Frames the sweep axis and the column edge are kept before they are measured again
 /// (sooner when the proxy count changes).
 pub const RESHAPE_FRAMES: u32 = 8;
@@ -125,10 +124,30 @@ impl Grid {
     /// First and last column of `p` on each column axis.
     #[inline]
     fn range(&self, p: &Proxy) -> [[u64; 2]; 2] {
-        let b = &p.bounds;
+        self.range_of(&self.ends(&p.bounds))
+    }
+
+    /// First and last column on each column axis of a box given by [`Self::ends`].
+    #[inline]
+    fn range_of(&self, ends: &[f64; 6]) -> [[u64; 2]; 2] {
         [
-            [self.cell(0, b.min[self.u]), self.cell(0, b.max[self.u])],
-            [self.cell(1, b.min[self.v]), self.cell(1, b.max[self.v])],
+            [self.cell(0, ends[2]), self.cell(0, ends[3])],
+            [self.cell(1, ends[4]), self.cell(1, ends[5])],
+        ]
+    }
+
+    /// `b`'s low and high ends on the sweep axis, then on `u`, then on `v`, metres. (Read
+    /// through arrays: a `DVec3` indexed by a run-time axis is a chain of branches.)
+    #[inline(always)]
+    fn ends(&self, b: &Aabb) -> [f64; 6] {
+        let (min, max) = (b.min.to_array(), b.max.to_array());
+        [
+            min[self.axis],
+            max[self.axis],
+            min[self.u],
+            max[self.u],
+            min[self.v],
+            max[self.v],
         ]
     }
 }
@@ -139,19 +158,18 @@ impl Grid {
 /// random) only for the pairs that pass.
 type RoundedBox = [f32; 6];
 
-/// `b` on the sweep axis and the column axes of `grid`, rounded outward. Always inlined:
+/// A box's [`Grid::ends`], rounded outward. Always inlined:
 /// called, its result is stored and read back through a stalled store forwarding (module
 /// docs, step 4).
 #[inline(always)]
-fn rounded_box(b: &Aabb, grid: &Grid) -> RoundedBox {
-    [
-        f32_round_down(b.min[grid.axis]),
-        f32_round_up(b.max[grid.axis]),
-        f32_round_down(b.min[grid.u]),
-        f32_round_up(b.max[grid.u]),
-        f32_round_down(b.min[grid.v]),
-        f32_round_up(b.max[grid.v]),
-    ]
+fn rounded_box(ends: &[f64; 6]) -> RoundedBox {
+    std::array::from_fn(|k| {
+        if k % 2 == 0 {
+            f32_round_down(ends[k])
+        } else {
+            f32_round_up(ends[k])
+        }
+    })
 }
 
 /// Lanes of the sweep's blocks: it tests an entry against this many later entries of its
@@ -277,6 +295,8 @@ pub struct SortAndSweep {
     shape: Option<Shape>,
     /// The other buffer of the pairs' radix sort.
     sorted: Vec<CandidatePair>,
+    /// Scratch of `order`'s sort.
+    order_sort: KeySort<(Slot, u32)>,
 }
 
 /// What [`SortAndSweep`] measures of the proxies to lay its grid, kept for
@@ -397,14 +417,13 @@ impl SortAndSweep {
         };
         let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
         let (u, v) = (u.min(v), u.max(v));
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for p in proxies {
-            for (k, axis) in [u, v].into_iter().enumerate() {
-                lo[k] = lo[k].min(p.bounds.min[axis]);
-                hi[k] = hi[k].max(p.bounds.max[axis]);
-            }
-        }
-        let span = [hi[0] - lo[0], hi[1] - lo[1]];
+        let (low, high) = proxies
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(low, high), p| {
+                (low.min(p.bounds.min), high.max(p.bounds.max))
+            });
+        let lo = [low[u], low[v]];
+        let span = [high[u] - low[u], high[v] - low[v]];
         // A few typical boxes; never so fine that the grid outgrows the proxies.
         let area_per_column = span[0].max(f64::MIN_POSITIVE) * span[1].max(f64::MIN_POSITIVE)
             / (MAX_COLUMNS_PER_PROXY * proxies.len()) as f64;
@@ -439,13 +458,14 @@ impl SortAndSweep {
         self.slots.clear();
         self.big.clear();
         for (i, p) in proxies.iter().enumerate() {
-            let [[u0, u1], [v0, v1]] = grid.range(p);
+            let ends = grid.ends(&p.bounds);
+            let [[u0, u1], [v0, v1]] = grid.range_of(&ends);
             let big = u1 - u0 >= BIG_COLUMNS || v1 - v0 >= BIG_COLUMNS;
             if big {
                 self.big.push(i as u32);
             }
             self.slots.push(Slot {
-                rounded: rounded_box(&p.bounds, &grid),
+                rounded: rounded_box(&ends),
                 first: if big {
                     [u32::MAX; 2]
                 } else {
@@ -501,12 +521,12 @@ impl SortAndSweep {
         self.starts[columns] = total as u32;
     }
 
-    /// Brings `order` up to date with `proxies` on the sweep axis: rebuilt and fully sorted
-    /// when the axis changed; otherwise entries past the new proxy count are dropped, every
-    /// entry's slot read again (entries are indices, so a proxy that changed place, e.g. by
-    /// a caller's `swap_remove`, is simply re-read), new indices appended and the order
-    /// insertion-sorted, which is linear when the bodies moved coherently; when that would
-    /// take more than [`MAX_SHIFTS_PER_PROXY`] shifts per proxy (teleports), a full sort.
+    /// Brings `order` up to date with `proxies` on the sweep axis: rebuilt when the axis
+    /// changed; otherwise entries past the new proxy count are dropped, every entry's slot
+    /// read again (entries are indices, so a proxy that changed place, e.g. by a caller's
+    /// `swap_remove`, is simply re-read) and new indices appended. Then sorted by
+    /// [`KeySort`]: by insertion while the proxies keep close to their last order, by a
+    /// radix sort when they do not (module docs, step 3).
     fn refresh_order(&mut self, n: usize) {
         let slots = &self.slots;
         let rebuild = self.grid.axis != self.order_axis || self.order.is_empty();
@@ -527,9 +547,8 @@ impl SortAndSweep {
                 .skip(kept)
                 .map(|(i, &s)| (s, i as u32)),
         );
-        if rebuild || !insertion_sort(&mut self.order, MAX_SHIFTS_PER_PROXY * n) {
-            self.order.sort_unstable_by(by_low_end);
-        }
+        self.order_sort
+            .sort(&mut self.order, |entry| entry.0.rounded[0]);
     }
 
     /// Checks the scratch of the last [`Self::pairs`] call against `proxies`, which must be
@@ -573,7 +592,7 @@ impl SortAndSweep {
                         "proxy {i} listed in column ({cu}, {cv}) it does not meet"
                     ));
                 }
-                if rounded != rounded_box(&p.bounds, &grid) {
+                if rounded != rounded_box(&grid.ends(&p.bounds)) {
                     return Err(format!(
                         "proxy {i}: stale box (low end {low}) in column ({cu}, {cv})"
                     ));
@@ -611,32 +630,6 @@ impl SortAndSweep {
         }
         Ok(())
     }
-}
-
-/// The order of `order`'s entries: by their slot's (rounded) low end on the sweep axis.
-#[inline]
-fn by_low_end(a: &(Slot, u32), b: &(Slot, u32)) -> std::cmp::Ordering {
-    a.0.rounded[0].total_cmp(&b.0.rounded[0])
-}
-
-/// Sorts [`by_low_end`] by insertion, giving up (`false`, order then partly sorted) once
-/// more than `max_shifts` entries have been shifted.
-fn insertion_sort(entries: &mut [(Slot, u32)], max_shifts: usize) -> bool {
-    let mut shifts = 0;
-    for i in 1..entries.len() {
-        let entry = entries[i];
-        let mut j = i;
-        while j > 0 && by_low_end(&entries[j - 1], &entry).is_gt() {
-            entries[j] = entries[j - 1];
-            j -= 1;
-        }
-        entries[j] = entry;
-        shifts += i - j;
-        if shifts > max_shifts {
-            return false;
-        }
-    }
-    true
 }
 
 /// The axis (0, 1, 2) along which the proxies' box centres have the largest variance (the sweep
