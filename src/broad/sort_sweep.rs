@@ -49,7 +49,7 @@
 //!    intervals meet, 27,300 passed the column rule and 5,000 are pairs; the time went to
 //!    mispredicted branches, so the column rule and the `u`, `v` test are one branch.
 //!
-//!    The sweep tests an entry against the next `LANES` (8) entries of its column at
+//!    The sweep tests an entry against the next `LANES` (16) entries of its column at
 //!    once, every test of every lane without a branch (the column entries are stored one
 //!    array per field, so the compares vectorise), and branches only on the lanes that
 //!    pass and on whether the run goes on past the block, which it rarely does. Measured
@@ -58,7 +58,11 @@
 //!    same runs to 494–510: called, its six `f32` results went through memory and were
 //!    read back as wider words, a stalled store forwarding per proxy. Both together:
 //!    uniform 619–622 → 523–525, stacked 640–648 → 583–598, clustered teleporting 10 %
-//!    735 → 652–657, 1,000 clustered 37–38 → 35–37.
+//!    735 → 652–657, 1,000 clustered 37–38 → 35–37 (blocks of 8). Blocks of 16 against
+//!    8, later: uniform 489–490 → 458–463, clustered 463–469 → 442–449, stacked 553–559
+//!    → 504–505, clustered 10 % moving 443–454 → 417–420, 1,000 uniform 43.6 → 42.1,
+//!    1,000 clustered the same; 32 lanes measured slower than both (uniform 515–519 µs, in
+//!    another run of the same day), 64 slower still.
 //! 5. Big proxies against everything, the pairs sorted (`pair_sort.rs`: a radix sort).
 //!
 //! Ties: cells are `⌊(x − origin) / c⌋` of non-negative values (a truncating conversion),
@@ -174,7 +178,9 @@ fn rounded_box(ends: &[f64; 6]) -> RoundedBox {
 
 /// Lanes of the sweep's blocks: it tests an entry against this many later entries of its
 /// column at once, branch-free, and branches only on the pairs that pass.
-const LANES: usize = 8;
+const LANES: usize = 16;
+// The block's lane mask is a `u32`, and `1 << LANES` must not overflow it.
+const _: () = assert!(LANES < u32::BITS as usize);
 
 /// [`ColumnEntries::first`] bit: the entry's column is the proxy's first on `u`.
 const FIRST_ON_U: u32 = 1;
@@ -197,10 +203,10 @@ struct ColumnEntries {
 }
 
 impl ColumnEntries {
-    /// `total` entries, filled with padding, plus the [`LANES`] padding entries.
-    fn reset(&mut self, total: usize) {
+    /// Room for `total` entries (their contents left as they are, for the caller to
+    /// overwrite), followed by the [`LANES`] padding entries.
+    fn resize(&mut self, total: usize) {
         for (k, end) in self.ends.iter_mut().enumerate() {
-            end.clear();
             // Low ends +∞ and high ends −∞: the padding meets nothing.
             let pad = if k % 2 == 0 {
                 f32::INFINITY
@@ -208,11 +214,12 @@ impl ColumnEntries {
                 f32::NEG_INFINITY
             };
             end.resize(total + LANES, pad);
+            end[total..].fill(pad);
         }
-        self.first.clear();
         self.first.resize(total + LANES, 0);
-        self.proxy.clear();
+        self.first[total..].fill(0);
         self.proxy.resize(total + LANES, u32::MAX);
+        self.proxy[total..].fill(u32::MAX);
     }
 
     fn set(&mut self, at: usize, rounded: &RoundedBox, first: u32, proxy: u32) {
@@ -332,7 +339,7 @@ impl SortAndSweep {
             self.shape = None;
             self.order.clear();
             self.starts.clear();
-            self.entries.reset(0);
+            self.entries.resize(0);
             self.slots.clear();
             self.big.clear();
             return;
@@ -496,7 +503,7 @@ impl SortAndSweep {
             self.starts[k] += self.starts[k - 1];
         }
         let total = self.starts[columns] as usize;
-        self.entries.reset(total);
+        self.entries.resize(total);
         // Fill each column from its end backwards, taking the proxies in descending order on
         // the sweep axis: every column comes out ascending, and `starts` ends at the column
         // starts.
@@ -778,9 +785,10 @@ mod tests {
             is_static: false,
             filter: CollisionFilter::ALL,
         };
-        // Corner to corner, and ten boxes sharing the same low end on every axis.
+        // Corner to corner, and forty boxes sharing the same low end on every axis (one
+        // run of the sweep spanning several blocks of `LANES` entries).
         let mut proxies = vec![unit(0.0, 0.0), unit(1.0, 1.0)];
-        proxies.extend((0..10).map(|_| unit(5.0, 5.0)));
+        proxies.extend((0..40).map(|_| unit(5.0, 5.0)));
         for (i, p) in proxies.iter_mut().enumerate() {
             p.body = i as u32;
         }
@@ -788,6 +796,7 @@ mod tests {
         pairs_brute_force(&proxies, &mut expected);
         SortAndSweep::new().pairs(&proxies, &mut found);
         assert_eq!(found, expected);
-        assert_eq!(found.len(), 1 + 45);
+        assert_eq!(found.len(), 1 + 40 * 39 / 2);
+        const { assert!(40 > 2 * LANES) };
     }
 }
