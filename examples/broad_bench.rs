@@ -54,7 +54,7 @@ use broad_phases::{NAMES, Phase};
 use broad_scenes::{BroadScene, Layout, Motion};
 use clap::Parser;
 use proxima::bounding::Aabb;
-use proxima::broad::CandidatePair;
+use proxima::broad::{BroadPhaseKind, BroadPhaseStats, CandidatePair, MoveCounts, choose};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -192,6 +192,13 @@ fn main() -> ExitCode {
             ""
         }
     );
+    let (stats, chosen) = automatic_choice(new_scene(), args.frames);
+    println!(
+        "moving {:.2}, mean relative shift {:.4}, far moves {:.2} %: the automatic choice is {chosen:?}",
+        stats.moving_fraction,
+        stats.mean_shift,
+        100.0 * stats.far_move_fraction
+    );
     let outcome = if args.one_at_a_time {
         one_at_a_time(&names, new_scene, &args)
     } else {
@@ -229,6 +236,26 @@ fn main() -> ExitCode {
         );
     }
     ExitCode::SUCCESS
+}
+
+/// The statistics the automatic choice reads (`proxima::broad::choose`), measured as the
+/// pipeline does (the last frame's boxes, the motion counted over all `frames`), and what
+/// it picks.
+fn automatic_choice(mut scene: BroadScene, frames: usize) -> (BroadPhaseStats, BroadPhaseKind) {
+    let (mut counts, mut moved) = (MoveCounts::default(), Vec::new());
+    let mut last_moved = 0;
+    let mut before: Vec<Aabb> = Vec::new();
+    for _ in 0..frames {
+        before.clear();
+        before.extend(scene.proxies.iter().map(|p| p.bounds));
+        scene.next_frame(&mut moved);
+        for &(body, bounds) in &moved {
+            counts.add(&before[body as usize], &bounds);
+        }
+        last_moved = moved.len();
+    }
+    let stats = BroadPhaseStats::measure(&scene.proxies, last_moved).with_moves(&counts);
+    (stats, choose(&stats))
 }
 
 /// The runner of `name`, one of [`NAMES`] (checked in `main`), loaded with `scene`.

@@ -482,7 +482,7 @@ pub struct MoveCounts {
 
 impl MoveCounts {
     /// Counts the move of a box from `old` to `new`.
-    fn add(&mut self, old: &Aabb, new: &Aabb) {
+    pub fn add(&mut self, old: &Aabb, new: &Aabb) {
         let shift = (((new.min + new.max) - (old.min + old.max)).abs() * 0.5).max_element();
         let edge = (old.max - old.min).max_element();
         self.moves += 1;
@@ -568,7 +568,7 @@ pub const MOSTLY_MOVING: f64 = 0.5;
 /// Mean relative shift per update ([`MoveCounts::mean_shift`]) up to which bodies count as
 /// creeping: the skin grid keeps them even when most move (measured crossovers in
 /// [`choose`]'s docs).
-pub const CREEPING: f64 = 0.01;
+pub const CREEPING: f64 = 0.018;
 /// Above this fraction of far moves among the updates, a scene counts as teleporting.
 pub const TELEPORTING: f64 = 0.01;
 /// Bodies up to which the [`SortAndSweep`] kind tests every pair instead of sweeping: the
@@ -644,16 +644,34 @@ pub const ALL_PAIRS_MAX: usize = 32;
 /// the column grid only when it leaves its skin: it is the fastest on every coherent class
 /// up to half the bodies moving. Sort and sweep costs the same whatever moved and wins
 /// once most bodies move fast for their size; slow ones stay cheaper in the skin grid.
-/// Where they cross, with all of 10,000 bodies moving (µs, sort and sweep / skin grid, at
-/// 1/6, 1/3, 1/2, 2/3 and all of the bench speed, one run): uniform 1,464 / 750,
-/// 1,527 / 1,023, 1,551 / 1,407, 1,455 / 1,465, 1,773 / 2,949; clustered 1,687 / 1,502,
-/// 1,644 / 1,792, 1,695 / 1,948, 1,420 / 1,609, 1,376 / 1,894. In mean relative shift
-/// (the farthest axis over the largest edge; a random direction's largest component is
-/// about 0.7 of the speed) the uniform bodies cross at about 0.013, the clustered ones,
-/// whose small bodies move far for their size, at about 0.010: [`CREEPING`]. The stacked
-/// dice creep at about 0.004. Teleports leave every skin, which costs the skin grid a
-/// refiling each: the column grid takes them, except on the stacked dice, whose
-/// "teleports" stay within 5 cm (not far moves: the rule picks the skin grid there).
+///
+/// Where they cross (2026-11-25, after the sort and sweep's blocks and radix-sorted order
+/// made it about 1.6 times faster than in the tables above): all bodies moving, each kind
+/// alone on the core (`--one-at-a-time`), mean µs a frame, sort and sweep / skin grid at
+/// 1/6, 1/3, 1/2, 2/3 and all of the bench speed, the mean relative shift the bench
+/// prints in brackets:
+///
+/// | bodies, layout | 1/6 | 1/3 | 1/2 | 2/3 | all |
+/// |---|---|---|---|---|---|
+/// | 10,000 uniform | 437 / 239 (0.0034) | 455 / 314 (0.0067) | 455 / 391 (0.0101) | 466 / 459 (0.0135) | 458 / 609 (0.0202) |
+/// | 10,000 clustered | 457 / 295 (0.0095) | 475 / 368 (0.0171) | 473 / 440 (0.0247) | 468 / 497 (0.0323) | 444 / 590 (0.0475) |
+/// | 10,000 stacked | 478 / 115 (0.0007) | 483 / 134 | 491 / 153 | 501 / 169 | 505 / 201 (0.0040) |
+/// | 1,000 uniform | 34 / 20 | 36 / 27 | 43 / 33 | 39 / 39 (0.0134) | 42 / 51 (0.0201) |
+/// | 1,000 clustered | 31 / 15 | 31 / 17 | 31 / 19 | 31 / 21 | 33 / 26 (0.0474) |
+/// | 1,000 stacked | 41 / 11 | 45 / 13 | 48 / 15 | 52 / 17 | 49 / 20 |
+///
+/// The uniform layout crosses at a shift of about 0.0135, the clustered one (a tenfold
+/// size spread: its small bodies move far for their size) at about 0.029 with 10,000
+/// bodies and not at all with 1,000; [`CREEPING`] at 0.018 sits between them (clear of
+/// the uniform full speed's 0.020), so the choice is the faster kind or within 8 % of it
+/// at 10,000 bodies (clustered at half speed: 473 against 440 µs), but not for 1,000
+/// clustered bodies from half speed on (31–33 against 19–26 µs). The mean hides the skin grid's tail: its refilings bunch, and its
+/// p99 was twice the sort and sweep's at 10,000 clustered bodies at full speed (1,162
+/// against 595 µs), which the rule does not weigh. Before (the sort and sweep slower),
+/// the crossings were at 0.013 and 0.010, and [`CREEPING`] was 0.01. Teleports leave every
+/// skin, which costs the skin grid a refiling each: the column grid takes them, except on
+/// the stacked dice, whose "teleports" stay within 5 cm (not far moves: the rule picks the
+/// skin grid there).
 ///
 /// [`BroadPhaseStats::size_spread`] and [`BroadPhaseStats::sweep_overlap_ratio`] are
 /// measured and reported ([`StepReport::broad_stats`](crate::pipeline::StepReport)) but the
