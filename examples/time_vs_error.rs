@@ -30,7 +30,8 @@
 //!   report exactly;
 //! - latency of `step_within`: p50, p99, p99.9, max; `deadline_misses`: frames over budget;
 //! - `truncated_pairs_per_frame`, and `separated_pairs_per_frame`: mesh pairs answered
-//!   "apart" by a separation kept from an earlier frame (no traversal);
+//!   "apart" with no traversal, by a separation kept from an earlier frame or by their
+//!   convex hulls; `hull_tests_per_frame`: the hull tests run;
 //! - `broad_us_mean`, `frontier_us_mean`, `narrow_us_mean`: the frame's stage times
 //!   ([`StepReport`]'s `broad_ns`, `mid_ns`, `narrow_ns`), mean µs.
 //!
@@ -373,8 +374,10 @@ struct Row {
     /// Frontier visits and truncated pairs, summed over the frames.
     visits: u64,
     truncated_pairs: u64,
-    /// Mesh pairs answered by a kept separation, summed over frames.
+    /// Mesh pairs answered apart with no traversal, summed over frames.
     separated_pairs: u64,
+    /// Hull tests, summed over the frames.
+    hull_tests: u64,
     /// Stage times of `step_within` (broad phase, budgeted frontier, narrow phase), summed
     /// over frames, nanoseconds.
     stage_ns: [u64; 3],
@@ -589,6 +592,7 @@ fn run_row(
         row.visits += report.frontier.visits;
         row.truncated_pairs += u64::from(report.truncated_pairs);
         row.separated_pairs += u64::from(report.separated_pairs);
+        row.hull_tests += u64::from(report.hull_tests);
         for (sum, ns) in
             row.stage_ns
                 .iter_mut()
@@ -605,12 +609,12 @@ fn run_row(
 
 fn csv(scene: &str, rows: &[Row]) -> String {
     let mut out = String::from(
-        "scene,budget_us,frames,missed_collisions,false_positive_pairs,false_positive_max_distance,precision,dist_abs_err_max,dist_rel_err_max,depth_err_max,depth_err_rel_max,normal_err_deg_max,truncated_frames,truncated_pairs_per_frame,visits_per_frame,latency_p50_us,latency_p99_us,latency_p999_us,latency_max_us,deadline_misses,separated_pairs_per_frame,broad_us_mean,frontier_us_mean,narrow_us_mean\n",
+        "scene,budget_us,frames,missed_collisions,false_positive_pairs,false_positive_max_distance,precision,dist_abs_err_max,dist_rel_err_max,depth_err_max,depth_err_rel_max,normal_err_deg_max,truncated_frames,truncated_pairs_per_frame,visits_per_frame,latency_p50_us,latency_p99_us,latency_p999_us,latency_max_us,deadline_misses,separated_pairs_per_frame,hull_tests_per_frame,broad_us_mean,frontier_us_mean,narrow_us_mean\n",
     );
     for r in rows {
         let _ = writeln!(
             out,
-            "{scene},{},{},{},{},{:e},{:.6},{:e},{:e},{:e},{:e},{:.6},{},{:.2},{:.0},{:.1},{:.1},{:.1},{:.1},{},{:.2},{:.2},{:.2},{:.2}",
+            "{scene},{},{},{},{},{:e},{:.6},{:e},{:e},{:e},{:e},{:.6},{},{:.2},{:.0},{:.1},{:.1},{:.1},{:.1},{},{:.2},{:.2},{:.2},{:.2},{:.2}",
             r.budget,
             r.frames,
             r.missed_collisions,
@@ -631,6 +635,7 @@ fn csv(scene: &str, rows: &[Row]) -> String {
             r.percentile(1.0),
             r.deadline_misses,
             r.separated_pairs as f64 / r.frames.max(1) as f64,
+            r.hull_tests as f64 / r.frames.max(1) as f64,
             r.stage_ns[0] as f64 / 1e3 / r.frames.max(1) as f64,
             r.stage_ns[1] as f64 / 1e3 / r.frames.max(1) as f64,
             r.stage_ns[2] as f64 / 1e3 / r.frames.max(1) as f64,

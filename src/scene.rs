@@ -38,6 +38,7 @@ use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::mesh::MeshEdges;
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
 use crate::math::{DVec3, Isometry, Pose, conservative_slack};
+use crate::narrow::mesh_hull::MeshHull;
 use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity, distance_mesh_mesh,
     proximity_mesh_mesh, rounding_bound,
@@ -70,6 +71,10 @@ pub struct MeshShape {
     /// The tree distance queries on this mesh refine, the budgeted frontier's and the
     /// exact ones', by measured tightness ([`QueryVolume::measure`]).
     pub query_volume: QueryVolume,
+    /// Convex hull of the vertices (`None` for a flat or degenerate mesh): a pair of
+    /// meshes whose hulls are apart by more than their margins is apart with no traversal
+    /// ([`MeshHull::gap`]).
+    pub hull: Option<MeshHull>,
 }
 
 impl MeshShape {
@@ -82,6 +87,7 @@ impl MeshShape {
         Self {
             edges: MeshEdges::new(&mesh),
             query_volume: QueryVolume::measure(&overlap_tree, &distance_tree),
+            hull: MeshHull::of(&mesh),
             overlap_tree,
             distance_tree,
             mesh,

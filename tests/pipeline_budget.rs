@@ -370,7 +370,7 @@ fn check_scene(
         );
         assert_eq!(unlimited.report.frontier.visits, 0);
         let full_run = run(scene, query, &mut VisitBudget(u64::MAX));
-        let full = full_run.report.frontier.visits;
+        let full = spent(&full_run.report);
         assert!(full > 0, "{name} {qname}: the frontier ran");
         fulls.push(full);
         let mut prev: Option<Frame> = None;
@@ -461,6 +461,11 @@ fn every_sampled_budget_of_the_fandisk_against_tori_is_conservative_and_monotone
     );
 }
 
+/// The visits a frame spent of its counted budget: the frontier's, and one per hull test.
+fn spent(report: &StepReport) -> u64 {
+    report.frontier.visits + u64::from(report.hull_tests)
+}
+
 /// Kept answers under a budget: only exact ones are reused, so a truncated pair is answered
 /// again next frame; while its bodies rest the frontier resumes where it stopped, so a
 /// budget too small for the frame's hardest pairs still reaches the exact frame, after as
@@ -471,10 +476,7 @@ fn truncated_answers_are_refined_frame_after_frame_until_the_frame_is_exact() {
     let mut scene = pile(1);
     let query = Query::CLOSE.union(Query::CONTACTS);
     let exact = run_exact(&scene, query);
-    let full = run(&scene, query, &mut VisitBudget(u64::MAX))
-        .report
-        .frontier
-        .visits;
+    let full = spent(&run(&scene, query, &mut VisitBudget(u64::MAX)).report);
     let budget = full / 4;
     let mut workspace = PipelineWorkspace::default();
     let mut results = FrameResults::default();
@@ -496,7 +498,7 @@ fn truncated_answers_are_refined_frame_after_frame_until_the_frame_is_exact() {
             report.candidates - report.truncated_pairs,
             report.truncated_pairs,
         );
-        visits += report.frontier.visits;
+        visits += spent(&report);
         if report.completeness == Completeness::Exact {
             let frame = Frame {
                 pairs: results.pairs.clone(),
@@ -510,7 +512,7 @@ fn truncated_answers_are_refined_frame_after_frame_until_the_frame_is_exact() {
             break;
         }
         assert!(report.truncated_pairs > 0);
-        assert!(report.frontier.visits >= budget, "frame {frames}");
+        assert!(spent(&report) >= budget, "frame {frames}");
     }
     assert!(frames >= 3, "the budget was not small: {frames} frames");
     assert_eq!(visits, full, "resumed pieces add up to one unlimited run");

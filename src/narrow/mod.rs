@@ -31,6 +31,7 @@ pub mod contact;
 pub mod convex_manifold;
 pub mod convex_mesh;
 pub mod gjk;
+pub mod mesh_hull;
 pub mod mesh_mesh;
 pub mod pairs;
 pub mod polygon;

@@ -12,13 +12,15 @@ use crate::scene::{MeshShape, Scene};
 /// Answers the frame's mesh–mesh candidates that no kept answer covers through the
 /// frontier, under `budget` (see [`step_within`]): resumes last frame's frontier when it
 /// can ([`FrontierRun::resumes`]), else runs a fresh one over those pairs in candidate
-/// order. Leaves the frontier's pairs in `workspace.frontier_pairs` and their answers in
+/// order, its budget already spent by `spent` visits (the frame's hull tests). Leaves the
+/// frontier's pairs in `workspace.frontier_pairs` and their answers in
 /// `workspace.frontier_answers` (a superset of the pairs asked when resuming, in candidate
 /// order); returns this frame's share of the frontier's counters.
 pub(super) fn run_frontier(
     scene: &Scene,
     query: Query,
     budget: &mut dyn Budget,
+    spent: u64,
     workspace: &mut PipelineWorkspace,
 ) -> FrontierStats {
     let PipelineWorkspace {
@@ -91,6 +93,7 @@ pub(super) fn run_frontier(
         &mut Resumed {
             inner: budget,
             base: before.visits,
+            spent,
         },
     );
     frontier.answers(pairs, frontier_answers);
@@ -153,15 +156,17 @@ impl FrontierRun {
     }
 }
 
-/// A budget asked about the visits since `base` (a resumed frontier counts from its start).
+/// A budget asked about the visits since `base` (a resumed frontier counts from its start)
+/// plus the `spent` ones the frame made before the frontier (its hull tests).
 struct Resumed<'b> {
     inner: &'b mut dyn Budget,
     base: u64,
+    spent: u64,
 }
 
 impl Budget for Resumed<'_> {
     fn allows(&mut self, visits: u64) -> bool {
-        self.inner.allows(visits - self.base)
+        self.inner.allows(visits - self.base + self.spent)
     }
 }
 

@@ -98,6 +98,27 @@
 //! the scene's own speed (links moving up to 6 cm per frame against 4 cm margins) 2.4 pairs,
 //! and no measurable change.
 //!
+//! # Separations proved by the hulls
+//! A mesh–mesh pair with no kept separation is first tested by its meshes' convex hulls
+//! ([`MeshHull::gap`](crate::narrow::mesh_hull::MeshHull::gap): GJK between the hulls,
+//! then the slab between them as the proof): hulls apart by more than the margins prove
+//! the meshes apart, and leave a separation like any other proof. A pair whose hulls meet
+//! is remembered with its relative pose and not tested again at that pose (a resting pair,
+//! a resumed frontier). Under a limited budget the tests spend the frontier's budget, one
+//! visit each, polled every second test: a budget of nothing tests nothing.
+//! [`StepReport::hull_tests`] counts them, `separated_pairs` the pairs they and the kept
+//! separations answered.
+//!
+//! Measured (`examples/time_vs_error`, query `CLOSE`, alternating runs of 400 frames,
+//! 2026-11-25): on `robot-chain` (six links of 216 triangles and a room of 2,180, 21 mesh
+//! pairs a frame) 6.2 pairs a frame answered apart with no traversal instead of 2.4; the
+//! precision of the reported close pairs at a 28 µs budget 0.841–0.854 → 0.900–0.907, at
+//! 35 µs 0.899–0.912 → 0.932–0.935; exact frames 109–115 → 113–117 µs at the median (the
+//! tests of hulls that meet cost more than the traversals the proofs save). On
+//! `mesh-pile` (12 tori and 4 spheres, 200 frames): 38 → 53 pairs a frame answered so,
+//! precision 0.927–0.934 → 0.980 at 100 µs and 0.69–0.74 → 0.75–0.78 at 50 µs, exact
+//! frames the same (889–929 against 893–952 µs). No collision was missed in any run.
+//!
 //! # Design note: determinism and ordering
 //! The same scene and query give the same results: the broad phase yields pairs sorted by
 //! `(a, b)`, each pair is answered independently in that order, and nothing depends on
@@ -144,8 +165,9 @@ use crate::broad::{
     SortAndSweep, choose,
 };
 use crate::bvh::frontier::{self, FrontierAnswer, FrontierStats, FrontierWorkspace};
-use crate::math::DVec3;
+use crate::math::{DVec3, Pose};
 use crate::narrow::contact::Manifold;
+use crate::narrow::gjk::GjkCache;
 use crate::narrow::mesh_mesh::DistanceCache;
 use crate::scene::MeshShape;
 use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
@@ -334,12 +356,17 @@ pub struct StepReport {
     /// Candidate pairs answered by last frame's answer, neither body having changed (see
     /// the [module docs](self)).
     pub reused_pairs: u32,
-    /// Mesh–mesh candidate pairs answered "apart" by a separation an earlier frame proved,
-    /// their relative motion since being smaller than its slack (see the
-    /// [module docs](self)); they take no path and no frontier visit.
+    /// Mesh–mesh candidate pairs answered "apart" with no traversal: by a separation an
+    /// earlier frame proved, their relative motion since being smaller than its slack, or
+    /// by their convex hulls this frame (see the [module docs](self)); they take no path
+    /// and no frontier visit.
     pub separated_pairs: u32,
-    /// The budgeted mesh–mesh frontier ([`step_within`] with a limited budget), nanoseconds;
-    /// 0 when it did not run. Not part of `narrow_ns`.
+    /// Hull tests run this frame (mesh–mesh pairs with no kept separation; under a limited
+    /// budget, each spends one of the frontier's visits).
+    pub hull_tests: u32,
+    /// The budgeted frontier with the hull tests before it ([`step_within`] with a
+    /// limited budget), nanoseconds; 0 when it did not run (unbudgeted, the hull tests are
+    /// part of `narrow_ns`). Not part of `narrow_ns`.
     pub mid_ns: u64,
     /// The frontier's counters of this frame (visits, rounds begun, bound and triangle
     /// tests, polls; a resumed frontier counts only this frame's share); all 0 when it did
@@ -424,6 +451,8 @@ pub struct PipelineWorkspace {
     separations: PairMap<Separation>,
     /// Per candidate (same index): whether a kept separation answers it this frame.
     separated: Vec<bool>,
+    /// The hull test's memory of each mesh–mesh candidate pair.
+    hull_caches: PairMap<HullCache>,
     /// Answers a frame's mesh–mesh pairs in parallel (see [`workers`]).
     workers: Option<Arc<WorkerPool>>,
     /// The pool's answers of this frame, by candidate slot.
@@ -596,20 +625,26 @@ pub fn step_within(
     }
     let broad_ns = elapsed_ns(started);
     let started = Instant::now();
-    mark_separated(scene, query, workspace);
     let limited = !budget.is_unlimited() && query.at_current_poses();
     let mut mid_ns = 0;
     let mut frontier_stats = FrontierStats::default();
+    let hull_tests;
     if limited {
         let mut reserved = budget.deadline().map(|d| frontier_deadline(started, d));
         let frontier_budget: &mut dyn Budget = match reserved.as_mut() {
             Some(deadline) => deadline,
             None => &mut *budget,
         };
-        frontier_stats = run_frontier(scene, query, frontier_budget, workspace);
+        // The hull tests spend the frontier's budget, a visit each: one settles a pair
+        // for the price of a few visits.
+        hull_tests = mark_separated(scene, query, Some(&mut *frontier_budget), workspace);
+        frontier_stats = run_frontier(scene, query, frontier_budget, hull_tests, workspace);
         mid_ns = elapsed_ns(started);
+    } else {
+        hull_tests = mark_separated(scene, query, None, workspace);
     }
-    let started = Instant::now();
+    // Unbudgeted, the hull tests answer pairs as the narrow phase does: its time.
+    let started = if limited { Instant::now() } else { started };
     let mut completeness = Completeness::Exact;
     let mut truncated_pairs = 0;
     let PipelineWorkspace {
@@ -825,6 +860,7 @@ pub fn step_within(
         paths: narrow.paths,
         reused_pairs: reused,
         separated_pairs,
+        hull_tests: index(hull_tests as usize),
         mid_ns,
         frontier: frontier_stats,
         truncated_pairs,
@@ -836,33 +872,87 @@ pub fn step_within(
 /// mesh–mesh pairs no kept answer covers, under a query that does not ask the distance,
 /// whose separation's bound, less the relative motion since, still exceeds their margins.
 /// Forgets the separations of pairs that are no longer candidates.
-fn mark_separated(scene: &Scene, query: Query, workspace: &mut PipelineWorkspace) {
+fn mark_separated(
+    scene: &Scene,
+    query: Query,
+    mut budget: Option<&mut dyn Budget>,
+    workspace: &mut PipelineWorkspace,
+) -> u64 {
     let PipelineWorkspace {
         candidates,
         kept,
         separations,
         separated,
+        hull_caches,
         ..
     } = workspace;
+    let (mut tests, mut refused) = (0u64, false);
     separations.retain(|pair, _| candidates.binary_search(pair).is_ok());
+    hull_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
     separated.clear();
-    if query.distance || separations.is_empty() {
-        // Nothing to look up (a scene without mesh pairs never gets here with a
-        // separation): one pass of `false`.
+    if query.distance {
         separated.resize(candidates.len(), false);
-        return;
+        return 0;
     }
     separated.extend(candidates.iter().map(|pair| {
-        let Some(separation) = separations.get(pair) else {
-            return false;
-        };
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        !kept.get(pair).is_some_and(|k| k.fits(scene, pair, query))
+        if kept.get(pair).is_some_and(|k| k.fits(scene, pair, query)) {
+            return false;
+        }
+        let margins = a.margin + b.margin;
+        if let Some(separation) = separations.get(pair)
             && separation
                 .lower_bound_now(scene, (a, b))
-                .is_some_and(|bound| bound > a.margin + b.margin)
+                .is_some_and(|bound| bound > margins)
+        {
+            return true;
+        }
+        let Some((ma, mb)) = mesh_pair(scene, pair) else {
+            return false;
+        };
+        let (Some(ha), Some(hb)) = (&ma.hull, &mb.hull) else {
+            return false;
+        };
+        let pose = Pose::relative(&a.pose, &b.pose);
+        let cache = hull_caches.entry(*pair).or_default();
+        if cache.met_at == Some(pose) {
+            // Tested at this very pose (a resting pair, a resumed frame): the hulls meet.
+            return false;
+        }
+        if let Some(budget) = budget.as_deref_mut()
+            && (refused || (tests % HULL_TESTS_PER_POLL == 0 && !budget.allows(tests)))
+        {
+            refused = true;
+            return false;
+        }
+        tests += 1;
+        match ha.gap(hb, &pose.to_isometry(), &mut cache.gjk) {
+            Some(gap) if gap > margins => {
+                cache.met_at = None;
+                separations.insert(*pair, Separation::new(scene, (a, b), gap));
+                true
+            }
+            _ => {
+                cache.met_at = Some(pose);
+                false
+            }
+        }
     }));
+    tests
 }
+
+/// What the hull test of [`mark_separated`] keeps of a pair between frames.
+#[derive(Debug, Default)]
+struct HullCache {
+    /// GJK's warm start between the two hulls.
+    gjk: GjkCache,
+    /// The relative pose at which the last test found the hulls meeting (no proof), so a
+    /// pair at that same pose is not tested again.
+    met_at: Option<Pose>,
+}
+
+/// Hull tests between two polls of a budgeted frame's budget (a test costs 0.2–1 µs).
+const HULL_TESTS_PER_POLL: u64 = 2;
 
 /// Time kept back from a frame's deadline for writing and publishing its results, when the
 /// pairs off the frontier are cut short (`PairClock`). 30 µs: an estimate of the daemon's
