@@ -667,7 +667,19 @@ pub const ALL_PAIRS_MAX: usize = 32;
 /// at 10,000 bodies (clustered at half speed: 473 against 440 µs), but not for 1,000
 /// clustered bodies from half speed on (31–33 against 19–26 µs). The mean hides the skin grid's tail: its refilings bunch, and its
 /// p99 was twice the sort and sweep's at 10,000 clustered bodies at full speed (1,162
-/// against 595 µs), which the rule does not weigh. Before (the sort and sweep slower),
+/// against 595 µs), which the rule does not weigh.
+///
+/// Later the same day, with [`MAX_SKIN`](super::skin_grid::MAX_SKIN) raised to 2, the
+/// same sweep (sort and sweep / skin grid at 1/3, 1/2, 2/3 and all of the speed): 3,000
+/// clustered bodies 104 / 62, 106 / 64, 109 / 69, 112 / 77; 1,000 clustered 32 / 16,
+/// 32 / 17, 32 / 19, 33 / 22; 3,000 uniform 120 / 89, 127 / 111, 129 / 131, 132 / 174;
+/// 10,000 clustered 491 / 383, 480 / 443, 473 / 501, 453 / 582. So below some 10,000
+/// clustered bodies the skin grid wins at every speed measured, and the rule's sort and
+/// sweep costs them up to 1.5 times the time. No statistic the rule has separates them
+/// from the uniform layout, where sort and sweep wins from 2/3 of the speed at every
+/// size: sweep overlaps per body are 21 / 43 / 100 clustered (1,000 / 3,000 / 10,000
+/// bodies) against 50 / 104 / 233 uniform, and the size spread (5.9 against 1.5) does not
+/// change with the count. Before (the sort and sweep slower),
 /// the crossings were at 0.013 and 0.010, and [`CREEPING`] was 0.01. Teleports leave every
 /// skin, which costs the skin grid a refiling each: the column grid takes them, except on
 /// the stacked dice, whose "teleports" stay within 5 cm (not far moves: the rule picks the
