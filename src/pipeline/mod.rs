@@ -138,8 +138,8 @@
 //!
 //! # Allocation
 //! None once the workspace and the output have grown to the largest frame, except one
-//! warm-start cache entry when a mesh–mesh pair becomes a candidate (and one separation
-//! entry when it is first found apart), and the kept broad
+//! warm-start cache entry and one hull-test entry when a mesh–mesh pair becomes a
+//! candidate (and one separation entry when it is first found apart), and the kept broad
 //! phase's own: a rebuild (or an `Auto` measurement) allocates it anew, and the stateful
 //! kinds' pair sets and hash cells allocate as pairs and occupied cells appear.
 
@@ -868,10 +868,14 @@ pub fn step_within(
     }
 }
 
-/// Marks in `workspace.separated` the candidates a kept [`Separation`] answers this frame:
+/// Marks in `workspace.separated` the candidates answered "apart" with no traversal:
 /// mesh–mesh pairs no kept answer covers, under a query that does not ask the distance,
-/// whose separation's bound, less the relative motion since, still exceeds their margins.
-/// Forgets the separations of pairs that are no longer candidates.
+/// whose separation's bound, less the relative motion since, still exceeds their margins,
+/// or, failing that, whose meshes' hulls are apart by more than the margins (a new
+/// separation; module docs, "Separations proved by the hulls"). Hull tests stop once
+/// `budget` (a budgeted frame's frontier budget) refuses the tests made so far. Returns
+/// how many it made. Forgets the separations and hull memories of pairs that are no
+/// longer candidates.
 fn mark_separated(
     scene: &Scene,
     query: Query,
@@ -916,7 +920,7 @@ fn mark_separated(
         let pose = Pose::relative(&a.pose, &b.pose);
         let cache = hull_caches.entry(*pair).or_default();
         if cache.met_at == Some(pose) {
-            // Tested at this very pose (a resting pair, a resumed frame): the hulls meet.
+            // Tested at this very pose (a resting pair, a resumed frame): no proof.
             return false;
         }
         if let Some(budget) = budget.as_deref_mut()
@@ -946,8 +950,8 @@ fn mark_separated(
 struct HullCache {
     /// GJK's warm start between the two hulls.
     gjk: GjkCache,
-    /// The relative pose at which the last test found the hulls meeting (no proof), so a
-    /// pair at that same pose is not tested again.
+    /// The relative pose at which the last test gave no proof (the hulls meet, or are not
+    /// apart by more than the margins), so a pair at that same pose is not tested again.
     met_at: Option<Pose>,
 }
 
