@@ -1,6 +1,9 @@
 //! Sorting a frame's candidate pairs into `(a, b)` order: a least-significant-digit radix
 //! sort on the 64-bit key `a · 2³² + b`, one pass per byte, skipping the bytes every key
-//! shares (the high bytes of both ids, in a scene of fewer than 2²⁴ bodies).
+//! shares (the high bytes of both ids, in a scene of fewer than 2²⁴ bodies); on the 32-bit
+//! key `a · 2¹⁶ + b` when every id is below 2¹⁶, which halves the counting pass
+//! (`examples/broad_bench`, 1,000 uniform bodies all moving, about 490 pairs a frame,
+//! alternating runs: 42.2–42.3 → 41.5–41.9 µs a frame; 10,000, within the noise).
 //!
 //! A comparison sort of `k` pairs makes about `k log₂ k` data-dependent compares; with
 //! ids below 2¹⁶ (four bytes differ at most) this makes four passes of `k` counted moves,
@@ -35,7 +38,12 @@ pub(crate) fn sort_pairs(pairs: &mut Vec<CandidatePair>, scratch: &mut Vec<Candi
         pairs.sort_unstable();
         return;
     }
-    radix_sort::<_, 8>(pairs, scratch, key);
+    // Every id below 2¹⁶: a 32-bit key, half the counting.
+    if pairs.iter().fold(0, |ids, p| ids | p.a | p.b) < 1 << 16 {
+        radix_sort::<_, 4>(pairs, scratch, |p| (u64::from(p.a) << 16) | u64::from(p.b));
+    } else {
+        radix_sort::<_, 8>(pairs, scratch, key);
+    }
 }
 
 #[cfg(test)]
