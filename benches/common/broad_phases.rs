@@ -21,7 +21,7 @@ pub const NAMES: [&str; 7] = [
 /// One broad phase under test and its latest pair list.
 pub enum Phase {
     /// Proxima's sort and sweep over the whole proxy list.
-    SortSweep(SortAndSweep),
+    SortSweep(Box<SortAndSweep>),
     /// Proxima's incremental three-axis sweep and prune.
     Sap(IncrementalSap),
     /// Proxima's hierarchical hash grid.
@@ -40,7 +40,7 @@ impl Phase {
     /// Broad phase `name` (one of [`NAMES`]) loaded with every proxy, its first pairs found.
     pub fn new(name: &str, proxies: &[Proxy], out: &mut Vec<CandidatePair>) -> Option<Self> {
         let mut phase = match name {
-            "sort_sweep" => Self::SortSweep(SortAndSweep::new()),
+            "sort_sweep" => Self::SortSweep(Box::default()),
             "incremental_sap" => Self::Sap(IncrementalSap::from_proxies(proxies)),
             "hash_grid" => {
                 let mut g = HashGrid::new();
