@@ -74,9 +74,9 @@
 //! side; the pair rule is [`Aabb::intersects`](crate::bounding::Aabb::intersects) (closed
 //! boxes), as in every broad phase.
 //!
-//! Costs: `O(n + s + columns + e + t + k)` for `s` insertion-sort shifts (at most
-//! `n log n` work with the fallback), `e` column entries, `t` interval tests in the
-//! columns and `k` pairs; no allocation once the scratch has grown.
+//! Costs: `O(n + s + columns + e + t + k)` for `s` insertion-sort shifts (at most `n`:
+//! beyond, the linear radix sort takes over), `e` column entries, `t` interval tests in
+//! the columns and `k` pairs; no allocation once the scratch has grown.
 
 use super::key_sort::KeySort;
 use super::pair_sort::sort_pairs;
@@ -243,7 +243,7 @@ impl ColumnEntries {
     /// column is the first of both on each column axis for at least one of them (the
     /// column of the overlap's low corner, see [`SortAndSweep`]), and their rounded boxes
     /// meet on `u` and `v`. Entries at `end` and past it (another column, or padding) are
-    /// masked off. Branch-free: the eight lanes' compares vectorise.
+    /// masked off. Branch-free: the lanes' compares vectorise.
     #[inline]
     fn candidates(&self, i: usize, j: usize, end: usize) -> u32 {
         let lanes =
@@ -344,6 +344,7 @@ impl SortAndSweep {
         if proxies.len() < 2 {
             self.grid = Grid::default();
             self.shape = None;
+            self.bounds_seen = None;
             self.order.clear();
             self.starts.clear();
             self.entries.resize(0);
@@ -374,13 +375,13 @@ impl SortAndSweep {
             );
             for i in start..end {
                 let reach = self.entries.ends[1][i];
+                let p = &proxies[self.entries.proxy[i] as usize];
                 let mut j = i + 1;
                 loop {
                     let mut hits = self.entries.candidates(i, j, end);
                     while hits != 0 {
                         let f = j + hits.trailing_zeros() as usize;
                         hits &= hits - 1;
-                        let p = &proxies[self.entries.proxy[i] as usize];
                         let q = &proxies[self.entries.proxy[f] as usize];
                         if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
                             out.push(CandidatePair::of(p.body, q.body));
@@ -424,7 +425,7 @@ impl SortAndSweep {
             }
             _ => {
                 let axis = widest_spread_axis(proxies);
-                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let (u, v) = column_axes(axis);
                 self.extents.clear();
                 self.extents.extend(proxies.iter().map(|p| {
                     let e = p.bounds.extents();
@@ -635,6 +636,12 @@ impl SortAndSweep {
     }
 }
 
+/// The column axes of sweep axis `axis`: the other two, in increasing order.
+fn column_axes(axis: usize) -> (usize, usize) {
+    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+    (u.min(v), u.max(v))
+}
+
 /// The smallest box holding every proxy's box.
 fn overall_bounds(proxies: &[Proxy]) -> (DVec3, DVec3) {
     proxies
@@ -648,8 +655,7 @@ fn overall_bounds(proxies: &[Proxy]) -> (DVec3, DVec3) {
 /// [`COLUMN_EDGE_PER_BOX`] times `p75` wide (or wider: at most [`MAX_COLUMNS_PER_PROXY`]
 /// columns a proxy), over the box from `low` to `high`.
 fn lay_grid(axis: usize, p75: f64, low: DVec3, high: DVec3, n: usize) -> Grid {
-    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-    let (u, v) = (u.min(v), u.max(v));
+    let (u, v) = column_axes(axis);
     let lo = [low[u], low[v]];
     let span = [high[u] - low[u], high[v] - low[v]];
     // A few typical boxes; never so fine that the grid outgrows the proxies.

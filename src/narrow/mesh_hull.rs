@@ -9,8 +9,8 @@
 //! and a mesh vertex left out of the hull lies within [`MeshHull::outside`] of it (measured
 //! once, by GJK from each vertex).
 
-use crate::geometry::{ConvexPolyhedron, SupportMap, TriMesh};
-use crate::math::{DVec3, Isometry, conservative_slack};
+use crate::geometry::{ConvexPolyhedron, Segment, SupportMap, TriMesh};
+use crate::math::{Isometry, conservative_slack};
 use crate::narrow::gjk::{GjkCache, GjkOutcome, GjkParams, gjk_distance};
 
 /// A mesh's convex hull and how far outside it any of the mesh's vertices lies.
@@ -20,15 +20,6 @@ pub struct MeshHull {
     /// Largest distance from a mesh vertex to the hull, metres: an upper bound (GJK's
     /// distance, which converges from above), 0 for meshes whose vertices all lie in it.
     outside: f64,
-}
-
-/// One point, as a support map: the point a hull's outside allowance is measured from.
-struct Point(DVec3);
-
-impl SupportMap for Point {
-    fn support(&self, _direction: DVec3) -> DVec3 {
-        self.0
-    }
 }
 
 impl MeshHull {
@@ -46,9 +37,10 @@ impl MeshHull {
             .vertices()
             .iter()
             .map(|&p| {
+                // A segment from `p` to itself: the point, as a support map.
                 let result = gjk_distance(
                     &hull,
-                    &Point(p),
+                    &Segment::new(p, p),
                     &Isometry::IDENTITY,
                     &params,
                     &mut GjkCache::default(),
@@ -93,6 +85,7 @@ impl MeshHull {
 mod tests {
     use super::*;
     use crate::geometry::Triangle;
+    use crate::math::DVec3;
     use crate::narrow::distance_triangle_triangle;
     use crate::test_support::meshes::{cuboid, grid, torus, triangle_soup, uv_sphere};
     use crate::test_support::{isometry, rng};
