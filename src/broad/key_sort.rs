@@ -5,9 +5,10 @@
 //! Insertion sort is linear in the items plus their shifts, and shifts grow with the
 //! density of the boxes along the axis as well as with their speed: at 10,000 uniform
 //! bodies all moving (`examples/broad_bench`) about 2 a proxy, at 100,000 about 8 or more,
-//! where each shift moves a whole item. The radix sort costs the same whatever moved: four
-//! counted passes over 8-byte `(key, position)` records, then one gather of the items in
-//! the new order, which for a kept order is close to the old one (near-sequential reads).
+//! where each shift moves a whole item. The radix sort costs the same whatever moved:
+//! three or four counted passes over 8-byte `(key, position)` records, then one gather of
+//! the items in the new order, which for a kept order is close to the old one
+//! (near-sequential reads).
 //!
 //! Measured in the sort and sweep (`examples/broad_bench`, shifts and displacement counted
 //! per proxy on one frame, alternating runs, means µs a frame) against insertion with a
@@ -28,7 +29,7 @@
 //! its 800,000 shifts of 44-byte items: 3.4 ms of the frame's 10, against 1.4 ms for the
 //! radix sort and its gather.
 
-use super::radix::radix_sort;
+use super::radix::{RadixScratch, radix_sort};
 
 /// A key's bits mapped to a `u32` whose unsigned order is [`f32::total_cmp`]'s.
 #[inline]
@@ -51,7 +52,7 @@ const RADIX_ABOVE_SHIFTS_PER_ITEM: f64 = 0.75;
 pub(crate) struct KeySort<T> {
     /// `(ordered key bits, position)` records and the other buffer of their passes.
     records: Vec<(u32, u32)>,
-    other: Vec<(u32, u32)>,
+    other: RadixScratch<(u32, u32)>,
     /// The items in their new order, before the swap.
     gathered: Vec<T>,
     /// Whether the next sort goes straight to the radix sort.
@@ -62,7 +63,7 @@ impl<T> Default for KeySort<T> {
     fn default() -> Self {
         Self {
             records: Vec::new(),
-            other: Vec::new(),
+            other: RadixScratch::default(),
             gathered: Vec::new(),
             radix: false,
         }
@@ -99,7 +100,7 @@ impl<T: Copy> KeySort<T> {
                 .enumerate()
                 .map(|(i, item)| (ordered_bits(key(item)), i as u32)),
         );
-        radix_sort::<_, 4>(&mut self.records, &mut self.other, |r| u64::from(r.0));
+        radix_sort(&mut self.records, &mut self.other, 32, |r| u64::from(r.0));
         self.gathered.clear();
         self.gathered
             .extend(self.records.iter().map(|&(_, i)| items[i as usize]));

@@ -80,6 +80,7 @@
 
 use super::key_sort::KeySort;
 use super::pair_sort::sort_pairs;
+use super::radix::RadixScratch;
 use super::{CandidatePair, Proxy};
 use crate::bounding::{Aabb, BoundingVolume};
 use crate::math::{DVec3, f32_round_down, f32_round_up};
@@ -304,8 +305,8 @@ pub struct SortAndSweep {
     extents: Vec<f64>,
     /// The sweep axis and typical box of the last measurement.
     shape: Option<Shape>,
-    /// The other buffer of the pairs' radix sort.
-    sorted: Vec<CandidatePair>,
+    /// Scratch of the pairs' radix sort.
+    sorted: RadixScratch<CandidatePair>,
     /// Scratch of `order`'s sort.
     order_sort: KeySort<(Slot, u32)>,
     /// The proxies' overall bounds, as the last frame's slots measured them: a kept shape's
