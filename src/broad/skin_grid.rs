@@ -66,15 +66,16 @@
 //!   every re-test of a pair split so. If the holder rests, the re-tester takes it all
 //!   instead.
 //!
-//! Each body also keeps a lower bound on its entries' due travels (`next_due`), lowered by
-//! every budget written and measured again when a move reaches it, so a move that makes
-//! nothing due reads none of its entries: measured (`examples/broad_bench`, three
-//! alternating runs, means a frame), 10,000 clustered bodies all moving at a sixth of the
-//! speed, 287–294 → 271–278 µs (0.19 re-tests a move); uniform, 261–267 → 243–250;
-//! 1,000 clustered all moving, 20.4–20.6 → 19.7–20.4. It costs a little where most
-//! moves find something due anyway: 10,000 stacked dice at 10 % moving 36.3 → 37.2–37.4,
-//! 100,000 clustered bodies at 10 % moving 1,420–1,535 → 1,451–1,568 (400 frames; 63 % of
-//! the moves skip their entries there, yet the budgets written cost more).
+//! A move compares its in-place entries' due travels all at once, without a branch, and
+//! branches only on the entries due (0.19 a move at 10,000 clustered bodies all moving at
+//! a sixth of the speed). Measured (`examples/broad_bench`, two alternating runs each,
+//! means a frame) against a loop branching on each entry: 10,000 bodies all moving at a
+//! sixth of the speed, clustered 306–308 → 275–283 µs, uniform 259–263 → 219–220;
+//! 1,000 clustered all moving 22.8–22.9 → 21.0–21.1; 10,000 stacked dice at 10 % moving
+//! 35.6–37.1 → 33.6–34.0; 100,000 clustered at 10 % moving 1,308–1,334 → 1,191–1,293;
+//! 1,000 stacked dice all moving 21.1–21.9 → 22.0–22.4. A lower bound on each body's due
+//! travels, kept so that a move below it reads no entry, measured 271–278 at the first
+//! row but 26–28 at the last (20.3–21.5 before): every budget written also wrote it.
 //!
 //! A new pair gives the whole room to a body refiled in the batch (the mover). Travel and
 //! budgets are `f32`, rounded towards re-testing, with a relative allowance
@@ -115,7 +116,6 @@
 //!   true boxes overlap.
 //! - The two entries of a pair share its budget as whole and none (the latter always
 //!   due) or half each, and what the two may still travel fits in the pair's room now.
-//! - No entry is due before its body's `next_due`.
 //! - The pair set is exactly the flagged neighbours: the brute-force pairs of the true
 //!   boxes.
 
@@ -249,9 +249,6 @@ struct Record {
     travel: f32,
     /// The batch the body last moved in (or was inserted in).
     moved_at: u32,
-    /// At most the least [`Neighbour::due_at`] of the list (`+∞` for none): a move that
-    /// leaves `travel` below it makes nothing due, and reads no entry.
-    next_due: f32,
     list: Neighbours,
 }
 
@@ -266,7 +263,6 @@ impl Record {
             filed_centre: bounds.center(),
             travel: 0.0,
             moved_at: batch,
-            next_due: f32::INFINITY,
             list: Neighbours::default(),
         }
     }
@@ -302,12 +298,6 @@ impl Record {
             entry.due_at = ((f64::from(entry.due_at) - travel) as f32).next_down();
         }
         self.travel = 0.0;
-        self.next_due = f32::NEG_INFINITY;
-    }
-
-    /// Lowers [`Self::next_due`] to an entry's new `due_at`.
-    fn note_due(&mut self, due_at: f32) {
-        self.next_due = self.next_due.min(due_at);
     }
 }
 
@@ -384,6 +374,16 @@ impl Neighbours {
 
     fn is_empty(&self) -> bool {
         self.len == 0
+    }
+
+    /// Bit `i` set when in-place entry `i` is due at `travel`: every in-place entry
+    /// compared at once, without a branch.
+    fn inline_due(&self, travel: f32) -> u32 {
+        let mut due = 0;
+        for (k, entry) in self.inline.iter().enumerate() {
+            due |= u32::from(entry.due_at <= travel) << k;
+        }
+        due & ((1 << self.len().min(INLINE)) - 1)
     }
 
     fn push(&mut self, entry: Neighbour) {
@@ -648,9 +648,6 @@ impl SkinGrid {
             if !encloses(&record.fat, &p.bounds) {
                 return Err(format!("body {} outside its fat box", p.body));
             }
-            if record.list.iter().any(|e| e.due_at < record.next_due) {
-                return Err(format!("body {}: an entry due before its next due", p.body));
-            }
             filed.push(Proxy {
                 bounds: record.fat,
                 ..*p
@@ -736,8 +733,6 @@ impl SkinGrid {
                     due_at(self.records[a].travel, room, share_a),
                     due_at(self.records[b].travel, room, share_a.twin()),
                 );
-                self.records[a].note_due(due_a);
-                self.records[b].note_due(due_b);
                 self.records[a].list.push(Neighbour {
                     slot: b as u32,
                     twin: at_b as u32,
@@ -806,17 +801,16 @@ impl SkinGrid {
             record.rebase();
         }
         let travel = record.travel;
-        if travel < record.next_due {
-            return;
+        let len = record.list.len();
+        let mut due = record.list.inline_due(travel);
+        while due != 0 {
+            let i = due.trailing_zeros() as usize;
+            due &= due - 1;
+            self.queue_retest(slot, i, prefetching);
         }
-        // Measured again from the entries not due; the re-tests lower it to theirs.
-        record.next_due = f32::INFINITY;
-        for i in 0..record.list.len() {
-            let due_at = self.records[slot].list[i].due_at;
-            if due_at <= travel {
+        for i in INLINE..len {
+            if self.records[slot].list[i].due_at <= travel {
                 self.queue_retest(slot, i, prefetching);
-            } else {
-                self.records[slot].note_due(due_at);
             }
         }
     }
@@ -891,13 +885,11 @@ impl SkinGrid {
             _ => Share::Whole,
         };
         let due = due_at(self.records[slot].travel, room, share);
-        self.records[slot].note_due(due);
         let entry = &mut self.records[slot].list[i];
         (entry.overlaps, entry.due_at, entry.share) = (now, due, share);
         if now != overlaps || was != Share::Whole {
             let other = &mut self.records[other as usize];
             let due = due_at(other.travel, room, share.twin());
-            other.note_due(due);
             let entry = &mut other.list[twin as usize];
             (entry.overlaps, entry.due_at, entry.share) = (now, due, share.twin());
         }
