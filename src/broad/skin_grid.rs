@@ -101,7 +101,11 @@
 //!   first neighbours side by side), and a box test for each pair due, reading the
 //!   neighbour's box; in a batch of a large grid the records are prefetched a few moves
 //!   ahead, and each re-test waits in a queue of `RETEST_AHEAD` while what it reads is
-//!   fetched. Measured before the budgets (`examples/broad_bench`, 100,000 bodies, 10 %
+//!   fetched; in a smaller one it runs at once, not through the queue (measured,
+//!   `examples/broad_bench`, alternating runs, means a frame: 1,000 stacked dice all
+//!   moving 21.2–21.9 → 19.4–19.6 µs, 1,000 clustered 20.4–20.7 → 19.5, 10,000 clustered
+//!   at a sixth of the speed 275–276 → 258–261, 10,000 stacked all moving 218–227 →
+//!   202–209). Measured before the budgets (`examples/broad_bench`, 100,000 bodies, 10 %
 //!   moving, six alternating runs, medians): the records' prefetch took uniform from 5.17
 //!   to 4.12 ms a frame, clustered from 6.31 to 5.19.
 //! - A move out of it: a column grid move (module docs of [`ColumnGrid`]) of the fat box,
@@ -819,19 +823,23 @@ impl SkinGrid {
     /// (the neighbour's box and its twin entry) when `prefetching`, and runs the re-tests
     /// queued [`RETEST_AHEAD`] re-tests before (all of them when not prefetching).
     fn queue_retest(&mut self, slot: usize, i: usize, prefetching: bool) {
-        if prefetching {
-            let Neighbour {
-                slot: other, twin, ..
-            } = self.records[slot].list[i];
-            super::prefetch(&raw const self.bodies.proxies[other as usize]);
-            super::prefetch(
-                self.records[other as usize]
-                    .list
-                    .entry_address(twin as usize),
-            );
+        if !prefetching {
+            // Nothing waits in the queue: the re-test runs at once.
+            debug_assert!(self.pending.is_empty());
+            self.retest(slot, i);
+            return;
         }
+        let Neighbour {
+            slot: other, twin, ..
+        } = self.records[slot].list[i];
+        super::prefetch(&raw const self.bodies.proxies[other as usize]);
+        super::prefetch(
+            self.records[other as usize]
+                .list
+                .entry_address(twin as usize),
+        );
         self.pending.push_back((slot as u32, i as u32));
-        self.run_retests(if prefetching { RETEST_AHEAD } else { 0 });
+        self.run_retests(RETEST_AHEAD);
     }
 
     /// Runs the queued re-tests, oldest first, until at most `left` wait.
