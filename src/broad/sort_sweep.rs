@@ -539,7 +539,11 @@ impl SortAndSweep {
             self.order.clear();
             self.order_axis = self.grid.axis;
         } else {
-            self.order.retain(|&(_, i)| (i as usize) < n);
+            // The order holds the indices below the last count: only fewer proxies
+            // leave some out of range.
+            if self.order.len() > n {
+                self.order.retain(|&(_, i)| (i as usize) < n);
+            }
             for entry in &mut self.order {
                 entry.0 = slots[entry.1 as usize];
             }
