@@ -20,23 +20,39 @@
 //! 2. The column edge `c`: [`COLUMN_EDGE_PER_BOX`] times the 75th percentile of the
 //!    boxes' larger extent on `u`, `v`, raised until the grid over the boxes has at most
 //!    [`MAX_COLUMNS_PER_PROXY`] × `n` columns (so tiny far-apart boxes do not make a huge
-//!    empty grid). The grid spans the boxes' overall bounds as the last frame's pass over
-//!    the proxies measured them (a pass fewer: 1,000 uniform bodies all moving 41.8–42.2 →
-//!    41.4–41.5 µs a frame); a box beyond the grid is listed in its edge columns, which is
-//!    exact, and when the boxes have left it by more than a column the grid is laid again
-//!    on this frame's bounds before anything is listed. Boxes wider than [`BIG_COLUMNS`]
+//!    empty grid). The grid is kept from frame to frame while the shape is (below) and the
+//!    boxes stay within a column of it; else it is laid on the boxes' overall bounds as
+//!    the last frame's pass over the proxies measured them, or on this frame's when they
+//!    have left those by more than a column. A box beyond the grid is listed in its edge
+//!    columns, which is exact. Boxes wider than [`BIG_COLUMNS`]
 //!    columns on `u` or `v` are *big*: tested against every proxy instead. The axis and
 //!    the percentile are measured again every [`RESHAPE_FRAMES`] frames, or when the
 //!    proxy count changes: a stale one only costs time, as any grid lists every box in
 //!    every column it meets (measured, 10,000 bodies all moving, three alternating runs:
 //!    1,415–1,530 → 1,355–1,365 µs a frame uniform, 1,420–1,532 → 1,310–1,347
 //!    clustered).
-//! 3. The kept order of the proxies by their low end on `s` is brought up to date by
-//!    insertion sort while few proxies change places, by a radix sort of the keys when
-//!    many do (`key_sort.rs`, whose docs give the rule and its measurements). Every other
-//!    box is listed in each column
-//!    its `u`, `v` extent meets (1 to 4 mostly), by a counting sort on the column filled in
-//!    that order, so each column comes out sorted by low end with no sort of its own.
+//! 3. Under the same grid and proxy count, with at most one proxy in [`KEPT_MOVES_PER`]
+//!    listed in other columns than last frame, the columns are *kept*: each entry's box is
+//!    read again from its proxy, the proxies that changed columns leave their old ones
+//!    and join their new ones, and each column is sorted by insertion (its entries keep
+//!    close to their last order, and a column holds a few dozen at most). Otherwise they
+//!    are *listed*: the kept order of the proxies by their low end on `s` is brought up
+//!    to date by insertion sort while few proxies change places, by a radix sort of the
+//!    keys when many do (`key_sort.rs`, whose docs give the rule and its measurements),
+//!    and every other box is listed in each column its `u`, `v` extent meets (1 to 4
+//!    mostly), by a counting sort on the column filled in that order, so each column
+//!    comes out sorted by low end with no sort of its own.
+//!
+//!    Measured (`examples/broad_bench`, all bodies moving, alternating runs, means a
+//!    frame), kept columns against listing every frame: 1,000 uniform bodies 41.9–43.1 →
+//!    37.0–38.1 µs (kept in 355 of 400 frames, 9 proxies changing columns a frame; keeping
+//!    took 10.6 µs a frame where sorting the order and listing took 16.3), clustered
+//!    32.1–32.6 → 29.3–29.4; 10,000 uniform 440–444 → 418–421, clustered 414–415 →
+//!    370–375; 100,000 uniform 8.9–10.2 → 7.4–7.5 ms, clustered 10.1–11.0 → 7.6–8.9. The
+//!    frames between are listed: the shape is measured again every [`RESHAPE_FRAMES`]. At
+//!    10 % teleporting (1,000 of 10,000 proxies moved a frame, so listed every frame) the
+//!    check costs 442–445 → 463–467 µs; with a bound of one in eight it kept those
+//!    frames, at 672 µs.
 //! 4. Each column is swept: entry `i` meets the entries after it whose low end is at most
 //!    its high end. A pair meeting in several columns is reported from one only: the column
 //!    holding the low corner of the two boxes' `u`, `v` overlap, which is the column pair of
@@ -104,6 +120,9 @@ pub const BIG_COLUMNS: u64 = 4;
 /// Frames the sweep axis and the column edge are kept before they are measured again
 /// (sooner when the proxy count changes).
 pub const RESHAPE_FRAMES: u32 = 8;
+/// The columns are kept from the last frame when at most one proxy in this many is listed
+/// in other columns than then (module docs, step 3).
+pub const KEPT_MOVES_PER: usize = 32;
 
 /// The column grid of the last frame.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -235,6 +254,31 @@ impl ColumnEntries {
         self.proxy[at] = proxy;
     }
 
+    /// Sorts entries `start..end` by their low end on the sweep axis, by insertion.
+    fn sort_column(&mut self, start: usize, end: usize) {
+        for k in start + 1..end {
+            let key = self.ends[0][k];
+            if self.ends[0][k - 1].total_cmp(&key).is_le() {
+                continue;
+            }
+            let (rounded, first, proxy) = (self.rounded(k), self.first[k], self.proxy[k]);
+            let mut m = k;
+            while m > start && self.ends[0][m - 1].total_cmp(&key).is_gt() {
+                for end in &mut self.ends {
+                    end[m] = end[m - 1];
+                }
+                self.first[m] = self.first[m - 1];
+                self.proxy[m] = self.proxy[m - 1];
+                m -= 1;
+            }
+            for (end, &x) in self.ends.iter_mut().zip(&rounded) {
+                end[m] = x;
+            }
+            self.first[m] = first;
+            self.proxy[m] = proxy;
+        }
+    }
+
     fn rounded(&self, at: usize) -> RoundedBox {
         std::array::from_fn(|k| self.ends[k][at])
     }
@@ -299,6 +343,21 @@ pub struct SortAndSweep {
     slots: Vec<Slot>,
     /// Indices of the big proxies.
     big: Vec<u32>,
+    /// The grid and proxy count the columns were listed for, if they can be kept.
+    listed: Option<(Grid, usize)>,
+    /// Each proxy's first and last columns (`u` then `v`) as listed.
+    listed_ranges: Vec<[u32; 4]>,
+    /// Scratch of [`Self::relist_kept_columns`]: whether each proxy changed columns, the
+    /// ones that did, the entries they add (column, proxy, first bits), the new column
+    /// starts, and the other buffer of the entries.
+    changed: Vec<bool>,
+    moved: Vec<u32>,
+    added: Vec<(u32, u32, u32)>,
+    new_starts: Vec<u32>,
+    spare: ColumnEntries,
+    /// Frames whose columns were kept, and the proxies those moved to other columns.
+    kept_frames: usize,
+    kept_moves: usize,
     /// The axis `order` is sorted on.
     order_axis: usize,
     /// Extents, for the column size.
@@ -351,23 +410,29 @@ impl SortAndSweep {
             self.entries.resize(0);
             self.slots.clear();
             self.big.clear();
+            self.listed = None;
             return;
         }
         let (axis, p75, kept) = self.shape_for(proxies);
-        // A kept shape lays the grid on the bounds the last frame's slots measured; if the
-        // boxes have left it by more than a column since, it is laid again on theirs.
-        let (low, high) = match self.bounds_seen.filter(|_| kept) {
-            Some(bounds) => bounds,
-            None => overall_bounds(proxies),
-        };
-        self.grid = lay_grid(axis, p75, low, high, proxies.len());
-        if !self.measure_slots(proxies) {
-            let (low, high) = self.bounds_seen.expect("measured");
+        // A kept shape keeps the grid while the boxes stay within a column of it; else it
+        // is laid on the bounds the last frame's slots measured, or on this frame's.
+        if !(kept && self.listed.is_some() && self.measure_slots(proxies)) {
+            let (low, high) = match self.bounds_seen.filter(|_| kept) {
+                Some(bounds) => bounds,
+                None => overall_bounds(proxies),
+            };
             self.grid = lay_grid(axis, p75, low, high, proxies.len());
-            self.measure_slots(proxies);
+            if !self.measure_slots(proxies) {
+                let (low, high) = self.bounds_seen.expect("measured");
+                self.grid = lay_grid(axis, p75, low, high, proxies.len());
+                self.measure_slots(proxies);
+            }
         }
-        self.refresh_order(proxies.len());
-        self.list_in_columns();
+        if !self.relist_kept_columns() {
+            self.refresh_order(proxies.len());
+            self.list_in_columns();
+            self.note_listing();
+        }
         let columns = self.starts.len() - 1;
         for column in 0..columns {
             let (start, end) = (
@@ -524,6 +589,121 @@ impl SortAndSweep {
         // `starts[k + 1]` now holds column k's start; shift back to one more than columns.
         self.starts.copy_within(1.., 0);
         self.starts[columns] = total as u32;
+    }
+
+    /// Notes the columns just listed as keepable: the grid, the count and each proxy's
+    /// columns (a big proxy's first column `u32::MAX`: it is in none).
+    fn note_listing(&mut self) {
+        self.listed = Some((self.grid, self.slots.len()));
+        self.listed_ranges.clear();
+        self.listed_ranges.extend(
+            self.slots
+                .iter()
+                .map(|s| [s.first[0], s.last[0], s.first[1], s.last[1]]),
+        );
+    }
+
+    /// Lists the columns from last frame's, when the grid and the proxy count are the same
+    /// and few proxies changed columns: each entry's box is read again from its slot, the
+    /// proxies that changed columns are taken out of their old ones and added to their new
+    /// ones, and each column is sorted by insertion (its entries keep close to their last
+    /// order). `false`, changing nothing, when it cannot.
+    fn relist_kept_columns(&mut self) -> bool {
+        let n = self.slots.len();
+        if self.listed != Some((self.grid, n)) {
+            return false;
+        }
+        self.moved.clear();
+        self.changed.clear();
+        self.changed.resize(n, false);
+        for (i, (slot, was)) in self.slots.iter().zip(&self.listed_ranges).enumerate() {
+            if [slot.first[0], slot.last[0], slot.first[1], slot.last[1]] != *was {
+                self.moved.push(i as u32);
+                self.changed[i] = true;
+            }
+        }
+        if self.moved.len() > n / KEPT_MOVES_PER {
+            return false;
+        }
+        let width = self.grid.count[1] as usize;
+        let columns = self.starts.len() - 1;
+        // New column sizes: the old, less the moved proxies' old entries, plus their new.
+        self.new_starts.clear();
+        self.new_starts
+            .extend(self.starts.windows(2).map(|w| w[1] - w[0]));
+        self.new_starts.push(0);
+        self.added.clear();
+        for &i in &self.moved {
+            let [u0, u1, v0, v1] = self.listed_ranges[i as usize];
+            // A big proxy is in no column, before or after.
+            let was_listed = u0 != u32::MAX;
+            for cu in (u0..=u1).filter(|_| was_listed) {
+                for cv in v0..=v1 {
+                    self.new_starts[cu as usize * width + cv as usize] -= 1;
+                }
+            }
+            let slot = &self.slots[i as usize];
+            let listed = slot.first[0] != u32::MAX;
+            for cu in (slot.first[0]..=slot.last[0]).filter(|_| listed) {
+                let on_u = if cu == slot.first[0] { FIRST_ON_U } else { 0 };
+                for cv in slot.first[1]..=slot.last[1] {
+                    let on_v = if cv == slot.first[1] { FIRST_ON_V } else { 0 };
+                    let column = cu as usize * width + cv as usize;
+                    self.new_starts[column] += 1;
+                    self.added.push((column as u32, i, on_u | on_v));
+                }
+            }
+        }
+        self.added.sort_unstable();
+        // Counts to starts, one more than the columns.
+        let mut start = 0;
+        for count in &mut self.new_starts {
+            (start, *count) = (start + *count, start);
+        }
+        let total = self.new_starts[columns] as usize;
+        self.spare.resize(total);
+        let mut added = self.added.iter().peekable();
+        for column in 0..columns {
+            let mut at = self.new_starts[column] as usize;
+            for k in self.starts[column] as usize..self.starts[column + 1] as usize {
+                let i = self.entries.proxy[k];
+                if self.changed[i as usize] {
+                    continue;
+                }
+                let first = self.entries.first[k];
+                self.spare
+                    .set(at, &self.slots[i as usize].rounded, first, i);
+                at += 1;
+            }
+            while let Some(&&(c, i, first)) = added.peek() {
+                if c as usize != column {
+                    break;
+                }
+                self.spare
+                    .set(at, &self.slots[i as usize].rounded, first, i);
+                at += 1;
+                added.next();
+            }
+            debug_assert_eq!(at, self.new_starts[column + 1] as usize);
+            self.spare.sort_column(self.new_starts[column] as usize, at);
+        }
+        std::mem::swap(&mut self.entries, &mut self.spare);
+        std::mem::swap(&mut self.starts, &mut self.new_starts);
+        for &i in &self.moved {
+            let slot = &self.slots[i as usize];
+            self.listed_ranges[i as usize] =
+                [slot.first[0], slot.last[0], slot.first[1], slot.last[1]];
+        }
+        self.kept_frames += 1;
+        self.kept_moves += self.moved.len();
+        true
+    }
+
+    /// Frames so far whose columns were kept from the last frame's, and the proxies that
+    /// moved to other columns in them.
+    #[must_use]
+    pub fn kept_counts(&self) -> (usize, usize) {
+        (self.kept_frames, self.kept_moves)
     }
 
     /// Brings `order` up to date with `proxies` on the sweep axis: rebuilt when the axis
@@ -770,6 +950,9 @@ mod tests {
                 pairs_brute_force(&proxies, &mut expected);
                 sweep.pairs(&proxies, &mut found);
                 assert_eq!(found, expected, "scene {scene} frame {frame}");
+                if let Err(e) = sweep.validate(&proxies) {
+                    panic!("scene {scene} frame {frame}: {e}");
+                }
                 total_pairs += expected.len();
                 empty_frames += usize::from(expected.is_empty());
             }
@@ -785,6 +968,44 @@ mod tests {
     /// measurements still pair exactly as brute force says. (Each step scales or shifts
     /// the whole scene, which keeps its pairs: the grid laid for the old scene is what is
     /// tested.)
+    /// Boxes drifting across column boundaries, with bursts of teleports now and then: the
+    /// columns are kept through most frames, with proxies moved between them, and listed
+    /// afresh after the bursts; every frame's pairs equal brute force and the listing
+    /// validates.
+    #[test]
+    fn kept_columns_follow_drifting_boxes_exactly() {
+        let mut rng = rng(93);
+        let mut sweep = SortAndSweep::new();
+        let (mut expected, mut found) = (Vec::new(), Vec::new());
+        let mut proxies: Vec<Proxy> = (0..400).map(|i| random_proxy(&mut rng, i, 8.0)).collect();
+        let frames = 600;
+        let mut total_pairs = 0;
+        for frame in 0..frames {
+            let burst = frame % 97 == 50;
+            for p in &mut proxies {
+                let step = if burst && rng.random_range(0..10) == 0 {
+                    point_in_cube(&mut rng, 8.0) - p.bounds.center()
+                } else {
+                    point_in_cube(&mut rng, 0.1)
+                };
+                p.bounds = Aabb::new(p.bounds.min + step, p.bounds.max + step);
+            }
+            pairs_brute_force(&proxies, &mut expected);
+            sweep.pairs(&proxies, &mut found);
+            assert_eq!(found, expected, "frame {frame}");
+            if let Err(e) = sweep.validate(&proxies) {
+                panic!("frame {frame}: {e}");
+            }
+            total_pairs += expected.len();
+        }
+        let (kept, moves) = sweep.kept_counts();
+        assert!(
+            kept > frames / 2 && kept < frames - 10 && moves > kept,
+            "{kept} of {frames} frames kept their columns, {moves} proxies moved in them"
+        );
+        assert!(total_pairs > 20_000, "pairs {total_pairs}");
+    }
+
     #[test]
     fn a_kept_axis_and_edge_never_change_the_pairs() {
         let mut rng = rng(92);
