@@ -568,7 +568,7 @@ pub const MOSTLY_MOVING: f64 = 0.5;
 /// Mean relative shift per update ([`MoveCounts::mean_shift`]) up to which bodies count as
 /// creeping: the skin grid keeps them even when most move (measured crossovers in
 /// [`choose`]'s docs).
-pub const CREEPING: f64 = 0.018;
+pub const CREEPING: f64 = 0.016;
 /// Above this fraction of far moves among the updates, a scene counts as teleporting.
 pub const TELEPORTING: f64 = 0.01;
 /// Size spread ([`BroadPhaseStats::size_spread`]) above which a scene of fewer than
@@ -671,8 +671,8 @@ pub const ALL_PAIRS_MAX: usize = 32;
 ///
 /// The uniform layout crosses at a shift of about 0.0135, the clustered one (a tenfold
 /// size spread: its small bodies move far for their size) at about 0.029 with 10,000
-/// bodies and not at all with 1,000; [`CREEPING`] at 0.018 sits between them (clear of
-/// the uniform full speed's 0.020), so the choice is the faster kind or within 8 % of it
+/// bodies and not at all with 1,000; [`CREEPING`], then 0.018, sat between them (clear
+/// of the uniform full speed's 0.020), so the choice was the faster kind or within 8 % of it
 /// at 10,000 bodies (clustered at half speed: 473 against 440 µs), but not for 1,000
 /// clustered bodies from half speed on (31–33 against 19–26 µs). The mean hides the skin grid's tail: its refilings bunch, and its
 /// p99 was twice the sort and sweep's at 10,000 clustered bodies at full speed (1,162
@@ -700,8 +700,18 @@ pub const ALL_PAIRS_MAX: usize = 32;
 ///
 /// Since (2026-11-25, later still) the sort and sweep keeps its columns between frames,
 /// 5–28 % faster when all bodies move (module docs of [`SortAndSweep`]), and the skin grid
-/// is 5–16 % faster on the slow and the all-moving classes; the crossings above have not
-/// been measured again. On uniform layouts at 10 % teleporting the rule's column grid is
+/// is 5–16 % faster on the slow and the all-moving classes. Measured again (200 frames,
+/// sort and sweep / skin grid, mean relative shift in brackets), 10,000 bodies all
+/// moving: uniform 456 / 380 (0.0101), 413 / 454 (0.0135), 415 / 488 (0.0152),
+/// 418–422 / 528–538 (0.0168), 419 / 589 (0.0202); clustered 410–411 / 335–338
+/// (0.0155), 418 / 367 (0.0186), 399 / 396 (0.0231), 396 / 435 (0.0307). The crossings
+/// moved to about 0.012 (uniform) and 0.023 (clustered), and no single threshold takes
+/// the faster kind on both: at 0.018 the rule lost 27 % at the uniform 0.0168 and 14 % at
+/// the clustered 0.0186; [`CREEPING`] at 0.016 takes the uniform 0.0168 right and still
+/// loses 10–17 % on uniform shifts from 0.012 to 0.016 and 14 % on clustered ones from
+/// 0.016 to 0.023. With fewer bodies the crossing in body count behind [`FEW_BODIES`]
+/// stayed: clustered, all moving, 300 frames, 3,000 bodies 98 / 92, 5,000 225 / 180,
+/// 7,000 246 / 296. On uniform layouts at 10 % teleporting the rule's column grid is
 /// slower than the sort and sweep (1,000 bodies 67–73 against 42–44 µs, 10,000 726–731
 /// against 457–475), on clustered ones faster; both are 4–30 times the peer's speed there.
 ///
