@@ -194,10 +194,12 @@ fn main() -> ExitCode {
     );
     let (stats, chosen) = automatic_choice(new_scene(), args.frames);
     println!(
-        "moving {:.2}, mean relative shift {:.4}, far moves {:.2} %, size spread {:.1}, \
-         sweep overlaps {:.1} per body: the automatic choice is {chosen:?}",
+        "moving {:.2}, mean relative shift {:.4}, shift for the typical box {:.4}, far moves \
+         {:.2} %, size spread {:.1}, sweep overlaps {:.1} per body: the automatic choice is \
+         {chosen:?}",
         stats.moving_fraction,
         stats.mean_shift,
+        stats.typical_shift,
         100.0 * stats.far_move_fraction,
         stats.size_spread,
         stats.sweep_overlap_ratio

@@ -287,7 +287,9 @@ fn kept_broad_phases_answer_like_a_fresh_workspace_and_reread_only_changed_bodie
                         let mut expected = BroadPhaseStats::measure(&proxies, moved);
                         expected.far_move_fraction = stats.far_move_fraction;
                         expected.mean_shift = stats.mean_shift;
+                        expected.typical_shift = stats.typical_shift;
                         assert_eq!(stats, expected, "{what}");
+                        assert!(stats.typical_shift >= 0.0, "{what}");
                         assert!((0.0..=1.0).contains(&stats.far_move_fraction), "{what}");
                         assert!((0.0..=1.0).contains(&stats.mean_shift), "{what}");
                         assert!(stats.mean_shift >= stats.far_move_fraction, "{what}");
@@ -483,6 +485,12 @@ fn the_measured_mean_shift_is_the_bodies_motion_and_the_pick_follows_it() {
             (stats.mean_shift - fraction).abs() < 1e-9 * fraction,
             "{fraction}: measured {}",
             stats.mean_shift
+        );
+        // One size of box: the shift for the typical box is the same fraction.
+        assert!(
+            (stats.typical_shift - fraction).abs() < 1e-9 * fraction,
+            "{fraction}: typical {}",
+            stats.typical_shift
         );
         assert_eq!(last.2, Some(kind), "{fraction}");
     }

@@ -463,6 +463,13 @@ pub struct BroadPhaseStats {
     /// [`far_move_fraction`](Self::far_move_fraction), 0 until
     /// [`with_moves`](Self::with_moves).
     pub mean_shift: f64,
+    /// The 75th percentile of the boxes' largest edge lengths, metres: the typical box.
+    pub typical_edge: f64,
+    /// Mean shift of the recent updates in metres ([`MoveCounts::mean_distance`]) over
+    /// [`typical_edge`](Self::typical_edge): how far the bodies move for the typical box
+    /// (1 when that box is a point and they move, 0 when they do not). What the rule reads
+    /// ([`choose`]); 0 until [`with_moves`](Self::with_moves).
+    pub typical_shift: f64,
 }
 
 /// What a broad phase's updates were like ([`BroadPhase::take_move_counts`]).
@@ -478,6 +485,8 @@ pub struct MoveCounts {
     /// axis over the box's largest edge, at most 1 (a far move counts 1; so does any move
     /// of a zero-size box).
     pub shift_sum: f64,
+    /// Sum over the updates of the farthest the centre moved on one axis, metres.
+    pub distance_sum: f64,
 }
 
 impl MoveCounts {
@@ -487,6 +496,7 @@ impl MoveCounts {
         let edge = (old.max - old.min).max_element();
         self.moves += 1;
         self.far_moves += u64::from(shift > edge);
+        self.distance_sum += shift;
         // A far move (a zero-size box's too: `shift / 0` is infinite) counts 1.
         if shift > 0.0 {
             self.shift_sum += (shift / edge).min(1.0);
@@ -500,6 +510,16 @@ impl MoveCounts {
             0.0
         } else {
             self.far_moves as f64 / self.moves as f64
+        }
+    }
+
+    /// Mean of the farthest the centre moved on one axis per update, metres; 0 with none.
+    #[must_use]
+    pub fn mean_distance(&self) -> f64 {
+        if self.moves == 0 {
+            0.0
+        } else {
+            self.distance_sum / self.moves as f64
         }
     }
 
@@ -530,6 +550,8 @@ impl BroadPhaseStats {
                 sweep_overlap_ratio: 0.0,
                 far_move_fraction: 0.0,
                 mean_shift: 0.0,
+                typical_edge: 0.0,
+                typical_shift: 0.0,
             };
         }
         let mut sizes: Vec<f64> = proxies
@@ -538,7 +560,7 @@ impl BroadPhaseStats {
             .collect();
         sizes.sort_unstable_by(f64::total_cmp);
         let percentile = |q: f64| sizes[(q * (n - 1) as f64).round() as usize];
-        let (p10, p90) = (percentile(0.1), percentile(0.9));
+        let (p10, p75, p90) = (percentile(0.1), percentile(0.75), percentile(0.9));
         let size_spread = if p90 == 0.0 { 1.0 } else { p90 / p10 };
         Self {
             bodies: n,
@@ -548,6 +570,8 @@ impl BroadPhaseStats {
                 / n as f64,
             far_move_fraction: 0.0,
             mean_shift: 0.0,
+            typical_edge: p75,
+            typical_shift: 0.0,
         }
     }
 
@@ -557,6 +581,16 @@ impl BroadPhaseStats {
         Self {
             far_move_fraction: counts.far_fraction(),
             mean_shift: counts.mean_shift(),
+            typical_shift: {
+                let distance = counts.mean_distance();
+                if distance == 0.0 {
+                    0.0
+                } else if self.typical_edge == 0.0 {
+                    1.0
+                } else {
+                    distance / self.typical_edge
+                }
+            },
             ..self
         }
     }
@@ -565,10 +599,10 @@ impl BroadPhaseStats {
 /// Above this fraction of bodies changing per frame, moving faster than [`CREEPING`], the
 /// stateless sort and sweep (which costs the same whatever moved) is chosen.
 pub const MOSTLY_MOVING: f64 = 0.5;
-/// Mean relative shift per update ([`MoveCounts::mean_shift`]) up to which bodies count as
-/// creeping: the skin grid keeps them even when most move (measured crossovers in
-/// [`choose`]'s docs).
-pub const CREEPING: f64 = 0.016;
+/// Shift per update for the typical box ([`BroadPhaseStats::typical_shift`]) up to which
+/// bodies count as creeping: the skin grid keeps them even when most move (measured
+/// crossovers in [`choose`]'s docs).
+pub const CREEPING: f64 = 0.011;
 /// Above this fraction of far moves among the updates, a scene counts as teleporting.
 pub const TELEPORTING: f64 = 0.01;
 /// Size spread ([`BroadPhaseStats::size_spread`]) above which a scene of fewer than
@@ -588,15 +622,16 @@ pub const ALL_PAIRS_MAX: usize = 32;
 /// The broad phase a scene with [`BroadPhaseChoice::Auto`] runs, given its statistics:
 ///
 /// 1. more than [`MOSTLY_MOVING`] of the bodies changing per frame, and moving more than
-///    [`CREEPING`] for their size ([`BroadPhaseStats::mean_shift`]): [`SortAndSweep`],
+///    [`CREEPING`] for the typical box ([`BroadPhaseStats::typical_shift`]): [`SortAndSweep`],
 ///    unless the scene has fewer than [`FEW_BODIES`] bodies of sizes spread wider than
 ///    [`WIDE_SIZE_SPREAD`] and is not teleporting (line 2): then the skin grid;
 /// 2. more than [`TELEPORTING`] of the updates far moves: [`ColumnGrid`] (a jump costs it
 ///    two queries, and always leaves a skin);
 /// 3. else [`SkinGrid`].
 ///
-/// A teleporting scene (over 1 % far moves, each counted a relative shift of 1) always has
-/// a mean shift over [`CREEPING`], so when most of its bodies move the first line takes it.
+/// A teleporting scene (over 1 % far moves) has a shift for the typical box far over
+/// [`CREEPING`] (the bench's: 7.7–41), so when most of its bodies move the first line
+/// takes it.
 /// The [`IncrementalSap`] and the [`HashGrid`] are never chosen: on every measured class
 /// the skin grid, the column grid or sort and sweep was faster (below); they stay
 /// available as fixed choices.
@@ -705,11 +740,18 @@ pub const ALL_PAIRS_MAX: usize = 32;
 /// moving: uniform 456 / 380 (0.0101), 413 / 454 (0.0135), 415 / 488 (0.0152),
 /// 418–422 / 528–538 (0.0168), 419 / 589 (0.0202); clustered 410–411 / 335–338
 /// (0.0155), 418 / 367 (0.0186), 399 / 396 (0.0231), 396 / 435 (0.0307). The crossings
-/// moved to about 0.012 (uniform) and 0.023 (clustered), and no single threshold takes
-/// the faster kind on both: at 0.018 the rule lost 27 % at the uniform 0.0168 and 14 % at
-/// the clustered 0.0186; [`CREEPING`] at 0.016 takes the uniform 0.0168 right and still
-/// loses 10–17 % on uniform shifts from 0.012 to 0.016 and 14 % on clustered ones from
-/// 0.016 to 0.023. With fewer bodies the crossing in body count behind [`FEW_BODIES`]
+/// moved to about 0.012 (uniform) and 0.023 (clustered), and no single threshold on the
+/// mean relative shift takes the faster kind on both: at 0.018 the rule lost 27 % at the
+/// uniform 0.0168 and 14 % at the clustered 0.0186, at 0.016 still 10–17 % and 14 %.
+///
+/// The mean relative shift is ruled by the smallest bodies, which move far for their
+/// size; the clustered layout's tenfold spread of sizes raises it, not its cost. Measured
+/// instead over the typical box ([`BroadPhaseStats::typical_shift`]: the mean distance
+/// moved over the 75th percentile of the largest edges, the same box the sort and sweep
+/// sizes its columns by), the same runs read uniform 0.0087 (skin grid faster), 0.0116
+/// (sort and sweep), clustered 0.0078 and 0.0092 (skin grid), 0.0114 (even), and both
+/// layouts cross near 0.011, where [`CREEPING`] now sits: every row above is taken by the
+/// faster kind or one within 1 %. With fewer bodies the crossing in body count behind [`FEW_BODIES`]
 /// stayed: clustered, all moving, 300 frames, 3,000 bodies 98 / 92, 5,000 225 / 180,
 /// 7,000 246 / 296. On uniform layouts at 10 % teleporting the rule's column grid is
 /// slower than the sort and sweep (1,000 bodies 67–73 against 42–44 µs, 10,000 726–731
@@ -721,7 +763,7 @@ pub const ALL_PAIRS_MAX: usize = 32;
 /// enters only the exception of line 1, together with the body count.
 #[must_use]
 pub fn choose(stats: &BroadPhaseStats) -> BroadPhaseKind {
-    let fast = stats.moving_fraction > MOSTLY_MOVING && stats.mean_shift > CREEPING;
+    let fast = stats.moving_fraction > MOSTLY_MOVING && stats.typical_shift > CREEPING;
     let teleporting = stats.far_move_fraction > TELEPORTING;
     // Few bodies of widely spread sizes stay in the skin grid, unless teleporting.
     let skin_keeps =
@@ -921,8 +963,42 @@ mod tests {
                 sweep_overlap_ratio: 0.0,
                 far_move_fraction: 0.0,
                 mean_shift: 0.0,
+                typical_edge: 0.0,
+                typical_shift: 0.0,
             }
         );
+    }
+
+    /// The typical shift is the mean distance moved over the 75th percentile of the largest
+    /// edges, whatever each body's own size; 1 for a point-sized typical box that moves.
+    #[test]
+    fn typical_shift_is_the_mean_distance_over_the_typical_edge() {
+        // Largest edges 1, 2, ..., 9: nearest-rank p75 is v[round(0.75 · 8)] = v[6] = 7.
+        let proxies: Vec<Proxy> = (1..=9)
+            .map(|k| cube(k, DVec3::ZERO, f64::from(k)))
+            .collect();
+        let stats = BroadPhaseStats::measure(&proxies, 9);
+        assert_eq!(stats.typical_edge, 7.0);
+        let counts = MoveCounts {
+            moves: 4,
+            far_moves: 0,
+            shift_sum: 0.9,
+            distance_sum: 0.56,
+        };
+        let moved = stats.with_moves(&counts);
+        assert!(
+            (moved.typical_shift - 0.02).abs() < 1e-15,
+            "{}",
+            moved.typical_shift
+        );
+        assert!((moved.mean_shift - 0.225).abs() < 1e-15);
+        assert_eq!(stats.with_moves(&MoveCounts::default()).typical_shift, 0.0);
+        let points: Vec<Proxy> = (0..4)
+            .map(|k| cube(k, DVec3::splat(f64::from(k)), 0.0))
+            .collect();
+        let still = BroadPhaseStats::measure(&points, 4);
+        assert_eq!(still.typical_edge, 0.0);
+        assert_eq!(still.with_moves(&counts).typical_shift, 1.0);
     }
 
     /// A row of unit cubes along y: apart (no overlaps), touching face to face (each meets
@@ -1022,13 +1098,16 @@ mod tests {
     #[test]
     fn the_rule_picks_the_measured_fastest_kind_for_each_scene_class() {
         use BroadPhaseKind::{ColumnGrid as Grid, SkinGrid as Skin, SortAndSweep as Sweep};
-        let stats = |bodies, moving_fraction, far_move_fraction, mean_shift| BroadPhaseStats {
+        // Shifts for the typical box; the per-body mean shift alike (bodies of one size).
+        let stats = |bodies, moving_fraction, far_move_fraction, shift| BroadPhaseStats {
             bodies,
             moving_fraction,
             size_spread: 3.0,
             sweep_overlap_ratio: 2.0,
             far_move_fraction,
-            mean_shift,
+            mean_shift: shift,
+            typical_edge: 1.0,
+            typical_shift: shift,
         };
         // The bench's scattered bodies shift about 0.02 of their size a frame, its stacked
         // dice 0.004.
@@ -1101,6 +1180,8 @@ mod tests {
         assert_eq!((counts.moves, counts.far_moves), (5, 2));
         assert_eq!(counts.shift_sum, 3.5);
         assert_eq!((counts.far_fraction(), counts.mean_shift()), (0.4, 0.7));
+        // Centre distances 0.5, 1, 1.1, 12.6 (through `set`), 0 metres.
+        assert!((counts.mean_distance() - 15.2 / 5.0).abs() < 1e-12);
         assert_eq!(broad.take_move_counts(), MoveCounts::default());
         assert_eq!(MoveCounts::default().mean_shift(), 0.0);
         // A point's every move is a full shift; a zero-size box that stays, none.
