@@ -323,6 +323,19 @@ struct Slot {
     last: [u32; 2],
 }
 
+impl Slot {
+    /// First and last column on `u`, then on `v`: what a proxy's listing depends on.
+    fn columns(&self) -> [u32; 4] {
+        [self.first[0], self.last[0], self.first[1], self.last[1]]
+    }
+
+    /// [`FIRST_ON_U`] and [`FIRST_ON_V`] of the proxy's entry in column `(cu, cv)`.
+    fn first_bits(&self, cu: u32, cv: u32) -> u32 {
+        (if cu == self.first[0] { FIRST_ON_U } else { 0 })
+            | (if cv == self.first[1] { FIRST_ON_V } else { 0 })
+    }
+}
+
 /// Scratch of the sweep, and its order of the proxies kept between frames.
 #[derive(Debug, Clone, Default)]
 pub struct SortAndSweep {
@@ -576,13 +589,12 @@ impl SortAndSweep {
             }
             for cu in slot.first[0]..=slot.last[0] {
                 let row = cu as usize * width;
-                let on_u = if cu == slot.first[0] { FIRST_ON_U } else { 0 };
                 for cv in slot.first[1]..=slot.last[1] {
-                    let on_v = if cv == slot.first[1] { FIRST_ON_V } else { 0 };
                     let column = row + cv as usize;
                     self.starts[column + 1] -= 1;
                     let at = self.starts[column + 1] as usize;
-                    self.entries.set(at, &slot.rounded, on_u | on_v, i);
+                    self.entries
+                        .set(at, &slot.rounded, slot.first_bits(cu, cv), i);
                 }
             }
         }
@@ -596,11 +608,8 @@ impl SortAndSweep {
     fn note_listing(&mut self) {
         self.listed = Some((self.grid, self.slots.len()));
         self.listed_ranges.clear();
-        self.listed_ranges.extend(
-            self.slots
-                .iter()
-                .map(|s| [s.first[0], s.last[0], s.first[1], s.last[1]]),
-        );
+        self.listed_ranges
+            .extend(self.slots.iter().map(Slot::columns));
     }
 
     /// Lists the columns from last frame's, when the grid and the proxy count are the same
@@ -617,7 +626,7 @@ impl SortAndSweep {
         self.changed.clear();
         self.changed.resize(n, false);
         for (i, (slot, was)) in self.slots.iter().zip(&self.listed_ranges).enumerate() {
-            if [slot.first[0], slot.last[0], slot.first[1], slot.last[1]] != *was {
+            if slot.columns() != *was {
                 self.moved.push(i as u32);
                 self.changed[i] = true;
             }
@@ -645,12 +654,10 @@ impl SortAndSweep {
             let slot = &self.slots[i as usize];
             let listed = slot.first[0] != u32::MAX;
             for cu in (slot.first[0]..=slot.last[0]).filter(|_| listed) {
-                let on_u = if cu == slot.first[0] { FIRST_ON_U } else { 0 };
                 for cv in slot.first[1]..=slot.last[1] {
-                    let on_v = if cv == slot.first[1] { FIRST_ON_V } else { 0 };
                     let column = cu as usize * width + cv as usize;
                     self.new_starts[column] += 1;
-                    self.added.push((column as u32, i, on_u | on_v));
+                    self.added.push((column as u32, i, slot.first_bits(cu, cv)));
                 }
             }
         }
@@ -691,8 +698,7 @@ impl SortAndSweep {
         std::mem::swap(&mut self.starts, &mut self.new_starts);
         for &i in &self.moved {
             let slot = &self.slots[i as usize];
-            self.listed_ranges[i as usize] =
-                [slot.first[0], slot.last[0], slot.first[1], slot.last[1]];
+            self.listed_ranges[i as usize] = slot.columns();
         }
         self.kept_frames += 1;
         self.kept_moves += self.moved.len();
