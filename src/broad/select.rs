@@ -506,30 +506,27 @@ impl MoveCounts {
     /// Fraction of the updates that were far moves; 0 with none.
     #[must_use]
     pub fn far_fraction(&self) -> f64 {
-        if self.moves == 0 {
-            0.0
-        } else {
-            self.far_moves as f64 / self.moves as f64
-        }
+        self.per_move(self.far_moves as f64)
     }
 
     /// Mean of the farthest the centre moved on one axis per update, metres; 0 with none.
     #[must_use]
     pub fn mean_distance(&self) -> f64 {
-        if self.moves == 0 {
-            0.0
-        } else {
-            self.distance_sum / self.moves as f64
-        }
+        self.per_move(self.distance_sum)
     }
 
     /// Mean relative shift per update, in `[0, 1]`; 0 with none.
     #[must_use]
     pub fn mean_shift(&self) -> f64 {
+        self.per_move(self.shift_sum)
+    }
+
+    /// `sum` over the updates counted; 0 with none.
+    fn per_move(&self, sum: f64) -> f64 {
         if self.moves == 0 {
             0.0
         } else {
-            self.shift_sum / self.moves as f64
+            sum / self.moves as f64
         }
     }
 }

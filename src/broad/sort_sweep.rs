@@ -347,6 +347,7 @@ pub struct SortAndSweep {
     /// (a cache miss per proxy in large scenes; measured with `examples/broad_bench`,
     /// 100,000 uniform bodies all moving, three alternating runs: 23.1–34.4 →
     /// 22.5–29.7 ms a frame, each run faster; at 10,000 bodies, and teleporting, alike).
+    /// Left as it is in frames whose columns are kept (module docs, step 3).
     order: Vec<(Slot, u32)>,
     /// Start of each column's entries in `entries` (one more than the columns).
     starts: Vec<u32>,
@@ -360,9 +361,10 @@ pub struct SortAndSweep {
     listed: Option<(Grid, usize)>,
     /// Each proxy's first and last columns (`u` then `v`) as listed.
     listed_ranges: Vec<[u32; 4]>,
-    /// Scratch of [`Self::relist_kept_columns`]: whether each proxy changed columns, the
-    /// ones that did, the entries they add (column, proxy, first bits), the new column
-    /// starts, and the other buffer of the entries.
+    /// Scratch of [`Self::relist_kept_columns`]: whether each proxy changed columns (a
+    /// flag read per entry: comparing the slot's columns with `listed_ranges` there instead
+    /// measured 3–6 % slower a frame), the ones that did, the entries they add (column,
+    /// proxy, first bits), the new column starts, and the other buffer of the entries.
     changed: Vec<bool>,
     moved: Vec<u32>,
     added: Vec<(u32, u32, u32)>,
@@ -427,9 +429,11 @@ impl SortAndSweep {
             return;
         }
         let (axis, p75, kept) = self.shape_for(proxies);
-        // A kept shape keeps the grid while the boxes stay within a column of it; else it
-        // is laid on the bounds the last frame's slots measured, or on this frame's.
-        if !(kept && self.listed.is_some() && self.measure_slots(proxies)) {
+        // A kept shape keeps the grid while the boxes stay within a column of it (measured
+        // on it first); else it is laid on the bounds the last frame's slots measured, or
+        // on this frame's.
+        let grid_kept = kept && self.listed.is_some() && self.measure_slots(proxies);
+        if !grid_kept {
             let (low, high) = match self.bounds_seen.filter(|_| kept) {
                 Some(bounds) => bounds,
                 None => overall_bounds(proxies),
@@ -922,13 +926,25 @@ mod tests {
         }
     }
 
+    /// One frame of `sweep` over `proxies` checked against brute force and `validate()`;
+    /// the frame's pair count.
+    fn frame_against_brute_force(sweep: &mut SortAndSweep, proxies: &[Proxy], what: &str) -> usize {
+        let (mut expected, mut found) = (Vec::new(), Vec::new());
+        pairs_brute_force(proxies, &mut expected);
+        sweep.pairs(proxies, &mut found);
+        assert_eq!(found, expected, "{what}");
+        if let Err(e) = sweep.validate(proxies) {
+            panic!("{what}: {e}");
+        }
+        expected.len()
+    }
+
     /// Coherent motion with occasional teleports, insertions and removals: the sweep's pairs
     /// equal brute force's every frame.
     #[test]
     fn sweep_pairs_equal_brute_force_over_coherent_frames() {
         let mut rng = rng(91);
         let mut sweep = SortAndSweep::new();
-        let (mut expected, mut found) = (Vec::new(), Vec::new());
         let (mut total_pairs, mut empty_frames) = (0usize, 0usize);
         for scene in 0..20 {
             let spread = [2.0, 10.0, 40.0][scene % 3];
@@ -953,14 +969,13 @@ mod tests {
                     proxies.push(random_proxy(&mut rng, next_id, spread));
                     next_id += 1;
                 }
-                pairs_brute_force(&proxies, &mut expected);
-                sweep.pairs(&proxies, &mut found);
-                assert_eq!(found, expected, "scene {scene} frame {frame}");
-                if let Err(e) = sweep.validate(&proxies) {
-                    panic!("scene {scene} frame {frame}: {e}");
-                }
-                total_pairs += expected.len();
-                empty_frames += usize::from(expected.is_empty());
+                let pairs = frame_against_brute_force(
+                    &mut sweep,
+                    &proxies,
+                    &format!("scene {scene} frame {frame}"),
+                );
+                total_pairs += pairs;
+                empty_frames += usize::from(pairs == 0);
             }
         }
         assert!(
@@ -969,11 +984,6 @@ mod tests {
         );
     }
 
-    /// The axis and column edge kept from an earlier frame only cost time: boxes that
-    /// shrink, grow a hundredfold, flatten onto another axis or fly off between
-    /// measurements still pair exactly as brute force says. (Each step scales or shifts
-    /// the whole scene, which keeps its pairs: the grid laid for the old scene is what is
-    /// tested.)
     /// Boxes drifting across column boundaries, with bursts of teleports now and then: the
     /// columns are kept through most frames, with proxies moved between them, and listed
     /// afresh after the bursts; every frame's pairs equal brute force and the listing
@@ -982,7 +992,6 @@ mod tests {
     fn kept_columns_follow_drifting_boxes_exactly() {
         let mut rng = rng(93);
         let mut sweep = SortAndSweep::new();
-        let (mut expected, mut found) = (Vec::new(), Vec::new());
         let mut proxies: Vec<Proxy> = (0..400).map(|i| random_proxy(&mut rng, i, 8.0)).collect();
         let frames = 600;
         let mut total_pairs = 0;
@@ -996,13 +1005,8 @@ mod tests {
                 };
                 p.bounds = Aabb::new(p.bounds.min + step, p.bounds.max + step);
             }
-            pairs_brute_force(&proxies, &mut expected);
-            sweep.pairs(&proxies, &mut found);
-            assert_eq!(found, expected, "frame {frame}");
-            if let Err(e) = sweep.validate(&proxies) {
-                panic!("frame {frame}: {e}");
-            }
-            total_pairs += expected.len();
+            total_pairs +=
+                frame_against_brute_force(&mut sweep, &proxies, &format!("frame {frame}"));
         }
         let (kept, moves) = sweep.kept_counts();
         assert!(
@@ -1012,6 +1016,11 @@ mod tests {
         assert!(total_pairs > 20_000, "pairs {total_pairs}");
     }
 
+    /// The axis and column edge kept from an earlier frame only cost time: boxes that
+    /// shrink, grow a hundredfold, flatten onto another axis or fly off between
+    /// measurements still pair exactly as brute force says. (Each step scales or shifts
+    /// the whole scene, which keeps its pairs: the grid laid for the old scene is what is
+    /// tested.)
     #[test]
     fn a_kept_axis_and_edge_never_change_the_pairs() {
         let mut rng = rng(92);
