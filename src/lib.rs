@@ -24,6 +24,9 @@ extern crate self as proxima;
 // Poses, isometries, tolerances.
 pub mod math;
 
+// Budgets, deadlines and the completeness of answers cut short.
+pub mod budget;
+
 // Shapes, meshes, convex hulls, exact predicates.
 pub mod geometry;
 

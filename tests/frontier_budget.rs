@@ -27,9 +27,9 @@
 mod support;
 
 use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, Rss};
+use proxima::budget::{Completeness, Unlimited, VisitBudget};
 use proxima::bvh::frontier::{
-    Completeness, FrontierAnswer, FrontierPair, FrontierWorkspace, PairTrees, RoundOrder,
-    Unlimited, VisitBudget, query_frontier,
+    FrontierAnswer, FrontierPair, FrontierWorkspace, PairTrees, RoundOrder, query_frontier,
 };
 use proxima::bvh::{BuildParams, Bvh};
 use proxima::geometry::{TriMesh, Triangle};

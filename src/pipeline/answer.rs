@@ -275,7 +275,7 @@ fn mesh_mesh_tail(
 }
 
 /// A mesh pair whose budgeted frontier traversal finished (`frontier` is
-/// [`Exact`](crate::bvh::frontier::Completeness::Exact)): the record [`mesh_mesh`] gives,
+/// [`Exact`](crate::budget::Completeness::Exact)): the record [`mesh_mesh`] gives,
 /// with the distance and witnesses taken from the frontier instead of a second traversal
 /// (the same minimum over all triangle pairs, with the same rounding bound; when several
 /// triangle pairs share the minimum, as intersecting meshes do at 0, the witnesses may name
@@ -341,7 +341,7 @@ pub(super) fn mesh_mesh_finished(
 }
 
 /// A mesh pair whose budgeted frontier traversal was cut short (`frontier` is
-/// [`Truncated`](crate::bvh::frontier::Completeness::Truncated), hence `maybe_close`): the
+/// [`Truncated`](crate::budget::Completeness::Truncated), hence `maybe_close`): the
 /// conservative answer DESIGN §4 asks for. Distance: the frontier's lower bound (never
 /// above the truth) with its error bound (`true ≤ distance + error_bound`), `exact` false.
 /// The pair *may touch* when that bound is `≤ 0`; its contact (when asked) is then one

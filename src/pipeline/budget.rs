@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-pub use crate::bvh::frontier::{Budget, Deadline, Unlimited, VisitBudget};
+pub use crate::budget::{Budget, Deadline, Unlimited, VisitBudget};
 
 /// Time kept back from a frame's deadline for what follows the budgeted mesh–mesh
 /// frontier: the pairs answered outside it (closed forms, GJK/EPA, convex–mesh walks), the

@@ -164,7 +164,7 @@ use crate::broad::{
     BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, PairMap, Proxy,
     SortAndSweep, choose,
 };
-use crate::bvh::frontier::{self, FrontierAnswer, FrontierStats, FrontierWorkspace};
+use crate::bvh::frontier::{FrontierAnswer, FrontierStats, FrontierWorkspace};
 use crate::math::{DVec3, Pose};
 use crate::narrow::contact::Manifold;
 use crate::narrow::gjk::GjkCache;
@@ -315,7 +315,7 @@ pub struct FrameResults {
 
 /// Whether a frame's answers are all exact: `Truncated` at the shallowest level any pair
 /// stopped at (0 = world boxes) when some pairs carry a conservative answer.
-pub use crate::bvh::frontier::Completeness;
+pub use crate::budget::Completeness;
 
 /// What [`step`] did: completeness, stage timings, counts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -744,7 +744,7 @@ pub fn step_within(
                     .find(|(p, _)| *p == pair)
                     .expect("a frontier answer for every mesh pair not kept");
                 match found.completeness {
-                    frontier::Completeness::Exact => answer::mesh_mesh_finished(
+                    Completeness::Exact => answer::mesh_mesh_finished(
                         pair,
                         (a, ma),
                         (b, mb),
@@ -754,7 +754,7 @@ pub fn step_within(
                         mesh,
                         contacts,
                     ),
-                    frontier::Completeness::Truncated { level } => {
+                    Completeness::Truncated { level } => {
                         truncated_pairs += 1;
                         truncated_level = Some(level);
                         answer::mesh_mesh_truncated(pair, (a, b), query, found, contacts)

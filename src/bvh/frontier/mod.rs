@@ -211,7 +211,8 @@
 //! # Example
 //! ```
 //! use proxima::bounding::Obb;
-//! use proxima::bvh::frontier::{FrontierPair, FrontierWorkspace, VisitBudget, query_frontier};
+//! use proxima::budget::VisitBudget;
+//! use proxima::bvh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
 //! use proxima::bvh::{BuildParams, Bvh};
 //! use proxima::geometry::TriMesh;
 //! use proxima::math::{DVec3, Isometry};
@@ -243,9 +244,9 @@ mod trees;
 
 pub use trees::{FrontierPair, PairTrees, TreesAt};
 
+use crate::budget::{Budget, Completeness};
 use crate::math::DVec3;
 use std::cmp::Ordering;
-use std::time::Instant;
 
 /// Visits between two budget polls unless set with [`FrontierWorkspace::with_poll_every`].
 ///
@@ -271,96 +272,6 @@ pub const PROBE_VISITS: u64 = 64;
 /// probes for the other pairs measured worse (128: 0.807 / 0.841 / 0.877 / 0.933 on
 /// robot-chain at 200–400 visits).
 pub const EXPECTED_PROBE_VISITS: u64 = 256;
-
-/// How much work the frontier may still do, polled between bounded batches of visits.
-pub trait Budget {
-    /// Whether work may go on after `visits` visits (bounding-volume tests plus triangle
-    /// tests) since [`FrontierWorkspace::start`].
-    fn allows(&mut self, visits: u64) -> bool;
-
-    /// The wall-clock instant this budget ends at, when it is one (so a caller can reserve
-    /// time for work after the traversal); `None` for counted and unlimited budgets.
-    #[must_use]
-    fn deadline(&self) -> Option<Instant> {
-        None
-    }
-
-    /// Whether this budget never refuses (callers may then take their exact, unbudgeted
-    /// paths, which give the same answers).
-    #[must_use]
-    fn is_unlimited(&self) -> bool {
-        false
-    }
-}
-
-/// A counted budget: allows work while fewer than `0` visits were made (so `VisitBudget(0)`
-/// does nothing). A batch started below the limit is finished, so a run may end up to one
-/// batch (`poll_every` visits plus one entry) beyond it. Deterministic: tests use only this.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct VisitBudget(pub u64);
-
-impl Budget for VisitBudget {
-    #[inline]
-    fn allows(&mut self, visits: u64) -> bool {
-        visits < self.0
-    }
-}
-
-/// A wall-clock budget: allows work until the instant is reached (for the frame pipeline).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Deadline(pub Instant);
-
-impl Budget for Deadline {
-    #[inline]
-    fn allows(&mut self, _visits: u64) -> bool {
-        Instant::now() < self.0
-    }
-
-    fn deadline(&self) -> Option<Instant> {
-        Some(self.0)
-    }
-}
-
-/// No limit: the traversal runs to the exact answers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Unlimited;
-
-impl Budget for Unlimited {
-    #[inline]
-    fn allows(&mut self, _visits: u64) -> bool {
-        true
-    }
-
-    fn is_unlimited(&self) -> bool {
-        true
-    }
-}
-
-/// Whether an answer is final: one pair's (here), or a whole frame's (the pipeline's
-/// [`StepReport`](crate::pipeline::StepReport): the shallowest of its pairs').
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Completeness {
-    /// The traversal finished: the answer is the exact one (every pair's, for a frame).
-    Exact,
-    /// The budget ran out with work left; `level` is the shallowest depth (descents from
-    /// the root pair; 0 = the world boxes) of the waiting node pairs.
-    Truncated {
-        /// Shallowest depth of the waiting entries.
-        level: u32,
-    },
-}
-
-impl Completeness {
-    /// `self` with one more answer truncated at `level`: truncated at the shallower of the
-    /// two levels.
-    #[must_use]
-    pub fn truncated_at(self, level: u32) -> Self {
-        match self {
-            Self::Truncated { level: seen } if seen <= level => self,
-            _ => Self::Truncated { level },
-        }
-    }
-}
 
 /// The closest triangle pair computed so far, A's frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -991,6 +902,7 @@ fn is_live(bound: f64, state: &PairState) -> bool {
 mod tests {
     use super::*;
     use crate::bounding::{BoundingVolume, Obb, Rss};
+    use crate::budget::{Deadline, Unlimited, VisitBudget};
     use crate::bvh::{BuildParams, Bvh};
     use crate::geometry::TriMesh;
     use crate::math::Isometry;
@@ -999,6 +911,7 @@ mod tests {
     use crate::narrow::mesh_mesh::{
         DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, distance_mesh_mesh,
     };
+    use std::time::Instant;
 
     fn entry(bound: f64, pair: u32, a: u32, b: u32) -> Entry {
         Entry {

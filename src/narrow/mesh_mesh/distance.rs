@@ -209,8 +209,9 @@ pub fn precedes_in_ties(x: [u32; 2], y: [u32; 2]) -> bool {
 mod tests {
     use super::*;
     use crate::bounding::{Obb, Rss};
+    use crate::budget::Unlimited;
     use crate::bvh::BuildParams;
-    use crate::bvh::frontier::{FrontierPair, FrontierWorkspace, Unlimited, query_frontier};
+    use crate::bvh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
     use crate::geometry::Triangle;
     use crate::math::DVec3;
 
