@@ -25,10 +25,10 @@ use common::mesh_scenes::data_dir;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use proxima::bounding::Obb;
 use proxima::budget::VisitBudget;
-use proxima::bvh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
 use proxima::bvh::{BuildParams, Bvh};
 use proxima::geometry::TriMesh;
 use proxima::math::{DVec3, Pose};
+use proxima::narrow::mesh_mesh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
 
 /// Links per frame.
 const LINKS: usize = 6;

@@ -48,9 +48,9 @@
 
 use clap::Parser;
 use plotters::prelude::*;
-use proxima::bvh::frontier::RoundOrder;
 use proxima::geometry::{Capsule, Cuboid, Sphere, TriMesh};
 use proxima::math::{DQuat, DVec3, Pose};
+use proxima::narrow::mesh_mesh::frontier::RoundOrder;
 use proxima::pipeline::{
     Budget, Deadline, FrameResults, PairResult, PipelineWorkspace, Query, StepReport, Unlimited,
     VisitBudget, WorkerPool, step, step_within,

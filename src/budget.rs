@@ -11,7 +11,7 @@ use std::time::Instant;
 pub trait Budget {
     /// Whether work may go on after `visits` visits (bounding-volume tests plus triangle
     /// tests) since the budgeted work started
-    /// ([`FrontierWorkspace::start`](crate::bvh::frontier::FrontierWorkspace::start) for the frontier).
+    /// ([`FrontierWorkspace::start`](crate::narrow::mesh_mesh::frontier::FrontierWorkspace::start) for the frontier).
     fn allows(&mut self, visits: u64) -> bool;
 
     /// The wall-clock instant this budget ends at, when it is one (so a caller can reserve

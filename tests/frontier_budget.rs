@@ -1,4 +1,4 @@
-//! The budgeted breadth-first frontier (`proxima::bvh::frontier`) against an independent
+//! The budgeted breadth-first frontier (`proxima::narrow::mesh_mesh::frontier`) against an independent
 //! oracle, at every interruption point of a counted budget.
 //!
 //! Oracle: the minimum of `distance_triangle_triangle` over *all* triangle pairs of a mesh
@@ -28,13 +28,13 @@ mod support;
 
 use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, Rss};
 use proxima::budget::{Completeness, Unlimited, VisitBudget};
-use proxima::bvh::frontier::{
-    FrontierAnswer, FrontierPair, FrontierWorkspace, PairTrees, RoundOrder, query_frontier,
-};
 use proxima::bvh::{BuildParams, Bvh};
 use proxima::geometry::{TriMesh, Triangle};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::narrow::distance_triangle_triangle;
+use proxima::narrow::mesh_mesh::frontier::{
+    FrontierAnswer, FrontierPair, FrontierWorkspace, PairTrees, RoundOrder, query_frontier,
+};
 use proxima::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh, within_distance_mesh_mesh,
 };

@@ -14,7 +14,7 @@
 //! bottom-up agglomerative clustering), chosen through [`BuildParams`] presets. The tandem
 //! traversal of two trees under a relative pose lives in [`tandem`]; exact mesh–mesh queries
 //! built on it are in [`crate::narrow::mesh_mesh`]. The budgeted breadth-first traversal of
-//! many mesh pairs at once (the time-critical frame) is [`frontier`].
+//! many mesh pairs at once (the time-critical frame) is [`crate::narrow::mesh_mesh::frontier`].
 //!
 //! # Invariants
 //! Checked by [`Bvh::validate`], which tests call after every build and refit:
@@ -27,7 +27,6 @@
 //!    exactly one parent; leaves hold `1 ..= leaf_size` triangles.
 
 pub mod build;
-pub mod frontier;
 mod refit;
 pub mod tandem;
 #[cfg(test)]

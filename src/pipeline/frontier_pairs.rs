@@ -2,8 +2,8 @@
 //! pipeline's workspace: listing them clones two `Arc`s per pair and allocates nothing once
 //! the list has grown to the largest frame seen.
 
-use crate::bvh::frontier::{FrontierWitnesses, PairTrees, TreesAt};
 use crate::math::Isometry;
+use crate::narrow::mesh_mesh::frontier::{FrontierWitnesses, PairTrees, TreesAt};
 use crate::scene::{MeshShape, QueryVolume};
 use std::sync::Arc;
 
@@ -17,9 +17,9 @@ pub struct MeshPairTrees {
     pub volume: QueryVolume,
     /// B's frame expressed in A's frame.
     pub pose_ab: Isometry,
-    /// The pair's threshold, metres ([`crate::bvh::frontier::FrontierPair::threshold`]).
+    /// The pair's threshold, metres ([`crate::narrow::mesh_mesh::frontier::FrontierPair::threshold`]).
     pub threshold: f64,
-    /// Triangles to try first ([`crate::bvh::frontier::FrontierPair::seed`]).
+    /// Triangles to try first ([`crate::narrow::mesh_mesh::frontier::FrontierPair::seed`]).
     pub seed: Option<[u32; 2]>,
 }
 

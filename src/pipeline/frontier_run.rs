@@ -4,9 +4,9 @@
 
 use super::{Budget, MeshPairTrees, PipelineWorkspace, Query, body, mesh_pair};
 use crate::broad::CandidatePair;
-use crate::bvh::frontier::FrontierStats;
 use crate::math::Pose;
 use crate::narrow::distance_triangle_triangle;
+use crate::narrow::mesh_mesh::frontier::FrontierStats;
 use crate::scene::{MeshShape, Scene};
 
 /// Answers the frame's mesh–mesh candidates that no kept answer covers through the

@@ -164,11 +164,11 @@ use crate::broad::{
     BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, PairMap, Proxy,
     SortAndSweep, choose,
 };
-use crate::bvh::frontier::{FrontierAnswer, FrontierStats, FrontierWorkspace};
 use crate::math::{DVec3, Pose};
 use crate::narrow::contact::Manifold;
 use crate::narrow::gjk::GjkCache;
 use crate::narrow::mesh_mesh::DistanceCache;
+use crate::narrow::mesh_mesh::frontier::{FrontierAnswer, FrontierStats, FrontierWorkspace};
 use crate::scene::MeshShape;
 use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
 use answer::{Answer, MeshScratch};
@@ -477,7 +477,7 @@ pub struct PipelineWorkspace {
     frontier_pairs: Vec<CandidatePair>,
     /// Per mesh–mesh candidate a budgeted frame's frontier found within its threshold, the
     /// triangle ids of its closest triangle pair found, kept until it is proven apart:
-    /// next frame's seed ([`crate::bvh::frontier::FrontierPair::seed`]), and first upper
+    /// next frame's seed ([`crate::narrow::mesh_mesh::frontier::FrontierPair::seed`]), and first upper
     /// bound under `DISTANCE`.
     frontier_seeds: PairMap<[u32; 2]>,
     /// What the frontier last ran over, to resume it next frame.
@@ -497,7 +497,7 @@ impl PipelineWorkspace {
 
     /// This workspace with its budgeted frontier polling the budget once at least `visits`
     /// (`≥ 1`) visits were made since the last poll (default
-    /// [`DEFAULT_POLL_EVERY`](crate::bvh::frontier::DEFAULT_POLL_EVERY)); 1 lets tests stop
+    /// [`DEFAULT_POLL_EVERY`](crate::narrow::mesh_mesh::frontier::DEFAULT_POLL_EVERY)); 1 lets tests stop
     /// it at every interruption point.
     #[must_use]
     pub fn with_frontier_poll_every(mut self, visits: u64) -> Self {
@@ -509,7 +509,10 @@ impl PipelineWorkspace {
     /// default, stages by width, is what the pipeline is meant to run; the others are the
     /// baselines `examples/time_vs_error --order` measures it against).
     #[must_use]
-    pub fn with_frontier_order(mut self, order: crate::bvh::frontier::RoundOrder) -> Self {
+    pub fn with_frontier_order(
+        mut self,
+        order: crate::narrow::mesh_mesh::frontier::RoundOrder,
+    ) -> Self {
         self.frontier = std::mem::take(&mut self.frontier).with_order(order);
         self
     }

@@ -211,9 +211,9 @@ mod tests {
     use crate::bounding::{Obb, Rss};
     use crate::budget::Unlimited;
     use crate::bvh::BuildParams;
-    use crate::bvh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
     use crate::geometry::Triangle;
     use crate::math::DVec3;
+    use crate::narrow::mesh_mesh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
 
     /// A flat fan of four triangles around the origin, and a triangle whose lowest vertex is
     /// 1 m above the origin: its closest point is the vertex every fan triangle shares, so

@@ -30,6 +30,7 @@
 
 mod collide;
 mod distance;
+pub mod frontier;
 
 pub use collide::{contacts_mesh_mesh, intersects_mesh_mesh};
 pub use distance::{

@@ -212,7 +212,7 @@
 //! ```
 //! use proxima::bounding::Obb;
 //! use proxima::budget::VisitBudget;
-//! use proxima::bvh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
+//! use proxima::narrow::mesh_mesh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
 //! use proxima::bvh::{BuildParams, Bvh};
 //! use proxima::geometry::TriMesh;
 //! use proxima::math::{DVec3, Isometry};
