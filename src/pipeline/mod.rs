@@ -531,7 +531,7 @@ pub fn step(
 }
 
 /// [`step`] under a budget (DESIGN §5): the frame's mesh–mesh pairs are answered through
-/// one budgeted breadth-first frontier ([`frontier`]) over all of them, and those it could
+/// one budgeted breadth-first frontier ([`frontier`](crate::narrow::mesh_mesh::frontier)) over all of them, and those it could
 /// not finish get conservative answers.
 ///
 /// # With an unlimited budget

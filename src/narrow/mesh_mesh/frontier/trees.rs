@@ -34,14 +34,6 @@ pub struct FrontierPair<'a, B> {
     /// docs, "Decide first"). `None`, or ids out of range, start from nothing. Exact
     /// distances do not depend on it (the witnesses of tied pairs may); a truncated answer
     /// stays conservative, and is usually tighter.
-    ///
-    /// Measured and not kept (2026-11-24): seeds carrying last frame's witness points,
-    /// each in its own body's frame, whose distance at the new pose (an upper bound of the
-    /// triangles' distance) proved the pair close without the triangle test, the test
-    /// deferred to when the pair is refined. On `examples/time_vs_error --scene
-    /// robot-chain` it saved about 1 of 16 triangle tests a frame, with no change in
-    /// precision or frame time: most pairs come without a seed, and touching links'
-    /// witnesses move out of the 4 cm margins within a frame.
     pub seed: Option<[u32; 2]>,
 }
 
