@@ -51,13 +51,12 @@ use plotters::prelude::*;
 use proxima::geometry::{Capsule, Cuboid, Sphere, TriMesh};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::narrow::mesh_mesh::frontier::RoundOrder;
+use proxima::narrow::{MeshShape, Shape};
 use proxima::pipeline::{
     Budget, Deadline, FrameResults, PairResult, PipelineWorkspace, Query, StepReport, Unlimited,
     VisitBudget, WorkerPool, step, step_within,
 };
-use proxima::scene::{
-    BodyDesc, BodyId, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape,
-};
+use proxima::scene::{BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits};
 use std::collections::BTreeMap;
 use std::error::Error;
 use std::fmt::Write as _;

@@ -20,12 +20,11 @@ use proxima::broad::select::CREEPING;
 use proxima::broad::{BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, choose};
 use proxima::geometry::{Capsule, Cuboid, Sphere};
 use proxima::math::{DVec3, Pose};
+use proxima::narrow::Shape;
 use proxima::pipeline::{
     AUTO_REMEASURE_FRAMES, FrameResults, PipelineWorkspace, Query, StepReport, step,
 };
-use proxima::scene::{
-    BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits, Shape, ShapeId,
-};
+use proxima::scene::{BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits, ShapeId};
 use rand::Rng;
 use std::collections::BTreeSet;
 use support::{TestRng, point_in_cube, rng, rotation};

@@ -449,8 +449,9 @@ fn every_gjk_kind_against_every_convex_kind_keeps_the_contact_contract() {
 #[test]
 fn resting_hulls_and_cylinders_get_four_world_contacts_from_the_pipeline() {
     use proxima::math::Pose;
+    use proxima::narrow::Shape;
     use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, step};
-    use proxima::scene::{BodyDesc, CollisionFilter, Motion, Scene, SceneLimits, Shape};
+    use proxima::scene::{BodyDesc, CollisionFilter, Motion, Scene, SceneLimits};
     use std::sync::Arc;
     let mut r = rng(506);
     let mut checked = 0;

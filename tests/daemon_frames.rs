@@ -13,9 +13,10 @@ use daemon_harness::{Daemon, body};
 use iceoryx2::prelude::ipc;
 use proxima::geometry::{Cuboid, Sphere};
 use proxima::math::{DQuat, DVec3, Pose};
+use proxima::narrow::{MeshShape, Shape};
 use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, StepReport, step};
 use proxima::scene::{
-    BodyDesc, BodyId, CollisionFilter, MeshShape, Motion as SceneMotion, Scene, SceneLimits, Shape,
+    BodyDesc, BodyId, CollisionFilter, Motion as SceneMotion, Scene, SceneLimits,
 };
 use proxima_ipc::client::{BodySpec, Client, Primitive};
 use proxima_ipc::scene_link::{ResultFrame, SceneLink};

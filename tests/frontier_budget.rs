@@ -38,8 +38,8 @@ use proxima::narrow::mesh_mesh::frontier::{
 use proxima::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh, within_distance_mesh_mesh,
 };
+use proxima::narrow::{MeshShape, QueryVolume};
 use proxima::pipeline::MeshPairTrees;
-use proxima::scene::{MeshShape, QueryVolume};
 use rand::Rng;
 use std::collections::HashMap;
 use std::sync::Arc;

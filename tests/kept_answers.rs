@@ -8,10 +8,9 @@ mod support;
 
 use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Sphere};
 use proxima::math::{DVec3, Pose};
+use proxima::narrow::{MeshShape, Shape};
 use proxima::pipeline::{FrameResults, PathCounts, PipelineWorkspace, Query, step};
-use proxima::scene::{
-    BodyDesc, BodyId, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape,
-};
+use proxima::scene::{BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits};
 use rand::Rng;
 use std::collections::BTreeSet;
 use std::sync::Arc;

@@ -9,10 +9,9 @@
 mod support;
 
 use proxima::math::{DQuat, DVec3, Pose};
+use proxima::narrow::{MeshShape, Shape};
 use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, VisitBudget, step, step_within};
-use proxima::scene::{
-    BodyDesc, BodyId, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape,
-};
+use proxima::scene::{BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits};
 use rand::Rng;
 use std::collections::BTreeSet;
 use std::sync::Arc;

@@ -9,9 +9,9 @@
 mod support;
 
 use proxima::math::Pose;
+use proxima::narrow::MeshShape;
 use proxima::narrow::gjk::GjkCache;
 use proxima::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
-use proxima::scene::MeshShape;
 use support::{meshes, point_in_cube, rng, rotation};
 
 /// The shared meshes, each scaled so its largest bounding-box edge is 1 m and centred.

@@ -21,11 +21,12 @@ mod support;
 
 use proxima::geometry::{Cuboid, Sphere};
 use proxima::math::{DVec3, Pose};
+use proxima::narrow::{MeshShape, Shape};
 use proxima::pipeline::{
     Budget, Completeness, ContactPoint, FrameResults, PairResult, PipelineWorkspace, Query,
     StepReport, Unlimited, VisitBudget, step, step_within,
 };
-use proxima::scene::{BodyDesc, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape};
+use proxima::scene::{BodyDesc, CollisionFilter, Motion, Scene, SceneLimits};
 use rand::Rng;
 use std::collections::BTreeMap;
 use std::sync::Arc;

@@ -10,10 +10,9 @@ mod support;
 
 use proxima::geometry::{Capsule, ConvexPolyhedron, Cylinder, Sphere};
 use proxima::math::Pose;
+use proxima::narrow::{MeshShape, Shape};
 use proxima::pipeline::{FrameResults, PathCounts, PipelineWorkspace, Query, StepReport, step};
-use proxima::scene::{
-    BodyDesc, BodyId, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape,
-};
+use proxima::scene::{BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits};
 use rand::Rng;
 use std::sync::Arc;
 use support::{TestRng, meshes, point_in_cube, rng, rotation};

@@ -24,13 +24,12 @@ use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Sphere, Triangle};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::narrow::distance_triangle_triangle;
 use proxima::narrow::toi::FrameMotion;
+use proxima::narrow::{MeshShape, Shape};
 use proxima::pipeline::{
     Completeness, Deadline, FrameResults, PipelineWorkspace, Query, TOI_TOLERANCE, step,
     step_within,
 };
-use proxima::scene::{
-    BodyDesc, BodyId, CollisionFilter, MeshShape, Motion, Scene, SceneLimits, Shape,
-};
+use proxima::scene::{BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits};
 use rand::Rng;
 use std::sync::Arc;
 use std::time::Instant;

@@ -7,8 +7,9 @@ use crate::geometry::{
     Sphere, TriMesh,
 };
 use crate::math::{DQuat, DVec3, Pose};
+use crate::narrow::{MeshShape, Shape};
 use crate::pipeline::{self, Query};
-use crate::scene::{CollisionFilter, MeshShape, Motion, Shape};
+use crate::scene::{CollisionFilter, Motion};
 use proxima_ipc::wire::{self, ControlRequest, ErrorCode, MotionCode, ShapeKindCode, query};
 use std::sync::Arc;
 

@@ -108,7 +108,8 @@ pub fn apply_pose_frame(
 mod tests {
     use super::*;
     use crate::geometry::Sphere;
-    use crate::scene::{BodyDesc, CollisionFilter, Motion, SceneLimits, Shape};
+    use crate::narrow::Shape;
+    use crate::scene::{BodyDesc, CollisionFilter, Motion, SceneLimits};
     use proxima_ipc::wire::query;
 
     fn scene_with_bodies(n: usize) -> Scene {

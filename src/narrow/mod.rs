@@ -35,6 +35,7 @@ pub mod mesh_hull;
 pub mod mesh_mesh;
 pub mod pairs;
 pub mod polygon;
+pub mod shape;
 pub mod toi;
 mod triangle_overlap;
 pub mod triangle_triangle;
@@ -53,6 +54,7 @@ pub use pairs::{
     manifold_cuboid_cuboid, manifold_cuboid_triangle, manifold_sphere_capsule,
     manifold_sphere_cuboid, manifold_sphere_sphere, manifold_sphere_triangle,
 };
+pub use shape::{MeshShape, QueryVolume, Shape};
 pub use triangle_triangle::{
     TriangleDistance, distance_triangle_triangle, intersection_segment_triangle_triangle,
     intersects_triangle_triangle,

@@ -20,7 +20,8 @@ use crate::narrow::mesh_mesh::frontier::FrontierAnswer;
 use crate::narrow::mesh_mesh::{
     DistanceCache, MeshMeshWorkspace, Proximity, contacts_mesh_mesh, intersects_mesh_mesh,
 };
-use crate::scene::{Body, MeshShape, Shape};
+use crate::narrow::{MeshShape, Shape};
+use crate::scene::Body;
 use std::ops::ControlFlow;
 
 /// One pair's answer before the report decision.

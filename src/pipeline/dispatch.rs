@@ -29,7 +29,7 @@ use crate::narrow::gjk::{
 };
 use crate::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
 use crate::narrow::pairs;
-use crate::scene::{MeshShape, Shape};
+use crate::narrow::{MeshShape, Shape};
 use std::sync::Arc;
 
 /// GJK/EPA settings of the pipeline: GJK's defaults (relative tolerance 1e-10).

@@ -4,7 +4,7 @@
 
 use crate::math::Isometry;
 use crate::narrow::mesh_mesh::frontier::{FrontierWitnesses, PairTrees, TreesAt};
-use crate::scene::{MeshShape, QueryVolume};
+use crate::narrow::{MeshShape, QueryVolume};
 use std::sync::Arc;
 
 /// One mesh pair of a budgeted frame, refined with the trees of its [`QueryVolume`].

@@ -5,9 +5,10 @@
 use super::{Budget, MeshPairTrees, PipelineWorkspace, Query, body, mesh_pair};
 use crate::broad::CandidatePair;
 use crate::math::Pose;
+use crate::narrow::MeshShape;
 use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::frontier::FrontierStats;
-use crate::scene::{MeshShape, Scene};
+use crate::scene::Scene;
 
 /// Answers the frame's mesh–mesh candidates that no kept answer covers through the
 /// frontier, under `budget` (see [`step_within`]): resumes last frame's frontier when it

@@ -62,7 +62,7 @@ use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
 use crate::narrow::convex_mesh::{for_each_overlapping_triangle, nearest_triangle};
 use crate::narrow::gjk::{EpaWorkspace, GjkCache, Rounded, signed_distance_convex};
 use crate::narrow::pairs;
-use crate::scene::{MeshShape, Shape};
+use crate::narrow::{MeshShape, Shape};
 use std::ops::ControlFlow;
 
 /// A normal within this angle (radians, as the sine) of a face normal counts as the face

@@ -165,12 +165,13 @@ use crate::broad::{
     SortAndSweep, choose,
 };
 use crate::math::{DVec3, Pose};
+use crate::narrow::MeshShape;
+use crate::narrow::Shape;
 use crate::narrow::contact::Manifold;
 use crate::narrow::gjk::GjkCache;
 use crate::narrow::mesh_mesh::DistanceCache;
 use crate::narrow::mesh_mesh::frontier::{FrontierAnswer, FrontierStats, FrontierWorkspace};
-use crate::scene::MeshShape;
-use crate::scene::{Body, BodyId, Scene, Shape, SyncPoint};
+use crate::scene::{Body, BodyId, Scene, SyncPoint};
 use answer::{Answer, MeshScratch};
 use dispatch::{NarrowScratch, Route};
 use frontier_run::{FrontierRun, run_frontier};
@@ -541,7 +542,7 @@ pub fn step(
 /// # With a limited budget
 /// Before the per-pair loop, every mesh–mesh candidate pair not answered by a kept answer
 /// or a kept separation joins one frontier run, refined with the trees its meshes chose
-/// ([`QueryVolume::for_pair`](crate::scene::QueryVolume::for_pair): OBBs for box-like
+/// ([`QueryVolume::for_pair`](crate::narrow::QueryVolume::for_pair): OBBs for box-like
 /// parts, RSSs for curved ones), with
 /// threshold the pair's margin sum (`CLOSE`, `OVERLAP`,
 /// `CONTACTS`) or, when `DISTANCE` is asked, an upper bound of the pair's distance: the
@@ -1135,11 +1136,12 @@ mod tests {
     use crate::bounding::Aabb;
     use crate::geometry::{Cuboid, Sphere};
     use crate::math::Pose;
+    use crate::narrow::MeshShape;
     use crate::narrow::mesh_mesh::{
         DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
         intersects_mesh_mesh,
     };
-    use crate::scene::{BodyDesc, CollisionFilter, MeshShape, Motion, SceneLimits};
+    use crate::scene::{BodyDesc, CollisionFilter, Motion, SceneLimits};
     use crate::test_support::{meshes, point_in_cube, rng, rotation};
     use rand::Rng;
     use std::ops::ControlFlow;

@@ -34,9 +34,10 @@ use super::Query;
 use super::dispatch::{self, NarrowScratch};
 use crate::broad::CandidatePair;
 use crate::math::{DVec3, Pose};
+use crate::narrow::Shape;
 use crate::narrow::contact::ShapeDistance;
 use crate::narrow::toi::{ToiOutcome, ToiParams, time_of_impact_until};
-use crate::scene::{Body, Scene, Shape};
+use crate::scene::{Body, Scene};
 
 /// Distance tolerance of the time-of-impact search, metres: at the reported time the pair
 /// is at most its margins plus this far apart.

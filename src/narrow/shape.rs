@@ -1,0 +1,337 @@
+//! The shape set every pair query matches on: [`Shape`], one variant per kind, in the
+//! canonical order the dispatcher writes pairs in (sphere < capsule < cuboid < cylinder <
+//! cone < convex < mesh), and [`MeshShape`], a triangle mesh with everything its queries
+//! need, built once when it is registered.
+
+use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
+use crate::bvh::{BuildParams, Bvh};
+use crate::geometry::mesh::MeshEdges;
+use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
+use crate::math::{DVec3, Isometry, Pose};
+use crate::narrow::mesh_hull::MeshHull;
+use crate::narrow::mesh_mesh::{
+    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity, distance_mesh_mesh,
+    proximity_mesh_mesh, rounding_bound,
+};
+use std::sync::Arc;
+
+/// A triangle mesh ready for queries: the mesh and its two BVHs (OBB trees answer overlap
+/// and contacts fastest, RSS trees distance; measured in `benches/mesh_pair.rs`).
+#[derive(Debug)]
+pub struct MeshShape {
+    /// The mesh, local frame.
+    pub mesh: TriMesh,
+    /// Binned-SAH tree of OBBs.
+    pub overlap_tree: Bvh<Obb>,
+    /// Binned-SAH tree of RSSs.
+    pub distance_tree: Bvh<Rss>,
+    /// Edge adjacency and bends, for convex–mesh contacts without ghost normals.
+    pub edges: MeshEdges,
+    /// The tree distance queries on this mesh refine, the budgeted frontier's and the
+    /// exact ones', by measured tightness ([`QueryVolume::measure`]).
+    pub query_volume: QueryVolume,
+    /// Convex hull of the vertices (`None` for a flat or degenerate mesh): a pair of
+    /// meshes whose hulls are apart by more than their margins is apart with no traversal
+    /// ([`MeshHull::gap`]).
+    pub hull: Option<MeshHull>,
+}
+
+impl MeshShape {
+    /// Builds both trees over `mesh` (offline work: about 1 s for 70,000 triangles), its
+    /// edge adjacency and its query volume choice.
+    #[must_use]
+    pub fn new(mesh: TriMesh) -> Self {
+        let overlap_tree = Bvh::from_mesh(&mesh, &BuildParams::BINNED_SAH);
+        let distance_tree = Bvh::from_mesh(&mesh, &BuildParams::BINNED_SAH);
+        Self {
+            edges: MeshEdges::new(&mesh),
+            query_volume: QueryVolume::measure(&overlap_tree, &distance_tree),
+            hull: MeshHull::of(&mesh),
+            overlap_tree,
+            distance_tree,
+            mesh,
+        }
+    }
+
+    /// The rounding bound of a triangle distance between this mesh and `other` placed at
+    /// `iso`, as every path states it: [`rounding_bound`] of the RSS trees, whichever trees
+    /// a query refined, so that a record does not depend on the choice.
+    #[must_use]
+    pub fn rounding_with(&self, other: &Self, iso: &Isometry) -> f64 {
+        rounding_bound(&self.distance_tree, &other.distance_tree, iso)
+    }
+
+    /// The exact distance between this mesh and `other` placed at `pose_ab` (`other`'s
+    /// frame in this one's), warm-started from `cache`: [`distance_mesh_mesh`] on the trees
+    /// [`QueryVolume::for_pair`] chooses, with the error bound of
+    /// [`rounding_with`](Self::rounding_with).
+    #[must_use]
+    pub fn distance_to(
+        &self,
+        other: &Self,
+        pose_ab: &Pose,
+        cache: &mut DistanceCache,
+        workspace: &mut MeshMeshWorkspace,
+    ) -> MeshDistance {
+        let exact = &DistanceParams::EXACT;
+        match QueryVolume::for_pair(self.query_volume, other.query_volume) {
+            QueryVolume::Obb => {
+                let (a, b) = (&self.overlap_tree, &other.overlap_tree);
+                let d = distance_mesh_mesh(a, b, pose_ab, exact, cache, workspace);
+                MeshDistance {
+                    error_bound: self.rounding_with(other, &pose_ab.to_isometry()),
+                    ..d
+                }
+            }
+            QueryVolume::Rss => {
+                let (a, b) = (&self.distance_tree, &other.distance_tree);
+                distance_mesh_mesh(a, b, pose_ab, exact, cache, workspace)
+            }
+        }
+    }
+
+    /// Whether some triangle of this mesh and one of `other` placed at `pose_ab` are within
+    /// `max_distance`, with a lower bound of the distance when not ([`proximity_mesh_mesh`]
+    /// on the trees [`QueryVolume::for_pair`] chooses).
+    #[must_use]
+    pub fn proximity(
+        &self,
+        other: &Self,
+        pose_ab: &Pose,
+        max_distance: f64,
+        workspace: &mut MeshMeshWorkspace,
+    ) -> Proximity {
+        match QueryVolume::for_pair(self.query_volume, other.query_volume) {
+            QueryVolume::Obb => {
+                let (a, b) = (&self.overlap_tree, &other.overlap_tree);
+                proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
+            }
+            QueryVolume::Rss => {
+                let (a, b) = (&self.distance_tree, &other.distance_tree);
+                proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
+            }
+        }
+    }
+}
+
+/// Which of a mesh's two trees distance queries refine it with: the budgeted frontier
+/// ([`MeshPairTrees`](crate::pipeline::MeshPairTrees)) and the exact queries
+/// ([`MeshShape::distance_to`], [`MeshShape::proximity`]).
+///
+/// Exact queries: on robot-chain (`examples/time_vs_error`, budget `inf`, 300 frames, two
+/// alternating runs), the OBB trees this choice names for the CAD meshes answered a frame
+/// in 185–188 µs at the median (p99 490–540 µs), against 318–348 µs (p99 760–820 µs) on
+/// the RSS trees every pair used before; the mesh pile's tori and spheres choose RSSs, as
+/// before.
+///
+/// The frontier: measured with `examples/time_vs_error` (query `CLOSE`, same frames,
+/// precision of the reported close pairs at a budget of about a quarter of the exact time,
+/// then measured on the RSS trees): on the robot-chain scene (CAD links against a room) the
+/// OBB frontier gave 0.835 at 100 µs
+/// against 0.710 with RSSs, and finished every frame by 1,000 µs, because its bound (a
+/// separating-axis gap) costs a fraction of the RSS's exact rectangle distance; on the
+/// mesh pile (tori and spheres) it gave 0.740 against 0.917 at 300 µs, because there the
+/// RSSs are as small as the boxes and their distance bound is much tighter. The measure
+/// that tells these apart is the volume of the top of the trees: RSS over OBB volume is
+/// 1.31–1.33 for the robot and room meshes and 1.00 for the torus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum QueryVolume {
+    /// The OBB tree: clearly the tighter of the two on this mesh.
+    Obb,
+    /// The RSS tree: about as tight as the boxes, and its distance bound is exact for
+    /// rounded rectangles.
+    Rss,
+}
+
+impl QueryVolume {
+    /// Depth of the top of the trees that is measured (the levels a budgeted frontier
+    /// spends most of its visits in).
+    const MEASURED_DEPTH: u32 = 5;
+    /// RSS volume over OBB volume above which the boxes are taken.
+    const OBB_TIGHTER: f64 = 1.15;
+
+    /// The choice for a mesh with these trees: OBBs when the RSSs of the nodes down to
+    /// depth 5 (`MEASURED_DEPTH`) hold more than 1.15 (`OBB_TIGHTER`) times the boxes'
+    /// volume, else RSSs.
+    #[must_use]
+    pub fn measure(overlap_tree: &Bvh<Obb>, distance_tree: &Bvh<Rss>) -> Self {
+        let (obb, rss) = (
+            top_volume(overlap_tree, Self::MEASURED_DEPTH),
+            top_volume(distance_tree, Self::MEASURED_DEPTH),
+        );
+        if rss > Self::OBB_TIGHTER * obb {
+            Self::Obb
+        } else {
+            Self::Rss
+        }
+    }
+
+    /// The volume type a pair of meshes is refined with: OBBs when both meshes chose them.
+    #[must_use]
+    pub fn for_pair(a: Self, b: Self) -> Self {
+        if a == Self::Obb && b == Self::Obb {
+            Self::Obb
+        } else {
+            Self::Rss
+        }
+    }
+}
+
+/// Total volume, cubic metres, of the nodes of `tree` down to `depth` (the root at 0).
+fn top_volume<B: BoundingVolume>(tree: &Bvh<B>, depth: u32) -> f64 {
+    let nodes = tree.nodes();
+    let mut total = 0.0;
+    let mut stack = vec![(0_usize, 0_u32)];
+    while let Some((i, d)) = stack.pop() {
+        let node = &nodes[i];
+        total += node.bv.volume();
+        if d < depth && !node.is_leaf() {
+            stack.extend(node.children().map(|c| (c, d + 1)));
+        }
+    }
+    total
+}
+
+/// A registered shape, in its local frame. Large shapes are shared (`Arc`) so bodies and
+/// frames never copy geometry.
+#[derive(Debug, Clone)]
+pub enum Shape {
+    /// A sphere about the origin.
+    Sphere(Sphere),
+    /// A capsule along local Z.
+    Capsule(Capsule),
+    /// A box about the origin.
+    Cuboid(Cuboid),
+    /// A cylinder along local Z.
+    Cylinder(Cylinder),
+    /// A cone along local Z, apex at `+half_height`.
+    Cone(Cone),
+    /// A convex polyhedron.
+    Convex(Arc<ConvexPolyhedron>),
+    /// A triangle mesh with its BVHs.
+    Mesh(Arc<MeshShape>),
+}
+
+impl Shape {
+    /// The smallest axis-aligned box of the local frame containing the shape.
+    #[must_use]
+    pub fn local_bounds(&self) -> Aabb {
+        let symmetric = |half: DVec3| Aabb::new(-half, half);
+        match self {
+            Self::Sphere(s) => symmetric(DVec3::splat(s.radius)),
+            Self::Capsule(c) => symmetric(DVec3::new(c.radius, c.radius, c.half_height + c.radius)),
+            Self::Cuboid(c) => symmetric(c.half_extents),
+            Self::Cylinder(c) => symmetric(DVec3::new(c.radius, c.radius, c.half_height)),
+            Self::Cone(c) => symmetric(DVec3::new(c.radius, c.radius, c.half_height)),
+            Self::Convex(c) => Aabb::fit_points(c.vertices()),
+            Self::Mesh(m) => {
+                let (min, max) = m.mesh.bounds();
+                Aabb::new(min, max)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::{meshes, pose, rng};
+
+    #[test]
+    fn the_frontier_takes_boxes_for_box_like_meshes_and_rsss_for_curved_ones() {
+        let choice = |m: TriMesh| MeshShape::new(m).query_volume;
+        assert_eq!(choice(meshes::torus(0.4, 0.12, 32, 16)), QueryVolume::Rss);
+        let slab = meshes::subdivided_cuboid(DVec3::new(1.0, 0.6, 0.3), 6);
+        assert_eq!(choice(slab), QueryVolume::Obb);
+        // The meshes the rule was measured on, when the shared data is present.
+        for file in ["rob.obj", "env.obj"] {
+            if let Some(m) = meshes::shared_data_mesh(file) {
+                assert_eq!(choice(m), QueryVolume::Obb, "{file}");
+            }
+        }
+        let pair = QueryVolume::for_pair;
+        assert_eq!(pair(QueryVolume::Obb, QueryVolume::Obb), QueryVolume::Obb);
+        assert_eq!(pair(QueryVolume::Obb, QueryVolume::Rss), QueryVolume::Rss);
+        assert_eq!(pair(QueryVolume::Rss, QueryVolume::Obb), QueryVolume::Rss);
+    }
+
+    /// The smallest distance over every triangle pair, in f64: the oracle.
+    fn brute_force(a: &TriMesh, b: &TriMesh, pose_ab: &Pose) -> f64 {
+        let iso = pose_ab.to_isometry();
+        let moved: Vec<_> = (0..b.triangle_count())
+            .map(|j| b.triangle(j).transformed(&iso))
+            .collect();
+        (0..a.triangle_count())
+            .flat_map(|i| {
+                let ta = a.triangle(i);
+                moved
+                    .iter()
+                    .map(move |tb| crate::narrow::distance_triangle_triangle(&ta, tb).distance)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The exact queries refine the trees the pair's volume names (OBBs for two slabs, RSSs
+    /// when a ball is in the pair) and answer as the brute force over every triangle pair
+    /// does, with the RSS trees' rounding bound on either path; `proximity` agrees with the
+    /// distance on both sides of the limit, and its lower bound when apart is one.
+    #[test]
+    fn exact_queries_on_either_volume_match_the_brute_force() {
+        let slab = MeshShape::new(meshes::subdivided_cuboid(DVec3::new(0.5, 0.3, 0.15), 3));
+        let ball = MeshShape::new(meshes::uv_sphere(0.35, 12, 8));
+        let mut r = rng(91);
+        let mut workspace = MeshMeshWorkspace::new();
+        let (mut within, mut beyond) = (0, 0);
+        for (a, b, volume) in [
+            (&slab, &slab, QueryVolume::Obb),
+            (&slab, &ball, QueryVolume::Rss),
+            (&ball, &ball, QueryVolume::Rss),
+        ] {
+            assert_eq!(
+                QueryVolume::for_pair(a.query_volume, b.query_volume),
+                volume
+            );
+            let mut cache = DistanceCache::new();
+            for case in 0..100 {
+                let pose_ab = pose(&mut r, 0.9);
+                let truth = brute_force(&a.mesh, &b.mesh, &pose_ab);
+                let d = a.distance_to(b, &pose_ab, &mut cache, &mut workspace);
+                let iso = pose_ab.to_isometry();
+                let rounding = rounding_bound(&a.distance_tree, &b.distance_tree, &iso);
+                assert_eq!(d.error_bound, rounding, "{volume:?} case {case}");
+                assert!(
+                    (d.distance - truth).abs() <= d.error_bound,
+                    "{volume:?} case {case}: {} against {truth}",
+                    d.distance
+                );
+                let limit = 0.05;
+                let proximity = a.proximity(b, &pose_ab, limit, &mut workspace);
+                if let Proximity::Apart { lower_bound } = proximity {
+                    assert!(
+                        lower_bound > limit && lower_bound <= truth + rounding,
+                        "{volume:?} case {case}: bound {lower_bound}, truth {truth}"
+                    );
+                }
+                if truth <= limit - rounding {
+                    assert_eq!(
+                        proximity,
+                        Proximity::Within,
+                        "{volume:?} case {case}: {truth}"
+                    );
+                    within += 1;
+                } else if truth > limit + rounding {
+                    assert_ne!(
+                        proximity,
+                        Proximity::Within,
+                        "{volume:?} case {case}: {truth}"
+                    );
+                    beyond += 1;
+                }
+            }
+        }
+        assert!(
+            within > 40 && beyond > 40,
+            "{within} within, {beyond} beyond"
+        );
+    }
+}
