@@ -659,8 +659,8 @@ mod tests {
     use super::*;
     use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere};
     use crate::narrow::MeshShape;
-    use std::sync::Arc;
     use crate::test_support::{meshes, pose, rng};
+    use std::sync::Arc;
 
     fn scene() -> Scene {
         Scene::try_new(

@@ -8,7 +8,7 @@ use crate::geometry::{
 };
 use crate::math::{DQuat, DVec3, Pose};
 use crate::narrow::{MeshShape, Shape};
-use crate::pipeline::{self, Query};
+use crate::pipeline::Query;
 use crate::scene::{CollisionFilter, Motion};
 use proxima_ipc::wire::{self, ControlRequest, ErrorCode, MotionCode, ShapeKindCode, query};
 use std::sync::Arc;
@@ -39,7 +39,7 @@ pub fn pose(position: [f64; 3], orientation: [f64; 4]) -> Result<Pose, Rejection
 }
 
 // The wire promises clients the engine's manifold size.
-const _: () = assert!(pipeline::MAX_CONTACTS_PER_PAIR as u32 == wire::MAX_CONTACTS_PER_PAIR);
+const _: () = assert!(crate::narrow::MANIFOLD_POINTS as u32 == wire::MAX_CONTACTS_PER_PAIR);
 
 /// The [`Query`] a pose frame's `query_flags` ask for.
 ///

@@ -31,6 +31,7 @@ pub mod contact;
 pub mod convex_manifold;
 pub mod convex_mesh;
 pub mod gjk;
+pub mod manifold_reduction;
 pub mod mesh_hull;
 pub mod mesh_mesh;
 pub mod pairs;
@@ -45,6 +46,7 @@ pub use convex_manifold::{ContactFeatures, manifold_convex_convex};
 pub use gjk::{
     GjkCache, GjkOutcome, GjkParams, GjkResult, Rounded, gjk_distance, signed_distance_convex,
 };
+pub use manifold_reduction::{EXACT_DIAMETER_POINTS, reduce_manifold};
 pub use pairs::{
     distance_bound_capsule_capsule, distance_bound_capsule_cuboid, distance_bound_cuboid_cuboid,
     distance_capsule_capsule, distance_capsule_cuboid, distance_capsule_triangle,

@@ -6,10 +6,9 @@
 //! input).
 //!
 //! Each function returns the pair's [`Answer`] and, when the query asks for contacts and the
-//! pair touches, appends its manifold (at most [`MAX_CONTACTS_PER_PAIR`] points) to
+//! pair touches, appends its manifold (at most [`MANIFOLD_POINTS`] points) to
 //! `contacts`. Whether the pair is *reported* is decided by the caller from the answer.
 
-use super::contacts::{MAX_CONTACTS_PER_PAIR, reduce_manifold};
 use super::dispatch::{self, NarrowScratch};
 use super::{ContactPoint, PairResult, Query};
 use crate::bounding::Aabb;
@@ -20,6 +19,7 @@ use crate::narrow::mesh_mesh::frontier::FrontierAnswer;
 use crate::narrow::mesh_mesh::{
     DistanceCache, MeshMeshWorkspace, Proximity, contacts_mesh_mesh, intersects_mesh_mesh,
 };
+use crate::narrow::{MANIFOLD_POINTS, reduce_manifold};
 use crate::narrow::{MeshShape, Shape};
 use crate::scene::Body;
 use std::ops::ControlFlow;
@@ -458,7 +458,7 @@ fn mesh_manifold(
     let Some(&first) = kept.first() else {
         return;
     };
-    debug_assert!(kept.len() <= MAX_CONTACTS_PER_PAIR);
+    debug_assert!(kept.len() <= MANIFOLD_POINTS);
     let normal_a = normals
         .iter()
         .sum::<DVec3>()

@@ -49,7 +49,6 @@
 //! shapes whose triangle manifold is one point (spheres and the GJK shapes). A pair beyond
 //! contact (distance `> 0`) gets an empty manifold with no walk at all.
 
-use super::contacts::reduce_manifold;
 use super::dispatch::{GJK, NarrowScratch, core_of};
 use crate::bounding::BoundingVolume;
 use crate::bounding::{Obb, Rss};
@@ -62,6 +61,7 @@ use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
 use crate::narrow::convex_mesh::{for_each_overlapping_triangle, nearest_triangle};
 use crate::narrow::gjk::{EpaWorkspace, GjkCache, Rounded, signed_distance_convex};
 use crate::narrow::pairs;
+use crate::narrow::reduce_manifold;
 use crate::narrow::{MeshShape, Shape};
 use std::ops::ControlFlow;
 

@@ -11,7 +11,7 @@
 //! | [`Query::close`] | distance ≤ the sum of the two margins; signed distance, witnesses, normal A→B | exact distance |
 //! | [`Query::overlap`] | the shapes touch or intersect (distance ≤ 0) | [`intersects_mesh_mesh`](crate::narrow::mesh_mesh::intersects_mesh_mesh), stops at the first proof |
 //! | [`Query::distance`] | every candidate pair, also beyond the margins, with its exact signed distance | exact distance |
-//! | [`Query::contacts`] | touching pairs, each with its manifold ([`ContactPoint`]s, at most [`MAX_CONTACTS_PER_PAIR`]) | every intersecting triangle pair ([`contacts_mesh_mesh`](crate::narrow::mesh_mesh::contacts_mesh_mesh)), then [`reduce_manifold`] |
+//! | [`Query::contacts`] | touching pairs, each with its manifold ([`ContactPoint`]s, at most [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS)) | every intersecting triangle pair ([`contacts_mesh_mesh`](crate::narrow::mesh_mesh::contacts_mesh_mesh)), then [`reduce_manifold`](crate::narrow::reduce_manifold) |
 //! | [`Query::toi`] | pairs that come within their margins during the frame's motion, each with its time of impact ([`PairToi`], in [`FrameResults::tois`]) | exact distance per conservative-advancement step |
 //!
 //! Flags combine: `CLOSE | CONTACTS` reports the close pairs, and the touching ones among
@@ -25,7 +25,7 @@
 //! Contacts per pair kind:
 //! - sphere–sphere: one point, the witnesses, `distance = −depth`;
 //! - mesh–mesh: the ends of every intersection segment of the two surfaces, reduced by
-//!   [`reduce_manifold`] to the extremes, each with `point_a == point_b` and depth 0 (meshes
+//!   [`reduce_manifold`](crate::narrow::reduce_manifold) to the extremes, each with `point_a == point_b` and depth 0 (meshes
 //!   are surfaces: intersecting meshes touch along curves and have no inside to measure a
 //!   depth in). One normal for the manifold: the sum of the intersecting triangles' normals
 //!   on A (A→B), one per segment end, normalised (when they cancel exactly, the normal at
@@ -145,7 +145,6 @@
 
 mod answer;
 pub mod budget;
-mod contacts;
 mod dispatch;
 mod frontier_pairs;
 mod frontier_run;
@@ -155,7 +154,6 @@ mod toi;
 pub mod workers;
 
 pub use budget::{Budget, Deadline, FRONTIER_RESERVE, Unlimited, VisitBudget, frontier_deadline};
-pub use contacts::{EXACT_DIAMETER_POINTS, MAX_CONTACTS_PER_PAIR, reduce_manifold};
 pub use dispatch::PathCounts;
 pub use frontier_pairs::MeshPairTrees;
 pub use toi::{PairToi, TOI_TOLERANCE};
@@ -280,7 +278,7 @@ pub struct PairResult {
     pub exact: bool,
     /// Index of the pair's first contact in [`FrameResults::contacts`] (0 when none).
     pub first_contact: u32,
-    /// Number of the pair's contacts, at most [`MAX_CONTACTS_PER_PAIR`].
+    /// Number of the pair's contacts, at most [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS).
     pub contact_count: u32,
 }
 
@@ -1141,6 +1139,7 @@ mod tests {
         DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
         intersects_mesh_mesh,
     };
+    use crate::narrow::{MANIFOLD_POINTS, reduce_manifold};
     use crate::scene::{BodyDesc, CollisionFilter, Motion, SceneLimits};
     use crate::test_support::{meshes, point_in_cube, rng, rotation};
     use rand::Rng;
@@ -1181,7 +1180,7 @@ mod tests {
     }
 
     /// Pairs in `(a, b)` order; each pair's contacts are exactly the ones that name it, in
-    /// one run, in pair order, at most `MAX_CONTACTS_PER_PAIR`.
+    /// one run, in pair order, at most `MANIFOLD_POINTS`.
     fn assert_links(results: &FrameResults) {
         assert!(
             results
@@ -1191,7 +1190,7 @@ mod tests {
         );
         let mut next = 0;
         for (i, p) in results.pairs.iter().enumerate() {
-            assert!(p.contact_count as usize <= MAX_CONTACTS_PER_PAIR);
+            assert!(p.contact_count as usize <= MANIFOLD_POINTS);
             if p.contact_count == 0 {
                 assert_eq!(p.first_contact, 0);
                 continue;

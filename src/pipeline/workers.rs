@@ -28,10 +28,10 @@
 //! answers that pair with the conservative box answer instead of leaving the frame waiting.
 
 use super::answer::{self, Answer, MeshScratch};
-use super::contacts::MAX_CONTACTS_PER_PAIR;
 use super::{ContactPoint, Query};
 use crate::broad::CandidatePair;
 use crate::math::DVec3;
+use crate::narrow::MANIFOLD_POINTS;
 use crate::narrow::MeshShape;
 use crate::narrow::mesh_mesh::DistanceCache;
 use crate::scene::Body;
@@ -65,20 +65,20 @@ pub(super) struct MeshJob {
 pub(super) struct MeshOutcome {
     pub slot: u32,
     pub answer: Answer,
-    contacts: [ContactPoint; MAX_CONTACTS_PER_PAIR],
+    contacts: [ContactPoint; MANIFOLD_POINTS],
     contact_count: usize,
     pub cache: DistanceCache,
 }
 
 impl MeshOutcome {
-    /// The outcome of pair `slot`: its answer, the first [`MAX_CONTACTS_PER_PAIR`] of
+    /// The outcome of pair `slot`: its answer, the first [`MANIFOLD_POINTS`] of
     /// `contacts` and its cache.
     fn new(slot: u32, answer: Answer, contacts: &[ContactPoint], cache: DistanceCache) -> Self {
         let mut outcome = Self {
             slot,
             answer,
-            contacts: [NO_CONTACT; MAX_CONTACTS_PER_PAIR],
-            contact_count: contacts.len().min(MAX_CONTACTS_PER_PAIR),
+            contacts: [NO_CONTACT; MANIFOLD_POINTS],
+            contact_count: contacts.len().min(MANIFOLD_POINTS),
             cache,
         };
         outcome.contacts[..outcome.contact_count]

@@ -1,4 +1,4 @@
-//! Contact manifold reduction: at most [`MAX_CONTACTS_PER_PAIR`] informative points out of a
+//! Contact manifold reduction: at most [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS) informative points out of a
 //! pair's whole contact set.
 //!
 //! A mesh–mesh intersection can produce thousands of segment endpoints; a physics client
@@ -19,21 +19,18 @@
 
 use crate::math::DVec3;
 
-/// Most contact points reported per pair (one manifold).
-pub const MAX_CONTACTS_PER_PAIR: usize = 4;
-
 /// Sets up to this many points get the exact farthest pair (quadratic); larger sets the
 /// linear double sweep.
 pub const EXACT_DIAMETER_POINTS: usize = 256;
 
-/// The indices into `points` of at most [`MAX_CONTACTS_PER_PAIR`] distinct points spanning
+/// The indices into `points` of at most [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS) distinct points spanning
 /// the set, written to `out` (cleared first) in the order chosen: the farthest pair (exact
 /// up to [`EXACT_DIAMETER_POINTS`] points, else a double sweep, at least half the diameter),
 /// the point making the largest triangle with it, the point adding the most area beyond
 /// that triangle. Equal points give one index, collinear ones two; empty input, none.
 ///
 /// # Allocation
-/// None once `out` holds [`MAX_CONTACTS_PER_PAIR`] indices.
+/// None once `out` holds [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS) indices.
 pub fn reduce_manifold(points: &[DVec3], out: &mut Vec<usize>) {
     out.clear();
     if points.is_empty() {
@@ -150,7 +147,7 @@ mod tests {
                 })
                 .collect();
             let kept = reduced(&points);
-            assert!(!kept.is_empty() && kept.len() <= MAX_CONTACTS_PER_PAIR);
+            assert!(!kept.is_empty() && kept.len() <= crate::narrow::MANIFOLD_POINTS);
             let mut sorted = kept.clone();
             sorted.sort_unstable();
             sorted.dedup();
