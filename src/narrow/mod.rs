@@ -30,6 +30,7 @@ mod closest_points;
 pub mod contact;
 pub mod convex_manifold;
 pub mod convex_mesh;
+pub mod dispatch;
 pub mod gjk;
 pub mod manifold_reduction;
 pub mod mesh_hull;

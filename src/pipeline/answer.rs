@@ -9,12 +9,12 @@
 //! pair touches, appends its manifold (at most [`MANIFOLD_POINTS`] points) to
 //! `contacts`. Whether the pair is *reported* is decided by the caller from the answer.
 
-use super::dispatch::{self, NarrowScratch};
 use super::{ContactPoint, PairResult, Query};
 use crate::bounding::Aabb;
 use crate::broad::CandidatePair;
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::contact::{Manifold, ShapeDistance};
+use crate::narrow::dispatch::{self, NarrowScratch};
 use crate::narrow::mesh_mesh::frontier::FrontierAnswer;
 use crate::narrow::mesh_mesh::{
     DistanceCache, MeshMeshWorkspace, Proximity, contacts_mesh_mesh, intersects_mesh_mesh,

@@ -145,16 +145,14 @@
 
 mod answer;
 pub mod budget;
-mod dispatch;
 mod frontier_pairs;
 mod frontier_run;
-mod mesh_contacts;
 mod separation;
 mod toi;
 pub mod workers;
 
+pub use crate::narrow::dispatch::PathCounts;
 pub use budget::{Budget, Deadline, FRONTIER_RESERVE, Unlimited, VisitBudget, frontier_deadline};
-pub use dispatch::PathCounts;
 pub use frontier_pairs::MeshPairTrees;
 pub use toi::{PairToi, TOI_TOLERANCE};
 
@@ -166,12 +164,12 @@ use crate::math::{DVec3, Pose};
 use crate::narrow::MeshShape;
 use crate::narrow::Shape;
 use crate::narrow::contact::Manifold;
+use crate::narrow::dispatch::{self, NarrowScratch, Route};
 use crate::narrow::gjk::GjkCache;
 use crate::narrow::mesh_mesh::DistanceCache;
 use crate::narrow::mesh_mesh::frontier::{FrontierAnswer, FrontierStats, FrontierWorkspace};
 use crate::scene::{Body, BodyId, Scene, SyncPoint};
 use answer::{Answer, MeshScratch};
-use dispatch::{NarrowScratch, Route};
 use frontier_run::{FrontierRun, run_frontier};
 use separation::Separation;
 use std::sync::Arc;

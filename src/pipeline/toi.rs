@@ -31,11 +31,11 @@
 //! is ever left out, and none is reported later than its first contact.
 
 use super::Query;
-use super::dispatch::{self, NarrowScratch};
 use crate::broad::CandidatePair;
 use crate::math::{DVec3, Pose};
 use crate::narrow::Shape;
 use crate::narrow::contact::ShapeDistance;
+use crate::narrow::dispatch::{self, NarrowScratch};
 use crate::narrow::toi::{ToiOutcome, ToiParams, time_of_impact_until};
 use crate::scene::{Body, Scene};
 

@@ -49,7 +49,7 @@
 //! shapes whose triangle manifold is one point (spheres and the GJK shapes). A pair beyond
 //! contact (distance `> 0`) gets an empty manifold with no walk at all.
 
-use super::dispatch::{GJK, NarrowScratch, core_of};
+use super::walk::{for_each_overlapping_triangle, nearest_triangle};
 use crate::bounding::BoundingVolume;
 use crate::bounding::{Obb, Rss};
 use crate::geometry::SupportMap;
@@ -58,7 +58,7 @@ use crate::geometry::mesh::{EdgeKind, NO_NEIGHBOUR};
 use crate::math::DMat3;
 use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
-use crate::narrow::convex_mesh::{for_each_overlapping_triangle, nearest_triangle};
+use crate::narrow::dispatch::{GJK, NarrowScratch, core_of};
 use crate::narrow::gjk::{EpaWorkspace, GjkCache, Rounded, signed_distance_convex};
 use crate::narrow::pairs;
 use crate::narrow::reduce_manifold;
@@ -74,7 +74,7 @@ const ON_EDGE: f64 = 1e-9;
 
 /// Scratch of the convex–mesh contacts (no allocation once grown).
 #[derive(Debug, Default)]
-pub(super) struct MeshContactScratch {
+pub(crate) struct MeshContactScratch {
     /// The pair the last distance walk answered, when it recorded every touching triangle.
     walked: Option<WalkKey>,
     /// The triangles the last distance walk found touching: id, A's frame, signed distance.
@@ -112,7 +112,7 @@ impl WalkKey {
 /// A convex shape against a mesh's triangles: the nearest (or deepest) triangle's signed
 /// distance, exact when at most `limit` (see [`nearest_triangle`]). Records the triangles
 /// it finds touching for [`shape_mesh_manifold`].
-pub(super) fn shape_mesh_distance(
+pub(crate) fn shape_mesh_distance(
     shape: &Shape,
     mesh: &MeshShape,
     pose_ab: &Pose,
@@ -191,7 +191,7 @@ fn plane_separation(core: &dyn SupportMap, radius: f64, triangle: &Triangle) -> 
 /// right after that distance walk of the same pair its record of touching triangles is used
 /// instead of walking the tree again. Falls back to `d`'s one point when the shape touches
 /// but no corrected point does (a graze at rounding level).
-pub(super) fn shape_mesh_manifold(
+pub(crate) fn shape_mesh_manifold(
     shape: &Shape,
     mesh: &MeshShape,
     pose_ab: &Pose,
@@ -563,7 +563,7 @@ fn feature(t: &Triangle, witness: DVec3) -> Feature {
 // One convex shape against one triangle, and the shape's volume for the tree walks.
 
 /// The signed distance of a convex shape (A's frame) and one triangle (A's frame).
-pub(super) fn shape_triangle_distance(
+pub(crate) fn shape_triangle_distance(
     shape: &Shape,
     triangle: &Triangle,
     epa: &mut EpaWorkspace,
@@ -591,7 +591,7 @@ pub(super) fn shape_triangle_distance(
 }
 
 /// The manifold of a convex shape and one triangle, both in A's frame.
-pub(super) fn shape_triangle_manifold(
+pub(crate) fn shape_triangle_manifold(
     shape: &Shape,
     triangle: &Triangle,
     epa: &mut EpaWorkspace,
@@ -662,10 +662,10 @@ fn box_corners(shape: &Shape) -> [DVec3; 8] {
 
 #[cfg(test)]
 mod tests {
-    use super::super::dispatch::{distance, manifold};
     use super::*;
     use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
     use crate::math::DQuat;
+    use crate::narrow::dispatch::{distance, manifold};
     use crate::test_support::{TestRng, meshes, point_in_cube, rng, rotation};
     use rand::Rng;
     use std::sync::Arc;

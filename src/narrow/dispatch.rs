@@ -6,7 +6,7 @@
 //! |---|---|---|
 //! | sphere, capsule, cuboid among themselves | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
 //! | a cylinder, cone or convex hull with any convex shape | GJK on the cores, EPA when they overlap ([`crate::narrow::gjk`]) | reference-face clipping of the shapes' contact features from the distance's normal, ≤ 4 points ([`crate::narrow::convex_manifold`]) |
-//! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`super::mesh_contacts`]) |
+//! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`crate::narrow::convex_mesh`]) |
 //! | mesh–mesh | [`Route::MeshMesh`]: the BVH tandem queries with warm starts and the worker pool | intersection segments, reduced |
 //!
 //! Canonical order: sphere < capsule < cuboid < cylinder < cone < convex < mesh. GJK is
@@ -18,12 +18,12 @@
 //! shape reaches through some triangle. A shape entirely inside a closed mesh without
 //! touching its surface is apart from it, as for mesh–mesh.
 
-use super::mesh_contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 use crate::geometry::{Segment, SupportMap};
 use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, ShapeDistance};
 use crate::narrow::convex_manifold::{ContactFeatures, manifold_convex_convex};
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
+use crate::narrow::convex_mesh::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 use crate::narrow::gjk::{
     EpaWorkspace, GjkCache, GjkParams, POINT, Rounded, signed_distance_convex,
 };
@@ -32,8 +32,8 @@ use crate::narrow::pairs;
 use crate::narrow::{MeshShape, Shape};
 use std::sync::Arc;
 
-/// GJK/EPA settings of the pipeline: GJK's defaults (relative tolerance 1e-10).
-pub(super) const GJK: GjkParams = GjkParams {
+/// GJK/EPA settings of the dispatcher: GJK's defaults (relative tolerance 1e-10).
+pub const GJK: GjkParams = GjkParams {
     rel_tol: 1e-10,
     epa_rel_tol: 1e-10,
     abs_tol: 0.0,
@@ -72,14 +72,14 @@ impl PathCounts {
 
 /// Scratch of the dispatcher for one thread (no allocation once grown).
 #[derive(Debug, Default)]
-pub(super) struct NarrowScratch {
+pub struct NarrowScratch {
     /// Paths taken since the pipeline last reset it (once per frame).
-    pub(super) paths: PathCounts,
-    pub(super) epa: EpaWorkspace,
-    pub(super) convex_mesh: ConvexMeshWorkspace,
+    pub(crate) paths: PathCounts,
+    pub(crate) epa: EpaWorkspace,
+    pub(crate) convex_mesh: ConvexMeshWorkspace,
     mesh_mesh: MeshMeshWorkspace,
     /// Convex–mesh contacts: the distance walk's touching triangles and the manifold's.
-    pub(super) mesh_contacts: MeshContactScratch,
+    pub(crate) mesh_contacts: MeshContactScratch,
 }
 
 /// Every convex kind, as a pattern (every kind but the mesh).
@@ -95,7 +95,7 @@ macro_rules! convex {
 }
 
 /// How the pipeline answers a pair.
-pub(super) enum Route<'s> {
+pub enum Route<'s> {
     /// Two meshes: the BVH tandem queries (warm starts, worker pool, manifold of the
     /// intersection set).
     MeshMesh(&'s Arc<MeshShape>, &'s Arc<MeshShape>),
@@ -104,7 +104,7 @@ pub(super) enum Route<'s> {
 }
 
 /// The route of the pair `(a, b)`.
-pub(super) fn route<'s>(a: &'s Shape, b: &'s Shape) -> Route<'s> {
+pub fn route<'s>(a: &'s Shape, b: &'s Shape) -> Route<'s> {
     match (a, b) {
         (Shape::Mesh(ma), Shape::Mesh(mb)) => Route::MeshMesh(ma, mb),
         (convex!(), convex!() | Shape::Mesh(_)) | (Shape::Mesh(_), convex!()) => Route::Direct,
@@ -114,9 +114,9 @@ pub(super) fn route<'s>(a: &'s Shape, b: &'s Shape) -> Route<'s> {
 /// Whether the pair's exact answer costs about what the conservative answer of its world
 /// boxes costs: a sphere against a sphere, capsule or cuboid, whose closed forms take
 /// 2.5–14 ns (`benches/narrow_phase.rs`, README). Such a pair is answered exactly even once
-/// the frame's deadline is near ([`super::PUBLISH_RESERVE`]): its box answer would save
+/// the frame's deadline is near (`crate::pipeline::PUBLISH_RESERVE`): its box answer would save
 /// nothing and, for a sphere whose box corners lie outside it, often report it close.
-pub(super) fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
+pub fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
     use Shape::{Capsule as C, Cuboid as B, Sphere as S};
     matches!((a, b), (S(_), S(_) | C(_) | B(_)) | (C(_) | B(_), S(_)))
 }
@@ -128,7 +128,7 @@ pub(super) fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
 /// which may stop once the lower bound exceeds `enough` metres, and are exact when the
 /// axes find the boxes apart but not beyond it. `None` for every other pair (sphere pairs
 /// answer exactly for about the same cost; the others have no such test).
-pub(super) fn distance_bound(
+pub fn distance_bound(
     a: &Shape,
     b: &Shape,
     pose_ab: &Isometry,
@@ -153,7 +153,7 @@ pub(super) fn distance_bound(
 /// lower bound from the separating axes of cuboid–cuboid pairs, or an upper bound,
 /// possibly `+∞`, from a convex shape's walk of a mesh stopped early. Mesh–mesh pairs get a
 /// cold exact distance here; the pipeline sends them down [`Route::MeshMesh`] instead.
-pub(super) fn distance(
+pub fn distance(
     a: &Shape,
     b: &Shape,
     pose_ab: &Pose,
@@ -229,7 +229,7 @@ pub(super) fn distance(
 /// [`distance`] (exact when they touch): pairs whose manifold is one point take it from
 /// `d` instead of running their query again. Mesh–mesh pairs go down [`Route::MeshMesh`];
 /// here they too get the one point of `d`.
-pub(super) fn manifold(
+pub fn manifold(
     a: &Shape,
     b: &Shape,
     pose_ab: &Pose,
@@ -284,14 +284,14 @@ fn flip_manifold(m: &mut Manifold, pose_ab: &Isometry) {
 
 /// A convex shape as GJK sees it: a core and a radius (a sphere is a point swept by its
 /// radius, a capsule a segment; the others have no radius).
-pub(super) enum Core<'s> {
+pub enum Core<'s> {
     Point,
     Segment(Segment),
     Support(&'s dyn SupportMap),
 }
 
 impl Core<'_> {
-    pub(super) fn support_map(&self) -> &dyn SupportMap {
+    pub fn support_map(&self) -> &dyn SupportMap {
         match self {
             Core::Point => &POINT,
             Core::Segment(s) => s,
@@ -301,7 +301,7 @@ impl Core<'_> {
 }
 
 /// The core and radius of a convex shape; `None` for a mesh.
-pub(super) fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
+pub fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
     Some(match shape {
         Shape::Sphere(s) => (Core::Point, s.radius),
         Shape::Capsule(c) => (Core::Segment(c.segment()), c.radius),
