@@ -162,6 +162,22 @@ impl Manifold {
         }
     }
 
+    /// The same manifold seen from B, in place: each point's witnesses swapped, the normal
+    /// reversed, all mapped by `pose_ba` (A's frame expressed in B's) into B's frame, as
+    /// [`ShapeDistance::flipped`].
+    pub fn flip(&mut self, pose_ba: &crate::math::Isometry) {
+        let mut flipped = Self::new();
+        flipped.reset(pose_ba.transform_vector(-self.normal));
+        for p in self.points() {
+            flipped.push(ManifoldPoint {
+                point_a: pose_ba.transform_point(p.point_b),
+                point_b: pose_ba.transform_point(p.point_a),
+                distance: p.distance,
+            });
+        }
+        *self = flipped;
+    }
+
     /// The one-point manifold of a signed distance: its witnesses under its normal when the
     /// shapes touch or overlap (`distance ≤ 0`), else empty with that normal. Pairs whose
     /// manifold is one point build it so, and then it always agrees with the distance.

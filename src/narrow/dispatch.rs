@@ -18,17 +18,15 @@
 //! shape reaches through some triangle. A shape entirely inside a closed mesh without
 //! touching its surface is apart from it, as for mesh–mesh.
 
-use crate::geometry::{Segment, SupportMap};
 use crate::math::{DVec3, Isometry, Pose};
-use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, ShapeDistance};
-use crate::narrow::convex_manifold::{ContactFeatures, manifold_convex_convex};
+use crate::narrow::contact::{DistanceBound, Manifold, ShapeDistance};
+use crate::narrow::convex_manifold::manifold_convex_convex;
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
 use crate::narrow::convex_mesh::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
-use crate::narrow::gjk::{
-    EpaWorkspace, GjkCache, GjkParams, POINT, Rounded, signed_distance_convex,
-};
+use crate::narrow::gjk::{EpaWorkspace, GjkCache, GjkParams, Rounded, signed_distance_convex};
 use crate::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
 use crate::narrow::pairs;
+use crate::narrow::shape::{core_of, features_of};
 use crate::narrow::{MeshShape, Shape};
 use std::sync::Arc;
 
@@ -195,7 +193,7 @@ pub fn distance(
             d
         }
         (C(_), S(_)) | (B(_), S(_) | C(_)) => {
-            flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso)
+            distance(b, a, &pose_ab.inverse(), limit, scratch).flipped(&iso)
         }
         (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
@@ -205,7 +203,7 @@ pub fn distance(
             paths.convex_mesh += 1;
             shape_mesh_distance(a, mesh, pose_ab, limit, scratch)
         }
-        (M(_), convex!()) => flip(&distance(b, a, &pose_ab.inverse(), limit, scratch), &iso),
+        (M(_), convex!()) => distance(b, a, &pose_ab.inverse(), limit, scratch).flipped(&iso),
         (M(x), M(y)) => {
             paths.mesh_mesh += 1;
             let d = x.distance_to(
@@ -248,7 +246,7 @@ pub fn manifold(
             let pose_ba = pose_ab.inverse();
             let d_ba = d.flipped(&pose_ba.to_isometry());
             manifold(b, a, &pose_ba, &d_ba, scratch, out);
-            flip_manifold(out, &iso);
+            out.flip(&iso);
         }
         // One point: sphere pairs (their closed-form manifolds are the distance's
         // witnesses) and mesh–mesh off the pipeline's route.
@@ -259,70 +257,6 @@ pub fn manifold(
             manifold_convex_convex(features_of(a), features_of(b), &iso, d, out);
         }
         (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, d, scratch, out),
-    }
-}
-
-/// The answer of B against A turned into A against B: points swapped, normal reversed,
-/// mapped from B's frame into A's by `pose_ab`.
-fn flip(d: &ShapeDistance, pose_ab: &Isometry) -> ShapeDistance {
-    d.flipped(pose_ab)
-}
-
-/// [`flip`] for a manifold, in place.
-fn flip_manifold(m: &mut Manifold, pose_ab: &Isometry) {
-    let mut flipped = Manifold::new();
-    flipped.reset(pose_ab.transform_vector(-m.normal));
-    for p in m.points() {
-        flipped.push(ManifoldPoint {
-            point_a: pose_ab.transform_point(p.point_b),
-            point_b: pose_ab.transform_point(p.point_a),
-            distance: p.distance,
-        });
-    }
-    *m = flipped;
-}
-
-/// A convex shape as GJK sees it: a core and a radius (a sphere is a point swept by its
-/// radius, a capsule a segment; the others have no radius).
-pub enum Core<'s> {
-    Point,
-    Segment(Segment),
-    Support(&'s dyn SupportMap),
-}
-
-impl Core<'_> {
-    pub fn support_map(&self) -> &dyn SupportMap {
-        match self {
-            Core::Point => &POINT,
-            Core::Segment(s) => s,
-            Core::Support(s) => *s,
-        }
-    }
-}
-
-/// The core and radius of a convex shape; `None` for a mesh.
-pub fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
-    Some(match shape {
-        Shape::Sphere(s) => (Core::Point, s.radius),
-        Shape::Capsule(c) => (Core::Segment(c.segment()), c.radius),
-        Shape::Cuboid(b) => (Core::Support(b), 0.0),
-        Shape::Cylinder(c) => (Core::Support(c), 0.0),
-        Shape::Cone(c) => (Core::Support(c), 0.0),
-        Shape::Convex(c) => (Core::Support(c.as_ref()), 0.0),
-        Shape::Mesh(_) => return None,
-    })
-}
-
-/// The contact features of a convex shape (the caller's arm guarantees it is not a mesh).
-fn features_of(shape: &Shape) -> &dyn ContactFeatures {
-    match shape {
-        Shape::Sphere(s) => s,
-        Shape::Capsule(c) => c,
-        Shape::Cuboid(b) => b,
-        Shape::Cylinder(c) => c,
-        Shape::Cone(c) => c,
-        Shape::Convex(c) => c.as_ref(),
-        Shape::Mesh(_) => unreachable!("the dispatcher sends only convex pairs here"),
     }
 }
 

@@ -7,7 +7,10 @@ use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::mesh::MeshEdges;
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
+use crate::geometry::{Segment, SupportMap};
 use crate::math::{DVec3, Isometry, Pose};
+use crate::narrow::convex_manifold::ContactFeatures;
+use crate::narrow::gjk::POINT;
 use crate::narrow::mesh_hull::MeshHull;
 use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity, distance_mesh_mesh,
@@ -229,6 +232,55 @@ impl Shape {
                 Aabb::new(min, max)
             }
         }
+    }
+}
+
+/// A convex shape as GJK sees it: a core and a radius (a sphere is a point swept by its
+/// radius, a capsule a segment; the others have no radius).
+pub enum Core<'s> {
+    /// A sphere's centre.
+    Point,
+    /// A capsule's axis.
+    Segment(Segment),
+    /// Any other convex shape, through its support map.
+    Support(&'s dyn SupportMap),
+}
+
+impl Core<'_> {
+    /// The core's support map (a point's is the origin's).
+    #[must_use]
+    pub fn support_map(&self) -> &dyn SupportMap {
+        match self {
+            Core::Point => &POINT,
+            Core::Segment(s) => s,
+            Core::Support(s) => *s,
+        }
+    }
+}
+
+/// The core and radius of a convex shape; `None` for a mesh.
+pub fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
+    Some(match shape {
+        Shape::Sphere(s) => (Core::Point, s.radius),
+        Shape::Capsule(c) => (Core::Segment(c.segment()), c.radius),
+        Shape::Cuboid(b) => (Core::Support(b), 0.0),
+        Shape::Cylinder(c) => (Core::Support(c), 0.0),
+        Shape::Cone(c) => (Core::Support(c), 0.0),
+        Shape::Convex(c) => (Core::Support(c.as_ref()), 0.0),
+        Shape::Mesh(_) => return None,
+    })
+}
+
+/// The contact features of a convex shape (the caller's arm guarantees it is not a mesh).
+pub(crate) fn features_of(shape: &Shape) -> &dyn ContactFeatures {
+    match shape {
+        Shape::Sphere(s) => s,
+        Shape::Capsule(c) => c,
+        Shape::Cuboid(b) => b,
+        Shape::Cylinder(c) => c,
+        Shape::Cone(c) => c,
+        Shape::Convex(c) => c.as_ref(),
+        Shape::Mesh(_) => unreachable!("the dispatcher sends only convex pairs here"),
     }
 }
 

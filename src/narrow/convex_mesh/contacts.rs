@@ -58,10 +58,11 @@ use crate::geometry::mesh::{EdgeKind, NO_NEIGHBOUR};
 use crate::math::DMat3;
 use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
-use crate::narrow::dispatch::{GJK, NarrowScratch, core_of};
+use crate::narrow::dispatch::{GJK, NarrowScratch};
 use crate::narrow::gjk::{EpaWorkspace, GjkCache, Rounded, signed_distance_convex};
 use crate::narrow::pairs;
 use crate::narrow::reduce_manifold;
+use crate::narrow::shape::core_of;
 use crate::narrow::{MeshShape, Shape};
 use std::ops::ControlFlow;
 

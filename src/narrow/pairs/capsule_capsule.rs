@@ -6,7 +6,7 @@
 //! zero-length ones a fixed axis crossed with the direction. Manifold: 2 points for parallel
 //! overlapping cores ([`super::clip`]), else 1.
 
-use super::core::{AXIS_RELATIVE, Core};
+use super::placed_core::{AXIS_RELATIVE, PlacedCore};
 use super::query::FEATURE_RELATIVE;
 use super::{clip, query};
 use crate::geometry::Capsule;
@@ -69,8 +69,8 @@ impl Segments {
     fn distance(&self, a: &Capsule, b: &Capsule, pose_ab: &Isometry) -> ShapeDistance {
         self.apart().unwrap_or_else(|| {
             query::distance(
-                &Core::capsule(a, &Isometry::IDENTITY),
-                &Core::capsule(b, pose_ab),
+                &PlacedCore::capsule(a, &Isometry::IDENTITY),
+                &PlacedCore::capsule(b, pose_ab),
             )
         })
     }
@@ -99,8 +99,8 @@ impl Segments {
 /// points on both surfaces with one normal A→B, A's frame; empty when apart.
 pub fn manifold_capsule_capsule(a: &Capsule, b: &Capsule, pose_ab: &Isometry, out: &mut Manifold) {
     clip::manifold(
-        &Core::capsule(a, &Isometry::IDENTITY),
-        &Core::capsule(b, pose_ab),
+        &PlacedCore::capsule(a, &Isometry::IDENTITY),
+        &PlacedCore::capsule(b, pose_ab),
         out,
     );
 }

@@ -10,7 +10,7 @@
 //! Manifold: up to 2 points (segment clipped against a box face), 1 for an edge or corner
 //! contact ([`super::clip`]).
 
-use super::core::{AXIS_RELATIVE, Core};
+use super::placed_core::{AXIS_RELATIVE, PlacedCore};
 use super::query::FEATURE_RELATIVE;
 use super::{clip, query};
 use crate::geometry::{Capsule, Cuboid};
@@ -29,8 +29,8 @@ pub fn distance_capsule_cuboid(a: &Capsule, b: &Cuboid, pose_ab: &Isometry) -> S
         .or_else(|| placed.overlapping(pose_ab))
         .unwrap_or_else(|| {
             query::distance(
-                &Core::capsule(a, &Isometry::IDENTITY),
-                &Core::cuboid(b, pose_ab),
+                &PlacedCore::capsule(a, &Isometry::IDENTITY),
+                &PlacedCore::cuboid(b, pose_ab),
             )
         })
 }
@@ -260,8 +260,8 @@ impl InBox {
 /// points on both surfaces with one normal A→B, A's frame; empty when apart.
 pub fn manifold_capsule_cuboid(a: &Capsule, b: &Cuboid, pose_ab: &Isometry, out: &mut Manifold) {
     clip::manifold(
-        &Core::capsule(a, &Isometry::IDENTITY),
-        &Core::cuboid(b, pose_ab),
+        &PlacedCore::capsule(a, &Isometry::IDENTITY),
+        &PlacedCore::cuboid(b, pose_ab),
         out,
     );
 }

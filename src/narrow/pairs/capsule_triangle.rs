@@ -4,7 +4,7 @@
 //! radius. Through [`super::query`]; manifold: up to 2 points (segment clipped against the
 //! triangle face), else 1 ([`super::clip`]).
 
-use super::core::Core;
+use super::placed_core::PlacedCore;
 use super::{clip, query};
 use crate::geometry::{Capsule, Triangle};
 use crate::math::Isometry;
@@ -16,8 +16,8 @@ use crate::narrow::contact::{Manifold, ShapeDistance};
 #[must_use]
 pub fn distance_capsule_triangle(a: &Capsule, b: &Triangle, pose_ab: &Isometry) -> ShapeDistance {
     query::distance(
-        &Core::capsule(a, &Isometry::IDENTITY),
-        &Core::triangle(b, pose_ab),
+        &PlacedCore::capsule(a, &Isometry::IDENTITY),
+        &PlacedCore::triangle(b, pose_ab),
     )
 }
 
@@ -30,8 +30,8 @@ pub fn manifold_capsule_triangle(
     out: &mut Manifold,
 ) {
     clip::manifold(
-        &Core::capsule(a, &Isometry::IDENTITY),
-        &Core::triangle(b, pose_ab),
+        &PlacedCore::capsule(a, &Isometry::IDENTITY),
+        &PlacedCore::triangle(b, pose_ab),
         out,
     );
 }
@@ -53,7 +53,7 @@ mod tests {
     #[test]
     fn a_core_piercing_the_triangle_is_pushed_out_along_the_shorter_way() {
         let c = Capsule::new(1.0, 0.25);
-        // Core along Z from -1 to 1 through the triangle at z = 0.3 (B frame: tri at -0.3).
+        // PlacedCore along Z from -1 to 1 through the triangle at z = 0.3 (B frame: tri at -0.3).
         let pose = Isometry::from_translation(DVec3::new(0.0, 0.0, -0.3));
         let d = distance_capsule_triangle(&c, &tri(), &pose);
         assert!((d.distance + 0.95).abs() < 1e-14, "{d:?}");

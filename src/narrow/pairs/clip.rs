@@ -21,7 +21,7 @@
 //! reduced by [`Manifold::push_reduced`] (the deepest, the farthest from it, then the two
 //! that span the largest area).
 
-use super::core::{Core, Kind, Polygon, line_interval};
+use super::placed_core::{Kind, PlacedCore, Polygon, line_interval};
 use super::query::{FEATURE_RELATIVE, best_axis, distance_with_axis};
 use crate::math::DVec3;
 use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
@@ -43,7 +43,7 @@ struct Candidates {
 
 /// Fills `out` with the contact manifold of two placed cores (module docs); empty when
 /// they are apart.
-pub(super) fn manifold(a: &Core, b: &Core, out: &mut Manifold) {
+pub(super) fn manifold(a: &PlacedCore, b: &PlacedCore, out: &mut Manifold) {
     let axis = best_axis(a, b);
     let slack = FEATURE_RELATIVE * a.scale().max(b.scale());
     if axis.separation - a.radius - b.radius > slack {
@@ -62,7 +62,12 @@ pub(super) fn manifold(a: &Core, b: &Core, out: &mut Manifold) {
 
 /// [`manifold`] given the cores' signed distance `d` (from [`super::query`], or from a
 /// pair's own faster path with the same contract).
-pub(super) fn manifold_from_distance(a: &Core, b: &Core, d: &ShapeDistance, out: &mut Manifold) {
+pub(super) fn manifold_from_distance(
+    a: &PlacedCore,
+    b: &PlacedCore,
+    d: &ShapeDistance,
+    out: &mut Manifold,
+) {
     out.reset(d.normal);
     if d.distance > 0.0 {
         return;
@@ -74,8 +79,8 @@ pub(super) fn manifold_from_distance(a: &Core, b: &Core, d: &ShapeDistance, out:
 /// signed distance `distance()` (whose normal is `n`) is computed only when no face or
 /// parallel-edge contact gives points and its witnesses are the one point left.
 pub(super) fn manifold_along(
-    a: &Core,
-    b: &Core,
+    a: &PlacedCore,
+    b: &PlacedCore,
     n: DVec3,
     distance: impl FnOnce() -> ShapeDistance,
     out: &mut Manifold,
@@ -128,7 +133,7 @@ pub(super) fn manifold_along(
 }
 
 /// The incident feature of `core` against a reference face of outward normal `f`.
-fn incident(core: &Core, f: DVec3) -> Polygon {
+fn incident(core: &PlacedCore, f: DVec3) -> Polygon {
     match core.kind {
         Kind::Box { .. } => match core.best_face(-f) {
             Some((poly, _, _)) => poly,
@@ -151,7 +156,7 @@ fn clip_face(
     poly: &Polygon,
     f: DVec3,
     r_ref: f64,
-    other: &Core,
+    other: &PlacedCore,
     ref_is_a: bool,
     slack: f64,
     out: &mut Candidates,
@@ -212,7 +217,7 @@ fn clip_face(
 }
 
 /// Two parallel edge features (both ⟂ the normal) give up to two points; else none.
-fn parallel_edges(a: &Core, b: &Core, n: DVec3, slack: f64, out: &mut Candidates) {
+fn parallel_edges(a: &PlacedCore, b: &PlacedCore, n: DVec3, slack: f64, out: &mut Candidates) {
     let fa = a.support_feature(n, EDGE_PARALLEL * a.extent());
     let fb = b.support_feature(-n, EDGE_PARALLEL * b.extent());
     if fa.len != 2 || fb.len != 2 {
@@ -261,7 +266,7 @@ fn parallel_edges(a: &Core, b: &Core, n: DVec3, slack: f64, out: &mut Candidates
 }
 
 /// A point or segment core without radius: nothing for a line to cross.
-fn is_bare(core: &Core) -> bool {
+fn is_bare(core: &PlacedCore) -> bool {
     core.radius == 0.0 && matches!(core.kind, Kind::Point | Kind::Segment)
 }
 
@@ -280,7 +285,7 @@ enum Column {
 /// A bare point or segment (radius 0) has no width for a line to cross: a discriminant of
 /// pure rounding would put the point `√ε·size` off it, or drop it. Its point nearest the
 /// line is taken instead, which lies on it exactly.
-fn column_point(core: &Core, q: DVec3, n: DVec3, end: Column) -> Option<DVec3> {
+fn column_point(core: &PlacedCore, q: DVec3, n: DVec3, end: Column) -> Option<DVec3> {
     if !is_bare(core) {
         let (enter, exit) = line_interval(core, q, -n)?;
         let s = match end {

@@ -16,7 +16,7 @@
 //! axis; so does the rare apart case whose support along a cross axis is a face.
 
 use super::clip;
-use super::core::{AXIS_RELATIVE, Core};
+use super::placed_core::{AXIS_RELATIVE, PlacedCore};
 use super::query::{self, Axis, BOUND_ULPS, FEATURE_RELATIVE};
 use crate::geometry::Cuboid;
 use crate::math::{DMat3, DVec3, Isometry};
@@ -111,10 +111,10 @@ pub fn manifold_cuboid_cuboid(a: &Cuboid, b: &Cuboid, pose_ab: &Isometry, out: &
 }
 
 /// The boxes as the shared engine's cores, A's frame.
-fn cores(a: &Cuboid, b: &Cuboid, pose_ab: &Isometry) -> (Core, Core) {
+fn cores(a: &Cuboid, b: &Cuboid, pose_ab: &Isometry) -> (PlacedCore, PlacedCore) {
     (
-        Core::cuboid(a, &Isometry::IDENTITY),
-        Core::cuboid(b, pose_ab),
+        PlacedCore::cuboid(a, &Isometry::IDENTITY),
+        PlacedCore::cuboid(b, pose_ab),
     )
 }
 

@@ -4,7 +4,7 @@
 //! overlap testing*, 2001, for the axis set). Through [`super::query`]; manifold: face
 //! clipping reduced to 4 points ([`super::clip`]).
 
-use super::core::Core;
+use super::placed_core::PlacedCore;
 use super::{clip, query};
 use crate::geometry::{Cuboid, Triangle};
 use crate::math::Isometry;
@@ -16,8 +16,8 @@ use crate::narrow::contact::{Manifold, ShapeDistance};
 #[must_use]
 pub fn distance_cuboid_triangle(a: &Cuboid, b: &Triangle, pose_ab: &Isometry) -> ShapeDistance {
     query::distance(
-        &Core::cuboid(a, &Isometry::IDENTITY),
-        &Core::triangle(b, pose_ab),
+        &PlacedCore::cuboid(a, &Isometry::IDENTITY),
+        &PlacedCore::triangle(b, pose_ab),
     )
 }
 
@@ -25,8 +25,8 @@ pub fn distance_cuboid_triangle(a: &Cuboid, b: &Triangle, pose_ab: &Isometry) ->
 /// points on both surfaces with one normal A→B, A's frame; empty when apart.
 pub fn manifold_cuboid_triangle(a: &Cuboid, b: &Triangle, pose_ab: &Isometry, out: &mut Manifold) {
     clip::manifold(
-        &Core::cuboid(a, &Isometry::IDENTITY),
-        &Core::triangle(b, pose_ab),
+        &PlacedCore::cuboid(a, &Isometry::IDENTITY),
+        &PlacedCore::triangle(b, pose_ab),
         out,
     );
 }

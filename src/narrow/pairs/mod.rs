@@ -9,7 +9,7 @@
 //!   A→B when they touch or overlap, empty when apart.
 //!
 //! All of them share one engine: every primitive is a convex polytope *core* swept by a ball
-//! (a sphere a point, a capsule a segment, cuboid and triangle radius 0; `core`); the
+//! (a sphere a point, a capsule a segment, cuboid and triangle radius 0; `placed_core`); the
 //! distance is the separating-axis test over the complete axis set of the two cores plus
 //! closed-form vertex/edge closest points (`query`); manifolds clip an incident feature
 //! against a reference face (`clip`). Exact to rounding, except the documented skip of
@@ -25,7 +25,7 @@
 //! - Triangles are two-sided and have no thickness.
 
 mod clip;
-mod core;
+mod placed_core;
 mod query;
 
 mod capsule_capsule;

@@ -31,7 +31,7 @@
 //!    out along the normal; sweeping by a ball adds its radius to the penetration depth too,
 //!    so every answer is exact (to rounding).
 
-use super::core::{AXIS_RELATIVE, Core, Kind, Polygon};
+use super::placed_core::{AXIS_RELATIVE, Kind, PlacedCore, Polygon};
 use crate::math::DVec3;
 use crate::narrow::closest_points::closest_points_segment_segment;
 #[cfg(doc)]
@@ -51,14 +51,14 @@ pub(super) struct Axis {
 
 /// The separating-axis test over the complete candidate set (module docs, step 1).
 #[must_use]
-pub(super) fn best_axis(a: &Core, b: &Core) -> Axis {
+pub(super) fn best_axis(a: &PlacedCore, b: &PlacedCore) -> Axis {
     best_axis_or_first_above(a, b, f64::INFINITY)
 }
 
 /// [`best_axis`], or the first axis found apart by more than `enough` metres (all that is
 /// needed to know the cores are apart).
 #[must_use]
-pub(super) fn best_axis_or_first_above(a: &Core, b: &Core, enough: f64) -> Axis {
+pub(super) fn best_axis_or_first_above(a: &PlacedCore, b: &PlacedCore, enough: f64) -> Axis {
     let mut best = Axis {
         normal: DVec3::X,
         separation: f64::NEG_INFINITY,
@@ -96,7 +96,8 @@ pub(super) fn best_axis_or_first_above(a: &Core, b: &Core, enough: f64) -> Axis 
             }
         }
     }
-    let solid = |c: &Core| matches!(c.kind, Kind::Box { half, .. } if half.min_element() > 0.0);
+    let solid =
+        |c: &PlacedCore| matches!(c.kind, Kind::Box { half, .. } if half.min_element() > 0.0);
     if !solid(a) && !solid(b) {
         // Without a solid box, the Minkowski difference can be flat (a triangle with a point or a
         // coplanar segment, two segments): its sides then have the normals `m × d` for its
@@ -205,7 +206,7 @@ pub(super) fn closest_pair(a: &Polygon, b: &Polygon) -> (DVec3, DVec3) {
 /// The closest pair `(on_a, on_b)` of two disjoint cores (module docs, step 2); `tiny`
 /// (metres) is the tolerance of the support features.
 #[must_use]
-fn closest_pair_disjoint(a: &Core, b: &Core, tiny: f64) -> (DVec3, DVec3) {
+fn closest_pair_disjoint(a: &PlacedCore, b: &PlacedCore, tiny: f64) -> (DVec3, DVec3) {
     let mut best = BestPair::default();
     offer_vertices(a, b, &mut best, false);
     offer_vertices(b, a, &mut best, true);
@@ -248,7 +249,7 @@ fn closest_pair_disjoint(a: &Core, b: &Core, tiny: f64) -> (DVec3, DVec3) {
 /// Offers every vertex of `from` with its closest point on `to` (`swapped`: `from` is B).
 /// A vertex farther from a triangle's plane than the best pair so far is skipped (its
 /// distance to the triangle is at least that: exact pruning), nearest to the plane first.
-fn offer_vertices(from: &Core, to: &Core, best: &mut BestPair, swapped: bool) {
+fn offer_vertices(from: &PlacedCore, to: &PlacedCore, best: &mut BestPair, swapped: bool) {
     let offer = |best: &mut BestPair, v: DVec3| {
         let q = to.closest_point(v);
         if swapped {
@@ -280,7 +281,7 @@ fn offer_vertices(from: &Core, to: &Core, best: &mut BestPair, swapped: bool) {
 
 /// The signed distance between two placed cores, A's frame (module docs).
 #[must_use]
-pub(super) fn distance(a: &Core, b: &Core) -> ShapeDistance {
+pub(super) fn distance(a: &PlacedCore, b: &PlacedCore) -> ShapeDistance {
     if a.radius + b.radius > 0.0
         && let Some(d) = apart_certified(a, b)
     {
@@ -296,7 +297,7 @@ pub(super) fn distance(a: &Core, b: &Core) -> ShapeDistance {
 /// direction, and then the closest pair of [`closest_pair_disjoint`] is exact). `None`
 /// when that proof fails. Rounded shapes in contact mostly have apart cores (they touch
 /// through their radii), so this skips the test for them.
-fn apart_certified(a: &Core, b: &Core) -> Option<ShapeDistance> {
+fn apart_certified(a: &PlacedCore, b: &PlacedCore) -> Option<ShapeDistance> {
     let tiny = FEATURE_RELATIVE * a.scale().max(b.scale());
     let (on_a, on_b) = closest_pair_disjoint(a, b, tiny);
     let gap = on_a.distance(on_b);
@@ -317,7 +318,7 @@ fn apart_certified(a: &Core, b: &Core) -> Option<ShapeDistance> {
 /// [`distance`] given the cores' best separating axis (from [`best_axis`], or from a
 /// pair's own faster test over the same axis set).
 #[must_use]
-pub(super) fn distance_with_axis(a: &Core, b: &Core, axis: &Axis) -> ShapeDistance {
+pub(super) fn distance_with_axis(a: &PlacedCore, b: &PlacedCore, axis: &Axis) -> ShapeDistance {
     let tiny = FEATURE_RELATIVE * a.scale().max(b.scale());
     if axis.separation > 0.0 {
         let (on_a, on_b) = closest_pair_disjoint(a, b, tiny);
@@ -389,11 +390,11 @@ mod tests {
     fn a_point_beside_a_coplanar_triangle_is_separated_by_an_in_plane_axis() {
         // The Minkowski difference is flat here: the triangle normal alone shows overlap 0.
         let t = Triangle::new(DVec3::ZERO, DVec3::X, DVec3::Y);
-        let a = Core::sphere(
+        let a = PlacedCore::sphere(
             &Sphere::new(0.0),
             &Isometry::from_translation(DVec3::new(2.0, 2.0, 0.0)),
         );
-        let b = Core::triangle(&t, &Isometry::IDENTITY);
+        let b = PlacedCore::triangle(&t, &Isometry::IDENTITY);
         assert!(best_axis(&a, &b).separation > 0.5);
         let d = distance(&a, &b);
         assert!((d.distance - 1.5 * 2f64.sqrt()).abs() < 1e-15, "{d:?}");
@@ -402,12 +403,12 @@ mod tests {
     #[test]
     fn coplanar_disjoint_segments_are_apart() {
         let c = Capsule::new(1.0, 0.0);
-        let a = Core::capsule(&c, &Isometry::IDENTITY);
+        let a = PlacedCore::capsule(&c, &Isometry::IDENTITY);
         let pose = Isometry::new(
             crate::math::DMat3::from_rotation_y(1.0),
             DVec3::new(3.0, 0.0, 0.0),
         );
-        let b = Core::capsule(&c, &pose);
+        let b = PlacedCore::capsule(&c, &pose);
         assert!(best_axis(&a, &b).separation > 0.0);
         assert!(distance(&a, &b).distance > 1.0);
     }

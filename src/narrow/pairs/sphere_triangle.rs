@@ -3,7 +3,7 @@
 //! along the triangle normal. Zero-area triangles are their segment or point. Through
 //! [`super::query`]; manifold: one point.
 
-use super::core::Core;
+use super::placed_core::PlacedCore;
 use super::{clip, query};
 use crate::geometry::{Sphere, Triangle};
 use crate::math::Isometry;
@@ -15,8 +15,8 @@ use crate::narrow::contact::{Manifold, ShapeDistance};
 #[must_use]
 pub fn distance_sphere_triangle(a: &Sphere, b: &Triangle, pose_ab: &Isometry) -> ShapeDistance {
     query::distance(
-        &Core::sphere(a, &Isometry::IDENTITY),
-        &Core::triangle(b, pose_ab),
+        &PlacedCore::sphere(a, &Isometry::IDENTITY),
+        &PlacedCore::triangle(b, pose_ab),
     )
 }
 
@@ -24,8 +24,8 @@ pub fn distance_sphere_triangle(a: &Sphere, b: &Triangle, pose_ab: &Isometry) ->
 /// points on both surfaces with one normal A→B, A's frame; empty when apart.
 pub fn manifold_sphere_triangle(a: &Sphere, b: &Triangle, pose_ab: &Isometry, out: &mut Manifold) {
     clip::manifold(
-        &Core::sphere(a, &Isometry::IDENTITY),
-        &Core::triangle(b, pose_ab),
+        &PlacedCore::sphere(a, &Isometry::IDENTITY),
+        &PlacedCore::triangle(b, pose_ab),
         out,
     );
 }

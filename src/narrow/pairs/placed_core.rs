@@ -2,7 +2,7 @@
 //!
 //! Every primitive of this module is a convex polytope core swept by a ball: a sphere is a
 //! point with a radius, a capsule a segment with a radius, a cuboid and a triangle have
-//! radius 0. A [`Core`] holds what the pair queries need of the core: its vertices, its
+//! radius 0. A [`PlacedCore`] holds what the pair queries need of the core: its vertices, its
 //! edges, its face normals and edge directions (the separating-axis candidates), the closest
 //! point to a query point, and its support features.
 
@@ -34,7 +34,7 @@ pub(super) enum Kind {
 
 /// A placed polytope core with a radius (see the module docs).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Core {
+pub(super) struct PlacedCore {
     pub kind: Kind,
     pub radius: f64,
     pub verts: [DVec3; 8],
@@ -63,7 +63,7 @@ const BOX_EDGES: [(usize, usize); 12] = [
     (3, 7),
 ];
 
-impl Core {
+impl PlacedCore {
     fn empty(kind: Kind, radius: f64) -> Self {
         Self {
             kind,
@@ -325,7 +325,7 @@ pub(super) type Polygon = crate::narrow::polygon::Polygon<8>;
 /// the rounded core (`None` when the line misses it). Only for point and segment cores
 /// (balls and capsules): the shapes whose surface a manifold point must be moved onto.
 #[must_use]
-pub(super) fn line_interval(core: &Core, o: DVec3, v: DVec3) -> Option<(f64, f64)> {
+pub(super) fn line_interval(core: &PlacedCore, o: DVec3, v: DVec3) -> Option<(f64, f64)> {
     let r = core.radius;
     let ball = |c: DVec3| {
         let w = o - c;
@@ -379,7 +379,7 @@ mod tests {
 
     #[test]
     fn line_intervals_through_a_capsule_hit_the_cylinder_and_the_caps() {
-        let c = Core::capsule(&Capsule::new(1.0, 0.5), &Isometry::IDENTITY);
+        let c = PlacedCore::capsule(&Capsule::new(1.0, 0.5), &Isometry::IDENTITY);
         // Across the cylinder part.
         let (s0, s1) = line_interval(&c, DVec3::new(-2.0, 0.0, 0.3), DVec3::X).unwrap();
         assert!((s0 - 1.5).abs() < 1e-15 && (s1 - 2.5).abs() < 1e-15);
@@ -392,10 +392,10 @@ mod tests {
 
     #[test]
     fn support_features_of_zero_size_boxes_span_their_nonzero_axes() {
-        let rod = Core::cuboid(&Cuboid::new(DVec3::new(0.0, 0.0, 1.0)), &Isometry::IDENTITY);
+        let rod = PlacedCore::cuboid(&Cuboid::new(DVec3::new(0.0, 0.0, 1.0)), &Isometry::IDENTITY);
         assert_eq!(rod.support_feature(DVec3::X, 1e-12).len, 2);
         assert_eq!(rod.support_feature(DVec3::Z, 1e-12).len, 1);
-        let cube = Core::cuboid(&Cuboid::new(DVec3::ONE), &Isometry::IDENTITY);
+        let cube = PlacedCore::cuboid(&Cuboid::new(DVec3::ONE), &Isometry::IDENTITY);
         assert_eq!(cube.support_feature(DVec3::X, 1e-12).len, 4);
         assert!(cube.best_face(DVec3::new(0.1, 0.0, -1.0)).unwrap().1 == -DVec3::Z);
     }
