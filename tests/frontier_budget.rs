@@ -32,6 +32,7 @@ use proxima::bvh::{BuildParams, Bvh};
 use proxima::geometry::{TriMesh, Triangle};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::narrow::distance_triangle_triangle;
+use proxima::narrow::mesh_mesh::frontier::MeshPairTrees;
 use proxima::narrow::mesh_mesh::frontier::{
     FrontierAnswer, FrontierPair, FrontierWorkspace, PairTrees, RoundOrder, query_frontier,
 };
@@ -39,7 +40,6 @@ use proxima::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, distance_mesh_mesh, within_distance_mesh_mesh,
 };
 use proxima::narrow::{MeshShape, QueryVolume};
-use proxima::pipeline::MeshPairTrees;
 use rand::Rng;
 use std::collections::HashMap;
 use std::sync::Arc;

@@ -118,7 +118,7 @@ impl MeshShape {
 }
 
 /// Which of a mesh's two trees distance queries refine it with: the budgeted frontier
-/// ([`MeshPairTrees`](crate::pipeline::MeshPairTrees)) and the exact queries
+/// ([`MeshPairTrees`](crate::narrow::mesh_mesh::frontier::MeshPairTrees)) and the exact queries
 /// ([`MeshShape::distance_to`], [`MeshShape::proximity`]).
 ///
 /// Exact queries: on robot-chain (`examples/time_vs_error`, budget `inf`, 300 frames, two

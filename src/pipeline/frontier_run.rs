@@ -2,12 +2,13 @@
 //! limited budget): which mesh pairs it refines, with which seeds, and resuming last
 //! frame's run while the bodies rest.
 
-use super::{Budget, MeshPairTrees, PipelineWorkspace, Query, body, mesh_pair};
+use super::{Budget, PipelineWorkspace, Query, body, mesh_pair};
 use crate::broad::CandidatePair;
 use crate::math::Pose;
 use crate::narrow::MeshShape;
 use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::frontier::FrontierStats;
+use crate::narrow::mesh_mesh::frontier::MeshPairTrees;
 use crate::scene::Scene;
 
 /// Answers the frame's mesh–mesh candidates that no kept answer covers through the

@@ -145,7 +145,6 @@
 
 mod answer;
 pub mod budget;
-mod frontier_pairs;
 mod frontier_run;
 mod separation;
 mod toi;
@@ -153,7 +152,6 @@ pub mod workers;
 
 pub use crate::narrow::dispatch::PathCounts;
 pub use budget::{Budget, Deadline, FRONTIER_RESERVE, Unlimited, VisitBudget, frontier_deadline};
-pub use frontier_pairs::MeshPairTrees;
 pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{

@@ -54,8 +54,10 @@
 //! # Allocation
 //! The workspace owns the two entry vectors (swapped every round), the per-pair state and
 //! the per-round counters; none of them allocates once grown to the largest frame seen.
+mod mesh_pair;
 mod trees;
 
+pub use mesh_pair::MeshPairTrees;
 pub use trees::{FrontierPair, PairTrees, TreesAt};
 
 use crate::budget::{Budget, Completeness};

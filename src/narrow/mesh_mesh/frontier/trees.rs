@@ -1,7 +1,7 @@
 //! The trees of one frontier pair, seen through [`PairTrees`]: the few operations the
 //! frontier needs (node bounds, splits, leaf tests), so that one frontier can hold pairs of
 //! different volume types, each pair's chosen by measured tightness (the pipeline's
-//! [`MeshPairTrees`](crate::pipeline::MeshPairTrees)).
+//! [`MeshPairTrees`](crate::narrow::mesh_mesh::frontier::MeshPairTrees)).
 
 use super::FrontierWitnesses;
 use crate::bounding::BoundingVolume;
@@ -40,7 +40,7 @@ pub struct FrontierPair<'a, B> {
 /// What the frontier needs of a pair's two trees. Nodes are named `[node of A, node of B]`
 /// (indices into each tree's nodes; `[0, 0]` is the root pair). Implemented by
 /// [`FrontierPair`] for every volume type and by the pipeline's
-/// [`MeshPairTrees`](crate::pipeline::MeshPairTrees), whose type is chosen per pair.
+/// [`MeshPairTrees`](crate::narrow::mesh_mesh::frontier::MeshPairTrees), whose type is chosen per pair.
 pub trait PairTrees {
     /// The pair's threshold ([`FrontierPair::threshold`]).
     fn threshold(&self) -> f64;

@@ -1,9 +1,9 @@
-//! The frame's mesh pairs as the budgeted frontier sees them ([`PairTrees`]), owned by the
-//! pipeline's workspace: listing them clones two `Arc`s per pair and allocates nothing once
-//! the list has grown to the largest frame seen.
+//! A pair of registered meshes as the budgeted frontier sees them ([`PairTrees`]), refined
+//! with the trees both meshes chose: listing a frame's pairs clones two `Arc`s per pair and
+//! allocates nothing once the list has grown to the largest frame seen.
 
+use super::{FrontierWitnesses, PairTrees, TreesAt};
 use crate::math::Isometry;
-use crate::narrow::mesh_mesh::frontier::{FrontierWitnesses, PairTrees, TreesAt};
 use crate::narrow::{MeshShape, QueryVolume};
 use std::sync::Arc;
 
