@@ -1,0 +1,647 @@
+use super::*;
+use crate::bounding::Aabb;
+use crate::geometry::{Cuboid, Sphere};
+use crate::math::Pose;
+use crate::narrow::MeshShape;
+use crate::narrow::mesh_mesh::{
+    DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
+    intersects_mesh_mesh,
+};
+use crate::narrow::{MANIFOLD_POINTS, reduce_manifold};
+use crate::scene::{BodyDesc, CollisionFilter, Motion, SceneLimits};
+use crate::test_support::{meshes, point_in_cube, rng, rotation};
+use rand::Rng;
+use std::ops::ControlFlow;
+use std::sync::Arc;
+
+fn add(scene: &mut Scene, shape: Shape, at: DVec3, margin: f64) -> BodyId {
+    let shape = scene.register_shape(shape).unwrap();
+    let desc = BodyDesc {
+        shape,
+        pose: Pose::from_translation(at),
+        motion: Motion::Dynamic,
+        filter: CollisionFilter::ALL,
+        margin: Some(margin),
+    };
+    scene.add_body(&desc).unwrap()
+}
+
+/// Every non-empty combination of the four flags.
+fn every_query() -> impl Iterator<Item = Query> {
+    (1u32..16).map(|bits| Query {
+        overlap: bits & 1 != 0,
+        close: bits & 2 != 0,
+        distance: bits & 4 != 0,
+        contacts: bits & 8 != 0,
+        toi: false,
+    })
+}
+
+fn run(scene: &Scene, query: Query, workspace: &mut PipelineWorkspace) -> FrameResults {
+    let mut results = FrameResults::default();
+    let report = step(scene, query, workspace, &mut results);
+    assert_eq!(report.pairs as usize, results.pairs.len());
+    assert_eq!(report.contacts as usize, results.contacts.len());
+    assert!(report.candidates >= report.pairs);
+    assert_links(&results);
+    results
+}
+
+/// Pairs in `(a, b)` order; each pair's contacts are exactly the ones that name it, in
+/// one run, in pair order, at most `MANIFOLD_POINTS`.
+fn assert_links(results: &FrameResults) {
+    assert!(
+        results
+            .pairs
+            .windows(2)
+            .all(|w| (w[0].a, w[0].b) < (w[1].a, w[1].b))
+    );
+    let mut next = 0;
+    for (i, p) in results.pairs.iter().enumerate() {
+        assert!(p.contact_count as usize <= MANIFOLD_POINTS);
+        if p.contact_count == 0 {
+            assert_eq!(p.first_contact, 0);
+            continue;
+        }
+        assert_eq!(p.first_contact as usize, next);
+        next += p.contact_count as usize;
+        for c in &results.contacts[p.first_contact as usize..next] {
+            assert_eq!(c.pair as usize, i);
+        }
+    }
+    assert_eq!(next, results.contacts.len());
+}
+
+#[test]
+fn sphere_scenes_report_exactly_what_each_query_asks_against_the_closed_form() {
+    let mut rng = rng(71);
+    let mut seen = [0usize; 4]; // close, far-but-candidate, touching, contacts
+    for case in 0..60 {
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let spheres: Vec<(DVec3, f64, f64)> = (0..rng.random_range(2..40))
+            .map(|_| {
+                (
+                    point_in_cube(&mut rng, 1.2),
+                    rng.random_range(0.05..0.6),
+                    rng.random_range(0.0..0.3),
+                )
+            })
+            .collect();
+        for &(c, r, m) in &spheres {
+            add(&mut scene, Shape::Sphere(Sphere::new(r)), c, m);
+        }
+        let mut workspace = PipelineWorkspace::default();
+        for query in every_query() {
+            let results = run(&scene, query, &mut workspace);
+            for i in 0..spheres.len() {
+                for j in i + 1..spheres.len() {
+                    let ((ci, ri, mi), (cj, rj, mj)) = (spheres[i], spheres[j]);
+                    let truth = ci.distance(cj) - ri - rj;
+                    // The broad phase's candidates: margin-grown boxes overlap.
+                    let reach = DVec3::splat(1.0);
+                    let candidate =
+                        ((ci - cj).abs() - (ri + mi + rj + mj) * reach).max_element() <= 0.0;
+                    let wanted = (query.distance && candidate)
+                        || (query.close && truth <= mi + mj)
+                        || ((query.overlap || query.contacts) && truth <= 0.0);
+                    let found = results
+                        .pairs
+                        .iter()
+                        .find(|r| (r.a, r.b) == (i as u32, j as u32));
+                    let Some(r) = found else {
+                        assert!(!wanted, "case {case} {query:?}: pair {i},{j} missed");
+                        continue;
+                    };
+                    assert!(wanted, "case {case} {query:?}: pair {i},{j} not asked");
+                    assert!((r.distance - truth).abs() <= r.error_bound.max(1e-12));
+                    assert!(
+                        (r.normal.length() - 1.0).abs() < 1e-12 && r.normal.dot(cj - ci) >= 0.0
+                    );
+                    assert!(
+                        (r.point_a.distance(ci) - ri).abs() < 1e-9
+                            && (r.point_b.distance(cj) - rj).abs() < 1e-9
+                    );
+                    if query.contacts && truth <= 0.0 {
+                        assert_eq!(r.contact_count, 1);
+                        let c = results.contacts[r.first_contact as usize];
+                        assert_eq!(
+                            (c.point_a, c.point_b, c.normal),
+                            (r.point_a, r.point_b, r.normal)
+                        );
+                        assert_eq!(c.distance, r.distance);
+                        assert!(c.distance <= 0.0);
+                        seen[3] += 1;
+                    } else {
+                        assert_eq!(r.contact_count, 0);
+                    }
+                    seen[0] += usize::from(truth <= mi + mj);
+                    seen[1] += usize::from(truth > mi + mj);
+                    seen[2] += usize::from(truth <= 0.0);
+                }
+            }
+        }
+    }
+    assert!(seen.iter().all(|&n| n > 500), "seen {seen:?}");
+}
+
+fn torus_scene() -> (Scene, BodyId, BodyId, Arc<MeshShape>) {
+    let torus = Arc::new(MeshShape::new(meshes::torus(1.0, 0.25, 24, 12)));
+    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let a = add(&mut scene, Shape::Mesh(torus.clone()), DVec3::ZERO, 0.5);
+    let b = add(&mut scene, Shape::Mesh(torus.clone()), DVec3::X, 0.5);
+    (scene, a, b, torus)
+}
+
+/// Tori and spheres moving coherently: a workspace with a worker pool gives exactly the
+/// results of one without, frame after frame (warm starts included), for every query.
+#[test]
+fn the_worker_pool_changes_nothing_but_who_answers() {
+    let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.6, 0.15, 20, 8))));
+    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let mut rng = rng(79);
+    let mut bodies = Vec::new();
+    for i in 0..10 {
+        let shape = if i % 3 == 2 {
+            Shape::Sphere(Sphere::new(0.3))
+        } else {
+            torus.clone()
+        };
+        bodies.push(add(&mut scene, shape, point_in_cube(&mut rng, 1.5), 0.2));
+    }
+    let pool = Arc::new(WorkerPool::new(2));
+    let queries = [
+        Query::CLOSE.union(Query::CONTACTS),
+        Query::DISTANCE,
+        Query::OVERLAP,
+    ];
+    let (mut serial, mut parallel) = (
+        PipelineWorkspace::default(),
+        PipelineWorkspace::with_workers(pool),
+    );
+    let (mut expected, mut found) = (FrameResults::default(), FrameResults::default());
+    let (mut mesh_pairs, mut contact_frames) = (0, 0);
+    for frame in 0..120 {
+        for &body in &bodies {
+            let pose = scene.body(body).unwrap().pose;
+            let moved = Pose::new(
+                (pose.position + point_in_cube(&mut rng, 0.08)).clamp_length_max(1.8),
+                rotation(&mut rng).slerp(pose.rotation, 0.9),
+            );
+            scene.set_pose(body, moved).unwrap();
+        }
+        let query = queries[frame % queries.len()];
+        let a = step(&scene, query, &mut serial, &mut expected);
+        let b = step(&scene, query, &mut parallel, &mut found);
+        assert_eq!(found.pairs, expected.pairs, "frame {frame}");
+        assert_eq!(found.contacts, expected.contacts, "frame {frame}");
+        assert_eq!(
+            (a.completeness, a.candidates, a.pairs, a.contacts),
+            (b.completeness, b.candidates, b.pairs, b.contacts)
+        );
+        mesh_pairs += parallel.outcomes.len();
+        contact_frames += usize::from(!found.contacts.is_empty());
+    }
+    assert!(
+        mesh_pairs > 200 && contact_frames > 10,
+        "mesh pairs through the pool {mesh_pairs}, frames with contacts {contact_frames}"
+    );
+}
+
+#[test]
+fn mesh_pairs_answer_each_query_as_the_mesh_queries_do_directly() {
+    let (mut scene, a, b, mesh) = torus_scene();
+    let mut rng = rng(73);
+    let mut workspace = PipelineWorkspace::default();
+    let (mut touching, mut close, mut far) = (0, 0, 0);
+    for frame in 0..80 {
+        let pose_b = Pose::new(point_in_cube(&mut rng, 2.2), rotation(&mut rng));
+        scene.set_pose(b, pose_b).unwrap();
+        let (mut proxies, mut candidates) = (Vec::new(), Vec::new());
+        scene.proxies(&mut proxies);
+        crate::broad::pairs_brute_force(&proxies, &mut candidates);
+        let candidate = !candidates.is_empty();
+        let pose_a = scene.body(a).unwrap().pose;
+        let pose_ab = Pose::relative(&pose_a, &pose_b);
+        let cold = distance_mesh_mesh(
+            &mesh.distance_tree,
+            &mesh.distance_tree,
+            &pose_ab,
+            &DistanceParams::EXACT,
+            &mut DistanceCache::new(),
+            &mut MeshMeshWorkspace::new(),
+        );
+        let intersects = intersects_mesh_mesh(
+            &mesh.overlap_tree,
+            &mesh.overlap_tree,
+            &pose_ab,
+            &mut MeshMeshWorkspace::new(),
+        );
+        let mut segment_ends = Vec::new();
+        contacts_mesh_mesh(
+            &mesh.overlap_tree,
+            &mesh.overlap_tree,
+            &pose_ab,
+            &mut MeshMeshWorkspace::new(),
+            |c| {
+                segment_ends.extend(c.segment.map(|p| pose_a.transform_point(p)));
+                ControlFlow::Continue(())
+            },
+        );
+        assert_eq!(intersects, cold.distance == 0.0, "frame {frame}");
+        assert_eq!(intersects, !segment_ends.is_empty(), "frame {frame}");
+        touching += usize::from(intersects);
+        close += usize::from(cold.distance <= 1.0);
+        far += usize::from(candidate && cold.distance > 1.0);
+        for query in every_query() {
+            let results = run(&scene, query, &mut workspace);
+            let wanted = (query.distance && candidate)
+                || (query.close && cold.distance <= 1.0)
+                || ((query.overlap || query.contacts) && intersects);
+            let r = match (results.pairs.as_slice(), wanted) {
+                ([r], true) => r,
+                ([], false) => continue,
+                (pairs, _) => panic!("frame {frame} {query:?}: {} pairs", pairs.len()),
+            };
+            assert!(r.exact);
+            if query.close || query.distance {
+                // Warm-started across frames and queries, the exact distance is the cold one.
+                assert_eq!(r.distance, cold.distance, "frame {frame}");
+                assert_eq!(
+                    (r.point_a, r.point_b),
+                    (
+                        pose_a.transform_point(cold.point_a),
+                        pose_a.transform_point(cold.point_b)
+                    )
+                );
+            } else {
+                assert_eq!(r.distance, 0.0);
+            }
+            if !(query.contacts && intersects) {
+                assert_eq!(r.contact_count, 0);
+                continue;
+            }
+            let range = r.first_contact as usize..(r.first_contact + r.contact_count) as usize;
+            let manifold = &results.contacts[range];
+            let mut kept = Vec::new();
+            reduce_manifold(&segment_ends, &mut kept);
+            assert_eq!(manifold.len(), kept.len(), "frame {frame}");
+            assert!(!manifold.is_empty());
+            for (c, &i) in manifold.iter().zip(&kept) {
+                assert_eq!((c.point_a, c.point_b), (segment_ends[i], segment_ends[i]));
+                assert_eq!((c.distance, c.normal), (0.0, manifold[0].normal));
+                assert!((c.normal.length() - 1.0).abs() < 1e-12);
+            }
+            if !(query.close || query.distance) {
+                assert_eq!(
+                    (r.point_a, r.normal),
+                    (manifold[0].point_a, manifold[0].normal)
+                );
+            }
+        }
+    }
+    assert!(
+        touching > 5 && close - touching > 3 && far > 3,
+        "{touching} {close} {far}"
+    );
+}
+
+#[test]
+fn overlap_alone_proves_mesh_contact_without_witnesses() {
+    let (mut scene, _, b, _) = torus_scene();
+    scene
+        .set_pose(b, Pose::from_translation(DVec3::new(0.3, 0.0, 0.0)))
+        .unwrap();
+    let results = run(&scene, Query::OVERLAP, &mut PipelineWorkspace::default());
+    let [r] = results.pairs.as_slice() else {
+        panic!("{} pairs", results.pairs.len())
+    };
+    assert_eq!((r.distance, r.error_bound), (0.0, 0.0));
+    assert_eq!(
+        (r.point_a, r.point_b, r.normal),
+        (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO)
+    );
+    assert!(results.contacts.is_empty());
+}
+
+/// One shape of every kind, in random poses: every pair is answered exactly, the same
+/// whichever body is A (distance equal, normal reversed, witnesses swapped), with a
+/// world-frame answer equal to the query run in A's frame and mapped by A's pose, and
+/// both touching and separated pairs occur.
+#[test]
+fn every_pair_of_shape_kinds_is_exact_and_the_same_from_either_side() {
+    use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cylinder};
+    let hull: Vec<DVec3> = meshes::uv_sphere(0.4, 6, 4).vertices().to_vec();
+    let kinds = [
+        Shape::Sphere(Sphere::new(0.3)),
+        Shape::Capsule(Capsule::new(0.3, 0.2)),
+        Shape::Cuboid(Cuboid::new(DVec3::new(0.3, 0.2, 0.4))),
+        Shape::Cylinder(Cylinder::new(0.3, 0.25)),
+        Shape::Cone(Cone::new(0.3, 0.3)),
+        Shape::Convex(Arc::new(ConvexPolyhedron::try_from_points(&hull).unwrap())),
+        Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.4, 0.12, 16, 8)))),
+    ];
+    let mut rng = rng(83);
+    let mut workspace = PipelineWorkspace::default();
+    let mut scratch = NarrowScratch::default();
+    let (mut touching, mut apart) = (0, 0);
+    for case in 0..700 {
+        let (i, j) = (case % kinds.len(), (case / kinds.len()) % kinds.len());
+        let (pa, pb) = (
+            Pose::new(point_in_cube(&mut rng, 3.0), rotation(&mut rng)),
+            Pose::new(point_in_cube(&mut rng, 0.6), rotation(&mut rng)),
+        );
+        let pb = Pose::new(pa.position + pb.position, pb.rotation);
+        let answer =
+            |first: &Shape, second: &Shape, p1: Pose, p2: Pose, ws: &mut PipelineWorkspace| {
+                let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+                add(&mut scene, first.clone(), DVec3::ZERO, 10.0);
+                add(&mut scene, second.clone(), DVec3::ZERO, 10.0);
+                scene.set_pose(BodyId(0), p1).unwrap();
+                scene.set_pose(BodyId(1), p2).unwrap();
+                let results = run(&scene, Query::CLOSE.union(Query::CONTACTS), ws);
+                assert_eq!(
+                    results.pairs.len(),
+                    1,
+                    "case {case}: margins cover the pair"
+                );
+                (results.pairs[0], results.contacts.clone())
+            };
+        let (ab, contacts) = answer(&kinds[i], &kinds[j], pa, pb, &mut workspace);
+        let (ba, _) = answer(&kinds[j], &kinds[i], pb, pa, &mut workspace);
+        assert!(ab.exact, "case {case}");
+        let tol = 1e-7;
+        assert!(
+            (ab.distance - ba.distance).abs() <= tol,
+            "case {case} ({i},{j}): {} vs {}",
+            ab.distance,
+            ba.distance
+        );
+        assert!(
+            (ab.normal + ba.normal).length() <= 1e-5 || ab.distance <= 0.0,
+            "case {case}"
+        );
+        assert!((ab.normal.length() - 1.0).abs() < 1e-9, "case {case}");
+        // World answer = A-frame answer mapped by A's pose.
+        let local = dispatch::distance(
+            &kinds[i],
+            &kinds[j],
+            &Pose::relative(&pa, &pb),
+            f64::INFINITY,
+            &mut scratch,
+        );
+        assert!(
+            (local.distance - ab.distance).abs() <= 1e-12 + ab.error_bound,
+            "case {case}"
+        );
+        assert!(
+            pa.transform_point(local.point_a).distance(ab.point_a) <= 1e-9,
+            "case {case}"
+        );
+        if ab.distance <= 0.0 {
+            assert!(
+                !contacts.is_empty(),
+                "case {case} ({i},{j}): touching without contacts"
+            );
+            assert!(
+                contacts
+                    .iter()
+                    .all(|c| c.distance <= 1e-9 && c.normal.is_finite())
+            );
+            touching += 1;
+        } else {
+            assert!(contacts.is_empty(), "case {case}");
+            apart += 1;
+        }
+    }
+    assert!(
+        touching > 100 && apart > 100,
+        "touching {touching}, apart {apart}"
+    );
+}
+
+/// Boxes and capsules with small margins, CLOSE only: a pair is reported exactly when
+/// its closed-form distance is within the margins, with that distance (pairs GJK proves
+/// farther than the margins skip the closed form, and must never hide a close one).
+#[test]
+fn close_pairs_of_boxes_and_capsules_are_exactly_those_within_their_margins() {
+    use crate::geometry::Capsule;
+    use crate::narrow::pairs;
+    let mut rng = rng(89);
+    let mut workspace = PipelineWorkspace::default();
+    let (mut reported, mut skipped_candidates) = (0, 0);
+    for case in 0..3_000 {
+        let shape = |rng: &mut crate::test_support::TestRng| {
+            if rng.random_range(0..2) == 0 {
+                Shape::Cuboid(Cuboid::new(DVec3::new(
+                    rng.random_range(0.05..0.5),
+                    rng.random_range(0.05..0.5),
+                    rng.random_range(0.05..0.5),
+                )))
+            } else {
+                Shape::Capsule(Capsule::new(
+                    rng.random_range(0.0..0.5),
+                    rng.random_range(0.02..0.3),
+                ))
+            }
+        };
+        let (sa, sb) = (shape(&mut rng), shape(&mut rng));
+        let (ma, mb) = (rng.random_range(0.0..0.1), rng.random_range(0.0..0.1));
+        let (pa, pb) = (
+            Pose::new(point_in_cube(&mut rng, 0.2), rotation(&mut rng)),
+            Pose::new(point_in_cube(&mut rng, 0.9), rotation(&mut rng)),
+        );
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        add(&mut scene, sa.clone(), DVec3::ZERO, ma);
+        add(&mut scene, sb.clone(), DVec3::ZERO, mb);
+        scene.set_pose(BodyId(0), pa).unwrap();
+        scene.set_pose(BodyId(1), pb).unwrap();
+        let mut results = FrameResults::default();
+        let report = step(&scene, Query::CLOSE, &mut workspace, &mut results);
+        let iso = Pose::relative(&pa, &pb).to_isometry();
+        let truth = match (&sa, &sb) {
+            (Shape::Cuboid(x), Shape::Cuboid(y)) => pairs::distance_cuboid_cuboid(x, y, &iso),
+            (Shape::Capsule(x), Shape::Cuboid(y)) => pairs::distance_capsule_cuboid(x, y, &iso),
+            (Shape::Cuboid(x), Shape::Capsule(y)) => {
+                let d = pairs::distance_capsule_cuboid(y, x, &iso.inverse());
+                d.flipped(&iso)
+            }
+            (Shape::Capsule(x), Shape::Capsule(y)) => pairs::distance_capsule_capsule(x, y, &iso),
+            _ => unreachable!(),
+        }
+        .distance;
+        match results.pairs.as_slice() {
+            [r] => {
+                assert!(
+                    truth <= ma + mb + 1e-12,
+                    "case {case}: far pair {truth} reported"
+                );
+                assert!((r.distance - truth).abs() <= 1e-12, "case {case}");
+                reported += 1;
+            }
+            [] => {
+                assert!(
+                    truth > ma + mb - 1e-12,
+                    "case {case}: close pair {truth} missed"
+                );
+                skipped_candidates += report.candidates as usize;
+            }
+            more => panic!("case {case}: {} pairs", more.len()),
+        }
+    }
+    assert!(
+        reported > 300 && skipped_candidates > 300,
+        "reported {reported}, candidates beyond their margins {skipped_candidates}"
+    );
+}
+
+/// The worker pool's fallback (a pair whose query panicked) is the box answer: a lower
+/// bound of the distance within its error bound, a contact covering the depth.
+#[test]
+fn the_box_answer_is_conservative() {
+    let sphere = Aabb::new(DVec3::splat(-0.5), DVec3::splat(0.5));
+    let cube_at = |x: f64| {
+        Aabb::new(
+            DVec3::new(x - 0.5, -0.2, -0.5),
+            DVec3::new(x + 0.5, 0.8, 0.5),
+        )
+    };
+    let pair = CandidatePair { a: 0, b: 1 };
+    let mut contacts = Vec::new();
+    let far = answer::boxes(&pair, &sphere, &cube_at(1.05), Query::CLOSE, &mut contacts);
+    // True distance: sphere centre to the box face x = 0.55, minus the radius.
+    let truth = 0.55 - 0.5;
+    assert!(!far.result.exact && !far.touching);
+    assert!(far.result.distance <= truth && truth - far.result.distance <= far.result.error_bound);
+    let near = answer::boxes(
+        &pair,
+        &sphere,
+        &cube_at(0.8),
+        Query::CONTACTS,
+        &mut contacts,
+    );
+    let depth = 0.5 - (0.8 - 0.5);
+    assert!(near.touching && contacts.len() == 1);
+    assert!(contacts[0].distance == 0.0 && depth <= contacts[0].error_bound);
+}
+
+/// A small body near the edge of a wide floor gets the floor's normal, not the direction
+/// between the centres.
+#[test]
+fn box_answers_take_their_normal_from_the_axis_that_separates_soonest() {
+    for (height, a_below) in [(0.45, true), (0.55, true), (0.45, false), (0.55, false)] {
+        let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+        let floor = Shape::Cuboid(Cuboid::new(DVec3::new(5.0, 5.0, 0.25)));
+        let ball = Shape::Sphere(Sphere::new(0.2));
+        let (floor_at, ball_at) = (DVec3::new(0.0, 0.0, 0.0), DVec3::new(4.5, -4.0, height));
+        // Body ids follow insertion: the first added is A.
+        if a_below {
+            add(&mut scene, floor, floor_at, 0.1);
+            add(&mut scene, ball, ball_at, 0.1);
+        } else {
+            add(&mut scene, ball, ball_at, 0.1);
+            add(&mut scene, floor, floor_at, 0.1);
+        }
+        let mut results = FrameResults::default();
+        step(
+            &scene,
+            Query::CLOSE,
+            &mut PipelineWorkspace::default(),
+            &mut results,
+        );
+        let expected = if a_below { DVec3::Z } else { -DVec3::Z };
+        assert_eq!(results.pairs.len(), 1, "height {height}");
+        assert_eq!(
+            results.pairs[0].normal, expected,
+            "height {height}, A below {a_below}"
+        );
+    }
+}
+
+#[test]
+fn a_warm_workspace_answers_frame_after_frame_without_growing() {
+    let (mut scene, _, b, _) = torus_scene();
+    let mut rng = rng(75);
+    let poses: Vec<Pose> = (0..20)
+        .map(|_| Pose::new(point_in_cube(&mut rng, 1.0), rotation(&mut rng)))
+        .collect();
+    let all = Query::CLOSE.union(Query::CONTACTS).union(Query::DISTANCE);
+    let (mut workspace, mut results) = (PipelineWorkspace::default(), FrameResults::default());
+    let capacities = |w: &PipelineWorkspace, r: &FrameResults| {
+        (
+            w.mesh.capacities(),
+            w.candidates.capacity(),
+            r.pairs.capacity(),
+            r.contacts.capacity(),
+        )
+    };
+    for &pose in &poses {
+        scene.set_pose(b, pose).unwrap();
+        step(&scene, all, &mut workspace, &mut results);
+    }
+    let warm = capacities(&workspace, &results);
+    for &pose in &poses {
+        scene.set_pose(b, pose).unwrap();
+        step(&scene, all, &mut workspace, &mut results);
+        assert_eq!(capacities(&workspace, &results), warm);
+    }
+}
+
+/// Spheres wandering in and out of each other's boxes, some resting, one removed and
+/// one added midway: after every frame the kept answers are exactly the frame's
+/// candidates (all answered exactly), whichever were reused or answered anew, and
+/// both happen.
+#[test]
+fn kept_answers_are_exactly_the_frame_candidates() {
+    let mut scene = Scene::try_new(0.01, SceneLimits::STANDARD).unwrap();
+    let mut rng = rng(76);
+    let mut bodies: Vec<BodyId> = (0..12)
+        .map(|_| {
+            let radius = rng.random_range(0.1..0.4);
+            add(
+                &mut scene,
+                Shape::Sphere(Sphere::new(radius)),
+                point_in_cube(&mut rng, 1.5),
+                0.05,
+            )
+        })
+        .collect();
+    let mut workspace = PipelineWorkspace::default();
+    let (mut reused, mut fresh, mut dropped) = (0, 0, 0);
+    for frame in 0..60 {
+        if frame == 30 {
+            scene.remove_body(bodies.remove(0)).unwrap();
+            let sphere = Shape::Sphere(Sphere::new(0.3));
+            bodies.push(add(&mut scene, sphere, DVec3::ZERO, 0.05));
+        }
+        for &body in &bodies {
+            if rng.random_bool(0.5) {
+                let pose = Pose::from_translation(point_in_cube(&mut rng, 1.5));
+                scene.set_pose(body, pose).unwrap();
+            }
+        }
+        let before = workspace.kept.len();
+        let mut results = FrameResults::default();
+        let report = step(&scene, Query::CLOSE, &mut workspace, &mut results);
+        let mut kept: Vec<CandidatePair> = workspace.kept.keys().copied().collect();
+        kept.sort_unstable();
+        assert_eq!(kept, workspace.candidates, "frame {frame}");
+        assert!(workspace.kept.values().all(|k| k.stamp == workspace.steps));
+        reused += report.reused_pairs;
+        fresh += report.candidates - report.reused_pairs;
+        dropped += usize::from(before > workspace.candidates.len());
+        scene.end_frame();
+    }
+    assert!(
+        reused > 0 && fresh > 0 && dropped > 0,
+        "{reused} {fresh} {dropped}"
+    );
+}
+
+#[test]
+fn a_frame_is_truncated_at_the_shallowest_level_of_its_pairs() {
+    let mut c = Completeness::Exact;
+    for (level, expected) in [(3, 3), (5, 3), (1, 1), (2, 1)] {
+        c = c.truncated_at(level);
+        assert_eq!(c, Completeness::Truncated { level: expected });
+    }
+}
