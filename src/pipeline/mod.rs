@@ -52,23 +52,9 @@
 //! each by its own rule.
 //!
 //! # Broad phase kept between frames
-//! The workspace keeps one stateful [`BroadPhase`] of the scene's bodies, of the kind the
-//! scene asks for ([`Scene::broad_phase`]): a fixed one, or with
-//! [`BroadPhaseChoice::Auto`] the kind [`choose`] picks from [`BroadPhaseStats`] measured on
-//! the scene at its first frame and again every [`AUTO_REMEASURE_FRAMES`] frames (a
-//! different pick rebuilds the broad phase; the share of far moves and the mean shift come
-//! from the kept broad phase's counts since the last measurement,
-//! [`BroadPhase::take_move_counts`]: none at the first measurement, which therefore sees
-//! no motion and picks for a scene at rest; the
-//! statistics are in [`StepReport::broad_stats`] on the frames that measured). Each frame it re-reads only the bodies in the
-//! scene's change log ([`Scene::changes_since`]): a body that did not change is never
-//! touched, static bodies included. It rebuilds from every body instead on a scene it was
-//! not synced to, after a skipped frame (or a frame asking only `TOI`, which does not
-//! sync), after changes made between its last frame's step and [`Scene::end_frame`], and
-//! when the kind changes. Stepping twice in one frame re-reads the same log and answers the
-//! same. [`StepReport::broad_kind`] and [`StepReport::broad_updates`] say which kind ran and
-//! how many bodies it re-read. Results never depend on the kind, only their cost. The swept
-//! boxes of `TOI` still go through a [`SortAndSweep`] over every body each frame.
+//! The workspace keeps one stateful broad phase of the scene's bodies, re-reading only the
+//! bodies in the scene's change log, and rebuilds it when it cannot (`broad_sync.rs`).
+//! Results never depend on the broad phase's kind, only their cost.
 //!
 //! # Answers kept between frames
 //! A candidate pair whose two bodies did not change since it was last answered (same
@@ -144,6 +130,7 @@
 //! kinds' pair sets and hash cells allocate as pairs and occupied cells appear.
 
 mod answer;
+mod broad_sync;
 pub mod budget;
 mod frontier_run;
 mod separation;
@@ -154,10 +141,7 @@ pub use crate::narrow::dispatch::PathCounts;
 pub use budget::{Budget, Deadline, FRONTIER_RESERVE, Unlimited, VisitBudget, frontier_deadline};
 pub use toi::{PairToi, TOI_TOLERANCE};
 
-use crate::broad::{
-    BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, PairMap, Proxy,
-    SortAndSweep, choose,
-};
+use crate::broad::{BroadPhaseKind, BroadPhaseStats, CandidatePair, PairMap};
 use crate::math::{DVec3, Pose};
 use crate::narrow::MeshShape;
 use crate::narrow::Shape;
@@ -166,8 +150,10 @@ use crate::narrow::dispatch::{self, NarrowScratch, Route};
 use crate::narrow::gjk::GjkCache;
 use crate::narrow::mesh_mesh::DistanceCache;
 use crate::narrow::mesh_mesh::frontier::{FrontierAnswer, FrontierStats, FrontierWorkspace};
-use crate::scene::{Body, BodyId, Scene, SyncPoint};
+use crate::scene::{Body, BodyId, Scene};
 use answer::{Answer, MeshScratch};
+pub use broad_sync::AUTO_REMEASURE_FRAMES;
+use broad_sync::BroadSync;
 use frontier_run::{FrontierRun, run_frontier};
 use separation::Separation;
 use std::sync::Arc;
@@ -341,8 +327,8 @@ pub struct StepReport {
     /// Bodies the kept broad phase re-read this frame: those in the scene's change log, or
     /// every body when it was rebuilt (see the [module docs](self)); 0 when it did not run.
     pub broad_updates: u32,
-    /// With [`BroadPhaseChoice::Auto`], the statistics measured this frame, from which
-    /// [`choose`] picked `broad_kind`; `None` on frames that kept the last pick.
+    /// With [`BroadPhaseChoice::Auto`](crate::broad::BroadPhaseChoice::Auto), the statistics measured this frame, from which
+    /// [`choose`](crate::broad::choose) picked `broad_kind`; `None` on frames that kept the last pick.
     pub broad_stats: Option<BroadPhaseStats>,
     /// Narrow-phase queries by path: which stages the frame entered (a scene of spheres
     /// and capsules never enters BVH or EPA code: `paths.bvh() == 0`, `paths.epa == 0`).
@@ -376,9 +362,6 @@ pub struct StepReport {
     pub truncated_tois: u32,
 }
 
-/// Frames between two measurements of a [`BroadPhaseChoice::Auto`] scene's statistics.
-pub const AUTO_REMEASURE_FRAMES: u64 = 256;
-
 /// A candidate pair's answer kept from the frame that computed it ("pairs whose relative
 /// pose did not change reuse last frame's answer", DESIGN §6): valid while the scene, the
 /// query and both bodies' [`versions`](crate::scene::Body::version) are the same, since an
@@ -408,30 +391,13 @@ impl KeptAnswer {
     }
 }
 
-/// The automatic choice made for one scene.
-#[derive(Debug, Clone, Copy)]
-struct AutoChoice {
-    /// [`Scene::uid`] of the scene measured.
-    scene: u64,
-    kind: BroadPhaseKind,
-    /// The frame of the measurement.
-    measured_at: u64,
-}
-
 /// State of [`step`] kept across frames: scratch space (no allocation once grown), the
 /// broad phase's order, the warm-start cache of every mesh–mesh pair that was a candidate
 /// last frame, and the worker pool when there is one.
 #[derive(Debug, Default)]
 pub struct PipelineWorkspace {
-    /// Every body's proxy, when the broad phase is rebuilt or the scene measured; the
-    /// changed bodies' proxies, when it is synced.
-    proxies: Vec<Proxy>,
-    /// The broad phase over the current boxes, kept in sync with the scene (module docs).
-    broad: Option<BroadPhase>,
-    /// Where `broad` was last synced to its scene.
-    synced: Option<SyncPoint>,
-    /// The last automatic choice, when the scene's choice is `Auto`.
-    auto: Option<AutoChoice>,
+    /// The broad phases kept in sync with the scene (`broad_sync.rs`).
+    broad: BroadSync,
     candidates: Vec<CandidatePair>,
     /// This thread's mesh–mesh scratch.
     mesh: MeshScratch,
@@ -458,10 +424,6 @@ pub struct PipelineWorkspace {
     narrow: NarrowScratch,
     /// One pair's manifold, before it joins the frame's contacts.
     manifold: Manifold,
-    /// Swept boxes of the bodies (time of impact).
-    swept: Vec<Proxy>,
-    /// The broad phase over the swept boxes, with its own order kept between frames.
-    swept_sweep: SortAndSweep,
     /// Candidate pairs of the swept boxes.
     toi_candidates: Vec<CandidatePair>,
     /// The budgeted frontier's state (frames with a limited budget).
@@ -603,24 +565,12 @@ pub fn step_within(
     results.contacts.clear();
     results.tois.clear();
     workspace.narrow.paths = PathCounts::default();
-    let mut broad_stats = None;
-    let (broad_kind, broad_updates) = if query.at_current_poses() {
-        let updates = sync_broad_phase(scene, workspace, &mut broad_stats);
-        let broad = workspace.broad.as_mut().expect("synced");
-        broad.pairs(&mut workspace.candidates);
-        (Some(broad.kind()), updates)
-    } else {
-        workspace.candidates.clear();
-        (None, 0)
-    };
-    if query.toi {
-        scene.swept_proxies(&mut workspace.swept);
-        workspace
-            .swept_sweep
-            .pairs(&workspace.swept, &mut workspace.toi_candidates);
-    } else {
-        workspace.toi_candidates.clear();
-    }
+    let broad = workspace.broad.candidates(
+        scene,
+        query,
+        &mut workspace.candidates,
+        &mut workspace.toi_candidates,
+    );
     let broad_ns = elapsed_ns(started);
     let started = Instant::now();
     let limited = !budget.is_unlimited() && query.at_current_poses();
@@ -852,9 +802,9 @@ pub fn step_within(
         pairs: index(results.pairs.len()),
         contacts: index(results.contacts.len()),
         tois: index(results.tois.len()),
-        broad_kind,
-        broad_updates: index(broad_updates),
-        broad_stats,
+        broad_kind: broad.kind,
+        broad_updates: index(broad.updates),
+        broad_stats: broad.stats,
         paths: narrow.paths,
         reused_pairs: reused,
         separated_pairs,
@@ -997,74 +947,6 @@ impl PairClock {
         }
         self.expired
     }
-}
-
-/// Brings the workspace's broad phase up to date with `scene` (see the [module
-/// docs](self)); returns how many bodies it re-read, and sets `measured` when it measured
-/// the scene for the automatic choice.
-fn sync_broad_phase(
-    scene: &Scene,
-    workspace: &mut PipelineWorkspace,
-    measured: &mut Option<BroadPhaseStats>,
-) -> usize {
-    let changes = workspace
-        .synced
-        .and_then(|point| scene.changes_since(point));
-    let mut listed = false;
-    let kind = match scene.broad_phase() {
-        BroadPhaseChoice::Fixed(kind) => {
-            workspace.auto = None;
-            kind
-        }
-        BroadPhaseChoice::Auto => match workspace.auto {
-            Some(auto)
-                if auto.scene == scene.uid()
-                    && (auto.measured_at..auto.measured_at + AUTO_REMEASURE_FRAMES)
-                        .contains(&scene.frame()) =>
-            {
-                auto.kind
-            }
-            _ => {
-                scene.proxies(&mut workspace.proxies);
-                listed = true;
-                let moved = changes.map_or(workspace.proxies.len(), <[u32]>::len);
-                let mut stats = BroadPhaseStats::measure(&workspace.proxies, moved);
-                if let Some(broad) = workspace.broad.as_mut() {
-                    stats = stats.with_moves(&broad.take_move_counts());
-                }
-                *measured = Some(stats);
-                let kind = choose(&stats);
-                workspace.auto = Some(AutoChoice {
-                    scene: scene.uid(),
-                    kind,
-                    measured_at: scene.frame(),
-                });
-                kind
-            }
-        },
-    };
-    workspace.synced = Some(scene.sync_point());
-    let PipelineWorkspace { broad, proxies, .. } = workspace;
-    if let (Some(broad), Some(changes)) = (broad.as_mut(), changes)
-        && broad.kind() == kind
-    {
-        proxies.clear();
-        for &id in changes {
-            match scene.proxy(BodyId(id)) {
-                Some(proxy) => proxies.push(proxy),
-                None => {
-                    broad.remove(id);
-                }
-            }
-        }
-        broad.set_all(proxies);
-        return changes.len();
-    }
-    if !listed {
-        scene.proxies(proxies);
-    }
-    *broad = Some(BroadPhase::from_proxies(kind, proxies));
-    proxies.len()
 }
 
 /// Adds `answer` (its contacts already at `results.contacts[first_contact..]`) to the

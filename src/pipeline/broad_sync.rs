@@ -1,0 +1,167 @@
+//! The broad phase of a frame: one stateful [`BroadPhase`] of the scene's bodies kept in
+//! sync with the scene between frames, and a [`SortAndSweep`] over the swept boxes for time
+//! of impact.
+//!
+//! # The kind
+//! The scene names it ([`Scene::broad_phase`]): a fixed kind, or with
+//! [`BroadPhaseChoice::Auto`] the kind [`choose`] picks from [`BroadPhaseStats`] measured
+//! on the scene at its first frame and again every [`AUTO_REMEASURE_FRAMES`] frames. The
+//! share of far moves and the mean shift come from the kept broad phase's counts since the
+//! last measurement ([`BroadPhase::take_move_counts`]): none at the first, which therefore
+//! picks for a scene at rest. A different pick rebuilds the broad phase.
+//!
+//! # Sync
+//! Each frame re-reads only the bodies in the scene's change log
+//! ([`Scene::changes_since`]): a body that did not change is never touched, static bodies
+//! included. It rebuilds from every body instead on a scene it was not synced to, after a
+//! skipped frame (or a frame asking only `TOI`, which does not sync), after changes made
+//! between its last frame's step and [`Scene::end_frame`], and when the kind changes.
+//! Stepping twice in one frame re-reads the same log and answers the same. The frame's
+//! [`StepReport`](super::StepReport) says which kind ran, how many bodies it re-read and,
+//! on the frames that measured, the statistics. The swept boxes of `TOI` go through a
+//! [`SortAndSweep`] over every body each frame.
+
+use super::Query;
+use crate::broad::{
+    BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, CandidatePair, Proxy,
+    SortAndSweep, choose,
+};
+use crate::scene::{BodyId, Scene, SyncPoint};
+
+/// Frames between two measurements of a [`BroadPhaseChoice::Auto`] scene's statistics.
+pub const AUTO_REMEASURE_FRAMES: u64 = 256;
+
+/// The automatic choice made for one scene.
+#[derive(Debug, Clone, Copy)]
+struct AutoChoice {
+    /// [`Scene::uid`] of the scene measured.
+    scene: u64,
+    kind: BroadPhaseKind,
+    /// The frame of the measurement.
+    measured_at: u64,
+}
+
+/// The broad phases a workspace keeps between frames.
+#[derive(Debug, Default)]
+pub(super) struct BroadSync {
+    /// Every body's proxy, when the broad phase is rebuilt or the scene measured; the
+    /// changed bodies' proxies, when it is synced.
+    proxies: Vec<Proxy>,
+    /// The broad phase over the current boxes, kept in sync with the scene (module docs).
+    broad: Option<BroadPhase>,
+    /// Where `broad` was last synced to its scene.
+    synced: Option<SyncPoint>,
+    /// The last automatic choice, when the scene's choice is `Auto`.
+    auto: Option<AutoChoice>,
+    /// Swept boxes of the bodies (time of impact).
+    swept: Vec<Proxy>,
+    /// The broad phase over the swept boxes, with its own order kept between frames.
+    swept_sweep: SortAndSweep,
+}
+
+/// What the broad phase of one frame did, for the frame's report.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct BroadOutcome {
+    /// The kind that ran (`None` when the frame asked only `TOI`).
+    pub(super) kind: Option<BroadPhaseKind>,
+    /// Bodies it re-read.
+    pub(super) updates: usize,
+    /// The scene's statistics, on the frames that measured them.
+    pub(super) stats: Option<BroadPhaseStats>,
+}
+
+impl BroadSync {
+    /// The frame's candidate pairs at the current poses (when `query` asks anything but
+    /// `TOI`) and over the swept boxes (when it asks `TOI`), each list cleared first.
+    pub(super) fn candidates(
+        &mut self,
+        scene: &Scene,
+        query: Query,
+        candidates: &mut Vec<CandidatePair>,
+        toi_candidates: &mut Vec<CandidatePair>,
+    ) -> BroadOutcome {
+        let mut stats = None;
+        let (kind, updates) = if query.at_current_poses() {
+            let updates = self.sync(scene, &mut stats);
+            let broad = self.broad.as_mut().expect("synced");
+            broad.pairs(candidates);
+            (Some(broad.kind()), updates)
+        } else {
+            candidates.clear();
+            (None, 0)
+        };
+        if query.toi {
+            scene.swept_proxies(&mut self.swept);
+            self.swept_sweep.pairs(&self.swept, toi_candidates);
+        } else {
+            toi_candidates.clear();
+        }
+        BroadOutcome {
+            kind,
+            updates,
+            stats,
+        }
+    }
+
+    /// Brings the kept broad phase up to date with `scene` (module docs); returns how
+    /// many bodies it re-read, and sets `measured` when it measured the scene for the
+    /// automatic choice.
+    fn sync(&mut self, scene: &Scene, measured: &mut Option<BroadPhaseStats>) -> usize {
+        let changes = self.synced.and_then(|point| scene.changes_since(point));
+        let mut listed = false;
+        let kind = match scene.broad_phase() {
+            BroadPhaseChoice::Fixed(kind) => {
+                self.auto = None;
+                kind
+            }
+            BroadPhaseChoice::Auto => match self.auto {
+                Some(auto)
+                    if auto.scene == scene.uid()
+                        && (auto.measured_at..auto.measured_at + AUTO_REMEASURE_FRAMES)
+                            .contains(&scene.frame()) =>
+                {
+                    auto.kind
+                }
+                _ => {
+                    scene.proxies(&mut self.proxies);
+                    listed = true;
+                    let moved = changes.map_or(self.proxies.len(), <[u32]>::len);
+                    let mut stats = BroadPhaseStats::measure(&self.proxies, moved);
+                    if let Some(broad) = self.broad.as_mut() {
+                        stats = stats.with_moves(&broad.take_move_counts());
+                    }
+                    *measured = Some(stats);
+                    let kind = choose(&stats);
+                    self.auto = Some(AutoChoice {
+                        scene: scene.uid(),
+                        kind,
+                        measured_at: scene.frame(),
+                    });
+                    kind
+                }
+            },
+        };
+        self.synced = Some(scene.sync_point());
+        let Self { broad, proxies, .. } = self;
+        if let (Some(broad), Some(changes)) = (broad.as_mut(), changes)
+            && broad.kind() == kind
+        {
+            proxies.clear();
+            for &id in changes {
+                match scene.proxy(BodyId(id)) {
+                    Some(proxy) => proxies.push(proxy),
+                    None => {
+                        broad.remove(id);
+                    }
+                }
+            }
+            broad.set_all(proxies);
+            return changes.len();
+        }
+        if !listed {
+            scene.proxies(proxies);
+        }
+        *broad = Some(BroadPhase::from_proxies(kind, proxies));
+        proxies.len()
+    }
+}
