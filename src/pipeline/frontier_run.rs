@@ -27,12 +27,11 @@ pub(super) fn run_frontier(
 ) -> FrontierStats {
     let PipelineWorkspace {
         candidates,
-        kept,
+        memory,
         separated,
         frontier,
         frontier_answers,
         frontier_pairs,
-        frontier_seeds,
         frontier_run,
         ..
     } = workspace;
@@ -44,7 +43,7 @@ pub(super) fn run_frontier(
             .filter(|&(pair, &apart)| {
                 !apart
                     && mesh_pair(scene, pair).is_some()
-                    && !kept.get(pair).is_some_and(|k| k.fits(scene, pair, query))
+                    && memory.kept_answer(scene, pair, query).is_none()
             })
             .map(|(pair, _)| pair)
     };
@@ -58,7 +57,6 @@ pub(super) fn run_frontier(
     let resume = frontier_run.resumes(scene, query, frontier_pairs, candidates)
         && needed().all(|pair| frontier_pairs.binary_search(pair).is_ok());
     if !resume {
-        frontier_seeds.retain(|pair, _| candidates.binary_search(pair).is_ok());
         frontier_pairs.clear();
         frontier_pairs.extend(needed());
         frontier_run.scene = scene.uid();
@@ -70,7 +68,7 @@ pub(super) fn run_frontier(
             let (ma, mb) = mesh_pair(scene, pair).expect("a mesh pair");
             let pose_ab = Pose::relative(&a.pose, &b.pose).to_isometry();
             // Last frame's closest triangles: the warm start the exact queries have.
-            let seed = frontier_seeds.get(pair).copied();
+            let seed = memory.get(pair).and_then(|m| m.seed);
             let threshold = if query.distance {
                 distance_upper_bound(ma, mb, &pose_ab, seed.unwrap_or([0, 0]))
             } else {
@@ -105,10 +103,12 @@ pub(super) fn run_frontier(
     for (pair, answer) in frontier_pairs.iter().zip(frontier_answers.iter()) {
         match answer.witnesses {
             Some(w) if answer.distance_upper.is_some_and(|d| d <= answer.threshold) => {
-                frontier_seeds.insert(*pair, w.triangles);
+                memory.entry(pair).seed = Some(w.triangles);
             }
             _ if !answer.maybe_close => {
-                frontier_seeds.remove(pair);
+                if let Some(record) = memory.get_mut(pair) {
+                    record.seed = None;
+                }
             }
             _ => {}
         }

@@ -133,6 +133,7 @@ mod answer;
 mod broad_sync;
 pub mod budget;
 mod frontier_run;
+mod pair_memory;
 mod separation;
 mod toi;
 pub mod workers;
@@ -141,20 +142,19 @@ pub use crate::narrow::dispatch::PathCounts;
 pub use budget::{Budget, Deadline, FRONTIER_RESERVE, Unlimited, VisitBudget, frontier_deadline};
 pub use toi::{PairToi, TOI_TOLERANCE};
 
-use crate::broad::{BroadPhaseKind, BroadPhaseStats, CandidatePair, PairMap};
+use crate::broad::{BroadPhaseKind, BroadPhaseStats, CandidatePair};
 use crate::math::{DVec3, Pose};
 use crate::narrow::MeshShape;
 use crate::narrow::Shape;
 use crate::narrow::contact::Manifold;
 use crate::narrow::dispatch::{self, NarrowScratch, Route};
-use crate::narrow::gjk::GjkCache;
-use crate::narrow::mesh_mesh::DistanceCache;
 use crate::narrow::mesh_mesh::frontier::{FrontierAnswer, FrontierStats, FrontierWorkspace};
 use crate::scene::{Body, BodyId, Scene};
 use answer::{Answer, MeshScratch};
 pub use broad_sync::AUTO_REMEASURE_FRAMES;
 use broad_sync::BroadSync;
 use frontier_run::{FrontierRun, run_frontier};
+use pair_memory::PairMemories;
 use separation::Separation;
 use std::sync::Arc;
 use std::time::Instant;
@@ -362,35 +362,6 @@ pub struct StepReport {
     pub truncated_tois: u32,
 }
 
-/// A candidate pair's answer kept from the frame that computed it ("pairs whose relative
-/// pose did not change reuse last frame's answer", DESIGN §6): valid while the scene, the
-/// query and both bodies' [`versions`](crate::scene::Body::version) are the same, since an
-/// answer depends on nothing else (shapes never change). Both bodies unchanged is stricter
-/// than an unchanged relative pose: the answer is in world frame, so a pair moved rigidly
-/// together is answered again.
-#[derive(Debug, Clone)]
-struct KeptAnswer {
-    scene: u64,
-    versions: [u64; 2],
-    query: Query,
-    answer: Answer,
-    /// Its contacts, world frame (`pair` rewritten when reused).
-    contacts: Vec<ContactPoint>,
-    /// The frame ([`PipelineWorkspace::steps`]) that last read or wrote it: a frame reads
-    /// or writes the entry of every candidate pair, so those it did not stamp are no longer
-    /// candidates and are dropped at its end.
-    stamp: u64,
-}
-
-impl KeptAnswer {
-    /// Whether it answers `pair` of `scene` under `query` now.
-    fn fits(&self, scene: &Scene, pair: &CandidatePair, query: Query) -> bool {
-        self.scene == scene.uid()
-            && self.query == query
-            && self.versions == [body(scene, pair.a).version(), body(scene, pair.b).version()]
-    }
-}
-
 /// State of [`step`] kept across frames: scratch space (no allocation once grown), the
 /// broad phase's order, the warm-start cache of every mesh–mesh pair that was a candidate
 /// last frame, and the worker pool when there is one.
@@ -401,19 +372,10 @@ pub struct PipelineWorkspace {
     candidates: Vec<CandidatePair>,
     /// This thread's mesh–mesh scratch.
     mesh: MeshScratch,
-    /// Closest triangle pair of each mesh–mesh candidate, for the next frame's first bound.
-    /// Pairs that stop being candidates are forgotten; a pair that appears inserts once.
-    mesh_caches: PairMap<DistanceCache>,
-    /// Last answer of each candidate pair, reused while neither body changes.
-    kept: PairMap<KeptAnswer>,
-    /// Frames stepped so far: the stamp of the kept answers a frame reads or writes.
-    steps: u64,
-    /// The last separation proved for each mesh–mesh candidate pair found apart.
-    separations: PairMap<Separation>,
+    /// What each candidate pair keeps between frames (`pair_memory.rs`).
+    memory: PairMemories,
     /// Per candidate (same index): whether a kept separation answers it this frame.
     separated: Vec<bool>,
-    /// The hull test's memory of each mesh–mesh candidate pair.
-    hull_caches: PairMap<HullCache>,
     /// Answers a frame's mesh–mesh pairs in parallel (see [`workers`]).
     workers: Option<Arc<WorkerPool>>,
     /// The pool's answers of this frame, by candidate slot.
@@ -432,11 +394,6 @@ pub struct PipelineWorkspace {
     frontier_answers: Vec<FrontierAnswer>,
     /// The candidate pairs the frontier answered this frame, in its order.
     frontier_pairs: Vec<CandidatePair>,
-    /// Per mesh–mesh candidate a budgeted frame's frontier found within its threshold, the
-    /// triangle ids of its closest triangle pair found, kept until it is proven apart:
-    /// next frame's seed ([`crate::narrow::mesh_mesh::frontier::FrontierPair::seed`]), and first upper
-    /// bound under `DISTANCE`.
-    frontier_seeds: PairMap<[u32; 2]>,
     /// What the frontier last ran over, to resume it next frame.
     frontier_run: FrontierRun,
 }
@@ -559,8 +516,7 @@ pub fn step_within(
     results: &mut FrameResults,
 ) -> StepReport {
     let started = Instant::now();
-    workspace.steps += 1;
-    let stamp = workspace.steps;
+    workspace.memory.begin_frame();
     results.pairs.clear();
     results.contacts.clear();
     results.tois.clear();
@@ -598,9 +554,7 @@ pub fn step_within(
     let PipelineWorkspace {
         candidates,
         mesh,
-        mesh_caches,
-        kept,
-        separations,
+        memory,
         separated,
         workers,
         outcomes,
@@ -610,11 +564,9 @@ pub fn step_within(
         toi_candidates,
         frontier_answers,
         frontier_pairs,
-        frontier_seeds,
         ..
     } = workspace;
-    mesh_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
-    let is_kept = |pair: &CandidatePair| kept.get(pair).is_some_and(|k| k.fits(scene, pair, query));
+    let is_kept = |pair: &CandidatePair| memory.kept_answer(scene, pair, query).is_some();
     outcomes.clear();
     let parallel = workers.as_ref().filter(|_| {
         !limited
@@ -642,7 +594,7 @@ pub fn step_within(
                 mesh_a: Arc::clone(mesh_a),
                 mesh_b: Arc::clone(mesh_b),
                 query,
-                cache: mesh_caches.get(pair).copied().unwrap_or_default(),
+                cache: memory.mesh_cache(pair),
             })
         });
         pool.answer_all(jobs, outcomes, mesh, job_contacts);
@@ -657,8 +609,8 @@ pub fn step_within(
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let first_contact = results.contacts.len();
         let contacts = &mut results.contacts;
-        if let Some(k) = kept.get_mut(pair).filter(|k| k.fits(scene, pair, query)) {
-            k.stamp = stamp;
+        memory.visit(pair);
+        if let Some(k) = memory.kept_answer(scene, pair, query) {
             reused += 1;
             contacts.extend_from_slice(&k.contacts);
             debug_assert!(k.answer.result.exact, "only exact answers are kept");
@@ -698,7 +650,7 @@ pub fn step_within(
                         (b, mb),
                         query,
                         found,
-                        mesh_caches.entry(*pair).or_default(),
+                        &mut memory.entry(pair).mesh_cache,
                         mesh,
                         contacts,
                     ),
@@ -714,7 +666,7 @@ pub fn step_within(
                 let outcome = pooled.next().expect("one pool outcome per mesh pair");
                 debug_assert_eq!(outcome.slot as usize, slot);
                 contacts.extend_from_slice(outcome.contacts());
-                mesh_caches.insert(*pair, outcome.cache);
+                memory.entry(pair).mesh_cache = outcome.cache;
                 outcome.answer
             }
             (Route::MeshMesh(ma, mb), None) => {
@@ -724,7 +676,7 @@ pub fn step_within(
                     (a, ma),
                     (b, mb),
                     query,
-                    mesh_caches.entry(*pair).or_default(),
+                    &mut memory.entry(pair).mesh_cache,
                     mesh,
                     contacts,
                 )
@@ -733,12 +685,11 @@ pub fn step_within(
         if searched_mesh_pair {
             match answer.apart_by {
                 Some(bound) => {
-                    separations.insert(*pair, Separation::new(scene, (a, b), bound));
-                    frontier_seeds.remove(pair);
+                    let kept = memory.entry(pair);
+                    kept.separation = Some(Separation::new(scene, (a, b), bound));
+                    kept.seed = None;
                 }
-                None => {
-                    separations.remove(pair);
-                }
+                None => memory.entry(pair).separation = None,
             }
         }
         if !answer.result.exact {
@@ -746,31 +697,14 @@ pub fn step_within(
             // 0: world boxes).
             completeness = completeness.truncated_at(truncated_level.unwrap_or(0));
             report(query, answer, (a, b), first_contact, results);
-            kept.remove(pair);
+            memory.entry(pair).answer = None;
             continue;
         }
-        let entry = kept.entry(*pair).or_insert_with(|| KeptAnswer {
-            scene: 0,
-            versions: [0; 2],
-            query,
-            answer,
-            contacts: Vec::new(),
-            stamp,
-        });
-        entry.stamp = stamp;
-        entry.scene = scene.uid();
-        entry.versions = [a.version(), b.version()];
-        entry.query = query;
-        entry.answer = answer;
-        entry.contacts.clear();
-        entry
-            .contacts
-            .extend_from_slice(&results.contacts[first_contact..]);
+        let contacts = &results.contacts[first_contact..];
+        memory.keep_answer(scene, pair, (a, b), query, answer, contacts);
         report(query, answer, (a, b), first_contact, results);
     }
-    // PERF: by stamp, not by a search of the candidates for each entry (a binary search
-    // per kept answer was about 6 % of a 150-primitive frame).
-    kept.retain(|_, k| k.stamp == stamp);
+    memory.forget_unvisited();
     // Time of impact keeps to the frame's deadline too (`toi.rs`, "Under a deadline").
     let mut toi_clock = PairClock::new(budget.deadline());
     let mut truncated_tois = 0;
@@ -832,15 +766,11 @@ fn mark_separated(
 ) -> u64 {
     let PipelineWorkspace {
         candidates,
-        kept,
-        separations,
+        memory,
         separated,
-        hull_caches,
         ..
     } = workspace;
     let (mut tests, mut refused) = (0u64, false);
-    separations.retain(|pair, _| candidates.binary_search(pair).is_ok());
-    hull_caches.retain(|pair, _| candidates.binary_search(pair).is_ok());
     separated.clear();
     if query.distance {
         separated.resize(candidates.len(), false);
@@ -848,11 +778,11 @@ fn mark_separated(
     }
     separated.extend(candidates.iter().map(|pair| {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        if kept.get(pair).is_some_and(|k| k.fits(scene, pair, query)) {
+        if memory.kept_answer(scene, pair, query).is_some() {
             return false;
         }
         let margins = a.margin + b.margin;
-        if let Some(separation) = separations.get(pair)
+        if let Some(separation) = memory.get(pair).and_then(|m| m.separation.as_ref())
             && separation
                 .lower_bound_now(scene, (a, b))
                 .is_some_and(|bound| bound > margins)
@@ -866,7 +796,8 @@ fn mark_separated(
             return false;
         };
         let pose = Pose::relative(&a.pose, &b.pose);
-        let cache = hull_caches.entry(*pair).or_default();
+        let kept = memory.entry(pair);
+        let cache = &mut kept.hull;
         if cache.met_at == Some(pose) {
             // Tested at this very pose (a resting pair, a resumed frame): no proof.
             return false;
@@ -881,7 +812,7 @@ fn mark_separated(
         match ha.gap(hb, &pose.to_isometry(), &mut cache.gjk) {
             Some(gap) if gap > margins => {
                 cache.met_at = None;
-                separations.insert(*pair, Separation::new(scene, (a, b), gap));
+                kept.separation = Some(Separation::new(scene, (a, b), gap));
                 true
             }
             _ => {
@@ -891,16 +822,6 @@ fn mark_separated(
         }
     }));
     tests
-}
-
-/// What the hull test of [`mark_separated`] keeps of a pair between frames.
-#[derive(Debug, Default)]
-struct HullCache {
-    /// GJK's warm start between the two hulls.
-    gjk: GjkCache,
-    /// The relative pose at which the last test gave no proof (the hulls meet, or are not
-    /// apart by more than the margins), so a pair at that same pose is not tested again.
-    met_at: Option<Pose>,
 }
 
 /// Hull tests between two polls of a budgeted frame's budget (a test costs 0.2–1 µs).

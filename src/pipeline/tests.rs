@@ -619,13 +619,13 @@ fn kept_answers_are_exactly_the_frame_candidates() {
                 scene.set_pose(body, pose).unwrap();
             }
         }
-        let before = workspace.kept.len();
+        let before = workspace.memory.kept_pairs().count();
         let mut results = FrameResults::default();
         let report = step(&scene, Query::CLOSE, &mut workspace, &mut results);
-        let mut kept: Vec<CandidatePair> = workspace.kept.keys().copied().collect();
+        let mut kept: Vec<CandidatePair> = workspace.memory.kept_pairs().copied().collect();
         kept.sort_unstable();
         assert_eq!(kept, workspace.candidates, "frame {frame}");
-        assert!(workspace.kept.values().all(|k| k.stamp == workspace.steps));
+        assert!(workspace.memory.all_visited_this_frame());
         reused += report.reused_pairs;
         fresh += report.candidates - report.reused_pairs;
         dropped += usize::from(before > workspace.candidates.len());
