@@ -1,9 +1,9 @@
 //! One stateful broad phase behind one API, and the choice of which one a scene uses.
 //!
-//! [`BroadPhase`] holds one of the three broad phases ([`BroadPhaseKind`]) and gives them the
+//! [`BroadPhase`] holds one of the five broad phases ([`BroadPhaseKind`]) and gives them the
 //! same body-level API: [`insert`](BroadPhase::insert), [`update`](BroadPhase::update),
 //! [`remove`](BroadPhase::remove), [`pairs`](BroadPhase::pairs). The stateful
-//! [`IncrementalSap`] and [`HashGrid`] take it as is; for the stateless [`SortAndSweep`] it
+//! [`IncrementalSap`], [`HashGrid`], [`ColumnGrid`] and [`SkinGrid`] take it as is; for the stateless [`SortAndSweep`] it
 //! keeps the proxy list itself (a dense list with an id → slot map; removal swaps the last
 //! proxy into the freed slot, which the sweep's kept order re-keys for free) and sweeps it in
 //! [`pairs`](BroadPhase::pairs). Every kind reports exactly the pairs of
@@ -597,23 +597,22 @@ impl BroadPhaseStats {
 /// stateless sort and sweep (which costs the same whatever moved) is chosen.
 pub const MOSTLY_MOVING: f64 = 0.5;
 /// Shift per update for the typical box ([`BroadPhaseStats::typical_shift`]) up to which
-/// bodies count as creeping: the skin grid keeps them even when most move (measured
-/// crossovers in [`choose`]'s docs).
+/// bodies count as creeping and the skin grid keeps them even when most move: where the
+/// skin grid and the sort and sweep cross, on the uniform and the clustered layouts alike.
 pub const CREEPING: f64 = 0.011;
-/// Above this fraction of far moves among the updates, a scene counts as teleporting.
+/// Above this fraction of far moves among the updates, a scene counts as teleporting: every
+/// jump leaves its skin, which costs the skin grid a refiling.
 pub const TELEPORTING: f64 = 0.01;
 /// Size spread ([`BroadPhaseStats::size_spread`]) above which a scene of fewer than
-/// [`FEW_BODIES`] keeps the skin grid even when most of its bodies move fast (measured
-/// crossovers in [`choose`]'s docs: the bench's clustered layout spreads 5.9, its
-/// scattered one 1.5, its dice 1.0).
+/// [`FEW_BODIES`] keeps the skin grid even when most of its bodies move fast: fitted to the
+/// bench's clustered layout (spread 5.9) against its uniform one (1.5) and its dice (1.0).
 pub const WIDE_SIZE_SPREAD: f64 = 4.0;
-/// See [`WIDE_SIZE_SPREAD`].
+/// See [`WIDE_SIZE_SPREAD`]: where the two kinds cross on the clustered layout with all
+/// bodies moving at full speed.
 pub const FEW_BODIES: usize = 6_000;
 /// Bodies up to which the [`SortAndSweep`] kind tests every pair instead of sweeping: the
 /// sweep's fixed cost (the axis, the column grid, listing the columns) exceeds `n²/2` box
-/// tests there. Measured (random boxes about one box apart, one core, two runs, ns per
-/// frame, sweep / all pairs): 7 bodies 435–516 / 106–114, 16 bodies 1,585–1,723 / 396–555,
-/// 32 bodies 3,128–4,813 / 1,148–2,173, 64 bodies 8,565–8,830 / 7,523–7,974.
+/// tests there.
 pub const ALL_PAIRS_MAX: usize = 32;
 
 /// The broad phase a scene with [`BroadPhaseChoice::Auto`] runs, given its statistics:
@@ -626,139 +625,21 @@ pub const ALL_PAIRS_MAX: usize = 32;
 ///    two queries, and always leaves a skin);
 /// 3. else [`SkinGrid`].
 ///
-/// A teleporting scene (over 1 % far moves) has a shift for the typical box far over
-/// [`CREEPING`] (the bench's: 7.7–41), so when most of its bodies move the first line
-/// takes it.
-/// The [`IncrementalSap`] and the [`HashGrid`] are never chosen: on every measured class
-/// the skin grid, the column grid or sort and sweep was faster (below); they stay
-/// available as fixed choices.
+/// The skin grid re-tests a moved body against its few listed neighbours and refiles it only
+/// when it leaves its skin: the fastest while few bodies move or they creep. Sort and sweep
+/// costs the same whatever moved and wins once most bodies move fast for their size. A
+/// teleporting scene has a shift for the typical box far over [`CREEPING`], so when most of
+/// its bodies move the first line takes it.
 ///
-/// # The measurements behind it
-/// `examples/broad_bench` on this machine (2-core AMD EPYC VM, one core used), mean µs per
-/// frame, the broad phases and rapier's BVH broad phase on parry's BVH (its 1 cm change
-/// margin: "peer") in lockstep on the same frames, uniform / clustered / stacked layouts
-/// of `common/broad_scenes.rs`, one run per row, on a host running about 1.25× slower
-/// than on 2026-11-21 (the peer took 22–25 ms at 100,000 uniform bodies against 19.8).
-/// Bold: what the rule takes.
-///
-/// First run (2026-11-24, before [`MIN_SKIN`](super::skin_grid::MIN_SKIN) was raised to
-/// 0.1, which changes none of these rows' skins: the bench's full speed is above it, the
-/// dice never leave their first skin, teleports take the largest):
-///
-/// | bodies | motion (share moving) | sort & sweep | incremental SAP | column grid | skin grid | peer |
-/// |---|---|---|---|---|---|---|
-/// | 1,000 | coherent (10 %) | 134 / 115 / 139 | 53 / 34 / 40 | 52 / 37 / 60 | **25 / 17 / 9.4** | 121 / 80 / 77 |
-/// | 1,000 | coherent (25 %) | 109 / 101 / 123 | 86 / 70 / 52 | 88 / 79 / 99 | **39 / 32 / 11** | 124 / 92 / 66 |
-/// | 1,000 | coherent (50 %) | 140 / 106 / 154 | 185 / 123 / 141 | 200 / 143 / 249 | **84 / 54 / 20** | 182 / 108 / 94 |
-/// | 1,000 | teleporting (10 %) | 165 / 143 / 129 | 5,777 / 4,602 / 200 | **159 / 96** / 56 | 291 / 128 / **10** | 595 / 268 / 75 |
-/// | 10,000 | coherent (25 %) | 1,444 / 1,526 / 1,580 | 2,536 / 2,320 / 3,154 | 1,283 / 1,575 / 1,146 | **787 / 843 / 399** | 1,793 / 1,755 / 1,105 |
-/// | 10,000 | coherent (50 %) | 1,546 / 1,487 / 1,954 | 4,992 / 3,834 / 7,568 | 2,385 / 2,775 / 2,071 | **1,355 / 1,280 / 443** | 2,349 / 2,103 / 1,479 |
-/// | 10,000 | teleporting (10 %) | 1,944 / 1,807 / 1,961 | 558,239 / 561,997 / 15,596 | **1,906 / 1,187** / 720 | 3,960 / 1,799 / **258** | 31,479 / 19,927 / 1,209 |
-///
-/// Second run (after it; the bench's speeds, 3 cm a frame scattered and 5 mm stacked, and
-/// a sixth of them, `--speed-scale 0.1667`):
-///
-/// | bodies | motion (share moving, speed) | sort & sweep | column grid | skin grid | peer |
-/// |---|---|---|---|---|---|
-/// | 1,000 | coherent (all, full) | **120 / 71** / 180 | 322 / 223 / 592 | 120 / 67 / **30** | 167 / 89 / 114 |
-/// | 1,000 | coherent (all, a sixth) | 102 / 99 / 183 | 285 / 281 / 603 | **48 / 60 / 32** | 95 / 82 / 89 |
-/// | 10,000 | coherent (10 %, full) | 1,259 / 1,427 / 1,238 | 444 / 676 / 453 | **250 / 410 / 146** | 1,133 / 1,206 / 613 |
-/// | 10,000 | coherent (10 %, a sixth) | 1,237 / 1,205 / 1,322 | 489 / 549 / 470 | **193 / 195 / 148** | 699 / 599 / 555 |
-/// | 10,000 | coherent (all, full) | **1,453 / 1,363** / 1,724 | 4,112 / 4,811 / 3,166 | 2,348 / 1,903 / **288** | 2,460 / 2,130 / 1,099 |
-/// | 10,000 | coherent (all, a sixth) | 1,370 / 1,427 / 1,871 | 4,004 / 5,082 / 3,809 | **746 / 1,246 / 372** | 1,268 / 1,400 / 1,072 |
-/// | 100,000 | coherent (10 %, full) | | 8,725 / 9,997 / 7,628 | **4,813 / 5,276 / 1,923** | 22,035 / 22,886 / 14,663 |
-///
-/// Third run (2026-11-24, later: the skin grid's skins reaching ahead of the motion, its
-/// travel budgets, and the bench on transparent huge pages like `proximad`):
-///
-/// | bodies | motion (share moving, speed) | sort & sweep | column grid | skin grid | peer |
-/// |---|---|---|---|---|---|
-/// | 1,000 | coherent (10 %, full) | 122 / 86 / 113 | 51 / 28 / 52 | **22 / 13 / 11** | 123 / 69 / 68 |
-/// | 10,000 | coherent (10 %, full) | 1,439 / 1,378 / 1,116 | 745 / 793 / 501 | **518 / 484 / 219** | 1,586 / 1,339 / 752 |
-/// | 10,000 | coherent (10 %, a sixth) | 1,147 / 1,212 / 1,097 | 507 / 641 / 537 | **216 / 272 / 203** | 751 / 732 / 770 |
-/// | 10,000 | coherent (all, full) | **1,464 / 1,611** / 1,924 | 4,745 / 6,199 / 4,285 | 2,129 / 2,836 / **481** | 2,787 / 3,054 / 1,641 |
-/// | 10,000 | coherent (all, a sixth) | 1,318 / 1,435 / 1,524 | 4,346 / 5,719 / 3,218 | **863 / 1,297 / 297** | 1,519 / 1,635 / 902 |
-/// | 10,000 | teleporting (10 %) | 2,040 / 1,717 / 1,936 | **1,857 / 1,099** / 801 | 3,826 / 1,618 / **403** | 35,495 / 22,078 / 1,396 |
-/// | 100,000 | coherent (10 %, full) | 20,355 / 18,460 / 16,691 | 9,316 / 9,448 / 6,573 | **3,856 / 4,260 / 1,659** | 22,879 / 21,740 / 16,350 |
-///
-/// The skin grid re-tests a moved body against its few listed neighbours and refiles it in
-/// the column grid only when it leaves its skin: it is the fastest on every coherent class
-/// up to half the bodies moving. Sort and sweep costs the same whatever moved and wins
-/// once most bodies move fast for their size; slow ones stay cheaper in the skin grid.
-///
-/// Where they cross (2026-11-25, after the sort and sweep's blocks and radix-sorted order
-/// made it about 1.6 times faster than in the tables above): all bodies moving, each kind
-/// alone on the core (`--one-at-a-time`), mean µs a frame, sort and sweep / skin grid at
-/// 1/6, 1/3, 1/2, 2/3 and all of the bench speed, the mean relative shift the bench
-/// prints in brackets:
-///
-/// | bodies, layout | 1/6 | 1/3 | 1/2 | 2/3 | all |
-/// |---|---|---|---|---|---|
-/// | 10,000 uniform | 437 / 239 (0.0034) | 455 / 314 (0.0067) | 455 / 391 (0.0101) | 466 / 459 (0.0135) | 458 / 609 (0.0202) |
-/// | 10,000 clustered | 457 / 295 (0.0095) | 475 / 368 (0.0171) | 473 / 440 (0.0247) | 468 / 497 (0.0323) | 444 / 590 (0.0475) |
-/// | 10,000 stacked | 478 / 115 (0.0007) | 483 / 134 | 491 / 153 | 501 / 169 | 505 / 201 (0.0040) |
-/// | 1,000 uniform | 34 / 20 | 36 / 27 | 43 / 33 | 39 / 39 (0.0134) | 42 / 51 (0.0201) |
-/// | 1,000 clustered | 31 / 15 | 31 / 17 | 31 / 19 | 31 / 21 | 33 / 26 (0.0474) |
-/// | 1,000 stacked | 41 / 11 | 45 / 13 | 48 / 15 | 52 / 17 | 49 / 20 |
-///
-/// The uniform layout crosses at a shift of about 0.0135, the clustered one (a tenfold
-/// size spread: its small bodies move far for their size) at about 0.029 with 10,000
-/// bodies and not at all with 1,000; [`CREEPING`], then 0.018, sat between them (clear
-/// of the uniform full speed's 0.020), so the choice was the faster kind or within 8 % of it
-/// at 10,000 bodies (clustered at half speed: 473 against 440 µs), but not for 1,000
-/// clustered bodies from half speed on (31–33 against 19–26 µs). The mean hides the skin grid's tail: its refilings bunch, and its
-/// p99 was twice the sort and sweep's at 10,000 clustered bodies at full speed (1,162
-/// against 595 µs), which the rule does not weigh.
-///
-/// Later the same day, with [`MAX_SKIN`](super::skin_grid::MAX_SKIN) raised to 2, the
-/// same sweep (sort and sweep / skin grid at 1/3, 1/2, 2/3 and all of the speed): 3,000
-/// clustered bodies 104 / 62, 106 / 64, 109 / 69, 112 / 77; 1,000 clustered 32 / 16,
-/// 32 / 17, 32 / 19, 33 / 22; 3,000 uniform 120 / 89, 127 / 111, 129 / 131, 132 / 174;
-/// 10,000 clustered 491 / 383, 480 / 443, 473 / 501, 453 / 582. So below some 10,000
-/// clustered bodies the skin grid wins at every speed measured, and the rule's sort and
-/// sweep costs them up to 1.5 times the time. No statistic the rule has separates them
-/// from the uniform layout, where sort and sweep wins from 2/3 of the speed at every
-/// size: sweep overlaps per body are 21 / 43 / 100 clustered (1,000 / 3,000 / 10,000
-/// bodies) against 50 / 104 / 233 uniform, and the size spread (5.9 against 1.5) does not
-/// change with the count. Hence the exception of line 1, by body count and size spread
-/// together, fitted to these layouts (no mechanism found for it): at full speed,
-/// clustered, sort and sweep / skin grid, 1,000 bodies 33 / 22 µs, 3,000 112 / 77, 5,000
-/// 199 / 185, 7,000 300 / 319, 10,000 453 / 582; [`FEW_BODIES`] sits at the crossing.
-/// Before (the sort and sweep slower),
-/// the crossings were at 0.013 and 0.010, and [`CREEPING`] was 0.01. Teleports leave every
-/// skin, which costs the skin grid a refiling each: the column grid takes them, except on
-/// the stacked dice, whose "teleports" stay within 5 cm (not far moves: the rule picks the
-/// skin grid there).
-///
-/// Since (2026-11-25, later still) the sort and sweep keeps its columns between frames,
-/// 5–28 % faster when all bodies move (module docs of [`SortAndSweep`]), and the skin grid
-/// is 5–16 % faster on the slow and the all-moving classes. Measured again (200 frames,
-/// sort and sweep / skin grid, mean relative shift in brackets), 10,000 bodies all
-/// moving: uniform 456 / 380 (0.0101), 413 / 454 (0.0135), 415 / 488 (0.0152),
-/// 418–422 / 528–538 (0.0168), 419 / 589 (0.0202); clustered 410–411 / 335–338
-/// (0.0155), 418 / 367 (0.0186), 399 / 396 (0.0231), 396 / 435 (0.0307). The crossings
-/// moved to about 0.012 (uniform) and 0.023 (clustered), and no single threshold on the
-/// mean relative shift takes the faster kind on both: at 0.018 the rule lost 27 % at the
-/// uniform 0.0168 and 14 % at the clustered 0.0186, at 0.016 still 10–17 % and 14 %.
-///
-/// The mean relative shift is ruled by the smallest bodies, which move far for their
-/// size; the clustered layout's tenfold spread of sizes raises it, not its cost. Measured
-/// instead over the typical box ([`BroadPhaseStats::typical_shift`]: the mean distance
-/// moved over the 75th percentile of the largest edges, the same box the sort and sweep
-/// sizes its columns by), the same runs read uniform 0.0087 (skin grid faster), 0.0116
-/// (sort and sweep), clustered 0.0078 and 0.0092 (skin grid), 0.0114 (even), and both
-/// layouts cross near 0.011, where [`CREEPING`] now sits: every row above is taken by the
-/// faster kind or one within 1 %. With fewer bodies the crossing in body count behind [`FEW_BODIES`]
-/// stayed: clustered, all moving, 300 frames, 3,000 bodies 98 / 92, 5,000 225 / 180,
-/// 7,000 246 / 296. On uniform layouts at 10 % teleporting the rule's column grid is
-/// slower than the sort and sweep (1,000 bodies 67–73 against 42–44 µs, 10,000 726–731
-/// against 457–475), on clustered ones faster; both are 4–30 times the peer's speed there.
-///
+/// The [`IncrementalSap`] and the [`HashGrid`] are never chosen: on every measured class one
+/// of the three above is faster; they stay available as fixed choices.
 /// [`BroadPhaseStats::sweep_overlap_ratio`] is measured and reported
-/// ([`StepReport::broad_stats`](crate::pipeline::StepReport)) but the rule does not read
-/// it: on the measured layouts no threshold on it picks a faster kind. The size spread
-/// enters only the exception of line 1, together with the body count.
-#[must_use]
+/// ([`StepReport::broad_stats`](crate::pipeline::StepReport)) but not read: no threshold on
+/// it picks a faster kind.
+///
+/// `examples/broad_bench` measures the thresholds: every kind on the same frames of the
+/// uniform, clustered and stacked layouts (`--speed-scale` for slower bodies,
+/// `--one-at-a-time` for each kind alone on the core).
 pub fn choose(stats: &BroadPhaseStats) -> BroadPhaseKind {
     let fast = stats.moving_fraction > MOSTLY_MOVING && stats.typical_shift > CREEPING;
     let teleporting = stats.far_move_fraction > TELEPORTING;
