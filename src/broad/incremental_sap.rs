@@ -54,7 +54,8 @@
 
 use super::body_map::Bodies;
 use super::pair_set::PairSet;
-use super::{CandidatePair, CollisionFilter, Proxy, SortAndSweep, debug_assert_valid_bounds};
+use super::stateful::{StatefulBroadPhase, stateful_api};
+use super::{CandidatePair, Proxy, SortAndSweep, debug_assert_valid_bounds};
 use crate::bounding::{Aabb, BoundingVolume};
 
 /// Index of a body's min endpoint in [`IncrementalSap::positions`].
@@ -126,30 +127,6 @@ impl IncrementalSap {
         Self::default()
     }
 
-    /// Number of bodies.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.bodies.len()
-    }
-
-    /// Whether there are no bodies.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.bodies.is_empty()
-    }
-
-    /// Whether `body` is in the broad phase.
-    #[must_use]
-    pub fn contains(&self, body: u32) -> bool {
-        self.bodies.contains(body)
-    }
-
-    /// The bodies as proxies, in no particular order.
-    #[must_use]
-    pub fn proxies(&self) -> &[Proxy] {
-        &self.bodies.proxies
-    }
-
     /// A broad phase holding `proxies` (distinct ids), built in `O(n log n + k log k)`: each
     /// axis's endpoints sorted once and the pairs found by one [`SortAndSweep`] pass,
     /// instead of `n` insertions at `O(n)` each (300 ms for 10,000 bodies, 44 s for
@@ -186,179 +163,6 @@ impl IncrementalSap {
             sap.pairs.insert(pair);
         }
         sap
-    }
-
-    /// Adds `body` with its margin-grown world box `bounds` (metres; finite, `min <= max`).
-    /// Its pairs are found directly, without re-sorting the other bodies. Inserting an id
-    /// that is already present replaces that body (remove, then insert).
-    ///
-    /// Static bodies never pair with each other; `filter` decides the rest
-    /// ([`Proxy::may_pair`]).
-    pub fn insert(&mut self, body: u32, bounds: Aabb, is_static: bool, filter: CollisionFilter) {
-        debug_assert_valid_bounds(&bounds);
-        if self.contains(body) {
-            self.remove(body);
-        }
-        let proxy = Proxy {
-            body,
-            bounds,
-            is_static,
-            filter,
-        };
-        let slot = self.bodies.push(proxy);
-        self.positions.push([[0; 2]; 3]);
-        for axis in 0..3 {
-            let endpoints = &mut self.axes[axis];
-            // After every endpoint that does not sort after it (stable among ties); the max
-            // sorts strictly after the min, so it lands after it.
-            let min = Endpoint::new(bounds.min[axis], slot, MIN);
-            let min_at = endpoints.partition_point(|x| !x.after(min));
-            endpoints.insert(min_at, min);
-            let max = Endpoint::new(bounds.max[axis], slot, MAX);
-            let max_at = endpoints.partition_point(|x| !x.after(max));
-            endpoints.insert(max_at, max);
-            self.renumber_from(axis, min_at);
-        }
-        // Every body overlapping it has its min before its max on every axis: scan the axis
-        // where the fewest endpoints precede that max.
-        let axis = self.axis_with_fewest_before_max(slot);
-        let end = self.positions[slot][axis][MAX] as usize;
-        for e in &self.axes[axis][..end] {
-            if e.is_max() || e.slot() == slot {
-                continue;
-            }
-            let other = &self.bodies.proxies[e.slot()];
-            if proxy.may_pair(other) && proxy.bounds.intersects(&other.bounds) {
-                self.pairs.insert(CandidatePair::of(body, other.body));
-            }
-        }
-    }
-
-    /// Removes `body` and its pairs; `false` when it was not present.
-    pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.bodies.unmap(body) else {
-            return false;
-        };
-        // Its pairs all have their min before its max on every axis.
-        let axis = self.axis_with_fewest_before_max(slot);
-        let end = self.positions[slot][axis][MAX] as usize;
-        for e in &self.axes[axis][..end] {
-            if !e.is_max() && e.slot() != slot {
-                let (p, q) = (&self.bodies.proxies[slot], &self.bodies.proxies[e.slot()]);
-                if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
-                    self.pairs.remove(CandidatePair::of(body, q.body));
-                }
-            }
-        }
-        for axis in 0..3 {
-            let [min_at, max_at] = self.positions[slot][axis];
-            self.axes[axis].remove(max_at as usize);
-            self.axes[axis].remove(min_at as usize);
-            self.renumber_from(axis, min_at as usize);
-        }
-        // The last slot moves into the freed one.
-        let last = self.bodies.len() - 1;
-        self.bodies.swap_remove(slot);
-        self.positions.swap_remove(slot);
-        if slot != last {
-            for axis in 0..3 {
-                for kind in [MIN, MAX] {
-                    let at = self.positions[slot][axis][kind] as usize;
-                    self.axes[axis][at] = Endpoint::new(self.axes[axis][at].value, slot, kind);
-                }
-            }
-        }
-        true
-    }
-
-    /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`), updating the pair set
-    /// by the endpoint swaps the move causes. A body that did not move need not be updated.
-    /// Updating a body that is not present is a contract violation (`debug_assert!`; ignored
-    /// in release builds).
-    pub fn update(&mut self, body: u32, bounds: Aabb) {
-        debug_assert_valid_bounds(&bounds);
-        let Some(slot) = self.bodies.slot(body) else {
-            debug_assert!(false, "update of absent body {body}");
-            return;
-        };
-        for axis in 0..3 {
-            let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
-            // Order the two moves so the stored interval is never inverted.
-            if lo < self.bodies.proxies[slot].bounds.min[axis] {
-                self.move_endpoint(slot, axis, MIN, lo);
-                self.move_endpoint(slot, axis, MAX, hi);
-            } else {
-                self.move_endpoint(slot, axis, MAX, hi);
-                self.move_endpoint(slot, axis, MIN, lo);
-            }
-        }
-    }
-
-    /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
-    /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
-    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over [`proxies`](Self::proxies).
-    ///
-    /// # Cost
-    /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
-    pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
-        out.clear();
-        out.extend_from_slice(self.pairs.commit());
-    }
-
-    /// Checks every invariant: the slot table and id map agree; each axis holds exactly the
-    /// two endpoints of every body, at the positions recorded, with the body's stored
-    /// coordinates, sorted (mins first at ties); stored boxes are finite and not inverted;
-    /// and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over the stored boxes. `O(n²)`: for
-    /// tests.
-    ///
-    /// # Errors
-    /// A description of the first violated invariant.
-    pub fn validate(&self) -> Result<(), String> {
-        self.bodies.check()?;
-        let n = self.bodies.len();
-        if self.positions.len() != n {
-            return Err(format!(
-                "{n} proxies, {} position rows",
-                self.positions.len()
-            ));
-        }
-        for p in &self.bodies.proxies {
-            let b = &p.bounds;
-            if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
-                return Err(format!("body {} has invalid bounds {b:?}", p.body));
-            }
-        }
-        for (axis, endpoints) in self.axes.iter().enumerate() {
-            if endpoints.len() != 2 * n {
-                return Err(format!(
-                    "axis {axis}: {} endpoints, {n} bodies",
-                    endpoints.len()
-                ));
-            }
-            for (i, e) in endpoints.iter().enumerate() {
-                let slot = e.slot();
-                if slot >= n || self.positions[slot][axis][e.kind()] as usize != i {
-                    return Err(format!(
-                        "axis {axis}: endpoint {i} ({e:?}) not where recorded"
-                    ));
-                }
-                let b = &self.bodies.proxies[slot].bounds;
-                let stored = if e.is_max() { b.max[axis] } else { b.min[axis] };
-                if stored.to_bits() != e.value.to_bits() {
-                    return Err(format!(
-                        "axis {axis}: endpoint {i} {} != stored {stored}",
-                        e.value
-                    ));
-                }
-                if i > 0 && endpoints[i - 1].after(*e) {
-                    return Err(format!(
-                        "axis {axis}: endpoints {} and {i} out of order",
-                        i - 1
-                    ));
-                }
-            }
-        }
-        self.pairs.check_against_brute_force(&self.bodies.proxies)
     }
 
     /// Sets one coordinate of slot `slot`'s box and moves that endpoint to its sorted place
@@ -423,6 +227,159 @@ impl IncrementalSap {
     }
 }
 
+stateful_api!(IncrementalSap);
+
+impl StatefulBroadPhase for IncrementalSap {
+    fn bodies(&self) -> &Bodies {
+        &self.bodies
+    }
+
+    fn bodies_mut(&mut self) -> &mut Bodies {
+        &mut self.bodies
+    }
+
+    /// Its endpoints inserted at their sorted places and its pairs found directly, without
+    /// re-sorting the other bodies.
+    fn file(&mut self, slot: usize) {
+        let proxy = self.bodies.proxies[slot];
+        let bounds = proxy.bounds;
+        self.positions.push([[0; 2]; 3]);
+        for axis in 0..3 {
+            let endpoints = &mut self.axes[axis];
+            // After every endpoint that does not sort after it (stable among ties); the max
+            // sorts strictly after the min, so it lands after it.
+            let min = Endpoint::new(bounds.min[axis], slot, MIN);
+            let min_at = endpoints.partition_point(|x| !x.after(min));
+            endpoints.insert(min_at, min);
+            let max = Endpoint::new(bounds.max[axis], slot, MAX);
+            let max_at = endpoints.partition_point(|x| !x.after(max));
+            endpoints.insert(max_at, max);
+            self.renumber_from(axis, min_at);
+        }
+        // Every body overlapping it has its min before its max on every axis: scan the axis
+        // where the fewest endpoints precede that max.
+        let axis = self.axis_with_fewest_before_max(slot);
+        let end = self.positions[slot][axis][MAX] as usize;
+        for e in &self.axes[axis][..end] {
+            if e.is_max() || e.slot() == slot {
+                continue;
+            }
+            let other = &self.bodies.proxies[e.slot()];
+            if proxy.may_pair(other) && proxy.bounds.intersects(&other.bounds) {
+                self.pairs.insert(CandidatePair::of(proxy.body, other.body));
+            }
+        }
+    }
+
+    fn unfile(&mut self, slot: usize) {
+        let body = self.bodies.proxies[slot].body;
+        // Its pairs all have their min before its max on every axis.
+        let axis = self.axis_with_fewest_before_max(slot);
+        let end = self.positions[slot][axis][MAX] as usize;
+        for e in &self.axes[axis][..end] {
+            if !e.is_max() && e.slot() != slot {
+                let (p, q) = (&self.bodies.proxies[slot], &self.bodies.proxies[e.slot()]);
+                if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
+                    self.pairs.remove(CandidatePair::of(body, q.body));
+                }
+            }
+        }
+        for axis in 0..3 {
+            let [min_at, max_at] = self.positions[slot][axis];
+            self.axes[axis].remove(max_at as usize);
+            self.axes[axis].remove(min_at as usize);
+            self.renumber_from(axis, min_at as usize);
+        }
+    }
+
+    fn swap_remove_slot(&mut self, slot: usize) {
+        let last = self.bodies.len() - 1;
+        self.positions.swap_remove(slot);
+        if slot != last {
+            for axis in 0..3 {
+                for kind in [MIN, MAX] {
+                    let at = self.positions[slot][axis][kind] as usize;
+                    self.axes[axis][at] = Endpoint::new(self.axes[axis][at].value, slot, kind);
+                }
+            }
+        }
+    }
+
+    /// Each endpoint moved by insertion sort, the pair set updated by the swaps the move
+    /// causes.
+    #[inline]
+    fn relocate(&mut self, slot: usize, bounds: Aabb) {
+        for axis in 0..3 {
+            let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
+            // Order the two moves so the stored interval is never inverted.
+            if lo < self.bodies.proxies[slot].bounds.min[axis] {
+                self.move_endpoint(slot, axis, MIN, lo);
+                self.move_endpoint(slot, axis, MAX, hi);
+            } else {
+                self.move_endpoint(slot, axis, MAX, hi);
+                self.move_endpoint(slot, axis, MIN, lo);
+            }
+        }
+    }
+
+    fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
+        self.pairs.list(out);
+    }
+
+    /// Checks every invariant: the slot table and id map agree; each axis holds exactly the
+    /// two endpoints of every body, at the positions recorded, with the body's stored
+    /// coordinates, sorted (mins first at ties); stored boxes are finite and not inverted;
+    /// and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over the
+    /// stored boxes.
+    fn validate(&self) -> Result<(), String> {
+        self.bodies.check()?;
+        let n = self.bodies.len();
+        if self.positions.len() != n {
+            return Err(format!(
+                "{n} proxies, {} position rows",
+                self.positions.len()
+            ));
+        }
+        for p in &self.bodies.proxies {
+            let b = &p.bounds;
+            if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
+                return Err(format!("body {} has invalid bounds {b:?}", p.body));
+            }
+        }
+        for (axis, endpoints) in self.axes.iter().enumerate() {
+            if endpoints.len() != 2 * n {
+                return Err(format!(
+                    "axis {axis}: {} endpoints, {n} bodies",
+                    endpoints.len()
+                ));
+            }
+            for (i, e) in endpoints.iter().enumerate() {
+                let slot = e.slot();
+                if slot >= n || self.positions[slot][axis][e.kind()] as usize != i {
+                    return Err(format!(
+                        "axis {axis}: endpoint {i} ({e:?}) not where recorded"
+                    ));
+                }
+                let b = &self.bodies.proxies[slot].bounds;
+                let stored = if e.is_max() { b.max[axis] } else { b.min[axis] };
+                if stored.to_bits() != e.value.to_bits() {
+                    return Err(format!(
+                        "axis {axis}: endpoint {i} {} != stored {stored}",
+                        e.value
+                    ));
+                }
+                if i > 0 && endpoints[i - 1].after(*e) {
+                    return Err(format!(
+                        "axis {axis}: endpoints {} and {i} out of order",
+                        i - 1
+                    ));
+                }
+            }
+        }
+        self.pairs.check_against_brute_force(&self.bodies.proxies)
+    }
+}
+
 /// The pair set's response to slot `s`'s endpoint passing one of slot `t`'s of the other
 /// kind on `axis`: when the swap may start an overlap, test the boxes (all axes) and the
 /// filters; when it ends one, drop the pair if it was in the set, that is when the two
@@ -457,7 +414,7 @@ fn crossed(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::broad::pairs_brute_force;
+    use crate::broad::{CollisionFilter, pairs_brute_force};
     use crate::math::DVec3;
     use crate::test_support::{point_in_cube, rng};
     use rand::Rng;

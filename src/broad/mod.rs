@@ -50,6 +50,7 @@ mod radix;
 pub mod select;
 pub mod skin_grid;
 pub mod sort_sweep;
+mod stateful;
 
 pub use brute_force::pairs_brute_force;
 pub use column_grid::ColumnGrid;

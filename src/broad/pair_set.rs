@@ -84,6 +84,14 @@ impl PairSet {
         &self.sorted
     }
 
+    /// Writes the pairs, the pending edits folded in ([`commit`](Self::commit)), to `out`
+    /// (cleared first).
+    #[inline]
+    pub(crate) fn list(&mut self, out: &mut Vec<CandidatePair>) {
+        out.clear();
+        out.extend_from_slice(self.commit());
+    }
+
     /// Moves the edits logged since the last commit or take to `out` (each pair and
     /// whether it is now present, in the order they were made), as a caller that keeps the
     /// set itself wants them; the sorted list is left as it was.
