@@ -165,6 +165,24 @@ impl IncrementalSap {
         sap
     }
 
+    /// Hands `edit` each pair of slot `slot`'s body: every body overlapping it has its min
+    /// before its max on every axis, so one scan of the axis where the fewest endpoints
+    /// precede that max finds them.
+    fn edit_pairs_of(&mut self, slot: usize, edit: fn(&mut PairSet, CandidatePair)) {
+        let axis = self.axis_with_fewest_before_max(slot);
+        let end = self.positions[slot][axis][MAX] as usize;
+        let p = &self.bodies.proxies[slot];
+        for e in &self.axes[axis][..end] {
+            if e.is_max() || e.slot() == slot {
+                continue;
+            }
+            let q = &self.bodies.proxies[e.slot()];
+            if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
+                edit(&mut self.pairs, CandidatePair::of(p.body, q.body));
+            }
+        }
+    }
+
     /// Sets one coordinate of slot `slot`'s box and moves that endpoint to its sorted place
     /// by adjacent swaps, updating the pair set at each min/max swap with another body.
     fn move_endpoint(&mut self, slot: usize, axis: usize, kind: usize, value: f64) {
@@ -256,34 +274,11 @@ impl StatefulBroadPhase for IncrementalSap {
             endpoints.insert(max_at, max);
             self.renumber_from(axis, min_at);
         }
-        // Every body overlapping it has its min before its max on every axis: scan the axis
-        // where the fewest endpoints precede that max.
-        let axis = self.axis_with_fewest_before_max(slot);
-        let end = self.positions[slot][axis][MAX] as usize;
-        for e in &self.axes[axis][..end] {
-            if e.is_max() || e.slot() == slot {
-                continue;
-            }
-            let other = &self.bodies.proxies[e.slot()];
-            if proxy.may_pair(other) && proxy.bounds.intersects(&other.bounds) {
-                self.pairs.insert(CandidatePair::of(proxy.body, other.body));
-            }
-        }
+        self.edit_pairs_of(slot, PairSet::insert);
     }
 
     fn unfile(&mut self, slot: usize) {
-        let body = self.bodies.proxies[slot].body;
-        // Its pairs all have their min before its max on every axis.
-        let axis = self.axis_with_fewest_before_max(slot);
-        let end = self.positions[slot][axis][MAX] as usize;
-        for e in &self.axes[axis][..end] {
-            if !e.is_max() && e.slot() != slot {
-                let (p, q) = (&self.bodies.proxies[slot], &self.bodies.proxies[e.slot()]);
-                if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
-                    self.pairs.remove(CandidatePair::of(body, q.body));
-                }
-            }
-        }
+        self.edit_pairs_of(slot, PairSet::remove);
         for axis in 0..3 {
             let [min_at, max_at] = self.positions[slot][axis];
             self.axes[axis].remove(max_at as usize);
