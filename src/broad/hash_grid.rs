@@ -97,7 +97,8 @@ use std::hash::{BuildHasher, Hash, Hasher};
 
 use super::body_map::Bodies;
 use super::pair_set::PairSet;
-use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64};
+use super::stateful::{StatefulBroadPhase, stateful_api};
+use super::{CandidatePair, floor_to_i64};
 use crate::bounding::{Aabb, BoundingVolume};
 
 /// Cell-size ratio between consecutive levels chosen by [`HashGrid::new`].
@@ -382,226 +383,12 @@ impl HashGrid {
         self.levels.iter().map(|l| l.size)
     }
 
-    /// Number of bodies.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.bodies.len()
-    }
-
-    /// Whether there are no bodies.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.bodies.is_empty()
-    }
-
-    /// Whether `body` is in the grid.
-    #[must_use]
-    pub fn contains(&self, body: u32) -> bool {
-        self.bodies.contains(body)
-    }
-
     /// The level `body` is stored at (`Some(None)` when it is oversized), `None` when absent.
     #[must_use]
     pub fn level(&self, body: u32) -> Option<Option<usize>> {
         let slot = self.bodies.slot(body)?;
         let level = self.level_of[slot];
         Some((level != OVERSIZED).then_some(usize::from(level)))
-    }
-
-    /// The bodies as proxies, in no particular order.
-    #[must_use]
-    pub fn proxies(&self) -> &[Proxy] {
-        &self.bodies.proxies
-    }
-
-    /// Adds `body` with its margin-grown world box `bounds` (metres; finite, `min <= max`)
-    /// and finds its pairs. Inserting an id that is already present replaces that body
-    /// (remove, then insert).
-    ///
-    /// Static bodies never pair with each other; `filter` decides the rest
-    /// ([`Proxy::may_pair`]).
-    pub fn insert(&mut self, body: u32, bounds: Aabb, is_static: bool, filter: CollisionFilter) {
-        debug_assert_valid_bounds(&bounds);
-        if self.contains(body) {
-            self.remove(body);
-        }
-        let slot = self.bodies.push(Proxy {
-            body,
-            bounds,
-            is_static,
-            filter,
-        });
-        debug_assert!(slot < FROM_FINER as usize, "too many bodies");
-        self.level_of.push(self.level_for(&bounds));
-        self.member_at.push(0);
-        self.seen.push(0);
-        if self.levels.is_empty() && self.bodies.proxies.len() == AUTO_SAMPLE {
-            self.choose_levels_from_bodies();
-        } else {
-            self.register(slot);
-        }
-        self.next_stamp();
-        self.gather(slot, &bounds, self.level_of[slot]);
-        self.refresh(slot, None);
-    }
-
-    /// Removes `body` and its pairs; `false` when it was not present.
-    pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.bodies.unmap(body) else {
-            return false;
-        };
-        self.next_stamp();
-        let p = self.bodies.proxies[slot];
-        self.gather(slot, &p.bounds, self.level_of[slot]);
-        for &other in &self.scratch {
-            let q = &self.bodies.proxies[other as usize];
-            if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
-                self.pairs.remove(CandidatePair::of(body, q.body));
-            }
-        }
-        self.unregister(slot);
-        // The last slot moves into the freed one.
-        let last = self.bodies.len() - 1;
-        if slot != last {
-            self.rename(last, slot);
-        }
-        self.bodies.swap_remove(slot);
-        self.level_of.swap_remove(slot);
-        self.member_at.swap_remove(slot);
-        self.seen.swap_remove(slot);
-        true
-    }
-
-    /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`) and refreshes its pairs
-    /// (module docs, "Finding a body's pairs"). A body that did not move need not be updated.
-    /// Updating a body that is not present is a contract violation (`debug_assert!`; ignored
-    /// in release builds).
-    pub fn update(&mut self, body: u32, bounds: Aabb) {
-        debug_assert_valid_bounds(&bounds);
-        let Some(slot) = self.bodies.slot(body) else {
-            debug_assert!(false, "update of absent body {body}");
-            return;
-        };
-        let old = self.bodies.proxies[slot].bounds;
-        let (old_level, new_level) = (self.level_of[slot], self.level_for(&bounds));
-        self.next_stamp();
-        self.gather(slot, &old, old_level);
-        if old_level != new_level || !self.same_query_cells(&old, &bounds, old_level) {
-            self.gather(slot, &bounds, new_level);
-        }
-        if old_level != new_level {
-            self.unregister(slot);
-            self.bodies.proxies[slot].bounds = bounds;
-            self.level_of[slot] = new_level;
-            self.register(slot);
-        } else {
-            // Same level: only the levels whose cells it left or entered change.
-            if old_level != OVERSIZED {
-                let own = usize::from(old_level);
-                for k in own..self.levels.len() {
-                    let inv = self.levels[k].inv;
-                    if CellRange::of(&old, inv) != CellRange::of(&bounds, inv) {
-                        self.unlist_at(slot, k, &old);
-                        self.list_at(slot, k, &bounds, own);
-                    }
-                }
-            }
-            self.bodies.proxies[slot].bounds = bounds;
-        }
-        self.refresh(slot, Some(&old));
-    }
-
-    /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
-    /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
-    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over [`proxies`](Self::proxies).
-    ///
-    /// # Cost
-    /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
-    pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
-        out.clear();
-        out.extend_from_slice(self.pairs.commit());
-    }
-
-    /// Checks every invariant: the slot table and id map agree; stored boxes are finite and
-    /// not inverted; each body is at the level its box calls for (oversized when none, or
-    /// while the levels are not chosen), listed once among that level's members at the
-    /// recorded index, and in exactly the cells its box covers at its level and (flagged
-    /// `FROM_FINER`) at every coarser one, once each, with no empty or foreign cell
-    /// entries; and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over
-    /// the stored boxes. `O(n²)`: for tests.
-    ///
-    /// # Errors
-    /// A description of the first violated invariant.
-    pub fn validate(&self) -> Result<(), String> {
-        self.bodies.check()?;
-        let n = self.bodies.len();
-        if [self.level_of.len(), self.member_at.len(), self.seen.len()] != [n; 3] {
-            return Err(format!("{n} proxies, per-slot tables disagree"));
-        }
-        let mut entries = vec![0usize; self.levels.len()];
-        for (slot, p) in self.bodies.proxies.iter().enumerate() {
-            let b = &p.bounds;
-            if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
-                return Err(format!("body {} has invalid bounds {b:?}", p.body));
-            }
-            let level = self.level_of[slot];
-            if level != self.level_for(b) {
-                return Err(format!(
-                    "body {} at level {level}, its box {b:?} calls for {}",
-                    p.body,
-                    self.level_for(b)
-                ));
-            }
-            let members = self.members(level);
-            let at = self.member_at[slot] as usize;
-            if members.get(at) != Some(&(slot as u32)) {
-                return Err(format!("body {} not listed at member index {at}", p.body));
-            }
-            if level == OVERSIZED {
-                continue;
-            }
-            let own = usize::from(level);
-            let mut bad = None;
-            for (k, grid) in self.levels.iter().enumerate().skip(own) {
-                let entry = slot as u32 | if k > own { FROM_FINER } else { 0 };
-                CellRange::of(b, grid.inv).for_each(|cell| {
-                    entries[k] += 1;
-                    let here = grid.cells.get(&cell).map_or(0, |list| {
-                        list.iter()
-                            .filter(|&&e| e & !FROM_FINER == slot as u32)
-                            .count()
-                    });
-                    let flagged = grid.cells.get(&cell).is_some_and(|l| l.contains(&entry));
-                    if (here != 1 || !flagged) && bad.is_none() {
-                        bad = Some(format!(
-                            "body {} listed {here} times in level {k} cell {cell:?} \
-                             (own level {own}, correctly flagged: {flagged})",
-                            p.body
-                        ));
-                    }
-                });
-            }
-            if let Some(e) = bad {
-                return Err(e);
-            }
-        }
-        let listed: usize = self.levels.iter().map(|l| l.members.len()).sum();
-        if listed + self.oversized.len() != n {
-            return Err(format!(
-                "{listed} + {} members, {n} bodies",
-                self.oversized.len()
-            ));
-        }
-        for (k, grid) in self.levels.iter().enumerate() {
-            let stored: usize = grid.cells.values().map(|l| l.len()).sum();
-            if stored != entries[k] || grid.cells.values().any(|l| l.is_empty()) {
-                return Err(format!(
-                    "level {k}: {stored} cell entries (or an empty cell), bodies cover {}",
-                    entries[k]
-                ));
-            }
-        }
-        self.pairs.check_against_brute_force(&self.bodies.proxies)
     }
 
     /// Builds the levels (see [`with_levels`](Self::with_levels) for the panics).
@@ -869,10 +656,178 @@ impl HashGrid {
     }
 }
 
+stateful_api!(HashGrid);
+
+impl StatefulBroadPhase for HashGrid {
+    fn bodies(&self) -> &Bodies {
+        &self.bodies
+    }
+
+    fn bodies_mut(&mut self) -> &mut Bodies {
+        &mut self.bodies
+    }
+
+    /// Registered at its level (or, at the [`AUTO_SAMPLE`]-th body, every body placed as
+    /// the levels are chosen), then its pairs found by one query.
+    fn file(&mut self, slot: usize) {
+        let bounds = self.bodies.proxies[slot].bounds;
+        debug_assert!(slot < FROM_FINER as usize, "too many bodies");
+        self.level_of.push(self.level_for(&bounds));
+        self.member_at.push(0);
+        self.seen.push(0);
+        if self.levels.is_empty() && self.bodies.proxies.len() == AUTO_SAMPLE {
+            self.choose_levels_from_bodies();
+        } else {
+            self.register(slot);
+        }
+        self.next_stamp();
+        self.gather(slot, &bounds, self.level_of[slot]);
+        self.refresh(slot, None);
+    }
+
+    fn unfile(&mut self, slot: usize) {
+        self.next_stamp();
+        let p = self.bodies.proxies[slot];
+        self.gather(slot, &p.bounds, self.level_of[slot]);
+        for &other in &self.scratch {
+            let q = &self.bodies.proxies[other as usize];
+            if p.may_pair(q) && p.bounds.intersects(&q.bounds) {
+                self.pairs.remove(CandidatePair::of(p.body, q.body));
+            }
+        }
+        self.unregister(slot);
+    }
+
+    fn swap_remove_slot(&mut self, slot: usize) {
+        let last = self.bodies.len() - 1;
+        if slot != last {
+            self.rename(last, slot);
+        }
+        self.level_of.swap_remove(slot);
+        self.member_at.swap_remove(slot);
+        self.seen.swap_remove(slot);
+    }
+
+    /// Refreshes its pairs (module docs, "Finding a body's pairs").
+    #[inline]
+    fn relocate(&mut self, slot: usize, bounds: Aabb) {
+        let old = self.bodies.proxies[slot].bounds;
+        let (old_level, new_level) = (self.level_of[slot], self.level_for(&bounds));
+        self.next_stamp();
+        self.gather(slot, &old, old_level);
+        if old_level != new_level || !self.same_query_cells(&old, &bounds, old_level) {
+            self.gather(slot, &bounds, new_level);
+        }
+        if old_level != new_level {
+            self.unregister(slot);
+            self.bodies.proxies[slot].bounds = bounds;
+            self.level_of[slot] = new_level;
+            self.register(slot);
+        } else {
+            // Same level: only the levels whose cells it left or entered change.
+            if old_level != OVERSIZED {
+                let own = usize::from(old_level);
+                for k in own..self.levels.len() {
+                    let inv = self.levels[k].inv;
+                    if CellRange::of(&old, inv) != CellRange::of(&bounds, inv) {
+                        self.unlist_at(slot, k, &old);
+                        self.list_at(slot, k, &bounds, own);
+                    }
+                }
+            }
+            self.bodies.proxies[slot].bounds = bounds;
+        }
+        self.refresh(slot, Some(&old));
+    }
+
+    fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
+        self.pairs.list(out);
+    }
+
+    /// Checks every invariant: the slot table and id map agree; stored boxes are finite and
+    /// not inverted; each body is at the level its box calls for (oversized when none, or
+    /// while the levels are not chosen), listed once among that level's members at the
+    /// recorded index, and in exactly the cells its box covers at its level and (flagged
+    /// `FROM_FINER`) at every coarser one, once each, with no empty or foreign cell
+    /// entries; and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over
+    /// the stored boxes.
+    fn validate(&self) -> Result<(), String> {
+        self.bodies.check()?;
+        let n = self.bodies.len();
+        if [self.level_of.len(), self.member_at.len(), self.seen.len()] != [n; 3] {
+            return Err(format!("{n} proxies, per-slot tables disagree"));
+        }
+        let mut entries = vec![0usize; self.levels.len()];
+        for (slot, p) in self.bodies.proxies.iter().enumerate() {
+            let b = &p.bounds;
+            if !(b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all()) {
+                return Err(format!("body {} has invalid bounds {b:?}", p.body));
+            }
+            let level = self.level_of[slot];
+            if level != self.level_for(b) {
+                return Err(format!(
+                    "body {} at level {level}, its box {b:?} calls for {}",
+                    p.body,
+                    self.level_for(b)
+                ));
+            }
+            let members = self.members(level);
+            let at = self.member_at[slot] as usize;
+            if members.get(at) != Some(&(slot as u32)) {
+                return Err(format!("body {} not listed at member index {at}", p.body));
+            }
+            if level == OVERSIZED {
+                continue;
+            }
+            let own = usize::from(level);
+            let mut bad = None;
+            for (k, grid) in self.levels.iter().enumerate().skip(own) {
+                let entry = slot as u32 | if k > own { FROM_FINER } else { 0 };
+                CellRange::of(b, grid.inv).for_each(|cell| {
+                    entries[k] += 1;
+                    let here = grid.cells.get(&cell).map_or(0, |list| {
+                        list.iter()
+                            .filter(|&&e| e & !FROM_FINER == slot as u32)
+                            .count()
+                    });
+                    let flagged = grid.cells.get(&cell).is_some_and(|l| l.contains(&entry));
+                    if (here != 1 || !flagged) && bad.is_none() {
+                        bad = Some(format!(
+                            "body {} listed {here} times in level {k} cell {cell:?} \
+                             (own level {own}, correctly flagged: {flagged})",
+                            p.body
+                        ));
+                    }
+                });
+            }
+            if let Some(e) = bad {
+                return Err(e);
+            }
+        }
+        let listed: usize = self.levels.iter().map(|l| l.members.len()).sum();
+        if listed + self.oversized.len() != n {
+            return Err(format!(
+                "{listed} + {} members, {n} bodies",
+                self.oversized.len()
+            ));
+        }
+        for (k, grid) in self.levels.iter().enumerate() {
+            let stored: usize = grid.cells.values().map(|l| l.len()).sum();
+            if stored != entries[k] || grid.cells.values().any(|l| l.is_empty()) {
+                return Err(format!(
+                    "level {k}: {stored} cell entries (or an empty cell), bodies cover {}",
+                    entries[k]
+                ));
+            }
+        }
+        self.pairs.check_against_brute_force(&self.bodies.proxies)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::broad::pairs_brute_force;
+    use crate::broad::{CollisionFilter, pairs_brute_force};
     use crate::math::DVec3;
     use crate::test_support::{TestRng, point_in_cube, rng};
     use rand::Rng;
