@@ -89,9 +89,8 @@
 
 use super::body_map::Bodies;
 use super::pair_set::PairSet;
-use super::{
-    CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds, floor_to_i64, prefetch,
-};
+use super::stateful::{StatefulBroadPhase, stateful_api};
+use super::{CandidatePair, Proxy, debug_assert_valid_bounds, floor_to_i64, prefetch};
 use crate::bounding::{Aabb, BoundingVolume};
 use crate::math::DVec3;
 
@@ -532,86 +531,6 @@ impl ColumnGrid {
         grid
     }
 
-    /// Number of bodies.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.bodies.len()
-    }
-
-    /// Whether there are no bodies.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.bodies.is_empty()
-    }
-
-    /// Whether `body` is present.
-    #[must_use]
-    pub fn contains(&self, body: u32) -> bool {
-        self.bodies.contains(body)
-    }
-
-    /// The bodies as proxies, in slot order (no particular order).
-    #[must_use]
-    pub fn proxies(&self) -> &[Proxy] {
-        &self.bodies.proxies
-    }
-
-    /// Adds `body` with box `bounds` (metres; finite, `min <= max`). Inserting an id that
-    /// is already present replaces that body.
-    pub fn insert(&mut self, body: u32, bounds: Aabb, is_static: bool, filter: CollisionFilter) {
-        debug_assert_valid_bounds(&bounds);
-        if self.contains(body) {
-            self.remove(body);
-        }
-        let slot = self.bodies.push(Proxy {
-            body,
-            bounds,
-            is_static,
-            filter,
-        });
-        self.last_move.push((0, 0));
-        let p = self.bodies.proxies[slot];
-        self.refresh(&p, None, Some(&bounds), slot);
-        self.place(slot);
-        let n = self.bodies.len();
-        if (self.built_at == 0 && n >= AUTO_SAMPLE) || (self.built_at > 0 && n > 2 * self.built_at)
-        {
-            self.rebuild();
-        }
-    }
-
-    /// Removes `body` and its pairs; `false` when it was not present.
-    pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.bodies.unmap(body) else {
-            return false;
-        };
-        let p = self.bodies.proxies[slot];
-        self.refresh(&p, Some(&p.bounds), None, slot);
-        self.unplace(slot);
-        // The last slot moves into the freed one.
-        let last = self.bodies.len() - 1;
-        if slot != last {
-            self.rename(last, slot);
-        }
-        self.bodies.swap_remove(slot);
-        self.last_move.swap_remove(slot);
-        true
-    }
-
-    /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`) and refreshes its pairs
-    /// (module docs, "Finding a body's pairs"). A body that did not move need not be updated.
-    /// Updating a body that is not present is a contract violation (`debug_assert!`; ignored
-    /// in release builds).
-    pub fn update(&mut self, body: u32, bounds: Aabb) {
-        debug_assert_valid_bounds(&bounds);
-        let Some(slot) = self.bodies.slot(body) else {
-            debug_assert!(false, "update of absent body {body}");
-            return;
-        };
-        let old = self.bodies.proxies[slot];
-        self.move_slot(slot, &old, bounds);
-    }
-
     /// [`update`](Self::update) of every `(body, bounds)` in `moves`; a body listed twice
     /// ends at its last box. The same pair set as updating one by one in the given order.
     ///
@@ -717,17 +636,6 @@ impl ColumnGrid {
         self.place(slot);
     }
 
-    /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
-    /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
-    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over [`proxies`](Self::proxies).
-    ///
-    /// # Cost
-    /// `O(k)` for `k` pairs; no allocation once `out` has grown to `k`.
-    pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
-        out.clear();
-        out.extend_from_slice(self.pairs.commit());
-    }
-
     /// Moves the changes of the pair set since the last call (or the last
     /// [`pairs`](Self::pairs)) to `out`: each pair and whether its boxes now overlap, in
     /// the order they happened. For a caller that keeps the pairs itself (the
@@ -735,19 +643,6 @@ impl ColumnGrid {
     /// lists the pair set, and [`validate_listing`](Self::validate_listing) is the check.
     pub(crate) fn take_pair_edits(&mut self, out: &mut Vec<(CandidatePair, bool)>) {
         self.pairs.take_edits(out);
-    }
-
-    /// Checks every invariant: the slot table and id map agree; stored boxes are finite and
-    /// not inverted; each body is at the level its box calls for (oversized before the first
-    /// rebuild), listed exactly once: in the oversized list, or in its home column with its
-    /// stored box; every column sorted; and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over
-    /// the stored boxes. `O(n²)`: for tests.
-    ///
-    /// # Errors
-    /// A description of the first violated invariant.
-    pub fn validate(&self) -> Result<(), String> {
-        self.validate_listing()?;
-        self.pairs.check_against_brute_force(&self.bodies.proxies)
     }
 
     /// [`validate`](Self::validate) but for the pair set (for a grid whose pair edits are
@@ -1058,9 +953,71 @@ impl ColumnGrid {
     }
 }
 
+stateful_api!(ColumnGrid);
+
+impl StatefulBroadPhase for ColumnGrid {
+    fn bodies(&self) -> &Bodies {
+        &self.bodies
+    }
+
+    fn bodies_mut(&mut self) -> &mut Bodies {
+        &mut self.bodies
+    }
+
+    /// Its pairs found by one query, then placed in its column; the levels chosen again
+    /// at the [`AUTO_SAMPLE`]-th body and whenever the count has doubled since.
+    fn file(&mut self, slot: usize) {
+        self.last_move.push((0, 0));
+        let p = self.bodies.proxies[slot];
+        self.refresh(&p, None, Some(&p.bounds), slot);
+        self.place(slot);
+        let n = self.bodies.len();
+        if (self.built_at == 0 && n >= AUTO_SAMPLE) || (self.built_at > 0 && n > 2 * self.built_at)
+        {
+            self.rebuild();
+        }
+    }
+
+    fn unfile(&mut self, slot: usize) {
+        let p = self.bodies.proxies[slot];
+        self.refresh(&p, Some(&p.bounds), None, slot);
+        self.unplace(slot);
+    }
+
+    fn swap_remove_slot(&mut self, slot: usize) {
+        let last = self.bodies.len() - 1;
+        if slot != last {
+            self.rename(last, slot);
+        }
+        self.last_move.swap_remove(slot);
+    }
+
+    /// Refreshes its pairs (module docs, "Finding a body's pairs").
+    #[inline]
+    fn relocate(&mut self, slot: usize, bounds: Aabb) {
+        let old = self.bodies.proxies[slot];
+        self.move_slot(slot, &old, bounds);
+    }
+
+    fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
+        self.pairs.list(out);
+    }
+
+    /// Checks every invariant: the slot table and id map agree; stored boxes are finite and
+    /// not inverted; each body is at the level its box calls for (oversized before the first
+    /// rebuild), listed exactly once: in the oversized list, or in its home column with its
+    /// stored box; every column sorted; and the pair set equals [`pairs_brute_force`](super::pairs_brute_force) over
+    /// the stored boxes.
+    fn validate(&self) -> Result<(), String> {
+        self.validate_listing()?;
+        self.pairs.check_against_brute_force(&self.bodies.proxies)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broad::CollisionFilter;
     use crate::broad::conformance::{self, pairs_of};
     use crate::test_support::{TestRng, point_in_cube, rng};
     use rand::Rng;
