@@ -126,7 +126,8 @@
 use super::body_map::Bodies;
 use super::column_grid::ColumnGrid;
 use super::pair_set::PairSet;
-use super::{CandidatePair, CollisionFilter, Proxy, debug_assert_valid_bounds};
+use super::stateful::{StatefulBroadPhase, stateful_api};
+use super::{CandidatePair, Proxy, debug_assert_valid_bounds};
 use crate::bounding::{Aabb, BoundingVolume};
 use crate::math::{DVec3, splitmix64};
 use std::collections::{BTreeMap, VecDeque};
@@ -497,83 +498,6 @@ impl SkinGrid {
         skin
     }
 
-    /// Number of bodies.
-    #[must_use]
-    pub fn len(&self) -> usize {
-        self.bodies.len()
-    }
-
-    /// Whether there are no bodies.
-    #[must_use]
-    pub fn is_empty(&self) -> bool {
-        self.bodies.is_empty()
-    }
-
-    /// Whether `body` is present.
-    #[must_use]
-    pub fn contains(&self, body: u32) -> bool {
-        self.bodies.contains(body)
-    }
-
-    /// The bodies as proxies (their true boxes), in slot order.
-    #[must_use]
-    pub fn proxies(&self) -> &[Proxy] {
-        &self.bodies.proxies
-    }
-
-    /// Adds `body` with box `bounds` (metres; finite, `min <= max`). Inserting an id that
-    /// is already present replaces that body.
-    pub fn insert(&mut self, body: u32, bounds: Aabb, is_static: bool, filter: CollisionFilter) {
-        debug_assert_valid_bounds(&bounds);
-        if self.contains(body) {
-            self.remove(body);
-        }
-        let extent = bounds.extents().max_element();
-        let reach = self.grid.level_reach(extent);
-        let record = Record::first(&bounds, self.batch, reach);
-        let fat = record.fat;
-        self.bodies.push(Proxy {
-            body,
-            bounds,
-            is_static,
-            filter,
-        });
-        self.records.push(record);
-        self.grid.insert(body, fat, is_static, filter);
-        self.apply_grid_edits();
-    }
-
-    /// Removes `body` and its pairs; `false` when it was not present.
-    pub fn remove(&mut self, body: u32) -> bool {
-        let Some(slot) = self.bodies.slot(body) else {
-            return false;
-        };
-        self.grid.remove(body);
-        self.apply_grid_edits();
-        debug_assert!(self.records[slot].list.is_empty(), "all its pairs gone");
-        self.bodies.unmap(body);
-        let last = self.bodies.len() - 1;
-        if slot != last {
-            // The last slot moves into the freed one: its neighbours' entries follow.
-            for i in 0..self.records[last].list.len() {
-                let Neighbour {
-                    slot: other, twin, ..
-                } = self.records[last].list[i];
-                self.records[other as usize].list[twin as usize].slot = slot as u32;
-            }
-        }
-        self.bodies.swap_remove(slot);
-        self.records.swap_remove(slot);
-        true
-    }
-
-    /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`) and refreshes its pairs
-    /// (module docs). Updating a body that is not present is a contract violation
-    /// (`debug_assert!`; ignored in release builds).
-    pub fn update(&mut self, body: u32, bounds: Aabb) {
-        self.update_all(&[(body, bounds)]);
-    }
-
     /// [`update`](Self::update) of every `(body, bounds)` in `moves`; a body listed twice
     /// ends at its last box. The moves out of the skin go to the column grid as one batch.
     ///
@@ -621,94 +545,6 @@ impl SkinGrid {
             }
         }
         self.run_retests(0);
-    }
-
-    /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
-    /// each with `a < b`, in increasing `(a, b)` order, written to `out` (cleared first):
-    /// exactly the pairs of [`pairs_brute_force`](super::pairs_brute_force) over
-    /// [`proxies`](Self::proxies).
-    pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
-        out.clear();
-        out.extend_from_slice(self.pairs.commit());
-    }
-
-    /// Checks every invariant (module docs). `O(n²)`: for tests.
-    ///
-    /// # Errors
-    /// A description of the first violated invariant.
-    pub fn validate(&self) -> Result<(), String> {
-        self.bodies.check()?;
-        self.grid.validate_listing()?;
-        let n = self.bodies.len();
-        if self.records.len() != n || self.grid.len() != n {
-            return Err(format!("{n} bodies, per-slot tables or grid disagree"));
-        }
-        let mut filed = Vec::with_capacity(n);
-        for (slot, p) in self.bodies.proxies.iter().enumerate() {
-            let record = &self.records[slot];
-            if record.list.iter().count() != record.list.len() {
-                return Err(format!("body {}: its list miscounts", p.body));
-            }
-            if !encloses(&record.fat, &p.bounds) {
-                return Err(format!("body {} outside its fat box", p.body));
-            }
-            filed.push(Proxy {
-                bounds: record.fat,
-                ..*p
-            });
-        }
-        let mut held: Vec<Proxy> = self.grid.proxies().to_vec();
-        held.sort_by_key(|p| p.body);
-        filed.sort_by_key(|p| p.body);
-        if held != filed {
-            return Err("the grid does not hold exactly the fat boxes".into());
-        }
-        let mut fat_pairs = Vec::new();
-        super::pairs_brute_force(&filed, &mut fat_pairs);
-        let mut listed = BTreeMap::new();
-        for (slot, record) in self.records.iter().enumerate() {
-            let p = &self.bodies.proxies[slot];
-            for e in record.list.iter() {
-                let q = self.bodies.proxies.get(e.slot as usize).ok_or(format!(
-                    "body {} lists slot {} out of range",
-                    p.body, e.slot
-                ))?;
-                let other = &self.records[e.slot as usize].list;
-                let twin = (e.twin < other.len).then(|| other[e.twin as usize]);
-                let Some(twin) = twin.filter(|t| {
-                    t.slot as usize == slot && t.overlaps == e.overlaps && t.share == e.share.twin()
-                }) else {
-                    return Err(format!("{}–{}: the twin entry is wrong", p.body, q.body));
-                };
-                if e.overlaps != p.bounds.intersects(&q.bounds) {
-                    return Err(format!("{}–{} overlap flag stale", p.body, q.body));
-                }
-                // What the two may still travel without a re-test must fit in the room
-                // the pair has now (module docs, "Travel budgets"); the side without the
-                // budget re-tests on any move.
-                let left = |entry: &Neighbour, owner: usize| {
-                    f64::from(entry.due_at) - f64::from(self.records[owner].travel)
-                };
-                let (_, room) = relation(&p.bounds, &q.bounds);
-                let both = left(e, slot) + left(&twin, e.slot as usize);
-                if both > room * (1.0 + 1e-9)
-                    || (e.share == Share::None && e.due_at != f32::NEG_INFINITY)
-                {
-                    return Err(format!(
-                        "{}–{}: budgets of {both} m left, {room} m of room",
-                        p.body, q.body
-                    ));
-                }
-                *listed.entry(CandidatePair::of(p.body, q.body)).or_insert(0) += 1;
-            }
-        }
-        if let Some((pair, times)) = listed.iter().find(|&(_, &times)| times != 2) {
-            return Err(format!("{pair:?} listed {times} times, not once per side"));
-        }
-        if !listed.keys().copied().eq(fat_pairs.iter().copied()) {
-            return Err("neighbour lists differ from the fat boxes' pairs".into());
-        }
-        self.pairs.check_against_brute_force(&self.bodies.proxies)
     }
 
     /// Takes the grid's pair edits (neighbours gained and lost, in order) into the lists,
@@ -918,6 +754,136 @@ impl SkinGrid {
     }
 }
 
+stateful_api!(SkinGrid);
+
+impl StatefulBroadPhase for SkinGrid {
+    fn bodies(&self) -> &Bodies {
+        &self.bodies
+    }
+
+    fn bodies_mut(&mut self) -> &mut Bodies {
+        &mut self.bodies
+    }
+
+    /// Its first fat box filed in the grid, whose pair edits list its neighbours.
+    fn file(&mut self, slot: usize) {
+        let p = self.bodies.proxies[slot];
+        let extent = p.bounds.extents().max_element();
+        let reach = self.grid.level_reach(extent);
+        let record = Record::first(&p.bounds, self.batch, reach);
+        let fat = record.fat;
+        self.records.push(record);
+        self.grid.insert(p.body, fat, p.is_static, p.filter);
+        self.apply_grid_edits();
+    }
+
+    fn unfile(&mut self, slot: usize) {
+        self.grid.remove(self.bodies.proxies[slot].body);
+        self.apply_grid_edits();
+        debug_assert!(self.records[slot].list.is_empty(), "all its pairs gone");
+    }
+
+    fn swap_remove_slot(&mut self, slot: usize) {
+        let last = self.bodies.len() - 1;
+        if slot != last {
+            // The last slot moves into the freed one: its neighbours' entries follow.
+            for i in 0..self.records[last].list.len() {
+                let Neighbour {
+                    slot: other, twin, ..
+                } = self.records[last].list[i];
+                self.records[other as usize].list[twin as usize].slot = slot as u32;
+            }
+        }
+        self.records.swap_remove(slot);
+    }
+
+    /// A batch of one move ([`update_all`](SkinGrid::update_all)).
+    fn relocate(&mut self, slot: usize, bounds: Aabb) {
+        let body = self.bodies.proxies[slot].body;
+        self.update_all(&[(body, bounds)]);
+    }
+
+    fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
+        self.pairs.list(out);
+    }
+
+    /// Checks every invariant (module docs).
+    fn validate(&self) -> Result<(), String> {
+        self.bodies.check()?;
+        self.grid.validate_listing()?;
+        let n = self.bodies.len();
+        if self.records.len() != n || self.grid.len() != n {
+            return Err(format!("{n} bodies, per-slot tables or grid disagree"));
+        }
+        let mut filed = Vec::with_capacity(n);
+        for (slot, p) in self.bodies.proxies.iter().enumerate() {
+            let record = &self.records[slot];
+            if record.list.iter().count() != record.list.len() {
+                return Err(format!("body {}: its list miscounts", p.body));
+            }
+            if !encloses(&record.fat, &p.bounds) {
+                return Err(format!("body {} outside its fat box", p.body));
+            }
+            filed.push(Proxy {
+                bounds: record.fat,
+                ..*p
+            });
+        }
+        let mut held: Vec<Proxy> = self.grid.proxies().to_vec();
+        held.sort_by_key(|p| p.body);
+        filed.sort_by_key(|p| p.body);
+        if held != filed {
+            return Err("the grid does not hold exactly the fat boxes".into());
+        }
+        let mut fat_pairs = Vec::new();
+        super::pairs_brute_force(&filed, &mut fat_pairs);
+        let mut listed = BTreeMap::new();
+        for (slot, record) in self.records.iter().enumerate() {
+            let p = &self.bodies.proxies[slot];
+            for e in record.list.iter() {
+                let q = self.bodies.proxies.get(e.slot as usize).ok_or(format!(
+                    "body {} lists slot {} out of range",
+                    p.body, e.slot
+                ))?;
+                let other = &self.records[e.slot as usize].list;
+                let twin = (e.twin < other.len).then(|| other[e.twin as usize]);
+                let Some(twin) = twin.filter(|t| {
+                    t.slot as usize == slot && t.overlaps == e.overlaps && t.share == e.share.twin()
+                }) else {
+                    return Err(format!("{}–{}: the twin entry is wrong", p.body, q.body));
+                };
+                if e.overlaps != p.bounds.intersects(&q.bounds) {
+                    return Err(format!("{}–{} overlap flag stale", p.body, q.body));
+                }
+                // What the two may still travel without a re-test must fit in the room
+                // the pair has now (module docs, "Travel budgets"); the side without the
+                // budget re-tests on any move.
+                let left = |entry: &Neighbour, owner: usize| {
+                    f64::from(entry.due_at) - f64::from(self.records[owner].travel)
+                };
+                let (_, room) = relation(&p.bounds, &q.bounds);
+                let both = left(e, slot) + left(&twin, e.slot as usize);
+                if both > room * (1.0 + 1e-9)
+                    || (e.share == Share::None && e.due_at != f32::NEG_INFINITY)
+                {
+                    return Err(format!(
+                        "{}–{}: budgets of {both} m left, {room} m of room",
+                        p.body, q.body
+                    ));
+                }
+                *listed.entry(CandidatePair::of(p.body, q.body)).or_insert(0) += 1;
+            }
+        }
+        if let Some((pair, times)) = listed.iter().find(|&(_, &times)| times != 2) {
+            return Err(format!("{pair:?} listed {times} times, not once per side"));
+        }
+        if !listed.keys().copied().eq(fat_pairs.iter().copied()) {
+            return Err("neighbour lists differ from the fat boxes' pairs".into());
+        }
+        self.pairs.check_against_brute_force(&self.bodies.proxies)
+    }
+}
+
 /// Whether `outer` holds all of `inner` (closed boxes): both of its corners.
 fn encloses(outer: &Aabb, inner: &Aabb) -> bool {
     outer.contains_point(inner.min) && outer.contains_point(inner.max)
@@ -968,6 +934,7 @@ fn travelled(travel: f32, old: &Aabb, new: &Aabb) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::broad::CollisionFilter;
     use crate::broad::conformance;
     use crate::broad::pairs_brute_force;
     use crate::math::DVec3;
