@@ -46,6 +46,7 @@ pub mod incremental_sap;
 mod key_sort;
 mod pair_set;
 mod pair_sort;
+pub mod phase;
 mod radix;
 pub mod select;
 pub mod skin_grid;
@@ -56,9 +57,8 @@ pub use brute_force::pairs_brute_force;
 pub use column_grid::ColumnGrid;
 pub use hash_grid::HashGrid;
 pub use incremental_sap::IncrementalSap;
-pub use select::{
-    BroadPhase, BroadPhaseChoice, BroadPhaseKind, BroadPhaseStats, MoveCounts, choose,
-};
+pub use phase::{BroadPhase, BroadPhaseChoice, BroadPhaseKind};
+pub use select::{BroadPhaseStats, MoveCounts, choose};
 pub use skin_grid::SkinGrid;
 pub use sort_sweep::SortAndSweep;
 
