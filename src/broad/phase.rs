@@ -2,15 +2,21 @@
 //!
 //! [`BroadPhase`] holds one of the five broad phases ([`BroadPhaseKind`]) and gives them the
 //! same body-level API: [`insert`](BroadPhase::insert), [`update`](BroadPhase::update),
-//! [`remove`](BroadPhase::remove), [`pairs`](BroadPhase::pairs). The stateful
-//! [`IncrementalSap`], [`HashGrid`], [`ColumnGrid`] and [`SkinGrid`] take it as is; for the stateless [`SortAndSweep`] it
-//! keeps the proxy list itself (a dense list with an id → slot map; removal swaps the last
-//! proxy into the freed slot, which the sweep's kept order re-keys for free) and sweeps it in
-//! [`pairs`](BroadPhase::pairs). Every kind reports exactly the pairs of
-//! [`pairs_brute_force`] over its bodies, in `(a, b)` order.
+//! [`remove`](BroadPhase::remove), [`pairs`](BroadPhase::pairs). Every kind sits behind
+//! the crate's `StatefulBroadPhase` trait (`stateful.rs`), over the one body table they
+//! share: the stateful [`IncrementalSap`], [`HashGrid`], [`ColumnGrid`] and [`SkinGrid`] as
+//! they are; the stateless [`SortAndSweep`] through a wrapper that keeps the body table and
+//! sweeps its proxy list in [`pairs`](BroadPhase::pairs). One match dispatches each call
+//! statically. Every kind reports exactly the pairs of [`pairs_brute_force`] over its
+//! bodies, in `(a, b)` order.
+//!
+//! Beside the kind, it keeps each body's static flag and filter (so [`set`](BroadPhase::set)
+//! tells a move from a replacement) and measures the moves ([`MoveCounts`]) the choice of
+//! kind reads.
 
-use super::body_map::BodyMap;
+use super::body_map::{Bodies, BodyMap};
 use super::select::MoveCounts;
+use super::stateful::StatefulBroadPhase;
 use super::{
     CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, Proxy, SkinGrid,
     SortAndSweep, pairs_brute_force,
@@ -59,16 +65,14 @@ pub enum BroadPhaseChoice {
     Fixed(BroadPhaseKind),
 }
 
-/// Per-body record of [`BroadPhase`]: what `update` must not change, and the body's slot in
-/// the sort-and-sweep proxy list.
+/// Per-body record of [`BroadPhase`]: what `update` must not change, and the box its moves
+/// are measured from.
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     is_static: bool,
     filter: CollisionFilter,
     /// Its box, to measure its moves ([`BroadPhase::take_move_counts`]).
     bounds: Aabb,
-    /// Index into [`Sweep::proxies`] (sort and sweep only; 0 otherwise).
-    slot: u32,
 }
 
 impl Entry {
@@ -80,15 +84,64 @@ impl Entry {
     }
 }
 
-/// Sort and sweep with its proxy list.
+/// The stateless [`SortAndSweep`] over the shared body table, handed the whole proxy list
+/// in `pairs` (up to [`ALL_PAIRS_MAX`] bodies, every pair tested instead).
 #[derive(Debug, Clone, Default)]
 struct Sweep {
-    proxies: Vec<Proxy>,
+    bodies: Bodies,
     sweep: SortAndSweep,
-    /// Whether `sweep`'s kept order matches `proxies` (no change since the last `pairs`).
+    /// Whether `sweep`'s kept order matches the proxies (no change since the last `pairs`).
     swept: bool,
 }
 
+impl StatefulBroadPhase for Sweep {
+    fn bodies(&self) -> &Bodies {
+        &self.bodies
+    }
+
+    fn bodies_mut(&mut self) -> &mut Bodies {
+        &mut self.bodies
+    }
+
+    fn file(&mut self, _slot: usize) {
+        self.swept = false;
+    }
+
+    fn unfile(&mut self, _slot: usize) {
+        self.swept = false;
+    }
+
+    /// Nothing to rename: the sweep's kept order is re-keyed by its next pass.
+    fn swap_remove_slot(&mut self, _slot: usize) {}
+
+    fn relocate(&mut self, slot: usize, bounds: Aabb) {
+        self.bodies.proxies[slot].bounds = bounds;
+        self.swept = false;
+    }
+
+    fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
+        if self.bodies.len() <= ALL_PAIRS_MAX {
+            pairs_brute_force(&self.bodies.proxies, out);
+            self.swept = false;
+        } else {
+            self.sweep.pairs(&self.bodies.proxies, out);
+            self.swept = true;
+        }
+    }
+
+    /// The body table, and the sweep's kept order when no body changed since the last
+    /// `pairs`.
+    fn validate(&self) -> Result<(), String> {
+        self.bodies.check()?;
+        if self.swept {
+            self.sweep.validate(&self.bodies.proxies)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// The kind a [`BroadPhase`] holds; every variant is a [`StatefulBroadPhase`].
 #[derive(Debug, Clone)]
 enum Inner {
     /// Boxed, as `Skin`: its scratch is a dozen vectors.
@@ -98,6 +151,20 @@ enum Inner {
     Columns(ColumnGrid),
     /// Boxed: it holds a column grid and its own tables besides.
     Skin(Box<SkinGrid>),
+}
+
+/// Evaluates `$body` with `$k` bound to the kind `$inner` holds: the one match over the
+/// kinds, each arm statically dispatched through [`StatefulBroadPhase`].
+macro_rules! with_kind {
+    ($inner:expr, $k:ident => $body:expr) => {
+        match $inner {
+            Inner::Sweep($k) => $body,
+            Inner::Sap($k) => $body,
+            Inner::Grid($k) => $body,
+            Inner::Columns($k) => $body,
+            Inner::Skin($k) => $body,
+        }
+    };
 }
 
 /// One broad phase of any [`BroadPhaseKind`] behind one stateful API over bodies identified
@@ -157,7 +224,6 @@ impl BroadPhase {
                     is_static: p.is_static,
                     filter: p.filter,
                     bounds: p.bounds,
-                    slot: 0,
                 },
             )
         }));
@@ -197,13 +263,7 @@ impl BroadPhase {
     /// The bodies as proxies, in no particular order.
     #[must_use]
     pub fn proxies(&self) -> &[Proxy] {
-        match &self.inner {
-            Inner::Sweep(s) => &s.proxies,
-            Inner::Sap(s) => s.proxies(),
-            Inner::Grid(g) => g.proxies(),
-            Inner::Columns(c) => c.proxies(),
-            Inner::Skin(c) => c.proxies(),
-        }
+        with_kind!(&self.inner, k => k.proxies())
     }
 
     /// Adds `body` with its margin-grown world box `bounds` (metres; finite, `min <= max`).
@@ -212,105 +272,37 @@ impl BroadPhase {
         if self.contains(body) {
             self.remove(body);
         }
-        let mut slot = 0;
-        match &mut self.inner {
-            Inner::Sweep(s) => {
-                debug_assert!(
-                    bounds.min.is_finite() && bounds.max.is_finite(),
-                    "non-finite bounds {bounds:?}"
-                );
-                debug_assert!(bounds.min.cmple(bounds.max).all(), "inverted bounds");
-                slot = s.proxies.len() as u32;
-                s.proxies.push(Proxy {
-                    body,
-                    bounds,
-                    is_static,
-                    filter,
-                });
-                s.swept = false;
-            }
-            Inner::Sap(s) => s.insert(body, bounds, is_static, filter),
-            Inner::Grid(g) => g.insert(body, bounds, is_static, filter),
-            Inner::Columns(c) => c.insert(body, bounds, is_static, filter),
-            Inner::Skin(c) => c.insert(body, bounds, is_static, filter),
-        }
+        with_kind!(&mut self.inner, k => k.insert(body, bounds, is_static, filter));
         self.entries.insert(
             body,
             Entry {
                 is_static,
                 filter,
                 bounds,
-                slot,
             },
         );
     }
 
     /// Removes `body` and its pairs; `false` when it was not present.
     pub fn remove(&mut self, body: u32) -> bool {
-        let Some(entry) = self.entries.remove(&body) else {
+        if self.entries.remove(&body).is_none() {
             return false;
-        };
-        match &mut self.inner {
-            Inner::Sweep(s) => {
-                let slot = entry.slot as usize;
-                s.proxies.swap_remove(slot);
-                if let Some(moved) = s.proxies.get(slot) {
-                    self.entries
-                        .get_mut(&moved.body)
-                        .expect("every listed proxy has an entry")
-                        .slot = slot as u32;
-                }
-                s.swept = false;
-            }
-            Inner::Sap(s) => {
-                s.remove(body);
-            }
-            Inner::Grid(g) => {
-                g.remove(body);
-            }
-            Inner::Columns(c) => {
-                c.remove(body);
-            }
-            Inner::Skin(c) => {
-                c.remove(body);
-            }
         }
+        with_kind!(&mut self.inner, k => {
+            k.remove(body);
+        });
         true
     }
 
     /// Moves `body`'s box to `bounds` (metres; finite, `min <= max`). Updating a body that is
     /// not present is a contract violation (`debug_assert!`; ignored in release builds).
     pub fn update(&mut self, body: u32, bounds: Aabb) {
-        let Some(slot) = self.record_move(body, bounds) else {
-            return;
-        };
-        match &mut self.inner {
-            Inner::Sweep(s) => {
-                debug_assert!(
-                    bounds.min.is_finite()
-                        && bounds.max.is_finite()
-                        && bounds.min.cmple(bounds.max).all(),
-                    "invalid bounds {bounds:?}"
-                );
-                s.proxies[slot as usize].bounds = bounds;
-                s.swept = false;
-            }
-            Inner::Sap(s) => s.update(body, bounds),
-            Inner::Grid(g) => g.update(body, bounds),
-            Inner::Columns(c) => c.update(body, bounds),
-            Inner::Skin(c) => c.update(body, bounds),
-        }
-    }
-
-    /// Counts `body`'s move to `bounds` and keeps its box; its sort-and-sweep slot, `None`
-    /// (with a `debug_assert!`) when absent.
-    fn record_move(&mut self, body: u32, bounds: Aabb) -> Option<u32> {
         let Some(entry) = self.entries.get_mut(&body) else {
             debug_assert!(false, "update of absent body {body}");
-            return None;
+            return;
         };
         entry.note_move(bounds, &mut self.counts);
-        Some(entry.slot)
+        with_kind!(&mut self.inner, k => k.update(body, bounds));
     }
 
     /// The updates since the last call, measured ([`MoveCounts`]); resets them.
@@ -338,7 +330,7 @@ impl BroadPhase {
     /// # Allocation
     /// None once the batch buffer has grown to the largest batch.
     pub fn set_all(&mut self, proxies: &[Proxy]) {
-        if !matches!(self.inner, Inner::Columns(_) | Inner::Skin(_)) {
+        if !with_kind!(&self.inner, k => k.batches()) {
             for proxy in proxies {
                 self.set(proxy);
             }
@@ -368,11 +360,7 @@ impl BroadPhase {
     /// Hands `moves` to the kinds that take them as one batch (the others got them one by
     /// one).
     fn update_batch(&mut self, moves: &[(u32, Aabb)]) {
-        match &mut self.inner {
-            Inner::Columns(c) => c.update_all(moves),
-            Inner::Skin(c) => c.update_all(moves),
-            Inner::Sweep(_) | Inner::Sap(_) | Inner::Grid(_) => {}
-        }
+        with_kind!(&mut self.inner, k => k.update_all(moves));
     }
 
     /// Every pair of bodies whose boxes overlap (touching counts) and that may pair, once
@@ -381,20 +369,7 @@ impl BroadPhase {
     /// [`proxies`](Self::proxies) (which the sort-and-sweep kind runs itself up to
     /// [`ALL_PAIRS_MAX`] bodies).
     pub fn pairs(&mut self, out: &mut Vec<CandidatePair>) {
-        match &mut self.inner {
-            Inner::Sweep(s) if s.proxies.len() <= ALL_PAIRS_MAX => {
-                pairs_brute_force(&s.proxies, out);
-                s.swept = false;
-            }
-            Inner::Sweep(s) => {
-                s.sweep.pairs(&s.proxies, out);
-                s.swept = true;
-            }
-            Inner::Sap(s) => s.pairs(out),
-            Inner::Grid(g) => g.pairs(out),
-            Inner::Columns(c) => c.pairs(out),
-            Inner::Skin(c) => c.pairs(out),
-        }
+        with_kind!(&mut self.inner, k => k.pairs(out));
     }
 
     /// Checks every invariant: the id map agrees with the wrapped broad phase's bodies (ids,
@@ -413,29 +388,15 @@ impl BroadPhase {
                 self.entries.len()
             ));
         }
-        let sweep = matches!(self.inner, Inner::Sweep(_));
-        for (slot, p) in proxies.iter().enumerate() {
+        for p in proxies {
             let Some(e) = self.entries.get(&p.body) else {
                 return Err(format!("body {} has no entry", p.body));
             };
             if e.is_static != p.is_static || e.filter != p.filter {
                 return Err(format!("body {}: entry disagrees with its proxy", p.body));
             }
-            if sweep && e.slot as usize != slot {
-                return Err(format!(
-                    "body {} at slot {slot}, entry says {}",
-                    p.body, e.slot
-                ));
-            }
         }
-        match &self.inner {
-            Inner::Sweep(s) if s.swept => s.sweep.validate(&s.proxies),
-            Inner::Sweep(_) => Ok(()),
-            Inner::Sap(s) => s.validate(),
-            Inner::Grid(g) => g.validate(),
-            Inner::Columns(c) => c.validate(),
-            Inner::Skin(c) => c.validate(),
-        }
+        with_kind!(&self.inner, k => k.validate())
     }
 }
 
