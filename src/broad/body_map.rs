@@ -52,9 +52,8 @@ impl Hasher for IdHasher {
 /// Body id → slot, as a plain array while the ids are small (every id below four times the
 /// count plus [`DENSE_SLACK`], so the array is at most about four cells per body plus
 /// 256 KiB: one read of a 4-byte cell where a hash map probes a table three times the
-/// size), and as a [`BodyMap`] from the first id beyond that. Measured
-/// (`examples/broad_bench`, column grid, 100,000 bodies, 10 % moving, six alternating
-/// runs): 6.5 ms median per frame against 7.1 with the map.
+/// size), and as a [`BodyMap`] from the first id beyond that (`examples/broad_bench`,
+/// 100,000 bodies).
 #[derive(Debug, Clone)]
 pub(crate) enum SlotTable {
     /// `slots[id]` is the slot of body `id`, or [`ABSENT`]; `count` ids are present.

@@ -46,22 +46,9 @@
 //! updated one at a time, so a candidate's stored box is the one the pair set already
 //! reflects.
 //!
-//! Measured and not kept (`examples/broad_bench`, 100,000 uniform bodies, 10 % moving): a
-//! batch update applying a frame's moves sorted by the column they land in, so consecutive
-//! queries share columns, was no faster than the moves in id order (6.6–6.9 ms a frame
-//! both). With a tenth of the bodies moving everywhere, a frame reads every column either
-//! way; what a move costs is its searches and box tests. Also measured and not kept: boxes
-//! rounded outward to `f32` in the columns (half the bytes), each hit re-tested on the
-//! exact box: 6.0 → 6.6 ms, the re-test's read of the proxy costing more than the lines
-//! saved; boxes and slots in parallel lists (48 bytes a scanned entry, not 56): 6.1 → 6.8
-//! ms median over five alternating runs. Kept: a search index per column (one low end per
-//! 16 entries) in place of the binary search: 5.4 → 4.6 ms at 100,000 bodies, 9–17 % at
-//! 10,000. Kept: a batch's queries prefetched four moves ahead (the first entries each
-//! column's search finds), at 100,000 uniform bodies a median 13.9 → 8.6–9.0 ms on a host
-//! then running about twice slower than the figures above, 25–35 % on the clustered
-//! layout; the prefetch's own search costs 10–20 % in grids that fit in cache, where it is
-//! off. Measured and not kept: a second prefetch stage, the search index's block fetched
-//! eight moves ahead (8.8 → 10.9 ms).
+//! Each column has a search index (one low end per 16 entries) that replaces the binary
+//! search, and in grids too large for the cache a batch's queries are prefetched a few
+//! moves ahead (`examples/broad_bench` measures both).
 //!
 //! # Exactness
 //! A pair is reported by [`Aabb::intersects`] on the stored boxes, as in every broad phase;
@@ -106,24 +93,15 @@ const WIDTH_PER_REACH: f64 = 2.0;
 const FINEST_QUANTILE: f64 = 0.9;
 /// Finest reach taken as the largest extent when that is within this factor of the quantile.
 const ONE_LEVEL_SPREAD: f64 = 1.5;
-/// How many moves ahead [`ColumnGrid::update_all`] prefetches a move's query (2, 4 and 8
-/// measured alike).
+/// How many moves ahead [`ColumnGrid::update_all`] prefetches a move's query.
 const PREFETCH_AHEAD: usize = 4;
 /// Fewest bodies for which [`ColumnGrid::update_all`] prefetches: below, the columns stay
-/// in the 2 MiB L2 cache and prefetching only adds work (measured: 10,000 bodies, 10-20 %
-/// slower with it; 30,000 alike; 50,000 to 100,000 faster).
+/// in the 2 MiB L2 cache and prefetching only adds work (`examples/broad_bench`).
 const PREFETCH_FROM_BODIES: usize = 30_000;
 /// What [`ColumnGrid::level_for`] says of a body wider than every level's reach.
 const OVERSIZED: u8 = u8::MAX;
 
 /// A body as its column stores it: its box and slot.
-///
-/// Measured and not kept (2026-11-24): the body's id and filter in the entry too (64
-/// bytes), so that a query logs a pair change without reading the other body's proxy, a
-/// cache miss in a large grid. `examples/broad_bench`, 100,000 bodies, 10 % moving, six
-/// alternating runs, best of each: skin grid uniform 4.00 → 4.17 ms, clustered 4.54 →
-/// 4.32 ms; column grid 6.84 → 7.19 ms and 8.58 → 8.47 ms. The longer scans cost what the
-/// saved reads gain.
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     bounds: Aabb,
@@ -147,8 +125,7 @@ impl Column {
     /// Number of entries whose low end is below `x` (`low.partition_point(|v| v < x)`):
     /// the blocks starting below `x`, counted, then the entries below `x` in the last of
     /// them. Each count is a sum of independent compares where a binary search makes one
-    /// dependent probe per halving (measured: `examples/broad_bench`, 10,000 bodies, the
-    /// searches were a third of a moved body's time).
+    /// dependent probe per halving.
     #[inline]
     fn count_below(&self, x: f64) -> usize {
         let blocks = if self.starts.len() <= 4 * BLOCK {
@@ -538,9 +515,7 @@ impl ColumnGrid {
     /// processor overlaps), the second moves them. In a grid of 30,000 bodies or more, each
     /// pass starts fetching what it reads four moves on, so that the cache misses overlap
     /// this move's work: the first pass the record, the second the first entries of the
-    /// query. (The first pass's prefetch, measured with `examples/broad_bench`, 100,000
-    /// bodies, 10 % moving, three alternating runs: uniform 8.9–9.2 → 7.0–8.8 ms a frame,
-    /// clustered 9.4–10.7 → 9.2–9.8.)
+    /// query.
     ///
     /// # Allocation
     /// None once the batch buffer has grown to the largest batch.

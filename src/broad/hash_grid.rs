@@ -34,11 +34,8 @@
 //! levels whose coarsest cell is at least 4 × the largest extent seen (two spare levels for
 //! larger bodies later), at most [`MAX_LEVELS`]. Then every body is placed. A body's cell is
 //! then 1 to 2 times its extent at its level (more at level 0), so its box covers about 3 to
-//! 8 cells; cells of just its size would make most boxes straddle 8. Measured with
-//! `examples/broad_bench` (10,000 bodies, 10 % moving, same run as parry's BVH): the 10th
-//! percentile itself made unit dice on a table sit exactly at a level boundary, split over
-//! two levels (0.51× parry); twice it gave 1.0× there, and 1.8× against 1.5× on uniform
-//! boxes.
+//! 8 cells; cells of just its size would make most boxes straddle 8, and unit dice on a
+//! table would sit exactly at a level boundary, split over two levels.
 //!
 //! # Finding a body's pairs
 //! A body at level `L` is listed in the cells its box covers at `L` and, flagged as coming
@@ -56,9 +53,9 @@
 //! and the finer body looks the coarser one up at the coarser level. Incrementally, a moved
 //! body must also find the bodies that did not move, finer or coarser, and this finds both
 //! with a few look-ups per level at or above its own, never by searching the many small
-//! cells of a finer level (which the first version of this grid did: a 2 m box looking for
-//! 0.25 m bodies probed up to 512 cells). Each candidate is tested once per query (stamps),
-//! by [`Aabb::intersects`] and [`Proxy::may_pair`]. A body `b` whose pairs must be
+//! cells of a finer level (a 2 m box looking for 0.25 m bodies would probe up to 512
+//! cells). Each candidate is tested once per query (stamps),
+//! by [`Aabb::intersects`] and [`Proxy::may_pair`](super::Proxy::may_pair). A body `b` whose pairs must be
 //! refreshed (inserted, moved, removed) queries its old box and, if it left or entered a cell
 //! at some queried level, its new box too: every old pair shares a cell with the old box and
 //! every new pair with the new box, so testing these candidates against the new box leaves

@@ -45,7 +45,7 @@
 //! A body that jumps far is moved by the same insertion sort, paying one swap per endpoint
 //! passed (up to `O(n)` per axis). Treating it as remove plus insert would not be cheaper:
 //! both of those are `O(n)` too (memmove and renumbering), so there is one path for all
-//! motion and no threshold to tune. Nothing was measured for this choice.
+//! motion and no threshold to tune.
 //!
 //! # Input
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant; the daemon

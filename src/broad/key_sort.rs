@@ -10,24 +10,8 @@
 //! the items in the new order, which for a kept order is close to the old one
 //! (near-sequential reads).
 //!
-//! Measured in the sort and sweep (`examples/broad_bench`, shifts and displacement counted
-//! per proxy on one frame, alternating runs, means µs a frame) against insertion with a
-//! full sort past 8 shifts a proxy:
-//!
-//! | scene | shifts | insertion, then full sort | now |
-//! |---|---|---|---|
-//! | 10,000 clustered, all moving | 1.3 | 482–484 | 445–461 (radix) |
-//! | 10,000 stacked, all moving | 3.6 | 575–578 | 519–522 (radix) |
-//! | 10,000 uniform, 10 % teleporting | | 662–674 | 479–502 (radix) |
-//! | 100,000 uniform, all moving | over 8 | 12.0–12.1 ms | 10.1–10.6 ms (radix) |
-//! | 10,000 clustered, all moving at a sixth | 0.2 | 464–481 | 473–510 (insertion) |
-//! | 1,000 clustered, all moving | 0.26 | 33.7–33.9 | 34.3–34.5 (insertion) |
-//!
-//! Radix sorts every frame measured 444–448 against insertion's 418–423 µs at 10,000
-//! clustered bodies with 10 % moving (0.19 shifts a proxy) and 35–36 against 33 at 1,000,
-//! hence the switch between them. At 100,000 the insertion sort gave up every frame after
-//! its 800,000 shifts of 44-byte items: 3.4 ms of the frame's 10, against 1.4 ms for the
-//! radix sort and its gather.
+//! The switch between them is a count of shifts per item: below it insertion is cheaper,
+//! above it the radix sort (`examples/broad_bench`, sort and sweep, measures both sides).
 
 use super::radix::{RadixScratch, radix_sort};
 

@@ -27,8 +27,9 @@
 //! re-tests only its listed neighbours, and the grid hears of it only when it leaves the
 //! skin (Verlet lists, fat boxes).
 //!
-//! [`select`] puts the five behind one stateful API ([`BroadPhase`]: insert, update, remove,
-//! pairs) and chooses among them from measured scene statistics ([`BroadPhaseStats`],
+//! [`phase`] puts the five behind one stateful API ([`BroadPhase`]: insert, update, remove,
+//! pairs), each over the one body table the stateful kinds share (`stateful.rs`), and
+//! [`select`] chooses among them from measured scene statistics ([`BroadPhaseStats`],
 //! [`choose`]); the pipeline keeps one per scene in sync with the scene's change log, so a
 //! body that did not change is never touched.
 //!

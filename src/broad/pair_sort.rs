@@ -1,22 +1,11 @@
 //! Sorting a frame's candidate pairs into `(a, b)` order: a least-significant-digit radix
 //! sort (`radix.rs`) on the key `a · 2^w + b`, `w` the width of the largest id, so a scene
 //! of 1,000 bodies sorts 20-bit keys and one of 100,000 34-bit keys, in as few passes as
-//! the digit width allows. Measured (`examples/broad_bench`, sort and sweep, three
-//! alternating runs, means a frame) against a 32-bit key `a · 2¹⁶ + b` (64-bit past 2¹⁶
-//! ids) sorted one byte a pass: 10,000 uniform bodies all moving (about 5,000 pairs a
-//! frame: three passes of 10 bits, not four of 8) 459–463 → 450–454 µs; 1,000 (about 490
-//! pairs) within the noise, 41.6–42.3 against 41.8–42.4. The 32-bit key had itself
-//! measured 42.2–42.3 → 41.5–41.9 µs against the 64-bit one at 1,000 bodies.
+//! the digit width allows.
 //!
 //! A comparison sort of `k` pairs makes about `k log₂ k` data-dependent compares; the
 //! radix sort a few passes of `k` counted moves, plus one pass counting every digit at
-//! once. Measured (one pass a byte then) in [`SortAndSweep`] (10,000
-//! bodies all moving, about 5,000 pairs a frame, three alternating runs, together with
-//! its kept grid shape against neither: 1,500–1,637 → 1,373–1,395 µs a frame uniform,
-//! 1,323–1,457 → 1,203–1,482 clustered; the kept shape alone had given 1,490–1,530 and
-//! 1,271–1,398 in the same runs).
-//!
-//! [`SortAndSweep`]: super::SortAndSweep
+//! once. `examples/broad_bench` (sort and sweep) measures it.
 
 use super::CandidatePair;
 use super::radix::{RadixScratch, radix_sort};

@@ -17,6 +17,8 @@
 use super::body_map::{Bodies, BodyMap};
 use super::select::MoveCounts;
 use super::stateful::StatefulBroadPhase;
+#[cfg(doc)]
+use super::{BroadPhaseStats, choose};
 use super::{
     CandidatePair, CollisionFilter, ColumnGrid, HashGrid, IncrementalSap, Proxy, SkinGrid,
     SortAndSweep, pairs_brute_force,

@@ -7,8 +7,6 @@
 //! `2^digit` counts (cleared, summed, scanned) plus its `n` scattered moves, so a wider
 //! digit saves a pass of moves for as long as its table is no longer than the records.
 //! Callers give the key's width in bits, so a key of fewer bits takes fewer passes.
-//! Measured against one pass per byte (`examples/broad_bench`, sort and sweep, alternating
-//! runs, means a frame): see the figures in `pair_sort.rs` and `key_sort.rs`.
 
 /// Narrowest digit, bits.
 const MIN_DIGIT_BITS: u32 = 8;

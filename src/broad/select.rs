@@ -6,7 +6,9 @@
 
 use super::sort_sweep::widest_spread_axis;
 #[cfg(doc)]
-use super::{BroadPhaseChoice, ColumnGrid, HashGrid, IncrementalSap, SkinGrid, SortAndSweep};
+use super::{
+    BroadPhase, BroadPhaseChoice, ColumnGrid, HashGrid, IncrementalSap, SkinGrid, SortAndSweep,
+};
 use super::{BroadPhaseKind, Proxy};
 use crate::bounding::Aabb;
 

@@ -36,17 +36,7 @@
 //! [`SKIN_FRAMES`] is divided by a number between 0.5 and 1.5 drawn from the body's id and
 //! the batch ([`SKIN_SPREAD`]), so that bodies which start moving together do not keep
 //! leaving their skins in the same frames. First skins are not spread: a thicker one
-//! would bridge gaps a resting body never crosses (stacked dice 0.23 m apart gained
-//! neighbours across the gap: 241 → 1,000–1,200 µs a frame at 10,000 dice all moving).
-//!
-//! Measured against a skin of the same thickness on every side (`max(MIN_SKIN,
-//! SKIN_FRAMES` × the largest speed along an axis`)`, at most `MAX_SKIN`), with
-//! `examples/broad_bench`, 10 % moving, five alternating runs, medians of the means:
-//! 100,000 uniform bodies 4.86 → 3.45 ms a frame, clustered 6.27 → 5.13, stacked dice
-//! 1.10 → 1.19 (within the drift; they turn back every few frames); 10,000 uniform 196 →
-//! 169 µs. Growing `MIN_SKIN` on every side as well, and the motion's reach on top of it
-//! ahead, measured 3.92 ms uniform and 1.36 ms stacked in the same runs: wider boxes
-//! bridge more gaps.
+//! would bridge gaps a resting body never crosses.
 //!
 //! # Travel budgets
 //! Two boxes keep their relation (overlapping or apart) while their corners move less, in
@@ -67,47 +57,20 @@
 //!   instead.
 //!
 //! A move compares its in-place entries' due travels all at once, without a branch, and
-//! branches only on the entries due (0.19 a move at 10,000 clustered bodies all moving at
-//! a sixth of the speed). Measured (`examples/broad_bench`, two alternating runs each,
-//! means a frame) against a loop branching on each entry: 10,000 bodies all moving at a
-//! sixth of the speed, clustered 306–308 → 275–283 µs, uniform 259–263 → 219–220;
-//! 1,000 clustered all moving 22.8–22.9 → 21.0–21.1; 10,000 stacked dice at 10 % moving
-//! 35.6–37.1 → 33.6–34.0; 100,000 clustered at 10 % moving 1,308–1,334 → 1,191–1,293;
-//! 1,000 stacked dice all moving 21.1–21.9 → 22.0–22.4. A lower bound on each body's due
-//! travels, kept so that a move below it reads no entry, measured 271–278 at the first
-//! row but 26–28 at the last (20.3–21.5 before): every budget written also wrote it.
+//! branches only on the entries due.
 //!
 //! A new pair gives the whole room to a body refiled in the batch (the mover). Travel and
 //! budgets are `f32`, rounded towards re-testing, with a relative allowance
 //! (`BUDGET_ROUNDING`) for the roundings before.
 //!
-//! Measured (`examples/broad_bench`, alternating runs of 100 frames, medians of the
-//! means), against re-testing every neighbour on every move: 100,000 uniform bodies, 10 %
-//! moving, 4.73 → 4.24 ms a frame (eight runs; about 2.5 neighbours listed per move, 0.7
-//! due); clustered 4.74 → 4.87 ms, within the drift; 10,000 uniform bodies all moving at a
-//! sixth of the speed, 696 → 497 µs, and at full speed 2,052 → 1,732 (three runs each,
-//! with the skins of "The skin" in both). Without the halves (the whole room to the latest
-//! re-tester, the other side always due) the all-moving rows measured 956 and 2,093: both
-//! sides re-tested every pair every move, writing the twin each time. Halves on both sides
-//! for every pair measured no faster than re-testing every neighbour, as every re-test
-//! writes both lists. Splitting whenever the side without a share moved, the holder
-//! moving or not (a pair made with the budget on the resting side then stayed split),
-//! measured 821 µs against 720 on 100,000 stacked dice, 10 % moving, and 525 against 458
-//! on 10,000 uniform bodies all moving at a sixth of the speed (five and four alternating
-//! runs).
+//! Halves only where both sides move: a split pair's every re-test writes both lists.
 //!
 //! # Costs (`d` neighbours a body has)
 //! - A move inside the skin: `O(d)` budget checks on the body's record (fat box and the
 //!   first neighbours side by side), and a box test for each pair due, reading the
 //!   neighbour's box; in a batch of a large grid the records are prefetched a few moves
 //!   ahead, and each re-test waits in a queue of `RETEST_AHEAD` while what it reads is
-//!   fetched; in a smaller one it runs at once, not through the queue (measured,
-//!   `examples/broad_bench`, alternating runs, means a frame: 1,000 stacked dice all
-//!   moving 21.2–21.9 → 19.4–19.6 µs, 1,000 clustered 20.4–20.7 → 19.5, 10,000 clustered
-//!   at a sixth of the speed 275–276 → 258–261, 10,000 stacked all moving 218–227 →
-//!   202–209). Measured before the budgets (`examples/broad_bench`, 100,000 bodies, 10 %
-//!   moving, six alternating runs, medians): the records' prefetch took uniform from 5.17
-//!   to 4.12 ms a frame, clustered from 6.31 to 5.19.
+//!   fetched; in a smaller one it runs at once, not through the queue.
 //! - A move out of it: a column grid move (module docs of [`ColumnGrid`]) of the fat box,
 //!   plus constant work per neighbour gained or lost (each entry knows its twin).
 //! - Teleports leave the skin every time: the column grid alone is the better choice then.
@@ -138,24 +101,14 @@ pub const FIRST_SKIN: f64 = 0.1;
 /// Frames a refiled box's skin reaches ahead of its motion, at the velocity the body
 /// moved at since it was last filed (module docs, "The skin"), within [`MAX_SKIN`] and the
 /// level's room: at 64, a body moving steadily gets about the most those allow.
-///
-/// Measured (`examples/broad_bench`, alternating runs, mean µs a frame, 8 → 64): 10,000
-/// bodies all moving at a sixth of the bench speed, clustered 418–440 → 305–310 (32:
-/// 323–345; 16 and 24: 380–383 and 340–369), uniform 293–300 → 249; 100,000 bodies, 10 %
-/// moving, uniform 1,134 → 901 (32: 909), clustered 1,312–1,341 → 1,154 (32: 1,141–1,151);
-/// 10,000 bodies 10 % moving, clustered 98 → 85, uniform 76 → 64 (32); 1,000 clustered
-/// 4.5 → 3.7; stacked dice alike (37 / 205 at 10 % / all moving). Fewer refilings (each a
-/// column-grid query) outweigh the neighbours the longer skins add.
+/// Fewer refilings (each a column-grid query) outweigh the neighbours the longer skins
+/// add (`examples/broad_bench`, `--speed-scale`).
 pub const SKIN_FRAMES: f64 = 64.0;
 /// Smallest skin ahead of a refiled box's motion, as a fraction of its largest extent.
 ///
 /// A slow body is better served by a skin many frames thick, as a refiling (a column-grid
-/// query over the fat box) costs as much as re-testing dozens of neighbours. Measured
-/// with symmetric skins (`examples/broad_bench`, 10,000 bodies all moving at a sixth of
-/// the bench speed, 5 mm a frame, medians of three alternating runs): 0.02 → 0.1 took the
-/// uniform layout from 904 to 778 µs a frame and the clustered one from 1,357 to 958; 0.2
-/// was slower again (804 uniform). With skins ahead of the motion, 0.05 measured the same
-/// as 0.1 (100,000 uniform bodies, 10 % moving, five alternating runs).
+/// query over the fat box) costs as much as re-testing dozens of neighbours; a thicker one
+/// bridges gaps the body never crosses (`examples/broad_bench`).
 pub const MIN_SKIN: f64 = 0.1;
 /// Skin behind a refiled box's motion, and on the axes it does not move along, as a
 /// fraction of its largest extent: room to turn back or drift sideways.
@@ -164,14 +117,7 @@ pub const BACK_SKIN: f64 = 0.05;
 /// either side: its skin behind and ahead together are at most twice this.
 ///
 /// Bodies fast for their size reach this cap before [`SKIN_FRAMES`] of motion, so it sets
-/// how often they are refiled. Measured (`examples/broad_bench`, skin grid alone,
-/// alternating runs, mean µs a frame) from 0.5 to 2: 1,000 clustered bodies all moving
-/// 22.9–24.0 → 20.1–20.4 (1: 20.5–21.1); 10,000 clustered all moving 578–602 → 549–554,
-/// 10 % moving 62–64 → 54–55; 100,000 clustered 10 % moving 1,201–1,228 → 1,042–1,060;
-/// 10,000 stacked dice teleporting 10 % 72–98 → 67; unchanged within the noise: 100,000
-/// uniform 10 % moving (968–1,002 → 990–1,008), 10,000 stacked all moving, 1,000 uniform
-/// and stacked all moving, 1,000 clustered at a sixth of the speed; 10,000 uniform at a
-/// sixth 240–243 → 247–252.
+/// how often they are refiled (`examples/broad_bench`, clustered layout).
 pub const MAX_SKIN: f64 = 2.0;
 /// Width of the spread of skin thicknesses: each refiling's [`SKIN_FRAMES`] is divided by
 /// a number drawn uniformly from `[1 − SKIN_SPREAD / 2, 1 + SKIN_SPREAD / 2)`
@@ -180,12 +126,8 @@ pub const MAX_SKIN: f64 = 2.0;
 /// so the mean rate of refilings stays what [`SKIN_FRAMES`] asks for.
 ///
 /// Without it, bodies that start moving together leave their skins together, every few
-/// frames, for as long as they keep their speeds. Measured (`examples/broad_bench`,
-/// 100,000 bodies, 10 % moving): without it, frame times swung between 1.0 and 10.5 ms to
-/// the end of a 150-frame run; with it they settle at 3.5–5 ms after the first ten frames.
-/// Four alternating runs of 120 frames on a host drifting ±20 %, medians of mean / p99 in
-/// ms, without and with it: uniform 4.17 / 9.34 → 4.91 / 7.95, clustered 5.60 / 9.11 →
-/// 5.09 / 7.14. The tail shrinks in both; the mean moves either way, within the drift.
+/// frames, for as long as they keep their speeds: the spread shortens the frame-time tail
+/// (`examples/broad_bench`, p99).
 pub const SKIN_SPREAD: f64 = 1.0;
 
 /// The factor [`SKIN_SPREAD`] draws for `body`'s filing in batch `batch`: one over a hash
@@ -314,9 +256,7 @@ impl Record {
 /// The cut to the room is not enough on its own: the grown box's corners and its extent
 /// are rounded, and a box whose skin fills its room exactly came out a few ulps wider than
 /// `reach`. The column grid then filed it one level up, where every query of its own level
-/// meets it: measured (`examples/broad_bench`, 100,000 uniform bodies, 10 % moving), 580
-/// bodies had leaked to a level of 4 columns after 50 frames, and a refiling met 54
-/// candidates instead of 21. So the extents are checked as the grid computes them, and the
+/// meets it, and such bodies pile up there. So the extents are checked as the grid computes them, and the
 /// growth cut by the excess until it fits (once, in practice; no growth at all fits, as
 /// `bounds` does).
 fn grown_within(bounds: &Aabb, below: DVec3, above: DVec3, reach: f64) -> Aabb {

@@ -28,9 +28,7 @@
 //!    columns on `u` or `v` are *big*: tested against every proxy instead. The axis and
 //!    the percentile are measured again every [`RESHAPE_FRAMES`] frames, or when the
 //!    proxy count changes: a stale one only costs time, as any grid lists every box in
-//!    every column it meets (measured, 10,000 bodies all moving, three alternating runs:
-//!    1,415–1,530 → 1,355–1,365 µs a frame uniform, 1,420–1,532 → 1,310–1,347
-//!    clustered).
+//!    every column it meets.
 //! 3. Under the same grid and proxy count, with at most one proxy in [`KEPT_MOVES_PER`]
 //!    listed in other columns than last frame, the columns are *kept*: each entry's box is
 //!    read again from its proxy, the proxies that changed columns leave their old ones
@@ -38,21 +36,10 @@
 //!    close to their last order, and a column holds a few dozen at most). Otherwise they
 //!    are *listed*: the kept order of the proxies by their low end on `s` is brought up
 //!    to date by insertion sort while few proxies change places, by a radix sort of the
-//!    keys when many do (`key_sort.rs`, whose docs give the rule and its measurements),
+//!    keys when many do (`key_sort.rs`, whose docs give the rule),
 //!    and every other box is listed in each column its `u`, `v` extent meets (1 to 4
 //!    mostly), by a counting sort on the column filled in that order, so each column
 //!    comes out sorted by low end with no sort of its own.
-//!
-//!    Measured (`examples/broad_bench`, all bodies moving, alternating runs, means a
-//!    frame), kept columns against listing every frame: 1,000 uniform bodies 41.9–43.1 →
-//!    37.0–38.1 µs (kept in 355 of 400 frames, 9 proxies changing columns a frame; keeping
-//!    took 10.6 µs a frame where sorting the order and listing took 16.3), clustered
-//!    32.1–32.6 → 29.3–29.4; 10,000 uniform 440–444 → 418–421, clustered 414–415 →
-//!    370–375; 100,000 uniform 8.9–10.2 → 7.4–7.5 ms, clustered 10.1–11.0 → 7.6–8.9. The
-//!    frames between are listed: the shape is measured again every [`RESHAPE_FRAMES`]. At
-//!    10 % teleporting (1,000 of 10,000 proxies moved a frame, so listed every frame) the
-//!    check costs 442–445 → 463–467 µs; with a bound of one in eight it kept those
-//!    frames, at 672 µs.
 //! 4. Each column is swept: entry `i` meets the entries after it whose low end is at most
 //!    its high end. A pair meeting in several columns is reported from one only: the column
 //!    holding the low corner of the two boxes' `u`, `v` overlap, which is the column pair of
@@ -60,29 +47,14 @@
 //!    the floors). The entries carry each box rounded outward to `f32` (a rounded gap is an
 //!    exact one), so the sweep and the `u`, `v` test read only the column; the proxies are
 //!    read for the pairs that pass, for the exact box test and [`Proxy::may_pair`].
-//!
-//!    Measured (`examples/broad_bench`, 10,000 bodies all moving, alternating runs, means
-//!    µs a frame) against entries holding the exact ends on the sweep axis only, every
-//!    rule-passing candidate then reading both proxies: uniform 810–864 → 710, clustered
-//!    786–789 → 728–741, stacked 946–960 → 678–679; 100,000 uniform bodies the same (12.9
-//!    → 12.7 ms, one run). Of 31,700 candidates a frame (uniform) whose sweep-axis
-//!    intervals meet, 27,300 passed the column rule and 5,000 are pairs; the time went to
-//!    mispredicted branches, so the column rule and the `u`, `v` test are one branch.
+//!    The sweep's cost is its mispredicted branches, so the column rule and the `u`, `v`
+//!    test are one branch.
 //!
 //!    The sweep tests an entry against the next `LANES` (16) entries of its column at
 //!    once, every test of every lane without a branch (the column entries are stored one
 //!    array per field, so the compares vectorise), and branches only on the lanes that
-//!    pass and on whether the run goes on past the block, which it rarely does. Measured
-//!    (10,000 bodies all moving, alternating runs) against one candidate at a time:
-//!    clustered 578–610 → 545–567 µs a frame. Forcing `rounded_box` inline took the
-//!    same runs to 494–510: called, its six `f32` results went through memory and were
-//!    read back as wider words, a stalled store forwarding per proxy. Both together:
-//!    uniform 619–622 → 523–525, stacked 640–648 → 583–598, clustered teleporting 10 %
-//!    735 → 652–657, 1,000 clustered 37–38 → 35–37 (blocks of 8). Blocks of 16 against
-//!    8, later: uniform 489–490 → 458–463, clustered 463–469 → 442–449, stacked 553–559
-//!    → 504–505, clustered 10 % moving 443–454 → 417–420, 1,000 uniform 43.6 → 42.1,
-//!    1,000 clustered the same; 32 lanes measured slower than both (uniform 515–519 µs, in
-//!    another run of the same day), 64 slower still.
+//!    pass and on whether the run goes on past the block, which it rarely does
+//!    (`examples/broad_bench` measures the block width).
 //! 5. Big proxies against everything, the pairs sorted (`pair_sort.rs`: a radix sort).
 //!
 //! Ties: cells are `⌊(x − origin) / c⌋` of non-negative values (a truncating conversion),
@@ -105,13 +77,7 @@ use crate::math::{DVec3, f32_round_down, f32_round_up};
 ///
 /// Wider columns list each box in fewer columns (fewer entries to fill and sweep, fewer
 /// pairs met twice) but give each entry more sweep candidates; the sweep's cost is its
-/// mispredicted branches more than its candidates. Measured (`examples/broad_bench`, all
-/// bodies moving unless said, mean µs a frame, alternating runs) from 2 to 4: 10,000
-/// clustered 693–703 → 623–630, uniform 693–696 → 651–692, stacked 700 → 664; 1,000
-/// clustered 42 → 36, uniform 56 → 53; 100,000 clustered 11.4 → 10.8 ms; 10,000 clustered
-/// teleporting 10 % 869 → 765. At 3: 653–658 / 661–688 / 650 (10,000 clustered /
-/// uniform / stacked); at 6: 607 / 672–674 / 713; at 1.5, 739–750 at 10,000 on the
-/// first two.
+/// mispredicted branches more than its candidates (`examples/broad_bench`).
 pub const COLUMN_EDGE_PER_BOX: f64 = 4.0;
 /// The column grid is at most this many columns per proxy.
 pub const MAX_COLUMNS_PER_PROXY: usize = 4;
@@ -344,9 +310,7 @@ pub struct SortAndSweep {
     /// axis: kept between frames and insertion-sorted (linear when bodies move
     /// coherently), so the columns filled in this order come out sorted. The whole slot
     /// rides along, so the filling reads it in order rather than looking it up at random
-    /// (a cache miss per proxy in large scenes; measured with `examples/broad_bench`,
-    /// 100,000 uniform bodies all moving, three alternating runs: 23.1–34.4 →
-    /// 22.5–29.7 ms a frame, each run faster; at 10,000 bodies, and teleporting, alike).
+    /// (a cache miss per proxy in large scenes).
     /// Left as it is in frames whose columns are kept (module docs, step 3).
     order: Vec<(Slot, u32)>,
     /// Start of each column's entries in `entries` (one more than the columns).
@@ -362,8 +326,7 @@ pub struct SortAndSweep {
     /// Each proxy's first and last columns (`u` then `v`) as listed.
     listed_ranges: Vec<[u32; 4]>,
     /// Scratch of [`Self::relist_kept_columns`]: whether each proxy changed columns (a
-    /// flag read per entry: comparing the slot's columns with `listed_ranges` there instead
-    /// measured 3–6 % slower a frame), the ones that did, the entries they add (column,
+    /// flag read per entry), the ones that did, the entries they add (column,
     /// proxy, first bits), the new column starts, and the other buffer of the entries.
     changed: Vec<bool>,
     moved: Vec<u32>,
