@@ -23,18 +23,8 @@
 //! **Choosing the levels.** As for the [`HashGrid`](super::HashGrid): until the grid has held
 //! [`AUTO_SAMPLE`] bodies every body is oversized (all pairs tested: the right algorithm for
 //! so few). Then, and again whenever the body count has doubled since, the grid is rebuilt
-//! from all its bodies: the sweep axis is the one along which the box centres spread the
-//! most (the columns split the other two); `reach₀` is the 90th percentile of the bodies'
-//! positive largest extents, or the largest extent when that is within 1.5 × of it (one level
-//! for a narrow spread of sizes); levels are added until the coarsest reach is at least 4 ×
-//! the largest extent (up to [`MAX_LEVELS`]).
-//!
-//! **The column table.** A level's columns are a table of `2^a × 2^b` buckets, column
-//! `(i, j)` in bucket `(i mod 2^a, j mod 2^b)`: neighbouring columns are neighbouring buckets,
-//! and the table never needs growing, as columns farther apart than its size share a bucket
-//! (their bodies are told apart by the box test, at some cost in candidates). The size is
-//! chosen at each rebuild to cover the level's bodies' spread without aliasing, at most
-//! about two buckets per body.
+//! from all its bodies (`ColumnGrid::rebuild`). A level's columns are a fixed table of
+//! buckets, neighbouring columns in neighbouring buckets (`Level::size_table`).
 //!
 //! # Finding a body's pairs
 //! A body whose pairs must be refreshed (inserted, moved, removed) queries the union of its
@@ -551,8 +541,12 @@ impl ColumnGrid {
         }
     }
 
-    /// Chooses the axes and levels from every body and lists each afresh (module docs,
-    /// "Choosing the levels").
+    /// Chooses the axes and levels from every body and lists each afresh: the sweep axis is
+    /// the one along which the box centres spread the most (the columns split the other
+    /// two); `reach₀` is the 90th percentile of the bodies' positive largest extents, or the
+    /// largest extent when that is within 1.5 × of it (one level for a narrow spread of
+    /// sizes); levels are added until the coarsest reach is at least 4 × the largest extent
+    /// (up to [`MAX_LEVELS`]).
     fn rebuild(&mut self) {
         self.axes = Axes::with_sweep(super::sort_sweep::widest_spread_axis(&self.bodies.proxies));
         let mut extents: Vec<f64> = self

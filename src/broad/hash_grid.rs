@@ -10,15 +10,9 @@
 //! `ratio ≥ 2` ([`HashGrid::with_levels`]; [`DEFAULT_RATIO`] is 2). A body lives at the
 //! smallest level whose cell edge is at least its box's largest extent, so its box covers 1
 //! or 2 cells per axis there (3 when rounding puts an end a hair across a boundary): at most
-//! 8 cells, 27 at worst. That holds even far from the origin: on an axis where the box has
-//! positive extent, the extent is at least one ulp of its coordinates and at most the cell
-//! edge, so `coordinate / edge` stays below 2⁵⁴, where products are spaced at most 2 apart
-//! and the two ends' cell indices still differ by at most 2 (checked by `debug_assert!` on
-//! every registration). Cell `(i, j, l)` of level `k` holds the bodies of that level whose
-//! box meets it; only occupied cells exist, in a per-level hash map keyed by the three cell
-//! coordinates, hashed by a multiply–rotate absorb of each coordinate from a seed that is
-//! the level, then the SplitMix64 finaliser (every input bit reaches the high bits the map's
-//! control bytes use and the low bits its bucket index uses).
+//! 8 cells, 27 at worst, far from the origin too (`CellRange`). Cell `(i, j, l)` of level
+//! `k` holds the bodies of that level whose box meets it; only occupied cells exist, in a
+//! per-level hash map (`CellHasher`).
 //!
 //! **Oversized bodies.** A body larger than the coarsest cell (and every body before the
 //! levels are chosen, below) goes to the *oversized* list instead: it is tested against every
@@ -27,15 +21,9 @@
 //! each of their moves `O(n)`.
 //!
 //! **Choosing the levels.** [`HashGrid::with_levels`] fixes them. [`HashGrid::new`] chooses
-//! them from the first [`AUTO_SAMPLE`] bodies: until the grid has held that many at once,
-//! every body is oversized (all pairs tested, which is the right algorithm for so few); at the
-//! [`AUTO_SAMPLE`]-th insertion, `min_cell` is twice the 10th percentile of the bodies'
-//! positive largest extents (1 m if all are points), `ratio` is 2 and `count` the fewest
-//! levels whose coarsest cell is at least 4 × the largest extent seen (two spare levels for
-//! larger bodies later), at most [`MAX_LEVELS`]. Then every body is placed. A body's cell is
-//! then 1 to 2 times its extent at its level (more at level 0), so its box covers about 3 to
-//! 8 cells; cells of just its size would make most boxes straddle 8, and unit dice on a
-//! table would sit exactly at a level boundary, split over two levels.
+//! them from the first [`AUTO_SAMPLE`] bodies, all oversized until then (all pairs tested,
+//! which is the right algorithm for so few), so that a body's box covers about 3 to 8 cells
+//! of its level (`HashGrid::choose_levels_from_bodies`).
 //!
 //! # Finding a body's pairs
 //! A body at level `L` is listed in the cells its box covers at `L` and, flagged as coming
@@ -53,9 +41,8 @@
 //! and the finer body looks the coarser one up at the coarser level. Incrementally, a moved
 //! body must also find the bodies that did not move, finer or coarser, and this finds both
 //! with a few look-ups per level at or above its own, never by searching the many small
-//! cells of a finer level (a 2 m box looking for 0.25 m bodies would probe up to 512
-//! cells). Each candidate is tested once per query (stamps),
-//! by [`Aabb::intersects`] and [`Proxy::may_pair`](super::Proxy::may_pair). A body `b` whose pairs must be
+//! cells of a finer level. Each candidate is tested once per query (stamps), by
+//! [`Aabb::intersects`] and [`Proxy::may_pair`](super::Proxy::may_pair). A body whose pairs must be
 //! refreshed (inserted, moved, removed) queries its old box and, if it left or entered a cell
 //! at some queried level, its new box too: every old pair shares a cell with the old box and
 //! every new pair with the new box, so testing these candidates against the new box leaves
@@ -72,18 +59,14 @@
 //! only prune; the pair rule is [`Aabb::intersects`] (closed boxes), as in every broad phase.
 //!
 //! # Costs (`n` bodies, `k` pairs in the set, `c` candidates a body gathers)
-//! - [`update`](HashGrid::update): `O(c)` (two box tests per candidate, each tested once,
-//!   and a logged set edit only when the pair appeared or disappeared) plus, at its own level
-//!   and each coarser level with bodies of its own, up to 8 hash look-ups (27 at worst),
-//!   twice when the body left or entered a cell at one of them; the cell lists change only at
-//!   the levels where it left or entered a cell, or all when it changed level. A body that
-//!   is not updated costs nothing. `O(n)` for an oversized body, and every body also gathers
-//!   every oversized one.
-//! - [`insert`](HashGrid::insert), [`remove`](HashGrid::remove): one such query plus up to
-//!   8 cell-list edits per level at or above its own, and an `O(1)` slot move; the [`AUTO_SAMPLE`]-th insertion of
-//!   [`HashGrid::new`] also places every body once.
-//! - [`pairs`](HashGrid::pairs): `O(k + e log e)` for `e` pair changes since the last call
-//!   (the pair set's commit, `pair_set.rs`).
+//! - [`update`](HashGrid::update): `O(c)` box tests, each candidate once, and up to 8 hash
+//!   look-ups (27 at worst) per level at or above its own, twice when it left or entered a
+//!   cell there; only those levels' cell lists change. `O(n)` for an oversized body, and
+//!   every body gathers every oversized one. A body not updated costs nothing.
+//! - [`insert`](HashGrid::insert), [`remove`](HashGrid::remove): one such query and up to 8
+//!   cell-list edits per level at or above its own (the [`AUTO_SAMPLE`]-th insertion places
+//!   every body once).
+//! - [`pairs`](HashGrid::pairs): `O(k + e log e)` for `e` pair changes (`pair_set.rs`).
 //!
 //! # Input
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant), checked by
@@ -142,7 +125,9 @@ impl BuildHasher for BuildCellHasher {
     }
 }
 
-/// FxHash-style absorb (rotate, xor, multiply) with a SplitMix64 finaliser.
+/// FxHash-style absorb (rotate, xor, multiply) of each cell coordinate from a seed that is
+/// the level, with a SplitMix64 finaliser: every input bit reaches the high bits the map's
+/// control bytes use and the low bits its bucket index uses.
 #[derive(Debug, Clone, Copy)]
 struct CellHasher {
     state: u64,
@@ -175,6 +160,12 @@ impl Hasher for CellHasher {
 }
 
 /// The cells a box covers at one level: `lo[axis] ..= hi[axis]`.
+///
+/// At most 3 per axis for a box no wider than the cell, even far from the origin: on an
+/// axis where the box has positive extent, the extent is at least one ulp of its
+/// coordinates and at most the cell edge, so `coordinate / edge` stays below 2⁵⁴, where
+/// products are spaced at most 2 apart and the two ends' cell indices still differ by at
+/// most 2 (checked by `debug_assert!` on every registration).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct CellRange {
     lo: [i64; 3],
@@ -422,7 +413,14 @@ impl HashGrid {
         );
     }
 
-    /// The automatic level choice (module docs), then every body placed.
+    /// The automatic level choice, then every body placed: at the [`AUTO_SAMPLE`]-th
+    /// insertion, `min_cell` is twice the 10th percentile of the bodies' positive largest
+    /// extents (1 m if all are points), `ratio` is 2 and `count` the fewest levels whose
+    /// coarsest cell is at least 4 × the largest extent seen (two spare levels for larger
+    /// bodies later), at most [`MAX_LEVELS`]. A body's cell is then 1 to 2 times its extent
+    /// at its level (more at level 0), so its box covers about 3 to 8 cells; cells of just
+    /// its size would make most boxes straddle 8, and unit dice on a table would sit exactly
+    /// at a level boundary, split over two levels.
     fn choose_levels_from_bodies(&mut self) {
         let mut extents: Vec<f64> = self
             .bodies

@@ -74,17 +74,6 @@
 //! - A move out of it: a column grid move (module docs of [`ColumnGrid`]) of the fat box,
 //!   plus constant work per neighbour gained or lost (each entry knows its twin).
 //! - Teleports leave the skin every time: the column grid alone is the better choice then.
-//!
-//! # Invariants (checked by [`SkinGrid::validate`])
-//! - Every body's true box lies inside its fat box, and the grid holds exactly the fat
-//!   boxes (its own invariants hold).
-//! - The neighbour lists are symmetric, and hold exactly the pairs of overlapping fat
-//!   boxes that may pair, each once per side; an entry's overlap flag says whether the
-//!   true boxes overlap.
-//! - The two entries of a pair share its budget as whole and none (the latter always
-//!   due) or half each, and what the two may still travel fits in the pair's room now.
-//! - The pair set is exactly the flagged neighbours: the brute-force pairs of the true
-//!   boxes.
 
 use super::body_map::Bodies;
 use super::column_grid::ColumnGrid;
@@ -388,6 +377,17 @@ impl std::ops::IndexMut<usize> for Neighbours {
 }
 
 /// The skin grid (see the [module docs](self)).
+///
+/// # Invariants (checked by [`validate`](SkinGrid::validate))
+/// - Every body's true box lies inside its fat box, and the grid holds exactly the fat
+///   boxes (its own invariants hold).
+/// - The neighbour lists are symmetric, and hold exactly the pairs of overlapping fat
+///   boxes that may pair, each once per side; an entry's overlap flag says whether the
+///   true boxes overlap.
+/// - The two entries of a pair share its budget as whole and none (the latter always
+///   due) or half each, and what the two may still travel fits in the pair's room now.
+/// - The pair set is exactly the flagged neighbours: the brute-force pairs of the true
+///   boxes.
 #[derive(Debug, Clone, Default)]
 pub struct SkinGrid {
     /// The fat boxes, filed; its pair edits are taken as neighbour changes.
@@ -755,7 +755,7 @@ impl StatefulBroadPhase for SkinGrid {
         self.pairs.list(out);
     }
 
-    /// Checks every invariant (module docs).
+    /// Checks every invariant ([`SkinGrid`]'s docs).
     fn validate(&self) -> Result<(), String> {
         self.bodies.check()?;
         self.grid.validate_listing()?;

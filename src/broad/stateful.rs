@@ -196,7 +196,7 @@ macro_rules! stateful_api {
                 $crate::broad::stateful::StatefulBroadPhase::pairs(self, out);
             }
 
-            /// Checks every invariant (module docs). `O(n²)`: for tests.
+            /// Checks every invariant (the type's or module's docs). `O(n²)`: for tests.
             ///
             /// # Errors
             /// A description of the first violated invariant.

@@ -201,6 +201,12 @@ impl Level {
     }
 
     /// Sizes the (empty) table for bodies whose low corners span `span_u × span_v` metres.
+    ///
+    /// The table has `2^a × 2^b` buckets, column `(i, j)` in bucket `(i mod 2^a, j mod
+    /// 2^b)`: neighbouring columns are neighbouring buckets, and the table never needs
+    /// growing, as columns farther apart than its size share a bucket (their bodies are told
+    /// apart by the box test, at some cost in candidates). It covers the level's bodies'
+    /// spread without aliasing, at most about two buckets per body.
     pub(super) fn size_table(&mut self, span_u: f64, span_v: f64) {
         let cells = |span: f64| {
             let c = (span * self.inv_width).ceil() + 2.0;
