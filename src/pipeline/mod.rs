@@ -131,19 +131,23 @@
 
 mod answer;
 mod broad_sync;
-pub mod budget;
 mod frontier_run;
 mod pair_memory;
+mod plan;
 mod separation;
 mod toi;
 pub mod workers;
 
+pub use crate::budget::Budget;
 pub use crate::narrow::dispatch::PathCounts;
-pub use budget::{Budget, Deadline, FRONTIER_RESERVE, Unlimited, VisitBudget, frontier_deadline};
+pub use plan::{
+    Deadline, FRONTIER_RESERVE, PUBLISH_RESERVE, Unlimited, VisitBudget, frontier_deadline,
+};
+use plan::{FramePlan, PairPlan};
 pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{BroadPhaseKind, BroadPhaseStats, CandidatePair};
-use crate::math::{DVec3, Pose};
+use crate::math::DVec3;
 use crate::narrow::MeshShape;
 use crate::narrow::Shape;
 use crate::narrow::contact::Manifold;
@@ -155,9 +159,10 @@ pub use broad_sync::AUTO_REMEASURE_FRAMES;
 use broad_sync::BroadSync;
 use frontier_run::{FrontierRun, run_frontier};
 use pair_memory::PairMemories;
-use separation::Separation;
+use separation::mark_separated;
 use std::sync::Arc;
 use std::time::Instant;
+use toi::answer_tois;
 pub use workers::{MIN_PARALLEL_MESH_PAIRS, WorkerPool};
 use workers::{MeshJob, MeshOutcome};
 
@@ -399,6 +404,16 @@ pub struct PipelineWorkspace {
 }
 
 impl PipelineWorkspace {
+    /// Starts a frame: `results` emptied, the dispatcher's counters reset, and the pairs'
+    /// memory stamping the pairs this frame visits.
+    fn begin_frame(&mut self, results: &mut FrameResults) {
+        self.memory.begin_frame();
+        results.pairs.clear();
+        results.contacts.clear();
+        results.tois.clear();
+        self.narrow.paths = PathCounts::default();
+    }
+
     /// A workspace that answers mesh–mesh pairs on `workers` too (when a frame has at least
     /// [`MIN_PARALLEL_MESH_PAIRS`] of them). Results are identical with or without.
     #[must_use]
@@ -516,11 +531,7 @@ pub fn step_within(
     results: &mut FrameResults,
 ) -> StepReport {
     let started = Instant::now();
-    workspace.memory.begin_frame();
-    results.pairs.clear();
-    results.contacts.clear();
-    results.tois.clear();
-    workspace.narrow.paths = PathCounts::default();
+    workspace.begin_frame(results);
     let broad = workspace.broad.candidates(
         scene,
         query,
@@ -529,28 +540,82 @@ pub fn step_within(
     );
     let broad_ns = elapsed_ns(started);
     let started = Instant::now();
-    let limited = !budget.is_unlimited() && query.at_current_poses();
-    let mut mid_ns = 0;
-    let mut frontier_stats = FrontierStats::default();
-    let hull_tests;
-    if limited {
-        let mut reserved = budget.deadline().map(|d| frontier_deadline(started, d));
-        let frontier_budget: &mut dyn Budget = match reserved.as_mut() {
-            Some(deadline) => deadline,
-            None => &mut *budget,
-        };
-        // The hull tests spend the frontier's budget, a visit each: one settles a pair
-        // for the price of a few visits.
-        hull_tests = mark_separated(scene, query, Some(&mut *frontier_budget), workspace);
-        frontier_stats = run_frontier(scene, query, frontier_budget, hull_tests, workspace);
-        mid_ns = elapsed_ns(started);
-    } else {
-        hull_tests = mark_separated(scene, query, None, workspace);
-    }
+    let mut plan = FramePlan::new(&*budget, query);
+    let (hull_tests, frontier) = mid_phase(scene, query, budget, &plan, started, workspace);
+    let mid_ns = if plan.limited { elapsed_ns(started) } else { 0 };
     // Unbudgeted, the hull tests answer pairs as the narrow phase does: its time.
-    let started = if limited { Instant::now() } else { started };
-    let mut completeness = Completeness::Exact;
-    let mut truncated_pairs = 0;
+    let started = if plan.limited {
+        Instant::now()
+    } else {
+        started
+    };
+    plan.pool = answer_on_pool(scene, query, &plan, workspace);
+    let tally = answer_candidates(scene, query, &mut plan, workspace, results);
+    let tois = answer_tois(scene, &*budget, workspace, results);
+    let completeness = if tois.expired {
+        tally.completeness.truncated_at(0)
+    } else {
+        tally.completeness
+    };
+    StepReport {
+        completeness,
+        broad_ns,
+        narrow_ns: elapsed_ns(started),
+        candidates: index(workspace.candidates.len()),
+        toi_candidates: index(workspace.toi_candidates.len()),
+        pairs: index(results.pairs.len()),
+        contacts: index(results.contacts.len()),
+        tois: index(results.tois.len()),
+        broad_kind: broad.kind,
+        broad_updates: index(broad.updates),
+        broad_stats: broad.stats,
+        paths: workspace.narrow.paths,
+        reused_pairs: tally.reused,
+        separated_pairs: tally.separated,
+        hull_tests: index(hull_tests as usize),
+        mid_ns,
+        frontier,
+        truncated_pairs: tally.truncated,
+        truncated_tois: tois.truncated,
+    }
+}
+
+/// The mid phase: the hull tests and kept separations that prove mesh pairs apart
+/// ([`mark_separated`]) and, under a limited budget, the frontier over the mesh pairs left
+/// ([`run_frontier`]), on a deadline moved earlier by [`frontier_deadline`] so the rest of
+/// the frame has time. Returns the hull tests made and the frontier's counters.
+fn mid_phase(
+    scene: &Scene,
+    query: Query,
+    budget: &mut dyn Budget,
+    plan: &FramePlan,
+    started: Instant,
+    workspace: &mut PipelineWorkspace,
+) -> (u64, FrontierStats) {
+    if !plan.limited {
+        let tests = mark_separated(scene, query, None, workspace);
+        return (tests, FrontierStats::default());
+    }
+    let mut reserved = budget.deadline().map(|d| frontier_deadline(started, d));
+    let frontier_budget: &mut dyn Budget = match reserved.as_mut() {
+        Some(deadline) => deadline,
+        None => budget,
+    };
+    // The hull tests spend the frontier's budget, a visit each: one settles a pair for the
+    // price of a few visits.
+    let tests = mark_separated(scene, query, Some(&mut *frontier_budget), workspace);
+    let stats = run_frontier(scene, query, frontier_budget, tests, workspace);
+    (tests, stats)
+}
+
+/// Answers the frame's mesh–mesh pairs on the worker pool, into `workspace.outcomes`, when
+/// the plan lets it ([`FramePlan::wants_pool`]); returns whether it did.
+fn answer_on_pool(
+    scene: &Scene,
+    query: Query,
+    plan: &FramePlan,
+    workspace: &mut PipelineWorkspace,
+) -> bool {
     let PipelineWorkspace {
         candidates,
         mesh,
@@ -559,314 +624,210 @@ pub fn step_within(
         workers,
         outcomes,
         job_contacts,
-        narrow,
-        manifold,
-        toi_candidates,
-        frontier_answers,
-        frontier_pairs,
         ..
     } = workspace;
-    let is_kept = |pair: &CandidatePair| memory.kept_answer(scene, pair, query).is_some();
     outcomes.clear();
-    let parallel = workers.as_ref().filter(|_| {
-        !limited
-            && candidates
-                .iter()
-                .zip(separated.iter())
-                .filter(|&(pair, &apart)| {
-                    !apart && mesh_pair(scene, pair).is_some() && !is_kept(pair)
-                })
-                .take(MIN_PARALLEL_MESH_PAIRS)
-                .count()
-                == MIN_PARALLEL_MESH_PAIRS
+    // The mesh pairs no kept answer or separation answers, by candidate slot.
+    let needed = || {
+        candidates.iter().enumerate().filter(|&(slot, pair)| {
+            !separated[slot]
+                && mesh_pair(scene, pair).is_some()
+                && memory.kept_answer(scene, pair, query).is_none()
+        })
+    };
+    let Some(pool) = workers.as_ref().filter(|_| plan.wants_pool(needed())) else {
+        return false;
+    };
+    let jobs = needed().map(|(slot, pair)| {
+        let (mesh_a, mesh_b) = mesh_pair(scene, pair).expect("a mesh pair");
+        MeshJob {
+            slot: index(slot),
+            pair: *pair,
+            a: *body(scene, pair.a),
+            b: *body(scene, pair.b),
+            mesh_a: Arc::clone(mesh_a),
+            mesh_b: Arc::clone(mesh_b),
+            query,
+            cache: memory.mesh_cache(pair),
+        }
     });
-    if let Some(pool) = parallel {
-        let jobs = candidates.iter().enumerate().filter_map(|(slot, pair)| {
-            if is_kept(pair) || separated[slot] {
-                return None;
-            }
-            let (mesh_a, mesh_b) = mesh_pair(scene, pair)?;
-            Some(MeshJob {
-                slot: index(slot),
-                pair: *pair,
-                a: *body(scene, pair.a),
-                b: *body(scene, pair.b),
-                mesh_a: Arc::clone(mesh_a),
-                mesh_b: Arc::clone(mesh_b),
-                query,
-                cache: memory.mesh_cache(pair),
-            })
-        });
-        pool.answer_all(jobs, outcomes, mesh, job_contacts);
-    }
-    let mut pooled = outcomes.iter();
-    let mut from_frontier = frontier_pairs.iter().zip(frontier_answers.iter());
-    let (mut reused, mut separated_pairs) = (0, 0);
-    // Pairs off the frontier's route keep to the frame's deadline too: once it is near,
-    // the rest get their world boxes' conservative answer.
-    let mut pair_clock = PairClock::new(budget.deadline().filter(|_| limited));
+    pool.answer_all(jobs, outcomes, mesh, job_contacts);
+    true
+}
+
+/// What the per-pair stage counted.
+struct PairTally {
+    /// The shallowest level of the pairs answered short of exact.
+    completeness: Completeness,
+    /// Pairs answered by their kept answer.
+    reused: u32,
+    /// Pairs answered apart by a kept separation or their hulls.
+    separated: u32,
+    /// Pairs answered short of exact.
+    truncated: u32,
+}
+
+/// Answers every candidate pair by its plan ([`FramePlan::pair`]), reusing kept answers,
+/// and writes the records the query reports to `results`; keeps what each pair remembers
+/// ([`pair_memory`]).
+fn answer_candidates(
+    scene: &Scene,
+    query: Query,
+    plan: &mut FramePlan,
+    workspace: &mut PipelineWorkspace,
+    results: &mut FrameResults,
+) -> PairTally {
+    let mut tally = PairTally {
+        completeness: Completeness::Exact,
+        reused: 0,
+        separated: 0,
+        truncated: 0,
+    };
+    let PipelineWorkspace {
+        candidates,
+        memory,
+        separated,
+        frontier_answers,
+        frontier_pairs,
+        outcomes,
+        narrow,
+        manifold,
+        mesh,
+        ..
+    } = workspace;
+    let mut sources = AnswerSources {
+        pooled: outcomes.iter(),
+        frontier: frontier_pairs.iter().zip(frontier_answers.iter()),
+        narrow,
+        manifold,
+        mesh,
+    };
     for (slot, pair) in candidates.iter().enumerate() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let first_contact = results.contacts.len();
-        let contacts = &mut results.contacts;
         memory.visit(pair);
         if let Some(k) = memory.kept_answer(scene, pair, query) {
-            reused += 1;
-            contacts.extend_from_slice(&k.contacts);
+            tally.reused += 1;
+            results.contacts.extend_from_slice(&k.contacts);
             debug_assert!(k.answer.result.exact, "only exact answers are kept");
             report(query, k.answer, (a, b), first_contact, results);
             continue;
         }
+        let pair_plan = plan.pair(shape(scene, a), shape(scene, b), separated[slot]);
+        let (answer, truncated_level) = sources.answer(
+            scene,
+            query,
+            (slot, pair),
+            &pair_plan,
+            memory,
+            &mut results.contacts,
+        );
+        tally.separated += u32::from(matches!(pair_plan, PairPlan::Separated));
+        tally.truncated += u32::from(matches!(pair_plan, PairPlan::Conservative))
+            + u32::from(truncated_level.is_some());
+        if pair_plan.searches_mesh_pair() {
+            memory.remember_search(scene, pair, (a, b), answer.apart_by);
+        }
+        if answer.result.exact {
+            let contacts = &results.contacts[first_contact..];
+            memory.keep_answer(scene, pair, (a, b), query, answer, contacts);
+        } else {
+            // A truncated frontier answer, or the worker pool's fallback box answer (level
+            // 0: world boxes).
+            tally.completeness = tally
+                .completeness
+                .truncated_at(truncated_level.unwrap_or(0));
+            memory.entry(pair).answer = None;
+        }
+        report(query, answer, (a, b), first_contact, results);
+    }
+    memory.forget_unvisited();
+    tally
+}
+
+/// Where a pair's answer comes from besides its own query: the pool's outcomes and the
+/// frontier's answers, both in candidate order, and this thread's scratch.
+struct AnswerSources<'w> {
+    pooled: std::slice::Iter<'w, MeshOutcome>,
+    frontier:
+        std::iter::Zip<std::slice::Iter<'w, CandidatePair>, std::slice::Iter<'w, FrontierAnswer>>,
+    narrow: &'w mut NarrowScratch,
+    manifold: &'w mut Manifold,
+    mesh: &'w mut MeshScratch,
+}
+
+impl AnswerSources<'_> {
+    /// The answer of `pair` (candidate `slot`) by `plan`, its contacts appended to
+    /// `contacts`, and the level it was truncated at when the frontier left it unfinished.
+    fn answer(
+        &mut self,
+        scene: &Scene,
+        query: Query,
+        (slot, pair): (usize, &CandidatePair),
+        plan: &PairPlan<'_>,
+        memory: &mut PairMemories,
+        contacts: &mut Vec<ContactPoint>,
+    ) -> (Answer, Option<u32>) {
+        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let (sa, sb) = (shape(scene, a), shape(scene, b));
-        let mut truncated_level = None;
-        let route = dispatch::route(sa, sb);
-        // Whether this frame's search may leave or lapse the pair's separation.
-        let searched_mesh_pair = matches!(route, Route::MeshMesh(..)) && !separated[slot];
-        let answer = match (route, parallel) {
+        let narrow = &mut *self.narrow;
+        let answer = match *plan {
             // Proven apart by a kept separation, which stays as it is (`DISTANCE` frames
             // never come here). Kept as an answer too, so an unchanged pair is reused.
-            _ if separated[slot] => {
-                separated_pairs += 1;
-                answer::apart(pair, None)
-            }
-            (Route::Direct, _)
-                if !dispatch::exact_costs_no_more_than_boxes(sa, sb) && pair_clock.expired() =>
-            {
-                truncated_pairs += 1;
+            PairPlan::Separated => answer::apart(pair, None),
+            PairPlan::Conservative => {
                 answer::conservative(pair, (a, sa), (b, sb), query, narrow, contacts)
             }
-            (Route::Direct, _) => {
-                answer::direct(pair, (a, sa), (b, sb), query, narrow, manifold, contacts)
-            }
-            (Route::MeshMesh(ma, mb), _) if limited => {
+            PairPlan::Direct => answer::direct(
+                pair,
+                (a, sa),
+                (b, sb),
+                query,
+                narrow,
+                self.manifold,
+                contacts,
+            ),
+            PairPlan::Frontier(ma, mb) => {
                 narrow.paths.mesh_mesh += 1;
-                let (_, found) = from_frontier
+                let (_, found) = self
+                    .frontier
                     .find(|(p, _)| *p == pair)
                     .expect("a frontier answer for every mesh pair not kept");
-                match found.completeness {
-                    Completeness::Exact => answer::mesh_mesh_finished(
-                        pair,
-                        (a, ma),
-                        (b, mb),
-                        query,
-                        found,
-                        &mut memory.entry(pair).mesh_cache,
-                        mesh,
-                        contacts,
-                    ),
-                    Completeness::Truncated { level } => {
-                        truncated_pairs += 1;
-                        truncated_level = Some(level);
-                        answer::mesh_mesh_truncated(pair, (a, b), query, found, contacts)
-                    }
-                }
+                let Completeness::Truncated { level } = found.completeness else {
+                    let cache = &mut memory.entry(pair).mesh_cache;
+                    let mesh = &mut *self.mesh;
+                    return (
+                        answer::mesh_mesh_finished(
+                            pair,
+                            (a, ma),
+                            (b, mb),
+                            query,
+                            found,
+                            cache,
+                            mesh,
+                            contacts,
+                        ),
+                        None,
+                    );
+                };
+                let truncated = answer::mesh_mesh_truncated(pair, (a, b), query, found, contacts);
+                return (truncated, Some(level));
             }
-            (Route::MeshMesh(..), Some(_)) => {
+            PairPlan::Pooled => {
                 narrow.paths.mesh_mesh += 1;
-                let outcome = pooled.next().expect("one pool outcome per mesh pair");
+                let outcome = self.pooled.next().expect("one pool outcome per mesh pair");
                 debug_assert_eq!(outcome.slot as usize, slot);
                 contacts.extend_from_slice(outcome.contacts());
                 memory.entry(pair).mesh_cache = outcome.cache;
                 outcome.answer
             }
-            (Route::MeshMesh(ma, mb), None) => {
+            PairPlan::MeshMesh(ma, mb) => {
                 narrow.paths.mesh_mesh += 1;
-                answer::mesh_mesh(
-                    pair,
-                    (a, ma),
-                    (b, mb),
-                    query,
-                    &mut memory.entry(pair).mesh_cache,
-                    mesh,
-                    contacts,
-                )
+                let cache = &mut memory.entry(pair).mesh_cache;
+                answer::mesh_mesh(pair, (a, ma), (b, mb), query, cache, self.mesh, contacts)
             }
         };
-        if searched_mesh_pair {
-            match answer.apart_by {
-                Some(bound) => {
-                    let kept = memory.entry(pair);
-                    kept.separation = Some(Separation::new(scene, (a, b), bound));
-                    kept.seed = None;
-                }
-                None => memory.entry(pair).separation = None,
-            }
-        }
-        if !answer.result.exact {
-            // A truncated frontier answer, or the worker pool's fallback box answer (level
-            // 0: world boxes).
-            completeness = completeness.truncated_at(truncated_level.unwrap_or(0));
-            report(query, answer, (a, b), first_contact, results);
-            memory.entry(pair).answer = None;
-            continue;
-        }
-        let contacts = &results.contacts[first_contact..];
-        memory.keep_answer(scene, pair, (a, b), query, answer, contacts);
-        report(query, answer, (a, b), first_contact, results);
-    }
-    memory.forget_unvisited();
-    // Time of impact keeps to the frame's deadline too (`toi.rs`, "Under a deadline").
-    let mut toi_clock = PairClock::new(budget.deadline());
-    let mut truncated_tois = 0;
-    for pair in toi_candidates.iter() {
-        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        if toi_clock.expired() {
-            truncated_tois += 1;
-            results.tois.push(toi::unsearched(scene, pair, a, b));
-            continue;
-        }
-        let shapes = (shape(scene, a), shape(scene, b));
-        let searched = toi::pair_toi(scene, pair, (a, shapes.0), (b, shapes.1), narrow, || {
-            !toi_clock.expired()
-        });
-        if let Some(toi) = searched {
-            results.tois.push(toi);
-        }
-    }
-    // Set once a candidate went unsearched or a search stopped at the deadline.
-    if toi_clock.expired {
-        completeness = completeness.truncated_at(0);
-    }
-    StepReport {
-        completeness,
-        broad_ns,
-        narrow_ns: elapsed_ns(started),
-        candidates: index(candidates.len()),
-        toi_candidates: index(toi_candidates.len()),
-        pairs: index(results.pairs.len()),
-        contacts: index(results.contacts.len()),
-        tois: index(results.tois.len()),
-        broad_kind: broad.kind,
-        broad_updates: index(broad.updates),
-        broad_stats: broad.stats,
-        paths: narrow.paths,
-        reused_pairs: reused,
-        separated_pairs,
-        hull_tests: index(hull_tests as usize),
-        mid_ns,
-        frontier: frontier_stats,
-        truncated_pairs,
-        truncated_tois,
-    }
-}
-
-/// Marks in `workspace.separated` the candidates answered "apart" with no traversal:
-/// mesh–mesh pairs no kept answer covers, under a query that does not ask the distance,
-/// whose separation's bound, less the relative motion since, still exceeds their margins,
-/// or, failing that, whose meshes' hulls are apart by more than the margins (a new
-/// separation; module docs, "Separations proved by the hulls"). Hull tests stop once
-/// `budget` (a budgeted frame's frontier budget) refuses the tests made so far. Returns
-/// how many it made. Forgets the separations and hull memories of pairs that are no
-/// longer candidates.
-fn mark_separated(
-    scene: &Scene,
-    query: Query,
-    mut budget: Option<&mut dyn Budget>,
-    workspace: &mut PipelineWorkspace,
-) -> u64 {
-    let PipelineWorkspace {
-        candidates,
-        memory,
-        separated,
-        ..
-    } = workspace;
-    let (mut tests, mut refused) = (0u64, false);
-    separated.clear();
-    if query.distance {
-        separated.resize(candidates.len(), false);
-        return 0;
-    }
-    separated.extend(candidates.iter().map(|pair| {
-        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        if memory.kept_answer(scene, pair, query).is_some() {
-            return false;
-        }
-        let margins = a.margin + b.margin;
-        if let Some(separation) = memory.get(pair).and_then(|m| m.separation.as_ref())
-            && separation
-                .lower_bound_now(scene, (a, b))
-                .is_some_and(|bound| bound > margins)
-        {
-            return true;
-        }
-        let Some((ma, mb)) = mesh_pair(scene, pair) else {
-            return false;
-        };
-        let (Some(ha), Some(hb)) = (&ma.hull, &mb.hull) else {
-            return false;
-        };
-        let pose = Pose::relative(&a.pose, &b.pose);
-        let kept = memory.entry(pair);
-        let cache = &mut kept.hull;
-        if cache.met_at == Some(pose) {
-            // Tested at this very pose (a resting pair, a resumed frame): no proof.
-            return false;
-        }
-        if let Some(budget) = budget.as_deref_mut()
-            && (refused || (tests % HULL_TESTS_PER_POLL == 0 && !budget.allows(tests)))
-        {
-            refused = true;
-            return false;
-        }
-        tests += 1;
-        match ha.gap(hb, &pose.to_isometry(), &mut cache.gjk) {
-            Some(gap) if gap > margins => {
-                cache.met_at = None;
-                kept.separation = Some(Separation::new(scene, (a, b), gap));
-                true
-            }
-            _ => {
-                cache.met_at = Some(pose);
-                false
-            }
-        }
-    }));
-    tests
-}
-
-/// Hull tests between two polls of a budgeted frame's budget (a test costs 0.2–1 µs).
-const HULL_TESTS_PER_POLL: u64 = 2;
-
-/// Time kept back from a frame's deadline for writing and publishing its results, when the
-/// pairs off the frontier are cut short (`PairClock`). 30 µs: an estimate of the daemon's
-/// publish stage (loan, write, send, notify) on the 2-core VM, to be replaced by a measured
-/// value.
-pub const PUBLISH_RESERVE: std::time::Duration = std::time::Duration::from_micros(30);
-
-/// Pairs answered between two looks at the clock by [`PairClock`]: a closed form costs
-/// tens of nanoseconds, GJK or a convex–mesh walk a few microseconds.
-const PAIRS_PER_CLOCK_CHECK: u32 = 8;
-
-/// The deadline of the per-pair loop: [`PUBLISH_RESERVE`] before the frame's, checked every
-/// [`PAIRS_PER_CLOCK_CHECK`] pairs; once passed, it stays passed.
-struct PairClock {
-    deadline: Option<Instant>,
-    count: u32,
-    expired: bool,
-}
-
-impl PairClock {
-    fn new(frame_deadline: Option<Instant>) -> Self {
-        Self {
-            deadline: frame_deadline.map(|d| d.checked_sub(PUBLISH_RESERVE).unwrap_or(d)),
-            count: 0,
-            expired: false,
-        }
-    }
-
-    /// Whether the next pair must take the conservative box answer.
-    fn expired(&mut self) -> bool {
-        if self.expired {
-            return true;
-        }
-        let Some(deadline) = self.deadline else {
-            return false;
-        };
-        self.count += 1;
-        if self.count.is_multiple_of(PAIRS_PER_CLOCK_CHECK) || self.count == 1 {
-            self.expired = Instant::now() >= deadline;
-        }
-        self.expired
+        (answer, None)
     }
 }
 

@@ -99,7 +99,9 @@ impl PairMemories {
     /// Whether every record was visited by the current frame (for tests).
     #[cfg(test)]
     pub(super) fn all_visited_this_frame(&self) -> bool {
-        self.records.values().all(|record| record.stamp == self.frame)
+        self.records
+            .values()
+            .all(|record| record.stamp == self.frame)
     }
 
     /// The kept answer of `pair` when it answers `pair` of `scene` under `query` now.
@@ -119,6 +121,27 @@ impl PairMemories {
             .get(pair)
             .map(|record| record.mesh_cache)
             .unwrap_or_default()
+    }
+
+    /// Remembers what this frame's search of mesh pair `pair` (bodies `a`, `b`) found:
+    /// `apart_by`, a proven lower bound of its distance beyond its margins, becomes its
+    /// separation (and its frontier seed, a proof of closeness, lapses); none lapses the
+    /// separation it had.
+    pub(super) fn remember_search(
+        &mut self,
+        scene: &Scene,
+        pair: &CandidatePair,
+        (a, b): (&Body, &Body),
+        apart_by: Option<f64>,
+    ) {
+        let record = self.entry(pair);
+        match apart_by {
+            Some(bound) => {
+                record.separation = Some(Separation::new(scene, (a, b), bound));
+                record.seed = None;
+            }
+            None => record.separation = None,
+        }
     }
 
     /// Keeps `answer`, exact, with its world-frame `contacts`, as the answer of `pair`

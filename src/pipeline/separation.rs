@@ -8,6 +8,8 @@
 //! ("apart") is the exact answer of a query that does not ask the distance, so frames that
 //! use it are as exact as frames that traverse.
 
+use super::{PipelineWorkspace, Query, body, mesh_pair};
+use crate::budget::Budget;
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::scene::{Body, Scene, ShapeId};
 
@@ -67,6 +69,83 @@ pub(super) fn relative_drift(then: &Pose, now: &Pose, reach_a: f64, reach_b: f64
     let scale = then.position.length() + now.position.length() + reach_a + reach_b;
     seen_from_a.min(seen_from_b) + 4.0 * conservative_slack(scale)
 }
+
+/// Marks in `workspace.separated` the candidates answered "apart" with no traversal:
+/// mesh–mesh pairs no kept answer covers, under a query that does not ask the distance,
+/// whose separation's bound, less the relative motion since, still exceeds their margins,
+/// or, failing that, whose meshes' hulls are apart by more than the margins (a new
+/// separation; module docs, "Separations proved by the hulls"). Hull tests stop once
+/// `budget` (a budgeted frame's frontier budget) refuses the tests made so far. Returns
+/// how many it made. Forgets the separations and hull memories of pairs that are no
+/// longer candidates.
+pub(super) fn mark_separated(
+    scene: &Scene,
+    query: Query,
+    mut budget: Option<&mut dyn Budget>,
+    workspace: &mut PipelineWorkspace,
+) -> u64 {
+    let PipelineWorkspace {
+        candidates,
+        memory,
+        separated,
+        ..
+    } = workspace;
+    let (mut tests, mut refused) = (0u64, false);
+    separated.clear();
+    if query.distance {
+        separated.resize(candidates.len(), false);
+        return 0;
+    }
+    separated.extend(candidates.iter().map(|pair| {
+        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+        if memory.kept_answer(scene, pair, query).is_some() {
+            return false;
+        }
+        let margins = a.margin + b.margin;
+        if let Some(separation) = memory.get(pair).and_then(|m| m.separation.as_ref())
+            && separation
+                .lower_bound_now(scene, (a, b))
+                .is_some_and(|bound| bound > margins)
+        {
+            return true;
+        }
+        let Some((ma, mb)) = mesh_pair(scene, pair) else {
+            return false;
+        };
+        let (Some(ha), Some(hb)) = (&ma.hull, &mb.hull) else {
+            return false;
+        };
+        let pose = Pose::relative(&a.pose, &b.pose);
+        let kept = memory.entry(pair);
+        let cache = &mut kept.hull;
+        if cache.met_at == Some(pose) {
+            // Tested at this very pose (a resting pair, a resumed frame): no proof.
+            return false;
+        }
+        if let Some(budget) = budget.as_deref_mut()
+            && (refused || (tests % HULL_TESTS_PER_POLL == 0 && !budget.allows(tests)))
+        {
+            refused = true;
+            return false;
+        }
+        tests += 1;
+        match ha.gap(hb, &pose.to_isometry(), &mut cache.gjk) {
+            Some(gap) if gap > margins => {
+                cache.met_at = None;
+                kept.separation = Some(Separation::new(scene, (a, b), gap));
+                true
+            }
+            _ => {
+                cache.met_at = Some(pose);
+                false
+            }
+        }
+    }));
+    tests
+}
+
+/// Hull tests between two polls of a budgeted frame's budget (a test costs 0.2–1 µs).
+const HULL_TESTS_PER_POLL: u64 = 2;
 
 #[cfg(test)]
 mod tests {

@@ -30,8 +30,10 @@
 //! lower bound) and those boxes' witnesses and normal. No pair that comes within contact
 //! is ever left out, and none is reported later than its first contact.
 
-use super::Query;
+use super::plan::PairClock;
+use super::{FrameResults, PipelineWorkspace, Query, body, shape};
 use crate::broad::CandidatePair;
+use crate::budget::Budget;
 use crate::math::{DVec3, Pose};
 use crate::narrow::Shape;
 use crate::narrow::contact::ShapeDistance;
@@ -167,5 +169,49 @@ pub(super) fn unsearched(scene: &Scene, pair: &CandidatePair, a: &Body, b: &Body
         normal: boxes.normal,
         reached: false,
         exact: false,
+    }
+}
+/// What the time-of-impact stage did under the frame's deadline.
+pub(super) struct ToiTally {
+    /// Candidates left unsearched ([`unsearched`]).
+    pub(super) truncated: u32,
+    /// The deadline came: some candidate went unsearched or a search stopped at it.
+    pub(super) expired: bool,
+}
+
+/// The time of impact of every swept-box candidate of the frame, into `results.tois`,
+/// keeping to the frame's deadline ("Under a deadline", module docs).
+pub(super) fn answer_tois(
+    scene: &Scene,
+    budget: &dyn Budget,
+    workspace: &mut PipelineWorkspace,
+    results: &mut FrameResults,
+) -> ToiTally {
+    let PipelineWorkspace {
+        toi_candidates,
+        narrow,
+        ..
+    } = workspace;
+    let mut toi_clock = PairClock::new(budget.deadline());
+    let mut truncated = 0;
+    for pair in toi_candidates.iter() {
+        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+        if toi_clock.expired() {
+            truncated += 1;
+            results.tois.push(unsearched(scene, pair, a, b));
+            continue;
+        }
+        let shapes = (shape(scene, a), shape(scene, b));
+        let searched = pair_toi(scene, pair, (a, shapes.0), (b, shapes.1), narrow, || {
+            !toi_clock.expired()
+        });
+        if let Some(toi) = searched {
+            results.tois.push(toi);
+        }
+    }
+    // Set once a candidate went unsearched or a search stopped at the deadline.
+    ToiTally {
+        truncated,
+        expired: toi_clock.expired,
     }
 }

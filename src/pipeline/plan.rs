@@ -1,0 +1,201 @@
+//! The plan of a frame ([`step_within`](super::step_within)), decided before the work
+//! starts: how its budget is split (the frontier's deadline, the time kept back for the
+//! work after it) and, per candidate pair, which route answers it ([`PairPlan`]).
+
+use super::{MIN_PARALLEL_MESH_PAIRS, Query};
+use crate::budget::Budget;
+pub use crate::budget::{Deadline, Unlimited, VisitBudget};
+use crate::narrow::dispatch::{self, Route};
+use crate::narrow::{MeshShape, Shape};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Time kept back from a frame's deadline for what follows the budgeted mesh–mesh
+/// frontier: the pairs answered outside it (closed forms, GJK/EPA, convex–mesh walks), the
+/// exact contacts of finished touching mesh pairs, the records of truncated pairs, and
+/// the daemon's writing and publishing of the result frame. 100 µs.
+///
+/// Why this much: publishing (loan, write, send, notify) is about half a raw iceoryx2 round
+/// trip (`examples/ipc_latency`), and the rest of the narrow phase for a few hundred
+/// primitive pairs is of the same order (`benches/narrow_phase.rs`). The quarter of
+/// [`frontier_deadline`] is the frontier's own slack as much as the tail's: its overrun of
+/// its deadline (a round's sort is not polled) must not push the frame past its own
+/// (`examples/time_vs_error`).
+pub const FRONTIER_RESERVE: Duration = Duration::from_micros(100);
+
+/// The deadline of a frontier starting at `start` inside a frame ending at
+/// `frame_deadline`: earlier by [`FRONTIER_RESERVE`] or by a quarter of the time left,
+/// whichever is less. A small budget keeps three quarters for the frontier (with
+/// the whole reserve, a 100 µs frame left it nothing: every mesh pair at level 0; the work
+/// after the frontier shrinks with the frame, and the pairs off the frontier keep to the
+/// deadline on their own). A deadline already past stays past.
+#[must_use]
+pub fn frontier_deadline(start: Instant, frame_deadline: Instant) -> Deadline {
+    let budget = frame_deadline.saturating_duration_since(start);
+    let reserve = FRONTIER_RESERVE.min(budget / 4);
+    Deadline(
+        frame_deadline
+            .checked_sub(reserve)
+            .unwrap_or(frame_deadline),
+    )
+}
+
+/// How a frame answers one candidate pair that no kept answer covers; decided before any of
+/// the pair's work runs.
+#[derive(Debug)]
+pub(super) enum PairPlan<'s> {
+    /// Proven apart by a kept separation or its meshes' hulls (`separation.rs`).
+    Separated,
+    /// The frame's deadline is near: its distance bounds' or world boxes' conservative
+    /// answer.
+    Conservative,
+    /// Exact, by the dispatcher: a closed form, GJK/EPA or a convex–mesh walk.
+    Direct,
+    /// Mesh–mesh, read from the budgeted frontier's answer.
+    Frontier(&'s Arc<MeshShape>, &'s Arc<MeshShape>),
+    /// Mesh–mesh, read from the worker pool's outcome.
+    Pooled,
+    /// Mesh–mesh, the exact tandem queries on this thread.
+    MeshMesh(&'s Arc<MeshShape>, &'s Arc<MeshShape>),
+}
+
+impl PairPlan<'_> {
+    /// Whether the pair's mesh–mesh search runs this frame, so its answer may leave or
+    /// lapse the pair's separation.
+    pub(super) fn searches_mesh_pair(&self) -> bool {
+        matches!(self, Self::Frontier(..) | Self::Pooled | Self::MeshMesh(..))
+    }
+}
+
+/// The frame's plan: whether its budget is limited, whether the pool answers its mesh
+/// pairs, and the clock of the pairs answered off the frontier.
+pub(super) struct FramePlan {
+    /// A limited budget on a frame at the current poses: mesh pairs go through the
+    /// frontier, and pairs off it keep to the deadline.
+    pub(super) limited: bool,
+    /// The worker pool answered the frame's mesh pairs.
+    pub(super) pool: bool,
+    /// Pairs off the frontier's route keep to the frame's deadline: once it is near, the
+    /// rest get conservative answers.
+    pair_clock: PairClock,
+}
+
+impl FramePlan {
+    /// The plan of a frame asking `query` under `budget` (the pool decided later, by
+    /// [`wants_pool`](Self::wants_pool)).
+    pub(super) fn new(budget: &dyn Budget, query: Query) -> Self {
+        let limited = !budget.is_unlimited() && query.at_current_poses();
+        Self {
+            limited,
+            pool: false,
+            pair_clock: PairClock::new(budget.deadline().filter(|_| limited)),
+        }
+    }
+
+    /// Whether a frame with these mesh pairs to answer uses the worker pool: never under a
+    /// limited budget (the frontier runs on one thread), and only with at least
+    /// [`MIN_PARALLEL_MESH_PAIRS`] of them.
+    pub(super) fn wants_pool<T>(&self, mut needed: impl Iterator<Item = T>) -> bool {
+        !self.limited
+            && needed.by_ref().take(MIN_PARALLEL_MESH_PAIRS).count() == MIN_PARALLEL_MESH_PAIRS
+    }
+
+    /// The route of a pair of shapes `sa`, `sb` (`separated` when a kept separation or the
+    /// hulls proved it apart). Reads the pair clock only for pairs it may cut short.
+    pub(super) fn pair<'s>(
+        &mut self,
+        sa: &'s Shape,
+        sb: &'s Shape,
+        separated: bool,
+    ) -> PairPlan<'s> {
+        match dispatch::route(sa, sb) {
+            _ if separated => PairPlan::Separated,
+            Route::Direct
+                if !dispatch::exact_costs_no_more_than_boxes(sa, sb)
+                    && self.pair_clock.expired() =>
+            {
+                PairPlan::Conservative
+            }
+            Route::Direct => PairPlan::Direct,
+            Route::MeshMesh(ma, mb) if self.limited => PairPlan::Frontier(ma, mb),
+            Route::MeshMesh(..) if self.pool => PairPlan::Pooled,
+            Route::MeshMesh(ma, mb) => PairPlan::MeshMesh(ma, mb),
+        }
+    }
+}
+
+/// Time kept back from a frame's deadline for writing and publishing its results, when the
+/// pairs off the frontier are cut short (`PairClock`). 30 µs: an estimate of the daemon's
+/// publish stage (loan, write, send, notify) on the 2-core VM, to be replaced by a measured
+/// value.
+pub const PUBLISH_RESERVE: Duration = Duration::from_micros(30);
+
+/// Pairs answered between two looks at the clock by [`PairClock`]: a closed form costs
+/// tens of nanoseconds, GJK or a convex–mesh walk a few microseconds.
+const PAIRS_PER_CLOCK_CHECK: u32 = 8;
+
+/// The deadline of the per-pair loop: [`PUBLISH_RESERVE`] before the frame's, checked every
+/// [`PAIRS_PER_CLOCK_CHECK`] pairs; once passed, it stays passed.
+pub(super) struct PairClock {
+    deadline: Option<Instant>,
+    count: u32,
+    pub(super) expired: bool,
+}
+
+impl PairClock {
+    pub(super) fn new(frame_deadline: Option<Instant>) -> Self {
+        Self {
+            deadline: frame_deadline.map(|d| d.checked_sub(PUBLISH_RESERVE).unwrap_or(d)),
+            count: 0,
+            expired: false,
+        }
+    }
+
+    /// Whether the next pair must take the conservative box answer.
+    pub(super) fn expired(&mut self) -> bool {
+        if self.expired {
+            return true;
+        }
+        let Some(deadline) = self.deadline else {
+            return false;
+        };
+        self.count += 1;
+        if self.count.is_multiple_of(PAIRS_PER_CLOCK_CHECK) || self.count == 1 {
+            self.expired = Instant::now() >= deadline;
+        }
+        self.expired
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_frontier_deadline_is_the_frame_deadline_less_the_reserve_or_a_quarter_budget() {
+        let now = Instant::now();
+        let frame = now + Duration::from_millis(2);
+        assert_eq!(frontier_deadline(now, frame).0 + FRONTIER_RESERVE, frame);
+        assert_eq!(
+            frontier_deadline(now, frame).deadline(),
+            Some(frame - FRONTIER_RESERVE)
+        );
+        let small = now + Duration::from_micros(200);
+        assert_eq!(
+            frontier_deadline(now, small).0,
+            now + Duration::from_micros(150)
+        );
+        // A deadline already past (before the frame started) stays where it is.
+        let past = now.checked_sub(Duration::from_micros(10)).unwrap_or(now);
+        assert_eq!(frontier_deadline(now, past).0, past);
+    }
+
+    #[test]
+    fn only_deadlines_name_an_instant_and_only_unlimited_is_unlimited() {
+        assert_eq!(VisitBudget(5).deadline(), None);
+        assert_eq!(Unlimited.deadline(), None);
+        assert!(Unlimited.is_unlimited());
+        assert!(!VisitBudget(u64::MAX).is_unlimited());
+        assert!(!Deadline(Instant::now()).is_unlimited());
+    }
+}
