@@ -1,69 +1,26 @@
-//! One frame of collision work over a scene: broad phase, then per candidate pair only the
-//! work the frame's [`Query`] asks for.
+//! One frame of collision work over a scene, in the order of its stages
+//! ([`step_within`]; [`step`] is the unlimited budget):
 //!
-//! # What a query asks (DESIGN §4)
-//! The broad phase yields *candidate pairs*: bodies whose world boxes, grown by their
-//! margins, overlap (never static–static, filtered by group/mask). Each flag selects pairs
-//! among them; the frame reports the union, once per pair, in `(a, b)` order:
+//! 1. **broad phase** (`broad_sync.rs`): the kept broad phase synced with the scene's change
+//!    log gives the candidate pairs; the swept boxes give the `TOI` candidates;
+//! 2. **plan** (`plan.rs`): the budget split (the frontier's deadline, the reserve for the
+//!    rest) and, per pair, which route answers it;
+//! 3. **mid phase**: kept separations and the meshes' hulls prove mesh pairs apart with no
+//!    traversal (`separation.rs`); under a limited budget the frontier refines the rest
+//!    (`frontier_run.rs`);
+//! 4. **narrow phase** (`answer.rs`, on the worker pool for many mesh pairs, `workers.rs`):
+//!    each candidate's answer by its route, or its kept answer;
+//! 5. **time of impact** (`toi.rs`);
 //!
-//! | flag | pairs reported | what it costs for meshes |
-//! |---|---|---|
-//! | [`Query::close`] | distance ≤ the sum of the two margins; signed distance, witnesses, normal A→B | exact distance |
-//! | [`Query::overlap`] | the shapes touch or intersect (distance ≤ 0) | [`intersects_mesh_mesh`](crate::narrow::mesh_mesh::intersects_mesh_mesh), stops at the first proof |
-//! | [`Query::distance`] | every candidate pair, also beyond the margins, with its exact signed distance | exact distance |
-//! | [`Query::contacts`] | touching pairs, each with its manifold ([`ContactPoint`]s, at most [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS)) | every intersecting triangle pair ([`contacts_mesh_mesh`](crate::narrow::mesh_mesh::contacts_mesh_mesh)), then [`reduce_manifold`](crate::narrow::reduce_manifold) |
-//! | [`Query::toi`] | pairs that come within their margins during the frame's motion, each with its time of impact ([`PairToi`], in [`FrameResults::tois`]) | exact distance per conservative-advancement step |
-//!
-//! Flags combine: `CLOSE | CONTACTS` reports the close pairs, and the touching ones among
-//! them carry contacts. `OVERLAP` adds nothing to `CLOSE` or `DISTANCE` (their records
-//! already say it: distance ≤ 0). A pair record always has `a`, `b`, `distance`,
-//! `error_bound`; when neither `CLOSE` nor `DISTANCE` is asked, a mesh pair's record says
-//! distance 0 (intersecting surfaces) and takes its witnesses and normal from its first
-//! contact, or, with `OVERLAP` alone, has none: points and normal all zero (a zero normal
-//! means "not computed"). Sphere–sphere records are always complete (closed form).
-//!
-//! Contacts per pair kind:
-//! - sphere–sphere: one point, the witnesses, `distance = −depth`;
-//! - mesh–mesh: the ends of every intersection segment of the two surfaces, reduced by
-//!   [`reduce_manifold`](crate::narrow::reduce_manifold) to the extremes, each with `point_a == point_b` and depth 0 (meshes
-//!   are surfaces: intersecting meshes touch along curves and have no inside to measure a
-//!   depth in). One normal for the manifold: the sum of the intersecting triangles' normals
-//!   on A (A→B), one per segment end, normalised (when they cancel exactly, the normal at
-//!   the first kept point);
-//! - box-answer pairs: one conservative point, the box witnesses and normal, distance 0
-//!   (depth unknown) with the box error bound, which covers the true depth.
-//!
-//! [`PairResult::first_contact`] and [`PairResult::contact_count`] locate a pair's contacts
-//! in [`FrameResults::contacts`]; each [`ContactPoint::pair`] names its pair back.
-//!
-//! # Time of impact
-//! `TOI` answers over the frame's *motion*: each body moves from its pose when the last
-//! frame was answered ([`Scene::end_frame`]) to its pose now, `t ∈ [0, 1]` the fraction of
-//! that motion (position linear, orientation shortest-arc slerp:
-//! [`FrameMotion`](crate::narrow::toi::FrameMotion)), world frame. Its candidates come from
-//! a second broad phase over the bodies' *swept* boxes ([`Scene::swept_proxies`]: the box
-//! of the whole motion, grown by the margin), a superset of the other flags' candidates, so
-//! pairs that pass through each other between two frames are found. Each candidate gets a
-//! conservative-advancement search over the dispatcher's signed distance: the reported `t`
-//! is never later than the first time the pair is within its margins, and the pair is then
-//! within its margins plus [`TOI_TOLERANCE`]; `t = 0` when it already is at the start;
-//! pairs that never come within their margins are not reported (see [`PairToi`]). Its
-//! records are separate from the pair records: a frame asking `CLOSE | TOI` gets both,
-//! each by its own rule.
-//!
-//! # Broad phase kept between frames
-//! The workspace keeps one stateful broad phase of the scene's bodies, re-reading only the
-//! bodies in the scene's change log, and rebuilds it when it cannot (`broad_sync.rs`).
-//! Results never depend on the broad phase's kind, only their cost.
+//! and, across frames, what each pair remembers (`pair_memory.rs`). What each [`Query`] flag
+//! reports, and the contacts of each pair kind, is on [`Query`].
 //!
 //! # Answers kept between frames
 //! A candidate pair whose two bodies did not change since it was last answered (same
 //! [`Body::version`](crate::scene::Body::version)s, same scene, same query) gets that
 //! answer again, contacts included, without running any query: resting bodies cost only
-//! the broad phase. Answers depend on nothing else, so the frame is identical to one that
-//! answers them afresh (tested). A pair that stops being a candidate forgets its answer.
-//! [`StepReport::reused_pairs`] counts them. Only exact answers are kept: a pair a
-//! budgeted frame left truncated ([`step_within`]) is answered again next frame.
+//! the broad phase. The frame is identical to one that answers them afresh (tested). Only
+//! exact answers are kept; [`StepReport::reused_pairs`] counts them.
 //!
 //! # Separations kept between frames
 //! A mesh–mesh pair found farther apart than its margins leaves a separation behind
@@ -76,14 +33,7 @@
 //! the witnesses of tied minima, whose warm starts differ; tested). Pairs that moved more
 //! are searched again, and leave a new separation when found apart. Under a budget they
 //! are taken off the frontier. [`StepReport::separated_pairs`] counts them.
-//!
-//! Measured (`examples/time_vs_error --scene robot-chain`, exact frames, 300 frames, two
-//! alternating runs): at a third of the scene's motion per frame (`--speed 0.3`), 5.7 of 18
-//! candidate pairs per frame were answered so, and a frame took 205–232 µs at the median
-//! against 397–421 µs without; at a tenth, 6.0 pairs and 132–153 µs against 169–179 µs; at
-//! the scene's own speed (links moving up to 6 cm per frame against 4 cm margins) 2.4 pairs,
-//! and no measurable change.
-//!
+
 //! # Separations proved by the hulls
 //! A mesh–mesh pair with no kept separation is first tested by its meshes' convex hulls
 //! ([`MeshHull::gap`](crate::narrow::mesh_hull::MeshHull::gap): GJK between the hulls,
@@ -94,17 +44,7 @@
 //! visit each, polled every second test: a budget of nothing tests nothing.
 //! [`StepReport::hull_tests`] counts them, `separated_pairs` the pairs they and the kept
 //! separations answered.
-//!
-//! Measured (`examples/time_vs_error`, query `CLOSE`, alternating runs of 400 frames,
-//! 2026-11-25): on `robot-chain` (six links of 216 triangles and a room of 2,180, 21 mesh
-//! pairs a frame) 6.2 pairs a frame answered apart with no traversal instead of 2.4; the
-//! precision of the reported close pairs at a 28 µs budget 0.841–0.854 → 0.900–0.907, at
-//! 35 µs 0.899–0.912 → 0.932–0.935; exact frames 109–115 → 113–117 µs at the median (the
-//! tests of hulls that meet cost more than the traversals the proofs save). On
-//! `mesh-pile` (12 tori and 4 spheres, 200 frames): 38 → 53 pairs a frame answered so,
-//! precision 0.927–0.934 → 0.980 at 100 µs and 0.69–0.74 → 0.75–0.78 at 50 µs, exact
-//! frames the same (889–929 against 893–952 µs). No collision was missed in any run.
-//!
+
 //! # Design note: determinism and ordering
 //! The same scene and query give the same results: the broad phase yields pairs sorted by
 //! `(a, b)`, each pair is answered independently in that order, and nothing depends on
@@ -124,9 +64,8 @@
 //!
 //! # Allocation
 //! None once the workspace and the output have grown to the largest frame, except one
-//! warm-start cache entry and one hull-test entry when a mesh–mesh pair becomes a
-//! candidate (and one separation entry when it is first found apart), and the kept broad
-//! phase's own: a rebuild (or an `Auto` measurement) allocates it anew, and the stateful
+//! pair-memory record when a pair first becomes a candidate, and the kept broad phase's
+//! own: a rebuild (or an `Auto` measurement) allocates it anew, and the stateful
 //! kinds' pair sets and hash cells allocate as pairs and occupied cells appear.
 
 mod answer;
@@ -166,8 +105,43 @@ use toi::answer_tois;
 pub use workers::{MIN_PARALLEL_MESH_PAIRS, WorkerPool};
 use workers::{MeshJob, MeshOutcome};
 
-/// What a frame asks for (see the [module docs](self)); at least one flag should be set, or
-/// the frame reports nothing.
+/// What a frame asks for; at least one flag should be set, or the frame reports nothing.
+///
+/// # What a query asks (DESIGN §4)
+/// The broad phase yields *candidate pairs*: bodies whose world boxes, grown by their
+/// margins, overlap (never static–static, filtered by group/mask). Each flag selects pairs
+/// among them; the frame reports the union, once per pair, in `(a, b)` order:
+///
+/// | flag | pairs reported | what it costs for meshes |
+/// |---|---|---|
+/// | [`Query::close`] | distance ≤ the sum of the two margins; signed distance, witnesses, normal A→B | exact distance |
+/// | [`Query::overlap`] | the shapes touch or intersect (distance ≤ 0) | [`intersects_mesh_mesh`](crate::narrow::mesh_mesh::intersects_mesh_mesh), stops at the first proof |
+/// | [`Query::distance`] | every candidate pair, also beyond the margins, with its exact signed distance | exact distance |
+/// | [`Query::contacts`] | touching pairs, each with its manifold ([`ContactPoint`]s, at most [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS)) | every intersecting triangle pair ([`contacts_mesh_mesh`](crate::narrow::mesh_mesh::contacts_mesh_mesh)), then [`reduce_manifold`](crate::narrow::reduce_manifold) |
+/// | [`Query::toi`] | pairs that come within their margins during the frame's motion, each with its time of impact ([`PairToi`], in [`FrameResults::tois`]) | exact distance per conservative-advancement step |
+///
+/// Flags combine: `CLOSE | CONTACTS` reports the close pairs, and the touching ones among
+/// them carry contacts. `OVERLAP` adds nothing to `CLOSE` or `DISTANCE` (their records
+/// already say it: distance ≤ 0). A pair record always has `a`, `b`, `distance`,
+/// `error_bound`; when neither `CLOSE` nor `DISTANCE` is asked, a mesh pair's record says
+/// distance 0 (intersecting surfaces) and takes its witnesses and normal from its first
+/// contact, or, with `OVERLAP` alone, has none: points and normal all zero (a zero normal
+/// means "not computed"). Sphere–sphere records are always complete (closed form).
+///
+/// Contacts per pair kind:
+/// - sphere–sphere: one point, the witnesses, `distance = −depth`;
+/// - mesh–mesh: the ends of every intersection segment of the two surfaces, reduced by
+///   [`reduce_manifold`](crate::narrow::reduce_manifold) to the extremes, each with `point_a == point_b` and depth 0 (meshes
+///   are surfaces: intersecting meshes touch along curves and have no inside to measure a
+///   depth in). One normal for the manifold: the sum of the intersecting triangles' normals
+///   on A (A→B), one per segment end, normalised (when they cancel exactly, the normal at
+///   the first kept point);
+/// - box-answer pairs: one conservative point, the box witnesses and normal, distance 0
+///   (depth unknown) with the box error bound, which covers the true depth.
+///
+/// [`PairResult::first_contact`] and [`PairResult::contact_count`] locate a pair's contacts
+/// in [`FrameResults::contacts`]; each [`ContactPoint::pair`] names its pair back.
+///
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Query {
     /// Pairs whose shapes touch or intersect.
