@@ -174,12 +174,83 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         .iter()
         .map(|p| p.a.abs().max_element().max(p.b.abs().max_element()))
         .fold(0.0, f64::max);
-    let floor = |scale: f64| params.abs_tol + ROUNDING_ULPS * f64::EPSILON * scale;
+    if !blow_up_to_tetrahedron(&mut sup, params, ws, &mut fallback, common, &mut scale) {
+        return fallback.result(0);
+    }
+    start_faces(ws);
 
-    // Blow up to a tetrahedron.
+    let mut iterations = 0;
+    while iterations < params.max_iterations {
+        iterations += 1;
+        let Some((best_i, best)) = ws
+            .faces
+            .iter()
+            .copied()
+            .enumerate()
+            .min_by(|x, y| x.1.dist.total_cmp(&y.1.dist))
+        else {
+            break;
+        };
+        if !best.dist.is_finite() {
+            break;
+        }
+        let p = sup(best.normal);
+        if !p.w.is_finite() {
+            break;
+        }
+        fallback.offer(best.normal, &p, face_point_a(&ws.vertices, &best));
+        scale = scale.max(p.a.abs().max_element().max(p.b.abs().max_element()));
+        let tol = floor(params, scale);
+        let h = p.w.dot(best.normal);
+        if h - best.dist <= params.epa_rel_tol * best.dist.abs() + tol {
+            // Coplanar faces tie on distance; the witnesses need the one whose triangle holds
+            // the origin's projection. Only faces in the confirmed plane qualify: a face
+            // through the origin at another angle has distance 0 too but no certificate.
+            let near = best.dist + (tol + 1e-9 * scale).max(h - best.dist);
+            let f = ws
+                .faces
+                .iter()
+                .filter(|f| f.dist <= near && f.normal.dot(best.normal) >= 1.0 - 1e-9)
+                .map(|f| (inside(&ws.vertices, f), f))
+                .max_by(|x, y| x.0.total_cmp(&y.0))
+                .map_or(best, |(_, f)| *f);
+            return converged(&ws.vertices, &f, iterations);
+        }
+        if ws.vertices.len() == MAX_VERTICES {
+            break;
+        }
+        match expand(ws, p, best_i, tol) {
+            Expansion::Grown => {}
+            Expansion::Full => break,
+            // The origin fell outside: rounding broke the polytope.
+            Expansion::Broken => return fallback.result(iterations),
+        }
+    }
+    fallback.result(iterations)
+}
+
+/// The smallest offset that counts at coordinates of magnitude `scale`: the absolute
+/// tolerance plus the rounding of `ROUNDING_ULPS` ulps.
+#[inline]
+fn floor(params: &GjkParams, scale: f64) -> f64 {
+    params.abs_tol + ROUNDING_ULPS * f64::EPSILON * scale
+}
+
+/// Grows `ws.vertices` (GJK's 1 to 4 points) to a tetrahedron by support points farthest
+/// from their span, offering each to `fallback`; `false` when no direction leaves the span
+/// (the Minkowski difference is flat there: the fallback answers).
+#[inline]
+fn blow_up_to_tetrahedron(
+    sup: &mut impl FnMut(DVec3) -> SupportPoint,
+    params: &GjkParams,
+    ws: &mut EpaWorkspace,
+    fallback: &mut Fallback,
+    common: DVec3,
+    scale: &mut f64,
+) -> bool {
     while ws.vertices.len() < 4 {
         let vs = &ws.vertices;
-        let tol = floor(scale);
+        let tol = floor(params, *scale);
         let (dirs, n_dirs): ([DVec3; 6], usize) = match vs.len() {
             1 => (
                 // +X first: when A − B is a single point, every direction ties and the
@@ -233,14 +304,18 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         }
         match best {
             Some((off, p)) if off > tol.max(1e-12 * span_size(vs)) => {
-                scale = scale.max(p.a.abs().max_element().max(p.b.abs().max_element()));
+                *scale = scale.max(p.a.abs().max_element().max(p.b.abs().max_element()));
                 ws.vertices.push(p);
             }
-            _ => return fallback.result(0),
+            _ => return false,
         }
     }
+    true
+}
 
-    // Four outward faces.
+/// The tetrahedron's four faces, each turned outward (away from its centre).
+#[inline]
+fn start_faces(ws: &mut EpaWorkspace) {
     let centre = ws.vertices.iter().map(|p| p.w).sum::<DVec3>() / 4.0;
     for f in [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]] {
         let mut fc = face(&ws.vertices, f);
@@ -249,84 +324,56 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         }
         ws.faces.push(fc);
     }
+}
 
-    let mut iterations = 0;
-    while iterations < params.max_iterations {
-        iterations += 1;
-        let Some((best_i, best)) = ws
-            .faces
-            .iter()
-            .copied()
-            .enumerate()
-            .min_by(|x, y| x.1.dist.total_cmp(&y.1.dist))
-        else {
-            break;
-        };
-        if !best.dist.is_finite() {
-            break;
-        }
-        let p = sup(best.normal);
-        if !p.w.is_finite() {
-            break;
-        }
-        fallback.offer(best.normal, &p, face_point_a(&ws.vertices, &best));
-        scale = scale.max(p.a.abs().max_element().max(p.b.abs().max_element()));
-        let tol = floor(scale);
-        let h = p.w.dot(best.normal);
-        if h - best.dist <= params.epa_rel_tol * best.dist.abs() + tol {
-            // Coplanar faces tie on distance; the witnesses need the one whose triangle holds
-            // the origin's projection. Only faces in the confirmed plane qualify: a face
-            // through the origin at another angle has distance 0 too but no certificate.
-            let near = best.dist + (tol + 1e-9 * scale).max(h - best.dist);
-            let f = ws
-                .faces
-                .iter()
-                .filter(|f| f.dist <= near && f.normal.dot(best.normal) >= 1.0 - 1e-9)
-                .map(|f| (inside(&ws.vertices, f), f))
-                .max_by(|x, y| x.0.total_cmp(&y.0))
-                .map_or(best, |(_, f)| *f);
-            return converged(&ws.vertices, &f, iterations);
-        }
-        if ws.vertices.len() == MAX_VERTICES {
-            break;
-        }
-        // Remove faces that see p; keep their boundary (edges not shared by two of them).
-        let new = ws.vertices.len() as u32;
-        ws.vertices.push(p);
-        ws.edges.clear();
-        let mut i = 0;
-        while i < ws.faces.len() {
-            let f = ws.faces[i];
-            let a = ws.vertices[f.v[0] as usize].w;
-            let sees = i == best_i || (f.normal != DVec3::ZERO && f.normal.dot(p.w - a) > tol);
-            if sees {
-                for k in 0..3 {
-                    let e = (f.v[k], f.v[(k + 1) % 3]);
-                    if let Some(j) = ws.edges.iter().position(|&x| x == (e.1, e.0)) {
-                        ws.edges.swap_remove(j);
-                    } else {
-                        ws.edges.push(e);
-                    }
+/// What adding a support point did to the polytope.
+enum Expansion {
+    /// The point joined: the faces that saw it were replaced by its cone over their horizon.
+    Grown,
+    /// No room for the new faces, or a degenerate horizon: stop with the best so far.
+    Full,
+    /// A new face has the origin outside: rounding broke the polytope.
+    Broken,
+}
+
+/// Adds `p` to the polytope: removes the faces that see it (face `best_i` always), keeps
+/// their horizon (edges not shared by two of them) and closes it with faces through `p`.
+#[inline]
+fn expand(ws: &mut EpaWorkspace, p: SupportPoint, best_i: usize, tol: f64) -> Expansion {
+    let new = ws.vertices.len() as u32;
+    ws.vertices.push(p);
+    ws.edges.clear();
+    let mut i = 0;
+    while i < ws.faces.len() {
+        let f = ws.faces[i];
+        let a = ws.vertices[f.v[0] as usize].w;
+        let sees = i == best_i || (f.normal != DVec3::ZERO && f.normal.dot(p.w - a) > tol);
+        if sees {
+            for k in 0..3 {
+                let e = (f.v[k], f.v[(k + 1) % 3]);
+                if let Some(j) = ws.edges.iter().position(|&x| x == (e.1, e.0)) {
+                    ws.edges.swap_remove(j);
+                } else {
+                    ws.edges.push(e);
                 }
-                ws.faces[i].dist = f64::NAN; // marked for removal
             }
-            i += 1;
+            ws.faces[i].dist = f64::NAN; // marked for removal
         }
-        ws.faces.retain(|f| !f.dist.is_nan());
-        if ws.edges.len() < 3 || ws.faces.len() + ws.edges.len() > MAX_FACES {
-            break;
-        }
-        for k in 0..ws.edges.len() {
-            let (i, j) = ws.edges[k];
-            let f = face(&ws.vertices, [i, j, new]);
-            if f.dist < -tol {
-                // The origin fell outside: rounding broke the polytope.
-                return fallback.result(iterations);
-            }
-            ws.faces.push(f);
-        }
+        i += 1;
     }
-    fallback.result(iterations)
+    ws.faces.retain(|f| !f.dist.is_nan());
+    if ws.edges.len() < 3 || ws.faces.len() + ws.edges.len() > MAX_FACES {
+        return Expansion::Full;
+    }
+    for k in 0..ws.edges.len() {
+        let (i, j) = ws.edges[k];
+        let f = face(&ws.vertices, [i, j, new]);
+        if f.dist < -tol {
+            return Expansion::Broken;
+        }
+        ws.faces.push(f);
+    }
+    Expansion::Grown
 }
 
 /// Distance of `w` from the affine span of `vs` (1 to 3 points).
