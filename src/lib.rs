@@ -9,12 +9,13 @@
 //! data flow of one frame:
 //!
 //! ```text
-//! poses in ─▶ math (Pose, Isometry) ─▶ geometry (shapes, meshes, hulls, predicates)
-//!          ─▶ bounding (sphere, AABB, OBB, k-DOP, PSS/LSS/RSS) ─▶ BVH traversal
-//!          ─▶ broad phase ─▶ narrow phase (triangle–triangle, …) ─▶ contacts out
+//! poses in ─▶ scene (bodies, change log) ─▶ pipeline: broad phase ─▶ plan
+//!          ─▶ mid phase (hull proofs, budgeted BVH frontier) ─▶ narrow phase ─▶ contacts out
 //! ```
 //!
-//! A module uses only modules listed above it.
+//! built on layers, lowest first: math and budget, geometry (shapes in their local frames),
+//! bounding volumes, BVHs and broad phases, narrow (every pair query, one dispatcher),
+//! scene, pipeline (one frame), daemon. A module uses only its own layer and those below.
 
 // So test support written against the public crate name compiles inside the crate's unit tests.
 extern crate self as proxima;
@@ -39,14 +40,15 @@ pub mod bvh;
 // Broad phase: candidate pairs from margin-grown world boxes.
 pub mod broad;
 
-// Exact queries: triangle–triangle overlap, intersection and distance; mesh–mesh queries.
+// Every pair query: the shape set, the one dispatcher, closed forms, GJK/EPA,
+// convex–mesh, mesh–mesh (exact and budgeted).
 pub mod narrow;
 
 #[cfg(test)]
 #[path = "../tests/support/mod.rs"]
 pub(crate) mod test_support;
 
-// Scene state: registered shapes and placed bodies.
+// Scene state: bodies, their change log, limits.
 pub mod scene;
 
 // One frame of collision work over a scene.
