@@ -416,20 +416,6 @@ impl BoundingVolume for Obb {
 
     /// The face axes first; their gap is returned as soon as it reaches `limit` (the nine
     /// edge axes, each needing a square root, are then skipped).
-    ///
-    /// Measured and not kept (2026-11-24): the gaps along one box's three (orthonormal)
-    /// axes combined as the root of their summed squares, a true bound up to √3 times the
-    /// largest gap for boxes apart along a diagonal. `examples/time_vs_error --scene
-    /// robot-chain` gave the same precision at 150, 250, 350 and 1,000 counted visits
-    /// (0.734, 0.851, 0.903, 0.987) and 0.949 → 0.951 at 500: the node pairs its frontier
-    /// meets near the threshold are apart along one axis.
-    ///
-    /// Also measured and not kept (2026-11-25, `benches/frontier.rs`'s scene, 250 visits a
-    /// frame): the edge axes skipped when the face axes overlap, 89 → 77 ns a visit, but
-    /// they drop entries the faces keep, and the precision per visit fell (0.865 → 0.836
-    /// at 250 visits, 0.930 → 0.904 at 350): at equal time, +0.008, within the drift of
-    /// deadline runs. Returning 0 at once when B's centre lies in A (34 of 214 bounds a
-    /// frame): no change measured.
     fn distance_lower_bound_within(&self, other: &Self, pose_ab: &Isometry, limit: f64) -> f64 {
         self.distance_lower_bound_to(&other.placed(pose_ab), limit)
     }

@@ -121,22 +121,12 @@ impl MeshShape {
 /// ([`MeshPairTrees`](crate::narrow::mesh_mesh::frontier::MeshPairTrees)) and the exact queries
 /// ([`MeshShape::distance_to`], [`MeshShape::proximity`]).
 ///
-/// Exact queries: on robot-chain (`examples/time_vs_error`, budget `inf`, 300 frames, two
-/// alternating runs), the OBB trees this choice names for the CAD meshes answered a frame
-/// in 185–188 µs at the median (p99 490–540 µs), against 318–348 µs (p99 760–820 µs) on
-/// the RSS trees every pair used before; the mesh pile's tori and spheres choose RSSs, as
-/// before.
-///
-/// The frontier: measured with `examples/time_vs_error` (query `CLOSE`, same frames,
-/// precision of the reported close pairs at a budget of about a quarter of the exact time,
-/// then measured on the RSS trees): on the robot-chain scene (CAD links against a room) the
-/// OBB frontier gave 0.835 at 100 µs
-/// against 0.710 with RSSs, and finished every frame by 1,000 µs, because its bound (a
-/// separating-axis gap) costs a fraction of the RSS's exact rectangle distance; on the
-/// mesh pile (tori and spheres) it gave 0.740 against 0.917 at 300 µs, because there the
-/// RSSs are as small as the boxes and their distance bound is much tighter. The measure
-/// that tells these apart is the volume of the top of the trees: RSS over OBB volume is
-/// 1.31–1.33 for the robot and room meshes and 1.00 for the torus.
+/// The tighter tree wins both: exact queries prune sooner, and the frontier's bounds are
+/// tighter per visit. The OBB's separating-axis gap costs a fraction of the RSS's exact
+/// rectangle distance, so box-like CAD parts, whose RSSs hold clearly more volume than
+/// their boxes, choose OBBs; curved meshes (tori, spheres), whose RSSs are as small as
+/// their boxes and bound distance more tightly, choose RSSs. `examples/time_vs_error`
+/// (`--scene robot-chain` and `--scene mesh-pile`) measures both.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum QueryVolume {
     /// The OBB tree: clearly the tighter of the two on this mesh.
