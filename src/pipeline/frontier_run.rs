@@ -2,6 +2,7 @@
 //! limited budget): which mesh pairs it refines, with which seeds, and resuming last
 //! frame's run while the bodies rest.
 
+use super::pair_memory::PairMemories;
 use super::{Budget, PipelineWorkspace, Query, body, mesh_pair};
 use crate::broad::CandidatePair;
 use crate::math::Pose;
@@ -59,26 +60,7 @@ pub(super) fn run_frontier(
     if !resume {
         frontier_pairs.clear();
         frontier_pairs.extend(needed());
-        frontier_run.scene = scene.uid();
-        frontier_run.query = query;
-        frontier_run.versions.clear();
-        frontier_run.trees.clear();
-        for pair in frontier_pairs.iter() {
-            let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-            let (ma, mb) = mesh_pair(scene, pair).expect("a mesh pair");
-            let pose_ab = Pose::relative(&a.pose, &b.pose).to_isometry();
-            // Last frame's closest triangles: the warm start the exact queries have.
-            let seed = memory.get(pair).and_then(|m| m.seed);
-            let threshold = if query.distance {
-                distance_upper_bound(ma, mb, &pose_ab, seed.unwrap_or([0, 0]))
-            } else {
-                a.margin + b.margin
-            };
-            frontier_run.versions.push([a.version(), b.version()]);
-            frontier_run
-                .trees
-                .push(MeshPairTrees::new(ma, mb, pose_ab, threshold, seed));
-        }
+        frontier_run.list(scene, query, frontier_pairs, memory);
     }
     // A resumed frontier's pairs are the same (unchanged bodies, so the same poses).
     let pairs = &frontier_run.trees;
@@ -136,6 +118,37 @@ pub(super) struct FrontierRun {
 }
 
 impl FrontierRun {
+    /// Lists `pairs` (mesh pairs of `scene`, candidate order) for a fresh run under `query`:
+    /// each with its trees, pose, threshold (the margins, or under `DISTANCE` an upper bound
+    /// of its distance) and seed, and both bodies' versions.
+    fn list(
+        &mut self,
+        scene: &Scene,
+        query: Query,
+        pairs: &[CandidatePair],
+        memory: &PairMemories,
+    ) {
+        self.scene = scene.uid();
+        self.query = query;
+        self.versions.clear();
+        self.trees.clear();
+        for pair in pairs {
+            let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+            let (ma, mb) = mesh_pair(scene, pair).expect("a mesh pair");
+            let pose_ab = Pose::relative(&a.pose, &b.pose).to_isometry();
+            // Last frame's closest triangles: the warm start the exact queries have.
+            let seed = memory.get(pair).and_then(|m| m.seed);
+            let threshold = if query.distance {
+                distance_upper_bound(ma, mb, &pose_ab, seed.unwrap_or([0, 0]))
+            } else {
+                a.margin + b.margin
+            };
+            self.versions.push([a.version(), b.version()]);
+            self.trees
+                .push(MeshPairTrees::new(ma, mb, pose_ab, threshold, seed));
+        }
+    }
+
     /// Whether the last frontier (over `pairs`) can go on this frame: same scene and query,
     /// every pair still a candidate with both bodies unchanged (so the same poses), and
     /// work left. A resumed frontier reaches the state a single run with the summed
