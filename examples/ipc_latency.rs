@@ -32,9 +32,9 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use proxima::daemon::{Daemon, DaemonConfig};
 use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion, Primitive};
-use proxima_ipc::daemon_process::{ChildProcess, Isolation};
-use proxima_ipc::latency::LatencyRecorder;
 use proxima_ipc::scene_link::SceneLink;
+use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation};
+use proxima_ipc::tools::latency::LatencyRecorder;
 use proxima_ipc::wire::{
     ErrorCode, PoseFrameHeader, PoseRecord, ResultFrameHeader, ResultRecord, query, stage,
 };

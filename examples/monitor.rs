@@ -16,8 +16,8 @@
 use clap::Parser;
 use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
 use proxima_ipc::client::ClientBuilder;
-use proxima_ipc::latency::LatencyRecorder;
 use proxima_ipc::result_feed::ResultFeed;
+use proxima_ipc::tools::latency::LatencyRecorder;
 use proxima_ipc::wire::{Completeness, ErrorCode, ResultFrameHeader, stage};
 use std::error::Error;
 use std::time::{Duration, Instant};

@@ -1338,7 +1338,7 @@ mod tests {
         assert!(client.create_scene().is_ok());
         drop((client, responder));
         // iceoryx2 leaves one small global-management segment per prefix behind.
-        crate::daemon_process::remove_shared_memory(&prefix);
+        crate::tools::daemon_process::remove_shared_memory(&prefix);
     }
 
     #[test]

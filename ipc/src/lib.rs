@@ -6,11 +6,10 @@
 //! iceoryx2 binds can speak it.
 
 pub mod client;
-pub mod daemon_process;
 pub mod error;
-pub mod latency;
 pub mod result_feed;
 pub mod scene_link;
+pub mod tools;
 pub mod wire;
 
 use iceoryx2::node::Node;

@@ -13,7 +13,7 @@ mod scene;
 use clap::Args;
 use iceoryx2::prelude::ipc;
 use proxima_ipc::client::ClientBuilder;
-use proxima_ipc::daemon_process::{ChildProcess, Isolation};
+use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation};
 use proxima_ipc::wire::query;
 use report::{FrameLine, Summary};
 use scene::DemoScene;

@@ -1,6 +1,6 @@
 //! What the demo prints: one line per sampled frame, and a summary of the run.
 
-use proxima_ipc::latency::LatencyRecorder;
+use proxima_ipc::tools::latency::LatencyRecorder;
 use proxima_ipc::wire::{Completeness, ErrorCode, ResultFrameHeader};
 use std::fmt;
 use std::time::Duration;

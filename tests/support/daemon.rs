@@ -172,7 +172,7 @@ pub fn signal(pid: u32, signal: &str) {
 }
 
 /// Removes the `/dev/shm` files of iceoryx2 prefix `prefix` (the client crate's helper).
-pub use proxima_ipc::daemon_process::remove_shared_memory;
+pub use proxima_ipc::tools::daemon_process::remove_shared_memory;
 
 /// A dynamic body of `shape` at `(x, 0, 0)`, unrotated, pairing with everything, with the
 /// scene's default margin.
