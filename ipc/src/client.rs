@@ -33,8 +33,9 @@
 //! ```
 //!
 //! Request–response ports cannot join a WaitSet, so a reply is awaited by polling with a
-//! short back-off: a spin of [`SPIN`], then sleeps of [`SLEEP`]. After each request the
-//! client notifies the control event service, which wakes a daemon blocked in its WaitSet.
+//! short back-off: a spin of [`CONTROL_REPLY_SPIN`], then sleeps of [`CONTROL_REPLY_SLEEP`].
+//! After each request the client notifies the control event service, which wakes a daemon
+//! blocked in its WaitSet.
 //!
 //! # When the daemon goes away
 //! A client is bound to the daemon that answered its `Hello` (its server port). When that
@@ -60,15 +61,12 @@ use iceoryx2::service::port_factory::request_response::PortFactory;
 
 use crate::error::{ClientConnectError, ControlError, SceneOpenError};
 use crate::scene_link::SceneLink;
+use crate::transport::{CONTROL_REPLY_SLEEP, CONTROL_REPLY_SPIN};
 use crate::wire::{
     BroadPhaseCode, Command, ControlReply, ControlRequest, ErrorCode, MotionCode, ShapeKindCode,
 };
 use crate::{CONTROL_INITIAL_MAX_SLICE_LEN, DEFAULT_ROOT, EVENT_CONTROL_SENT, PROTOCOL_VERSION};
 
-/// How long a reply is awaited by spinning before the wait starts sleeping.
-pub const SPIN: Duration = Duration::from_micros(20);
-/// One sleep of the reply wait after the spin.
-pub const SLEEP: Duration = Duration::from_micros(50);
 /// The default reply timeout of [`ClientBuilder`].
 pub const DEFAULT_REPLY_TIMEOUT: Duration = Duration::from_secs(2);
 
@@ -686,7 +684,7 @@ fn encode_geometry(out: &mut [u8], vertices: &[[f64; 3]], triangles: &[[u32; 3]]
 }
 
 /// Polls `poll` until it yields a value or `deadline` passes (`Ok(None)`): spins for
-/// [`SPIN`], then sleeps [`SLEEP`] between polls. Polls at least once.
+/// [`CONTROL_REPLY_SPIN`], then sleeps [`CONTROL_REPLY_SLEEP`] between polls. Polls at least once.
 fn poll_until<T, E>(
     deadline: Instant,
     mut poll: impl FnMut() -> Result<Option<T>, E>,
@@ -700,10 +698,10 @@ fn poll_until<T, E>(
         if now >= deadline {
             return Ok(None);
         }
-        if now - start < SPIN {
+        if now - start < CONTROL_REPLY_SPIN {
             std::hint::spin_loop();
         } else {
-            std::thread::sleep(SLEEP.min(deadline - now));
+            std::thread::sleep(CONTROL_REPLY_SLEEP.min(deadline - now));
         }
     }
 }

@@ -10,6 +10,7 @@ pub mod error;
 pub mod result_feed;
 pub mod scene_link;
 pub mod tools;
+pub mod transport;
 pub mod wire;
 
 use iceoryx2::node::Node;

@@ -17,7 +17,7 @@ use iceoryx2::service::port_factory::event::PortFactory as EventPortFactory;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPortFactory;
 
 use crate::error::{FrameReceiveError, SceneOpenError};
-use crate::scene_link::{SPIN, transport};
+use crate::transport::{RESULTS_SPIN, open_error};
 use crate::wire::{ResultFrameHeader, ResultRecord};
 
 /// A subscription to one scene's result frames.
@@ -55,23 +55,23 @@ impl<S: Service> ResultFeed<S> {
         let results_service = crate::results_service_builder(node, root, scene)
             .map_err(invalid)?
             .open_or_create()
-            .map_err(|e| transport("opening the result service", e))?;
+            .map_err(|e| open_error("opening the result service", e))?;
         let results_ready_service = crate::results_ready_service_builder(node, root, scene)
             .map_err(invalid)?
             .open_or_create()
-            .map_err(|e| transport("opening the results-ready event service", e))?;
+            .map_err(|e| open_error("opening the results-ready event service", e))?;
         let results = results_service
             .subscriber_builder()
             .create()
-            .map_err(|e| transport("creating the result subscriber", e))?;
+            .map_err(|e| open_error("creating the result subscriber", e))?;
         let listener = results_ready_service
             .listener_builder()
             .create()
-            .map_err(|e| transport("creating the event listener", e))?;
+            .map_err(|e| open_error("creating the event listener", e))?;
         Ok(Self {
             results,
             listener,
-            spin: SPIN,
+            spin: RESULTS_SPIN,
             _results_service: results_service,
             _results_ready_service: results_ready_service,
         })
@@ -88,10 +88,10 @@ impl<S: Service> ResultFeed<S> {
             .map_err(|e| FrameReceiveError::Transport(format!("receiving a result frame: {e}")))
     }
 
-    /// Sets how long a receive polls before it blocks ([`SPIN`] by default). A longer spin
-    /// saves the 60–120 µs of waking a halted vCPU when answers take longer than [`SPIN`],
-    /// at the price of a busy core while waiting: worth it only when this process has a core
-    /// of its own (never spin on a core the daemon needs).
+    /// Sets how long a receive polls before it blocks ([`RESULTS_SPIN`] by default). A
+    /// longer spin saves the 60–120 µs of waking a halted vCPU when answers take longer than
+    /// [`RESULTS_SPIN`], at the price of a busy core while waiting: worth it only when this
+    /// process has a core of its own (never spin on a core the daemon needs).
     pub fn set_spin(&mut self, spin: Duration) {
         self.spin = spin;
     }

@@ -30,9 +30,10 @@
 //! ```
 //!
 //! Waiting is hybrid (see `shared/notes/iceoryx2-0.10.md`): the subscriber is polled for
-//! [`SPIN`], then the wait blocks on the scene's results-ready listener until the daemon
-//! notifies [`EVENT_RESULTS_READY`](crate::EVENT_RESULTS_READY) or the deadline passes.
-//! Waking a halted vCPU costs 60–120 µs on a VM; the spin catches answers that come sooner.
+//! [`RESULTS_SPIN`](crate::transport::RESULTS_SPIN), then the wait blocks on the scene's
+//! results-ready listener until the daemon notifies
+//! [`EVENT_RESULTS_READY`](crate::EVENT_RESULTS_READY) or the deadline passes. Waking a
+//! halted vCPU costs 60–120 µs on a VM; the spin catches answers that come sooner.
 //! Pose frames are announced on a separate poses-ready service, so the client's own
 //! notifications never wake its wait.
 //!
@@ -50,13 +51,12 @@ use iceoryx2::service::port_factory::event::PortFactory as EventPortFactory;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPortFactory;
 
 use crate::error::{FrameReceiveError, FrameSendError, SceneOpenError};
+use crate::transport::open_error;
 use crate::wire::{PoseFrameHeader, PoseRecord};
 use crate::{EVENT_POSES_SENT, PROTOCOL_VERSION};
 
 pub use crate::result_feed::{ResultFeed, ResultFrame};
 
-/// How long a receive polls the result subscriber before it blocks on the event listener.
-pub const SPIN: Duration = Duration::from_micros(50);
 /// Pose records the publisher's first shared-memory segment holds; a larger frame makes it
 /// allocate a segment of the next power of two (a one-off cost, for the daemon too).
 pub const POSES_INITIAL_MAX_SLICE_LEN: usize = 1024;
@@ -102,22 +102,22 @@ impl<S: Service> SceneLink<S> {
         let poses_service = crate::poses_service_builder(node, root, scene)
             .map_err(invalid)?
             .open_or_create()
-            .map_err(|e| transport("opening the pose service", e))?;
+            .map_err(|e| open_error("opening the pose service", e))?;
         let poses_ready_service = crate::poses_ready_service_builder(node, root, scene)
             .map_err(invalid)?
             .open_or_create()
-            .map_err(|e| transport("opening the poses-ready event service", e))?;
+            .map_err(|e| open_error("opening the poses-ready event service", e))?;
         let poses = poses_service
             .publisher_builder()
             .initial_max_slice_len(POSES_INITIAL_MAX_SLICE_LEN)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
             .max_loaned_samples(1)
             .create()
-            .map_err(|e| transport("creating the pose publisher", e))?;
+            .map_err(|e| open_error("creating the pose publisher", e))?;
         let notifier = poses_ready_service
             .notifier_builder()
             .create()
-            .map_err(|e| transport("creating the event notifier", e))?;
+            .map_err(|e| open_error("creating the event notifier", e))?;
         let feed = ResultFeed::open(node, root, scene)?;
         Ok(Self {
             scene,
@@ -263,11 +263,6 @@ impl<S: Service> SceneLink<S> {
             .map(drop)
             .map_err(|e| FrameSendError::Transport(format!("notifying the daemon: {e}")))
     }
-}
-
-/// A transport error: `what` failed with iceoryx2's error `e`.
-pub(crate) fn transport(what: &str, e: impl std::fmt::Display) -> SceneOpenError {
-    SceneOpenError::Transport(format!("{what}: {e}"))
 }
 
 #[cfg(test)]

@@ -1,0 +1,26 @@
+//! How the client waits on iceoryx2 and reports its failures, shared by the control half
+//! ([`client`](crate::client)) and the frame half ([`scene_link`](crate::scene_link),
+//! [`result_feed`](crate::result_feed)).
+//!
+//! Each wait polls for a bounded few tens of µs before it gives up the core: waking a
+//! blocked process costs 60–120 µs on this machine class against ~7 µs for a polled
+//! hand-over (DESIGN §3), and a longer spin would hold a core the daemon may need.
+//! `examples/ipc_latency.rs` measures the round trips these waits end.
+
+use std::time::Duration;
+
+use crate::error::SceneOpenError;
+
+/// How long a control request's reply is awaited by spinning before the wait starts
+/// sleeping: request–response ports cannot join a WaitSet, so the reply is polled.
+pub const CONTROL_REPLY_SPIN: Duration = Duration::from_micros(20);
+/// One sleep of the control reply wait after [`CONTROL_REPLY_SPIN`].
+pub const CONTROL_REPLY_SLEEP: Duration = Duration::from_micros(50);
+/// How long a receive polls the result subscriber before it blocks on the scene's
+/// results-ready listener: it catches the answers that come sooner than a wake-up.
+pub const RESULTS_SPIN: Duration = Duration::from_micros(50);
+
+/// A scene's services or ports could not be opened: `what` failed with iceoryx2's error `e`.
+pub(crate) fn open_error(what: &str, e: impl std::fmt::Display) -> SceneOpenError {
+    SceneOpenError::Transport(format!("{what}: {e}"))
+}
