@@ -3,7 +3,6 @@
 
 use super::*;
 use crate::EVENT_RESULTS_READY;
-use crate::result_feed::{contacts_of, split};
 use crate::wire::{RecordKind, ResultFrameHeader, ResultRecord, query};
 use iceoryx2::node::NodeBuilder;
 use iceoryx2::prelude::local;
@@ -400,52 +399,6 @@ fn pairs_and_contacts_clamp_to_the_payload_when_the_header_lies() {
         assert_eq!(frame.pairs(), &frame.records()[..pairs]);
         assert_eq!(frame.contacts(), &frame.records()[pairs..pairs + contacts]);
     }
-}
-
-#[test]
-fn split_never_exceeds_the_slice_for_any_counts() {
-    let records: Vec<_> = (0..6)
-        .map(|i| ResultRecord {
-            index: i,
-            ..ResultRecord::default()
-        })
-        .collect();
-    let counts = [0u32, 1, 2, 5, 6, 7, 100, u32::MAX - 1, u32::MAX];
-    for len in 0..=records.len() {
-        for &p in &counts {
-            for &c in &counts {
-                let (pairs, contacts) = split(&records[..len], p, c);
-                let expected_pairs = (p as usize).min(len);
-                assert_eq!(pairs, &records[..expected_pairs]);
-                let expected_contacts = (c as usize).min(len - expected_pairs);
-                assert_eq!(
-                    contacts,
-                    &records[expected_pairs..expected_pairs + expected_contacts]
-                );
-            }
-        }
-    }
-}
-
-#[test]
-fn a_pairs_contacts_are_its_index_and_count_clamped_to_the_contact_records() {
-    let contacts: Vec<_> = (0..5)
-        .map(|i| ResultRecord {
-            index: i,
-            ..ResultRecord::default()
-        })
-        .collect();
-    let pair = |index, count| ResultRecord {
-        index,
-        count,
-        ..ResultRecord::default()
-    };
-    assert_eq!(contacts_of(&contacts, &pair(1, 3)), &contacts[1..4]);
-    assert_eq!(contacts_of(&contacts, &pair(0, 0)), &[]);
-    assert_eq!(contacts_of(&contacts, &pair(3, 9)), &contacts[3..]);
-    assert_eq!(contacts_of(&contacts, &pair(5, 1)), &[]);
-    assert_eq!(contacts_of(&contacts, &pair(u32::MAX, u32::MAX)), &[]);
-    assert_eq!(contacts_of(&[], &pair(0, 4)), &[]);
 }
 
 #[test]
