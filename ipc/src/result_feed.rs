@@ -225,10 +225,7 @@ impl<S: Service> ResultFrame<S> {
 }
 
 /// `pair.count` records of `contacts` from `pair.index` on, clamped to the slice.
-pub(crate) fn contacts_of<'r>(
-    contacts: &'r [ResultRecord],
-    pair: &ResultRecord,
-) -> &'r [ResultRecord] {
+fn contacts_of<'r>(contacts: &'r [ResultRecord], pair: &ResultRecord) -> &'r [ResultRecord] {
     let start = usize::try_from(pair.index).map_or(contacts.len(), |i| i.min(contacts.len()));
     let rest = &contacts[start..];
     let count = usize::try_from(pair.count).map_or(rest.len(), |c| c.min(rest.len()));
@@ -237,7 +234,7 @@ pub(crate) fn contacts_of<'r>(
 
 /// Splits `records` into `pair_count` pairs and the `contact_count` contacts after them,
 /// each clamped to what the slice holds, so a header that lies cannot cause a panic.
-pub(crate) fn split(
+fn split(
     records: &[ResultRecord],
     pair_count: u32,
     contact_count: u32,
@@ -247,7 +244,7 @@ pub(crate) fn split(
 }
 
 /// The `toi_count` records after the pairs and contacts of [`split`], clamped like it.
-pub(crate) fn toi_records(
+fn toi_records(
     records: &[ResultRecord],
     pair_count: u32,
     contact_count: u32,
@@ -267,14 +264,19 @@ fn clamp(count: u32, len: usize) -> usize {
 mod tests {
     use super::*;
 
-    #[test]
-    fn toi_records_follow_the_contacts_and_never_exceed_the_slice() {
-        let records: Vec<_> = (0..6)
+    /// `n` default records, record `i` with `index` `i`.
+    fn indexed(n: u32) -> Vec<ResultRecord> {
+        (0..n)
             .map(|i| ResultRecord {
                 index: i,
                 ..ResultRecord::default()
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn toi_records_follow_the_contacts_and_never_exceed_the_slice() {
+        let records = indexed(6);
         let counts = [0u32, 1, 2, 5, 6, 7, u32::MAX];
         for len in 0..=records.len() {
             for &p in &counts {
@@ -293,12 +295,7 @@ mod tests {
 
     #[test]
     fn split_never_exceeds_the_slice_for_any_counts() {
-        let records: Vec<_> = (0..6)
-            .map(|i| ResultRecord {
-                index: i,
-                ..ResultRecord::default()
-            })
-            .collect();
+        let records = indexed(6);
         let counts = [0u32, 1, 2, 5, 6, 7, 100, u32::MAX - 1, u32::MAX];
         for len in 0..=records.len() {
             for &p in &counts {
@@ -318,12 +315,7 @@ mod tests {
 
     #[test]
     fn a_pairs_contacts_are_its_index_and_count_clamped_to_the_contact_records() {
-        let contacts: Vec<_> = (0..5)
-            .map(|i| ResultRecord {
-                index: i,
-                ..ResultRecord::default()
-            })
-            .collect();
+        let contacts = indexed(5);
         let pair = |index, count| ResultRecord {
             index,
             count,
