@@ -4,14 +4,31 @@
 //! names and the protocol version a client checks on connect. Depends only on iceoryx2 and
 //! std; records use plain arrays (`[f64; 3]`), never glam, so clients in any language that
 //! iceoryx2 binds can speak it.
+//!
+//! The protocol, in the order a client meets it:
+//! - [`wire`]: the records and headers that cross shared memory, their codes and query flags;
+//! - this crate's root: [`PROTOCOL_VERSION`], the service names and the builders both sides
+//!   open every service with ([`control_service_builder`], [`poses_service_builder`],
+//!   [`results_service_builder`], the event services), and the event ids;
+//! - [`client`]: [`ClientBuilder`](client::ClientBuilder) → [`Client`](client::Client), one
+//!   control request and its reply per call;
+//! - [`scene_link`]: a scene's pose frames out and its result frames back;
+//!   [`result_feed`] is the receiving half alone, for monitors;
+//! - [`error`]: one error enum per operation.
+//!
+//! [`transport`] holds how the client waits on iceoryx2 (its spins and sleeps).
+//! [`tools`] is **not part of the protocol**: helpers for tools and tests (child-process
+//! isolation, latency summaries).
 
 pub mod client;
 pub mod error;
 pub mod result_feed;
 pub mod scene_link;
-pub mod tools;
-pub mod transport;
 pub mod wire;
+
+pub mod transport;
+
+pub mod tools;
 
 use iceoryx2::node::Node;
 use iceoryx2::service::builder::event::Builder as EventBuilder;

@@ -32,8 +32,8 @@
 //! Waiting is hybrid (see `shared/notes/iceoryx2-0.10.md`): the subscriber is polled for
 //! [`RESULTS_SPIN`](crate::transport::RESULTS_SPIN), then the wait blocks on the scene's
 //! results-ready listener until the daemon notifies
-//! [`EVENT_RESULTS_READY`](crate::EVENT_RESULTS_READY) or the deadline passes. Waking a
-//! halted vCPU costs 60–120 µs on a VM; the spin catches answers that come sooner.
+//! [`EVENT_RESULTS_READY`](crate::EVENT_RESULTS_READY) or the deadline passes; the spin
+//! catches the answers that come sooner than a wake-up (see [`transport`](crate::transport)).
 //! Pose frames are announced on a separate poses-ready service, so the client's own
 //! notifications never wake its wait.
 //!
