@@ -1,0 +1,368 @@
+use super::*;
+use proxima_ipc::wire::{MotionCode, ShapeKindCode};
+
+fn request(command: Command) -> ControlRequest {
+    ControlRequest {
+        protocol_version: PROTOCOL_VERSION,
+        command: command as u32,
+        orientation: [0.0, 0.0, 0.0, 1.0],
+        motion: MotionCode::Dynamic as u32,
+        group: u32::MAX,
+        mask: u32::MAX,
+        margin: -1.0,
+        ..ControlRequest::default()
+    }
+}
+
+fn mesh_payload(vertices: &[[f64; 3]], indices: &[u32]) -> Vec<u8> {
+    let mut bytes: Vec<u8> = vertices
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_ne_bytes())
+        .collect();
+    bytes.extend(indices.iter().flat_map(|i| i.to_ne_bytes()));
+    bytes
+}
+
+fn mesh_request(scene: u32, vertices: usize, indices: usize) -> ControlRequest {
+    ControlRequest {
+        scene,
+        shape_kind: ShapeKindCode::Mesh as u32,
+        vertex_count: vertices as u32,
+        index_count: indices as u32,
+        ..request(Command::RegisterShape)
+    }
+}
+
+fn code(reply: &ControlReply) -> ErrorCode {
+    ErrorCode::from_u32(reply.status).expect("a defined code")
+}
+
+const TETRA: [[f64; 3]; 4] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+];
+const TETRA_INDICES: [u32; 12] = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
+
+#[test]
+fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
+    let mut state = ControlState::new(DaemonConfig::default());
+    assert_eq!(
+        state.handle(&request(Command::Hello), &[]).id,
+        PROTOCOL_VERSION
+    );
+    let scene = state.handle(&request(Command::CreateScene), &[]).id;
+    let sphere = ControlRequest {
+        scene,
+        shape_kind: ShapeKindCode::Sphere as u32,
+        dimensions: [0.5, 0.0, 0.0, 0.0],
+        ..request(Command::RegisterShape)
+    };
+    let sphere = state.handle(&sphere, &[]);
+    assert_eq!(code(&sphere), ErrorCode::Ok, "{}", sphere.reason());
+    let mesh = state.handle(
+        &mesh_request(scene, 4, 12),
+        &mesh_payload(&TETRA, &TETRA_INDICES),
+    );
+    assert_eq!(code(&mesh), ErrorCode::Ok, "{}", mesh.reason());
+    let add = |state: &mut ControlState, shape: u32, x: f64| {
+        state.handle(
+            &ControlRequest {
+                scene,
+                target: shape,
+                position: [x, 0.0, 0.0],
+                ..request(Command::AddBody)
+            },
+            &[],
+        )
+    };
+    let a = add(&mut state, sphere.id, 0.0);
+    let b = add(&mut state, mesh.id, 2.0);
+    assert_eq!((code(&a), code(&b)), (ErrorCode::Ok, ErrorCode::Ok));
+    let s = state.scene(scene).unwrap();
+    assert_eq!(s.body_count(), 2);
+    assert_eq!(s.body(BodyId(b.id)).unwrap().pose.position.x, 2.0);
+    let update = ControlRequest {
+        scene,
+        target: a.id,
+        motion: MotionCode::Static as u32,
+        margin: 0.25,
+        ..request(Command::UpdateBody)
+    };
+    assert_eq!(code(&state.handle(&update, &[])), ErrorCode::Ok);
+    assert_eq!(
+        state
+            .scene(scene)
+            .unwrap()
+            .body(BodyId(a.id))
+            .unwrap()
+            .margin,
+        0.25
+    );
+    let remove = ControlRequest {
+        scene,
+        target: a.id,
+        ..request(Command::RemoveBody)
+    };
+    assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::Ok);
+    assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::UnknownBody);
+    for (wire_code, choice) in [
+        (5, BroadPhaseChoice::Fixed(BroadPhaseKind::SkinGrid)),
+        (4, BroadPhaseChoice::Fixed(BroadPhaseKind::ColumnGrid)),
+        (3, BroadPhaseChoice::Fixed(BroadPhaseKind::HashGrid)),
+        (2, BroadPhaseChoice::Fixed(BroadPhaseKind::IncrementalSap)),
+        (1, BroadPhaseChoice::Fixed(BroadPhaseKind::SortAndSweep)),
+        (0, BroadPhaseChoice::Auto),
+    ] {
+        let params = ControlRequest {
+            scene,
+            broad_phase: wire_code,
+            ..request(Command::SetSceneParams)
+        };
+        let reply = state.handle(&params, &[]);
+        assert_eq!((code(&reply), reply.id), (ErrorCode::Ok, scene));
+        assert_eq!(state.scene(scene).unwrap().broad_phase(), choice);
+    }
+    let drop = ControlRequest {
+        scene,
+        ..request(Command::DropScene)
+    };
+    assert_eq!(code(&state.handle(&drop, &[])), ErrorCode::Ok);
+    assert!(state.scene(scene).is_none());
+    assert_eq!(code(&state.handle(&drop, &[])), ErrorCode::UnknownScene);
+}
+
+#[test]
+fn every_bad_request_gets_its_code_and_changes_nothing() {
+    let mut state = ControlState::new(DaemonConfig {
+        max_scenes: 2,
+        mesh_limits: crate::geometry::MeshLimits {
+            max_vertices: 8,
+            max_triangles: 8,
+        },
+        ..DaemonConfig::default()
+    });
+    let scene = state.handle(&request(Command::CreateScene), &[]).id;
+    let sphere = ControlRequest {
+        scene,
+        shape_kind: ShapeKindCode::Sphere as u32,
+        dimensions: [1.0; 4],
+        ..request(Command::RegisterShape)
+    };
+    let shape = state.handle(&sphere, &[]).id;
+    let body = state
+        .handle(
+            &ControlRequest {
+                scene,
+                target: shape,
+                ..request(Command::AddBody)
+            },
+            &[],
+        )
+        .id;
+    let snapshot = format!("{:?}", state.scene(scene));
+    let big: Vec<[f64; 3]> = (0..9).map(|i| [f64::from(i), 0.0, 0.0]).collect();
+    let cases: Vec<(ControlRequest, Vec<u8>, ErrorCode)> = vec![
+        (
+            ControlRequest {
+                protocol_version: 99,
+                ..request(Command::Hello)
+            },
+            vec![],
+            ErrorCode::ProtocolMismatch,
+        ),
+        (
+            ControlRequest {
+                command: 77,
+                ..request(Command::Hello)
+            },
+            vec![],
+            ErrorCode::MalformedMessage,
+        ),
+        (
+            ControlRequest { scene: 5, ..sphere },
+            vec![],
+            ErrorCode::UnknownScene,
+        ),
+        (
+            ControlRequest {
+                shape_kind: 42,
+                ..sphere
+            },
+            vec![],
+            ErrorCode::MalformedMessage,
+        ),
+        (
+            ControlRequest {
+                dimensions: [f64::NAN; 4],
+                ..sphere
+            },
+            vec![],
+            ErrorCode::InvalidShape,
+        ),
+        (
+            ControlRequest {
+                dimensions: [-1.0; 4],
+                ..sphere
+            },
+            vec![],
+            ErrorCode::InvalidShape,
+        ),
+        (sphere, vec![1, 2, 3], ErrorCode::MalformedMessage),
+        (
+            mesh_request(scene, 4, 12),
+            mesh_payload(&TETRA, &TETRA_INDICES)[..50].to_vec(),
+            ErrorCode::MalformedMessage,
+        ),
+        (
+            mesh_request(scene, 4, 3),
+            mesh_payload(&TETRA, &[0, 1, 9]),
+            ErrorCode::MeshIndexOutOfRange,
+        ),
+        (
+            mesh_request(scene, 4, 4),
+            mesh_payload(&TETRA, &[0, 1, 2, 3]),
+            ErrorCode::MalformedMessage,
+        ),
+        (mesh_request(scene, 0, 0), vec![], ErrorCode::EmptyGeometry),
+        (
+            mesh_request(scene, 3, 3),
+            mesh_payload(
+                &[[0.0, f64::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+                &[0, 1, 2],
+            ),
+            ErrorCode::InvalidShape,
+        ),
+        (
+            mesh_request(scene, 9, 3),
+            mesh_payload(&big, &[0, 1, 2]),
+            ErrorCode::LimitExceeded,
+        ),
+        (
+            ControlRequest {
+                scene,
+                target: 9,
+                ..request(Command::AddBody)
+            },
+            vec![],
+            ErrorCode::UnknownShape,
+        ),
+        (
+            ControlRequest {
+                scene,
+                target: shape,
+                position: [f64::NAN, 0.0, 0.0],
+                ..request(Command::AddBody)
+            },
+            vec![],
+            ErrorCode::InvalidPose,
+        ),
+        (
+            ControlRequest {
+                scene,
+                target: shape,
+                orientation: [0.0, 0.0, 0.0, 2.0],
+                ..request(Command::AddBody)
+            },
+            vec![],
+            ErrorCode::InvalidPose,
+        ),
+        (
+            ControlRequest {
+                scene,
+                target: shape,
+                motion: 9,
+                ..request(Command::AddBody)
+            },
+            vec![],
+            ErrorCode::MalformedMessage,
+        ),
+        (
+            ControlRequest {
+                scene,
+                target: shape,
+                margin: f64::INFINITY,
+                ..request(Command::AddBody)
+            },
+            vec![],
+            ErrorCode::MalformedMessage,
+        ),
+        (
+            ControlRequest {
+                scene,
+                broad_phase: 6,
+                ..request(Command::SetSceneParams)
+            },
+            vec![],
+            ErrorCode::MalformedMessage,
+        ),
+        (
+            ControlRequest {
+                scene: 5,
+                broad_phase: 2,
+                ..request(Command::SetSceneParams)
+            },
+            vec![],
+            ErrorCode::UnknownScene,
+        ),
+        (
+            ControlRequest {
+                scene,
+                broad_phase: 2,
+                ..request(Command::SetSceneParams)
+            },
+            vec![1],
+            ErrorCode::MalformedMessage,
+        ),
+        (
+            ControlRequest {
+                scene,
+                target: 9,
+                ..request(Command::RemoveBody)
+            },
+            vec![],
+            ErrorCode::UnknownBody,
+        ),
+        (
+            ControlRequest {
+                scene,
+                target: body,
+                margin: f64::NAN,
+                ..request(Command::UpdateBody)
+            },
+            vec![],
+            ErrorCode::MalformedMessage,
+        ),
+    ];
+    for (i, (req, payload, expected)) in cases.iter().enumerate() {
+        let reply = state.handle(req, payload);
+        assert_eq!(code(&reply), *expected, "case {i}: {}", reply.reason());
+        assert_eq!(reply.id, u32::MAX, "case {i}");
+        assert!(!reply.reason().is_empty(), "case {i}");
+        assert_eq!(
+            format!("{:?}", state.scene(scene)),
+            snapshot,
+            "case {i} changed the scene"
+        );
+    }
+    // The scene limit, and the scene still serves after all of it.
+    assert_eq!(
+        code(&state.handle(&request(Command::CreateScene), &[])),
+        ErrorCode::Ok
+    );
+    assert_eq!(
+        code(&state.handle(&request(Command::CreateScene), &[])),
+        ErrorCode::LimitExceeded
+    );
+    let again = state.handle(
+        &ControlRequest {
+            scene,
+            target: shape,
+            ..request(Command::AddBody)
+        },
+        &[],
+    );
+    assert_eq!(code(&again), ErrorCode::Ok);
+}
