@@ -679,19 +679,19 @@ fn answer_candidates(
     for (slot, pair) in candidates.iter().enumerate() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let first_contact = results.contacts.len();
-        memory.visit(pair);
-        if let Some(k) = memory.kept_answer(scene, pair, query) {
+        if let Some(k) = memory.visit(scene, pair, query) {
             tally.reused += 1;
             results.contacts.extend_from_slice(&k.contacts);
             debug_assert!(k.answer.result.exact, "only exact answers are kept");
             report(query, k.answer, (a, b), first_contact, results);
             continue;
         }
-        let pair_plan = plan.pair(shape(scene, a), shape(scene, b), separated[slot]);
+        let shapes = (shape(scene, a), shape(scene, b));
+        let pair_plan = plan.pair(shapes.0, shapes.1, separated[slot]);
         let (answer, truncated_level) = sources.answer(
-            scene,
             query,
             (slot, pair),
+            ((a, shapes.0), (b, shapes.1)),
             &pair_plan,
             memory,
             &mut results.contacts,
@@ -711,7 +711,7 @@ fn answer_candidates(
             tally.completeness = tally
                 .completeness
                 .truncated_at(truncated_level.unwrap_or(0));
-            memory.entry(pair).answer = None;
+            memory.drop_answer(pair);
         }
         report(query, answer, (a, b), first_contact, results);
     }
@@ -731,19 +731,18 @@ struct AnswerSources<'w> {
 }
 
 impl AnswerSources<'_> {
-    /// The answer of `pair` (candidate `slot`) by `plan`, its contacts appended to
-    /// `contacts`, and the level it was truncated at when the frontier left it unfinished.
+    /// The answer of `pair` (candidate `slot`; bodies `a`, `b` with shapes `sa`, `sb`) by
+    /// `plan`, its contacts appended to `contacts`, and the level it was truncated at when
+    /// the frontier left it unfinished.
     fn answer(
         &mut self,
-        scene: &Scene,
         query: Query,
         (slot, pair): (usize, &CandidatePair),
+        ((a, sa), (b, sb)): ((&Body, &Shape), (&Body, &Shape)),
         plan: &PairPlan<'_>,
         memory: &mut PairMemories,
         contacts: &mut Vec<ContactPoint>,
     ) -> (Answer, Option<u32>) {
-        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        let (sa, sb) = (shape(scene, a), shape(scene, b));
         let narrow = &mut *self.narrow;
         let answer = match *plan {
             // Proven apart by a kept separation, which stays as it is (`DISTANCE` frames

@@ -57,11 +57,18 @@ impl PairMemories {
         self.frame += 1;
     }
 
-    /// Marks `pair` a candidate of this frame (its record, if any, is kept).
-    pub(super) fn visit(&mut self, pair: &CandidatePair) {
-        if let Some(record) = self.records.get_mut(pair) {
-            record.stamp = self.frame;
-        }
+    /// Marks `pair` a candidate of this frame (its record, if any, is kept), and gives its
+    /// kept answer when that answers `pair` of `scene` under `query` now: one look-up.
+    pub(super) fn visit(
+        &mut self,
+        scene: &Scene,
+        pair: &CandidatePair,
+        query: Query,
+    ) -> Option<&KeptAnswer> {
+        let record = self.records.get_mut(pair)?;
+        record.stamp = self.frame;
+        let kept = record.answer.as_ref()?;
+        kept.fits(scene, pair, query).then_some(kept)
     }
 
     /// Forgets the records of the pairs this frame did not visit.
@@ -96,12 +103,10 @@ impl PairMemories {
             .map(|(pair, _)| pair)
     }
 
-    /// Whether every record was visited by the current frame (for tests).
+    /// The pairs that have a record, whatever it holds (for tests).
     #[cfg(test)]
-    pub(super) fn all_visited_this_frame(&self) -> bool {
-        self.records
-            .values()
-            .all(|record| record.stamp == self.frame)
+    pub(super) fn recorded_pairs(&self) -> impl Iterator<Item = &CandidatePair> {
+        self.records.keys()
     }
 
     /// The kept answer of `pair` when it answers `pair` of `scene` under `query` now.
@@ -134,13 +139,24 @@ impl PairMemories {
         (a, b): (&Body, &Body),
         apart_by: Option<f64>,
     ) {
-        let record = self.entry(pair);
         match apart_by {
             Some(bound) => {
+                let record = self.entry(pair);
                 record.separation = Some(Separation::new(scene, (a, b), bound));
                 record.seed = None;
             }
-            None => record.separation = None,
+            None => {
+                if let Some(record) = self.records.get_mut(pair) {
+                    record.separation = None;
+                }
+            }
+        }
+    }
+
+    /// Drops the kept answer of `pair` (answered short of exact this frame).
+    pub(super) fn drop_answer(&mut self, pair: &CandidatePair) {
+        if let Some(record) = self.records.get_mut(pair) {
+            record.answer = None;
         }
     }
 

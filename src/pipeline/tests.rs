@@ -625,7 +625,15 @@ fn kept_answers_are_exactly_the_frame_candidates() {
         let mut kept: Vec<CandidatePair> = workspace.memory.kept_pairs().copied().collect();
         kept.sort_unstable();
         assert_eq!(kept, workspace.candidates, "frame {frame}");
-        assert!(workspace.memory.all_visited_this_frame());
+        // The one forgetting rule: no pair keeps a record past a frame it was not a
+        // candidate of, whatever its record holds.
+        assert!(
+            workspace
+                .memory
+                .recorded_pairs()
+                .all(|pair| workspace.candidates.binary_search(pair).is_ok()),
+            "frame {frame}"
+        );
         reused += report.reused_pairs;
         fresh += report.candidates - report.reused_pairs;
         dropped += usize::from(before > workspace.candidates.len());
