@@ -672,10 +672,6 @@ impl StatefulBroadPhase for ColumnGrid {
         self.move_slot(slot, &old, bounds);
     }
 
-    fn batches(&self) -> bool {
-        true
-    }
-
     fn update_all(&mut self, moves: &[(u32, Aabb)]) {
         Self::update_all(self, moves);
     }

@@ -325,19 +325,14 @@ impl BroadPhase {
     }
 
     /// [`set`](Self::set) of every proxy in `proxies`, the plain moves (same static flag
-    /// and filter) handed over as one batch: [`ColumnGrid::update_all`] reads all their
-    /// records before moving any, [`SkinGrid::update_all`] refiles the bodies that left
-    /// their skins as one batch; the other kinds update one by one.
+    /// and filter) handed over as one batch, flushed before any replacement so each kind
+    /// sees the same sequence as one `set` at a time: [`ColumnGrid::update_all`] reads all
+    /// their records before moving any, [`SkinGrid::update_all`] refiles the bodies that
+    /// left their skins as one batch; the other kinds update one by one.
     ///
     /// # Allocation
     /// None once the batch buffer has grown to the largest batch.
     pub fn set_all(&mut self, proxies: &[Proxy]) {
-        if !with_kind!(&self.inner, k => k.batches()) {
-            for proxy in proxies {
-                self.set(proxy);
-            }
-            return;
-        }
         let mut moves = std::mem::take(&mut self.batch);
         moves.clear();
         for proxy in proxies {
@@ -359,8 +354,7 @@ impl BroadPhase {
         self.batch = moves;
     }
 
-    /// Hands `moves` to the kinds that take them as one batch (the others got them one by
-    /// one).
+    /// Hands `moves` to the kind (as one batch to those that take one).
     fn update_batch(&mut self, moves: &[(u32, Aabb)]) {
         with_kind!(&mut self.inner, k => k.update_all(moves));
     }

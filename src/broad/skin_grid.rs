@@ -743,10 +743,6 @@ impl StatefulBroadPhase for SkinGrid {
         self.update_all(&[(body, bounds)]);
     }
 
-    fn batches(&self) -> bool {
-        true
-    }
-
     fn update_all(&mut self, moves: &[(u32, Aabb)]) {
         Self::update_all(self, moves);
     }

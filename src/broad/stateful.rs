@@ -49,11 +49,6 @@ pub(crate) trait StatefulBroadPhase {
     /// A description of the first violated invariant.
     fn validate(&self) -> Result<(), String>;
 
-    /// Whether the kind takes a frame's moves as one batch ([`update_all`](Self::update_all)).
-    fn batches(&self) -> bool {
-        false
-    }
-
     /// [`update`](Self::update) of every `(body, bounds)` in `moves`, in order.
     fn update_all(&mut self, moves: &[(u32, Aabb)]) {
         for &(body, bounds) in moves {
