@@ -70,7 +70,7 @@ use proxima::geometry::{
 use proxima::math::{DMat3, DQuat, DVec3, Isometry, Pose};
 use proxima::narrow::gjk::{EpaWorkspace, GjkCache, GjkParams, Rounded, signed_distance_convex};
 use proxima::narrow::{
-    Manifold, ManifoldPoint, ShapeDistance, distance_capsule_capsule, distance_capsule_cuboid,
+    Manifold, ShapeDistance, distance_capsule_capsule, distance_capsule_cuboid,
     distance_capsule_triangle, distance_cuboid_cuboid, distance_cuboid_triangle,
     distance_sphere_capsule, distance_sphere_cuboid, distance_sphere_sphere,
     distance_sphere_triangle, distance_triangle_triangle, intersects_triangle_triangle,
@@ -289,15 +289,9 @@ fn closed_manifold(a: &Shape, b: &Shape, pose: &Isometry) -> Option<Manifold> {
         (S::Cuboid(a), S::Cuboid(b)) => manifold_cuboid_cuboid(a, b, pose, &mut m),
         (S::Cuboid(a), S::Triangle(b)) => manifold_cuboid_triangle(a, b, pose, &mut m),
         _ if b.rank() < a.rank() && a.rank() <= 3 => {
-            let mb = closed_manifold(b, a, &pose.inverse())?;
-            m.reset(pose.transform_vector(-mb.normal));
-            for p in mb.points() {
-                m.push(ManifoldPoint {
-                    point_a: pose.transform_point(p.point_b),
-                    point_b: pose.transform_point(p.point_a),
-                    distance: p.distance,
-                });
-            }
+            // The reversed pair's manifold, seen from A: as the dispatcher flips it.
+            m = closed_manifold(b, a, &pose.inverse())?;
+            m.flip(pose);
         }
         _ => return None,
     }
