@@ -158,54 +158,18 @@ pub fn distance(
     limit: f64,
     scratch: &mut NarrowScratch,
 ) -> ShapeDistance {
-    use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
-    let iso = pose_ab.to_isometry();
-    let paths = &mut scratch.paths;
+    use Shape::Mesh as M;
     match (a, b) {
-        (S(x), S(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_sphere_sphere(x, y, &iso)
-        }
-        (S(x), C(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_sphere_capsule(x, y, &iso)
-        }
-        (S(x), B(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_sphere_cuboid(x, y, &iso)
-        }
-        // No early-out for a capsule: its closed form costs what the separating axes would.
-        (C(x), C(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_capsule_capsule(x, y, &iso)
-        }
-        (C(x), B(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_capsule_cuboid(x, y, &iso)
-        }
-        (B(x), B(y)) => {
-            let (d, beyond_limit) = pairs::distance_cuboid_cuboid_within(x, y, &iso, limit);
-            if beyond_limit {
-                paths.separating_axes += 1;
-            } else {
-                paths.closed_form += 1;
-            }
-            d
-        }
-        (C(_), S(_)) | (B(_), S(_) | C(_)) => {
-            distance(b, a, &pose_ab.inverse(), limit, scratch).flipped(&iso)
-        }
-        (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
-        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
-            convex_distance(a, b, &iso, scratch)
-        }
+        (convex!(), convex!()) => distance_convex(a, b, &pose_ab.to_isometry(), limit, scratch),
         (convex!(), M(mesh)) => {
-            paths.convex_mesh += 1;
+            scratch.paths.convex_mesh += 1;
             shape_mesh_distance(a, mesh, pose_ab, limit, scratch)
         }
-        (M(_), convex!()) => distance(b, a, &pose_ab.inverse(), limit, scratch).flipped(&iso),
+        (M(_), convex!()) => {
+            distance(b, a, &pose_ab.inverse(), limit, scratch).flipped(&pose_ab.to_isometry())
+        }
         (M(x), M(y)) => {
-            paths.mesh_mesh += 1;
+            scratch.paths.mesh_mesh += 1;
             let d = x.distance_to(
                 y,
                 pose_ab,
@@ -222,6 +186,59 @@ pub fn distance(
     }
 }
 
+/// [`distance`] for a pair of convex shapes placed by an isometry: the closed forms and
+/// GJK/EPA. A pair with a mesh is passed on to [`distance`].
+pub fn distance_convex(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    limit: f64,
+    scratch: &mut NarrowScratch,
+) -> ShapeDistance {
+    use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
+    let paths = &mut scratch.paths;
+    match (a, b) {
+        (S(x), S(y)) => {
+            paths.closed_form += 1;
+            pairs::distance_sphere_sphere(x, y, pose_ab)
+        }
+        (S(x), C(y)) => {
+            paths.closed_form += 1;
+            pairs::distance_sphere_capsule(x, y, pose_ab)
+        }
+        (S(x), B(y)) => {
+            paths.closed_form += 1;
+            pairs::distance_sphere_cuboid(x, y, pose_ab)
+        }
+        // No early-out for a capsule: its closed form costs what the separating axes would.
+        (C(x), C(y)) => {
+            paths.closed_form += 1;
+            pairs::distance_capsule_capsule(x, y, pose_ab)
+        }
+        (C(x), B(y)) => {
+            paths.closed_form += 1;
+            pairs::distance_capsule_cuboid(x, y, pose_ab)
+        }
+        (B(x), B(y)) => {
+            let (d, beyond_limit) = pairs::distance_cuboid_cuboid_within(x, y, pose_ab, limit);
+            if beyond_limit {
+                paths.separating_axes += 1;
+            } else {
+                paths.closed_form += 1;
+            }
+            d
+        }
+        (C(_), S(_)) | (B(_), S(_) | C(_)) => {
+            distance_convex(b, a, &pose_ab.inverse(), limit, scratch).flipped(pose_ab)
+        }
+        (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
+            convex_distance(a, b, pose_ab, scratch)
+        }
+        (M(_), _) | (_, M(_)) => distance(a, b, &pose_ab.to_pose(), limit, scratch),
+    }
+}
+
 /// The contact manifold of `a` and `b` placed by `pose_ab`, A's frame, into `out` (emptied
 /// first; stays empty when they are apart). `d` is their signed distance from
 /// [`distance`] (exact when they touch): pairs whose manifold is one point take it from
@@ -235,28 +252,57 @@ pub fn manifold(
     scratch: &mut NarrowScratch,
     out: &mut Manifold,
 ) {
-    use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
-    let iso = pose_ab.to_isometry();
-    out.reset(DVec3::ZERO);
+    use Shape::Mesh as M;
     match (a, b) {
-        (C(x), C(y)) => pairs::manifold_capsule_capsule(x, y, &iso, out),
-        (C(x), B(y)) => pairs::manifold_capsule_cuboid(x, y, &iso, out),
-        (B(x), B(y)) => pairs::manifold_cuboid_cuboid(x, y, &iso, out),
-        (C(_), S(_)) | (B(_), S(_) | C(_)) | (M(_), convex!()) => {
+        (convex!(), convex!()) => manifold_convex(a, b, &pose_ab.to_isometry(), d, scratch, out),
+        (M(_), convex!()) => {
             let pose_ba = pose_ab.inverse();
             let d_ba = d.flipped(&pose_ba.to_isometry());
             manifold(b, a, &pose_ba, &d_ba, scratch, out);
-            out.flip(&iso);
+            out.flip(&pose_ab.to_isometry());
+        }
+        // Mesh–mesh off the pipeline's route: the one point of `d`.
+        (M(_), M(_)) => {
+            out.reset(DVec3::ZERO);
+            out.set_from_distance(d);
+        }
+        (convex!(), M(mesh)) => {
+            out.reset(DVec3::ZERO);
+            shape_mesh_manifold(a, mesh, pose_ab, d, scratch, out);
+        }
+    }
+}
+
+/// [`manifold`] for a pair of convex shapes placed by an isometry (`d` from
+/// [`distance_convex`]). A pair with a mesh is passed on to [`manifold`].
+pub fn manifold_convex(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    d: &ShapeDistance,
+    scratch: &mut NarrowScratch,
+    out: &mut Manifold,
+) {
+    use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
+    out.reset(DVec3::ZERO);
+    match (a, b) {
+        (C(x), C(y)) => pairs::manifold_capsule_capsule(x, y, pose_ab, out),
+        (C(x), B(y)) => pairs::manifold_capsule_cuboid(x, y, pose_ab, out),
+        (B(x), B(y)) => pairs::manifold_cuboid_cuboid(x, y, pose_ab, out),
+        (C(_), S(_)) | (B(_), S(_) | C(_)) => {
+            let pose_ba = pose_ab.inverse();
+            manifold_convex(b, a, &pose_ba, &d.flipped(&pose_ba), scratch, out);
+            out.flip(pose_ab);
         }
         // One point: sphere pairs (their closed-form manifolds are the distance's
-        // witnesses) and mesh–mesh off the pipeline's route.
-        (S(_), S(_) | C(_) | B(_)) | (M(_), M(_)) => out.set_from_distance(d),
+        // witnesses).
+        (S(_), S(_) | C(_) | B(_)) => out.set_from_distance(d),
         // GJK pairs: reference-face clipping from the distance's normal.
         (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
-            manifold_convex_convex(features_of(a), features_of(b), &iso, d, out);
+            manifold_convex_convex(features_of(a), features_of(b), pose_ab, d, out);
         }
-        (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, d, scratch, out),
+        (M(_), _) | (_, M(_)) => manifold(a, b, &pose_ab.to_pose(), d, scratch, out),
     }
 }
 

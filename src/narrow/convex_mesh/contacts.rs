@@ -563,8 +563,13 @@ fn feature(t: &Triangle, witness: DVec3) -> Feature {
 // ---------------------------------------------------------------------------------------
 // One convex shape against one triangle, and the shape's volume for the tree walks.
 
-/// The signed distance of a convex shape (A's frame) and one triangle (A's frame).
-pub(crate) fn shape_triangle_distance(
+/// The signed distance of a convex shape (A's frame) and one triangle (A's frame): the
+/// closed form for a sphere, capsule or cuboid, GJK/EPA for the others. This is the query
+/// a mesh's walk runs on each triangle it reaches.
+///
+/// # Panics
+/// If `shape` is a mesh (mesh–triangle pairs are the mesh–mesh queries').
+pub fn shape_triangle_distance(
     shape: &Shape,
     triangle: &Triangle,
     epa: &mut EpaWorkspace,
@@ -591,8 +596,9 @@ pub(crate) fn shape_triangle_distance(
     }
 }
 
-/// The manifold of a convex shape and one triangle, both in A's frame.
-pub(crate) fn shape_triangle_manifold(
+/// The manifold of a convex shape and one triangle, both in A's frame: the closed form's
+/// for a sphere, capsule or cuboid, the one point of the distance for the others.
+pub fn shape_triangle_manifold(
     shape: &Shape,
     triangle: &Triangle,
     epa: &mut EpaWorkspace,

@@ -10,4 +10,5 @@ mod contacts;
 mod walk;
 
 pub(crate) use contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
+pub use contacts::{shape_triangle_distance, shape_triangle_manifold};
 pub use walk::{ConvexMeshWorkspace, for_each_overlapping_triangle, nearest_triangle};
