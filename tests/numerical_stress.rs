@@ -64,21 +64,17 @@ mod support;
 mod exact_sat;
 
 use exact_sat::{I3, exact_sat};
-use proxima::geometry::{
-    Capsule, ConvexPolyhedron, Cuboid, Cylinder, Segment, Sphere, SupportMap, Triangle,
-};
+use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Sphere, Triangle};
 use proxima::math::{DMat3, DQuat, DVec3, Isometry, Pose};
 use proxima::narrow::gjk::{EpaWorkspace, GjkCache, GjkParams, Rounded, signed_distance_convex};
+use proxima::narrow::shape::Core;
 use proxima::narrow::{
-    Manifold, ShapeDistance, distance_capsule_capsule, distance_capsule_cuboid,
-    distance_capsule_triangle, distance_cuboid_cuboid, distance_cuboid_triangle,
-    distance_sphere_capsule, distance_sphere_cuboid, distance_sphere_sphere,
-    distance_sphere_triangle, distance_triangle_triangle, intersects_triangle_triangle,
-    manifold_capsule_capsule, manifold_capsule_cuboid, manifold_capsule_triangle,
-    manifold_cuboid_cuboid, manifold_cuboid_triangle, manifold_sphere_capsule,
-    manifold_sphere_cuboid, manifold_sphere_sphere, manifold_sphere_triangle,
+    Manifold, Shape as Body, ShapeDistance, distance_triangle_triangle,
+    intersects_triangle_triangle,
 };
 use rand::Rng;
+use std::sync::Arc;
+use support::pair_queries::{self, Piece};
 use support::{TestRng, isometry, rng, rotation};
 
 const EPS: f64 = f64::EPSILON;
@@ -110,29 +106,6 @@ enum Shape {
     Triangle(Triangle),
     Cylinder(Cylinder),
     Hull(ConvexPolyhedron),
-}
-
-/// The core GJK runs on (a sphere's centre, a capsule's segment, or the shape itself).
-enum Core<'a> {
-    Point,
-    Segment(Segment),
-    Cuboid(&'a Cuboid),
-    Triangle(&'a Triangle),
-    Cylinder(&'a Cylinder),
-    Hull(&'a ConvexPolyhedron),
-}
-
-impl SupportMap for Core<'_> {
-    fn support(&self, d: DVec3) -> DVec3 {
-        match self {
-            Core::Point => DVec3::ZERO,
-            Core::Segment(s) => s.support(d),
-            Core::Cuboid(c) => c.support(d),
-            Core::Triangle(t) => t.support(d),
-            Core::Cylinder(c) => c.support(d),
-            Core::Hull(h) => h.support(d),
-        }
-    }
 }
 
 fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
@@ -167,14 +140,28 @@ fn triangle_distance(p: DVec3, t: &Triangle) -> f64 {
 }
 
 impl Shape {
+    /// The core GJK runs on (a sphere's centre, a capsule's segment, or the shape itself)
+    /// and its radius.
     fn core(&self) -> (Core<'_>, f64) {
         match self {
             Shape::Sphere(s) => (Core::Point, s.radius),
             Shape::Capsule(c) => (Core::Segment(c.segment()), c.radius),
-            Shape::Cuboid(c) => (Core::Cuboid(c), 0.0),
-            Shape::Triangle(t) => (Core::Triangle(t), 0.0),
-            Shape::Cylinder(c) => (Core::Cylinder(c), 0.0),
-            Shape::Hull(h) => (Core::Hull(h), 0.0),
+            Shape::Cuboid(c) => (Core::Support(c), 0.0),
+            Shape::Triangle(t) => (Core::Support(t), 0.0),
+            Shape::Cylinder(c) => (Core::Support(c), 0.0),
+            Shape::Hull(h) => (Core::Support(h), 0.0),
+        }
+    }
+
+    /// The shape as the library's dispatch takes it.
+    fn piece(&self) -> Piece {
+        match self {
+            Shape::Sphere(s) => Piece::Shape(Body::Sphere(*s)),
+            Shape::Capsule(c) => Piece::Shape(Body::Capsule(*c)),
+            Shape::Cuboid(c) => Piece::Shape(Body::Cuboid(*c)),
+            Shape::Triangle(t) => Piece::Triangle(*t),
+            Shape::Cylinder(c) => Piece::Shape(Body::Cylinder(*c)),
+            Shape::Hull(h) => Piece::Shape(Body::Convex(Arc::new(h.clone()))),
         }
     }
 
@@ -239,7 +226,7 @@ impl Shape {
     /// The support value `max n · x` over the shape (local frame).
     fn support_value(&self, n: DVec3) -> f64 {
         let (core, radius) = self.core();
-        core.support(n).dot(n) + radius * n.length()
+        core.support_map().support(n).dot(n) + radius * n.length()
     }
 
     fn rank(&self) -> u8 {
@@ -254,56 +241,26 @@ impl Shape {
 }
 
 /// The closed-form answer, if the pair has one (every pair of sphere, capsule, cuboid,
-/// triangle except triangle–triangle, which has no penetration depth).
+/// triangle except triangle–triangle, which has no penetration depth), as the library's
+/// dispatch answers it.
 fn closed(a: &Shape, b: &Shape, pose: &Isometry) -> Option<ShapeDistance> {
-    use Shape as S;
-    Some(match (a, b) {
-        (S::Sphere(a), S::Sphere(b)) => distance_sphere_sphere(a, b, pose),
-        (S::Sphere(a), S::Capsule(b)) => distance_sphere_capsule(a, b, pose),
-        (S::Sphere(a), S::Cuboid(b)) => distance_sphere_cuboid(a, b, pose),
-        (S::Sphere(a), S::Triangle(b)) => distance_sphere_triangle(a, b, pose),
-        (S::Capsule(a), S::Capsule(b)) => distance_capsule_capsule(a, b, pose),
-        (S::Capsule(a), S::Cuboid(b)) => distance_capsule_cuboid(a, b, pose),
-        (S::Capsule(a), S::Triangle(b)) => distance_capsule_triangle(a, b, pose),
-        (S::Cuboid(a), S::Cuboid(b)) => distance_cuboid_cuboid(a, b, pose),
-        (S::Cuboid(a), S::Triangle(b)) => distance_cuboid_triangle(a, b, pose),
-        _ if b.rank() < a.rank() && a.rank() <= 3 => {
-            return closed(b, a, &pose.inverse()).map(|d| d.flipped(pose));
-        }
-        _ => return None,
-    })
+    let has_closed_form = a.rank() <= 3 && b.rank() <= 3;
+    has_closed_form.then(|| pair_queries::distance(&a.piece(), &b.piece(), pose))?
 }
 
-/// The closed-form manifold, A's frame, if the pair has one.
+/// The closed-form manifold, A's frame, if the pair has one, as the library's dispatch
+/// answers it.
 fn closed_manifold(a: &Shape, b: &Shape, pose: &Isometry) -> Option<Manifold> {
-    use Shape as S;
-    let mut m = Manifold::new();
-    match (a, b) {
-        (S::Sphere(a), S::Sphere(b)) => manifold_sphere_sphere(a, b, pose, &mut m),
-        (S::Sphere(a), S::Capsule(b)) => manifold_sphere_capsule(a, b, pose, &mut m),
-        (S::Sphere(a), S::Cuboid(b)) => manifold_sphere_cuboid(a, b, pose, &mut m),
-        (S::Sphere(a), S::Triangle(b)) => manifold_sphere_triangle(a, b, pose, &mut m),
-        (S::Capsule(a), S::Capsule(b)) => manifold_capsule_capsule(a, b, pose, &mut m),
-        (S::Capsule(a), S::Cuboid(b)) => manifold_capsule_cuboid(a, b, pose, &mut m),
-        (S::Capsule(a), S::Triangle(b)) => manifold_capsule_triangle(a, b, pose, &mut m),
-        (S::Cuboid(a), S::Cuboid(b)) => manifold_cuboid_cuboid(a, b, pose, &mut m),
-        (S::Cuboid(a), S::Triangle(b)) => manifold_cuboid_triangle(a, b, pose, &mut m),
-        _ if b.rank() < a.rank() && a.rank() <= 3 => {
-            // The reversed pair's manifold, seen from A: as the dispatcher flips it.
-            m = closed_manifold(b, a, &pose.inverse())?;
-            m.flip(pose);
-        }
-        _ => return None,
-    }
-    Some(m)
+    let has_closed_form = a.rank() <= 3 && b.rank() <= 3;
+    has_closed_form.then(|| pair_queries::manifold(&a.piece(), &b.piece(), pose))?
 }
 
 /// GJK/EPA on the cores, radii subtracted (`signed_distance_convex`).
 fn gjk(a: &Shape, b: &Shape, pose: &Isometry) -> ShapeDistance {
     let ((ca, ra), (cb, rb)) = (a.core(), b.core());
     signed_distance_convex(
-        &Rounded::new(&ca, ra),
-        &Rounded::new(&cb, rb),
+        &Rounded::new(ca.support_map(), ra),
+        &Rounded::new(cb.support_map(), rb),
         pose,
         &GjkParams::default(),
         &mut GjkCache::default(),

@@ -21,8 +21,11 @@ mod support;
 use proxima::geometry::{Capsule, Cuboid, Sphere, Triangle};
 use proxima::math::{DMat3, DQuat, DVec3, Isometry, Pose};
 use proxima::narrow::pairs::*;
-use proxima::narrow::{DistanceBound, Manifold, ShapeDistance, distance_triangle_triangle};
+use proxima::narrow::{
+    DistanceBound, Manifold, Shape as Body, ShapeDistance, distance_triangle_triangle,
+};
 use rand::Rng;
+use support::pair_queries::{self, Piece};
 use support::{TestRng, rng, rotation};
 
 #[derive(Debug, Clone, Copy)]
@@ -34,6 +37,16 @@ enum Shape {
 }
 
 impl Shape {
+    /// The shape as the library's dispatch takes it.
+    fn piece(&self) -> Piece {
+        match *self {
+            Shape::Sphere(s) => Piece::Shape(Body::Sphere(s)),
+            Shape::Capsule(c) => Piece::Shape(Body::Capsule(c)),
+            Shape::Cuboid(b) => Piece::Shape(Body::Cuboid(b)),
+            Shape::Triangle(t) => Piece::Triangle(t),
+        }
+    }
+
     fn rank(&self) -> u8 {
         match self {
             Shape::Sphere(_) => 0,
@@ -157,36 +170,15 @@ fn robust_triangles(t: Triangle) -> Vec<Triangle> {
     }
 }
 
+/// The library's answer (its dispatch: the closed form, flipped when the pair is given in
+/// the other order). Triangle–triangle has no closed form here.
 fn distance(a: &Shape, b: &Shape, pose: &Isometry) -> ShapeDistance {
-    use Shape::*;
-    match (a, b) {
-        (Sphere(a), Sphere(b)) => distance_sphere_sphere(a, b, pose),
-        (Sphere(a), Capsule(b)) => distance_sphere_capsule(a, b, pose),
-        (Capsule(a), Capsule(b)) => distance_capsule_capsule(a, b, pose),
-        (Sphere(a), Cuboid(b)) => distance_sphere_cuboid(a, b, pose),
-        (Capsule(a), Cuboid(b)) => distance_capsule_cuboid(a, b, pose),
-        (Cuboid(a), Cuboid(b)) => distance_cuboid_cuboid(a, b, pose),
-        (Sphere(a), Triangle(b)) => distance_sphere_triangle(a, b, pose),
-        (Capsule(a), Triangle(b)) => distance_capsule_triangle(a, b, pose),
-        (Cuboid(a), Triangle(b)) => distance_cuboid_triangle(a, b, pose),
-        _ => unreachable!("non-canonical pair"),
-    }
+    pair_queries::distance(&a.piece(), &b.piece(), pose).expect("a pair with a closed form")
 }
 
+/// The library's manifold, A's frame, into `out`.
 fn manifold(a: &Shape, b: &Shape, pose: &Isometry, out: &mut Manifold) {
-    use Shape::*;
-    match (a, b) {
-        (Sphere(a), Sphere(b)) => manifold_sphere_sphere(a, b, pose, out),
-        (Sphere(a), Capsule(b)) => manifold_sphere_capsule(a, b, pose, out),
-        (Capsule(a), Capsule(b)) => manifold_capsule_capsule(a, b, pose, out),
-        (Sphere(a), Cuboid(b)) => manifold_sphere_cuboid(a, b, pose, out),
-        (Capsule(a), Cuboid(b)) => manifold_capsule_cuboid(a, b, pose, out),
-        (Cuboid(a), Cuboid(b)) => manifold_cuboid_cuboid(a, b, pose, out),
-        (Sphere(a), Triangle(b)) => manifold_sphere_triangle(a, b, pose, out),
-        (Capsule(a), Triangle(b)) => manifold_capsule_triangle(a, b, pose, out),
-        (Cuboid(a), Triangle(b)) => manifold_cuboid_triangle(a, b, pose, out),
-        _ => unreachable!("non-canonical pair"),
-    }
+    *out = pair_queries::manifold(&a.piece(), &b.piece(), pose).expect("a pair with a closed form");
 }
 
 /// Oracle: exact distance between the cores (0 when they meet).

@@ -11,6 +11,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 pub mod meshes;
+pub mod pair_queries;
 pub mod triangle_pairs;
 
 /// The PRNG every test uses, always seeded explicitly.
