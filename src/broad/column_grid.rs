@@ -1,68 +1,43 @@
 //! Column grid: a stateful broad phase for large scenes where a fraction of the bodies moves
 //! each frame. Each body is stored once, in one column of a hierarchy of 2-D grids, and each
 //! column keeps its bodies sorted along the third axis, so a moved body re-tests only the
-//! few bodies of the 1 to 4 columns around it, each found by a binary search.
+//! few bodies of the 1 to 4 columns around it, each run found by a search of the column.
 //!
-//! # Why columns, and why sorted
-//! A hash grid stores a body in every cell its box covers, so a query probes up to 8 hashed
-//! cells per level and must drop the candidates it meets twice. Here a body is listed once,
-//! in the column of its box's *low corner*, and every body of a level is at most `reach`
-//! wide on every axis. So the bodies whose boxes can meet a window `W` have their low corner
-//! in `[W.min − reach, W.max]` on each axis: on the two column axes that names a rectangle of
-//! columns (1 or 2 per axis for a body of the same level, as a column is `2 · reach` wide),
-//! and on the sweep axis a run of each column's sorted list. No candidate is met twice, and
-//! a column's list is contiguous memory.
-//!
-//! # Levels
-//! Level `k` takes the bodies whose largest box extent is at most `reach₀ · 4ᵏ` (and above
-//! the level below), in columns `2 · reach₀ · 4ᵏ` wide. A body queries every level that holds
-//! bodies; at a coarser level than its own it meets few, larger columns, at a finer one the
-//! small bodies near it. Bodies wider than the coarsest reach are *oversized*: kept in a
-//! list, tested against every moved body and, when they move, against every body.
-//!
-//! **Choosing the levels.** As for the [`HashGrid`](super::HashGrid): until the grid has held
-//! [`AUTO_SAMPLE`] bodies every body is oversized (all pairs tested: the right algorithm for
-//! so few). Then, and again whenever the body count has doubled since, the grid is rebuilt
-//! from all its bodies (`ColumnGrid::rebuild`). A level's columns are a fixed table of
-//! buckets, neighbouring columns in neighbouring buckets (`Level::size_table`).
-//!
-//! # Finding a body's pairs
-//! A body whose pairs must be refreshed (inserted, moved, removed) queries the union of its
-//! old and new box once when the two overlap, else each box on its own (after a jump their
-//! union may span the world). Each candidate `c` (every other body whose low corner is in the
-//! window's reach) is tested against both: the pair was in the set exactly when the old box
-//! met `c`'s stored box, and is now when the new one does; only a change, for bodies that
-//! may pair ([`Proxy::may_pair`]), is logged in the pair set (`pair_set.rs`). Bodies are
-//! updated one at a time, so a candidate's stored box is the one the pair set already
-//! reflects.
-//!
-//! Each column has a search index (one low end per 16 entries) that replaces the binary
-//! search, and in grids too large for the cache a batch's queries are prefetched a few
-//! moves ahead (`examples/broad_bench` measures both).
-//!
-//! # Exactness
-//! A pair is reported by [`Aabb::intersects`] on the stored boxes, as in every broad phase;
-//! the columns only prune, and prune conservatively: the low end of a window,
-//! `W.min − reach`, is computed with `reach` raised by a relative 1e-9 and then stepped one
-//! representable value down, so it is at or below the exact value even after rounding, far
-//! from the origin too; column indices are `⌊x / width⌋` by a monotone map, so any low corner
-//! at or above that end falls in a column at or after the window's first. Zero-size boxes,
-//! boxes ending on a column boundary and `-0.0` need no special case.
+//! # Invariants
+//! - Level `k` holds the bodies whose largest box extent is at most its *reach*
+//!   `reach₀ · 4ᵏ` (and above the level below), in columns `2 · reach₀ · 4ᵏ` wide, each
+//!   body once, in the column of its box's *low corner*, each column sorted by low end on
+//!   the sweep axis. Bodies wider than the coarsest reach, and every body until the levels
+//!   are chosen (`ColumnGrid::rebuild`), are *oversized*: in a list every query tests.
+//! - So the bodies of a level whose boxes can meet a window `W` have their low corner in
+//!   `[W.min − reach, W.max]` on each axis: a rectangle of columns (1 or 2 per axis for a
+//!   body of the same level) and a run of each column's list. No candidate is met twice.
+//! - The columns only prune, and conservatively: the low end of the window is rounded down
+//!   (`low_end`) and column indices are `⌊x / width⌋` by a monotone map, so any low corner
+//!   at or above that end falls in a column at or after the window's first. A pair is
+//!   reported by [`Aabb::intersects`] on the stored boxes and [`Proxy::may_pair`], as in
+//!   every broad phase; zero-size boxes, boxes ending on a column boundary and `-0.0` need
+//!   no special case.
+//! - A body whose pairs must be refreshed (inserted, moved, removed) queries its old and
+//!   new boxes (`query_windows`), and each candidate is tested against both: the pair was in
+//!   the set exactly when the old box met the candidate's stored box, and is now when the
+//!   new one does; only a change is logged. Bodies are updated one at a time, so a
+//!   candidate's stored box is the one the pair set already reflects.
 //!
 //! # Costs (`n` bodies, `k` pairs, `c` candidates a query meets)
-//! - [`update`](ColumnGrid::update): one query (`O(c)`, plus a binary search per column per
-//!   level with bodies) and the body's move in its column list: in place when it stays in its
-//!   column (a few swaps if it passed a neighbour on the sweep axis), else a removal and an
-//!   insertion, `O(column length)`. `O(n)` for an oversized body, and every query also tests
-//!   every oversized one.
-//! - [`insert`](ColumnGrid::insert), [`remove`](ColumnGrid::remove): the same, plus an
-//!   `O(n log n)` rebuild each time the body count doubles.
-//! - [`pairs`](ColumnGrid::pairs): `O(k + e log e)` for `e` pair changes (the pair set's
-//!   commit).
+//! - [`update`](ColumnGrid::update): one query (`O(c)`, plus a search of the column's index
+//!   for each column visited at each level with bodies) and the body's move in its column
+//!   list: in place when it stays in its column (a few swaps if it passed a neighbour on the
+//!   sweep axis), else a removal and an insertion, `O(column length)`. An oversized body's
+//!   own query scans every level's columns under its box, `O(n)` at worst, and every query
+//!   tests every oversized body.
+//! - [`insert`](ColumnGrid::insert), [`remove`](ColumnGrid::remove): the same, and for an
+//!   insertion an `O(n log n)` rebuild each time the body count has more than doubled.
+//! - [`pairs`](ColumnGrid::pairs): `O(k + e log e)` for `e` pair changes (`pair_set.rs`).
 //!
-//! # Input
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant), checked by
-//! `debug_assert!`.
+//! `debug_assert!`. The automatic choice ([`choose`](super::choose)) takes it for scenes
+//! that teleport, where every jump would leave a [`SkinGrid`](super::SkinGrid)'s skin.
 
 use super::body_map::Bodies;
 use super::pair_set::PairSet;
@@ -73,7 +48,8 @@ use crate::bounding::{Aabb, BoundingVolume};
 mod columns;
 use columns::{Axes, BLOCK, Entry, Level, Listing, Place};
 
-/// Bodies held before the first rebuild chooses the levels (all oversized until then).
+/// Bodies held before the first rebuild chooses the levels (all oversized until then: all
+/// pairs tested, the right algorithm for so few).
 pub const AUTO_SAMPLE: usize = 64;
 /// Most levels.
 pub const MAX_LEVELS: usize = 16;
@@ -107,7 +83,7 @@ fn query_windows(old: Option<&Aabb>, new: Option<&Aabb>) -> [Option<Aabb>; 2] {
 /// `x − reach`, rounded down past any rounding error: the exact difference with `reach`
 /// raised by a relative 1e-9 (more than the rounding of an extent computed as
 /// `max − min`), stepped one representable value down (more than the subtraction's own
-/// rounding). See the module docs, "Exactness".
+/// rounding). See the module docs, "Invariants".
 #[inline]
 fn low_end(x: f64, reach: f64) -> f64 {
     (x - reach * (1.0 + 1e-9)).next_down()
@@ -159,7 +135,8 @@ impl Default for ColumnGrid {
 }
 
 impl ColumnGrid {
-    /// An empty grid; its levels are chosen at the [`AUTO_SAMPLE`]-th body (module docs).
+    /// An empty grid; its levels are chosen at the [`AUTO_SAMPLE`]-th body, and again
+    /// whenever the body count has more than doubled since.
     #[must_use]
     pub fn new() -> Self {
         Self {
@@ -403,6 +380,10 @@ impl ColumnGrid {
     /// Calls `f(pairs, proxies, bounds, slot)` with the stored box and slot of every body
     /// other than `skip` whose box meets `window`, each once; returns where `skip` itself
     /// was met (a query over a window holding its stored box meets it), if it was.
+    ///
+    /// Tests every oversized body and queries every level that holds bodies: at a coarser
+    /// level than the window's it meets few, larger columns, at a finer one the small bodies
+    /// near it.
     #[inline]
     fn for_each_candidate(
         &mut self,
@@ -442,8 +423,8 @@ impl ColumnGrid {
     }
 
     /// Logs the pair changes of body `p` (at slot `slot`) whose box goes from `old` to `new`
-    /// (`None`: not present), against every other body's stored box (module docs, "Finding
-    /// a body's pairs"). Returns where the query met the body's own stored entry, if it
+    /// (`None`: not present), against every other body's stored box (module docs,
+    /// "Invariants"). Returns where the query met the body's own stored entry, if it
     /// did.
     #[inline]
     fn refresh(
@@ -665,7 +646,7 @@ impl StatefulBroadPhase for ColumnGrid {
         self.last_move.swap_remove(slot);
     }
 
-    /// Refreshes its pairs (module docs, "Finding a body's pairs").
+    /// Refreshes its pairs (module docs, "Invariants").
     #[inline]
     fn relocate(&mut self, slot: usize, bounds: Aabb) {
         let old = self.bodies.proxies[slot];

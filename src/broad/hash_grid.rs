@@ -5,58 +5,24 @@
 //! the overlapping-pair set kept between frames so that a body that did not move costs
 //! nothing.
 //!
-//! # Levels
-//! Level `k` has cubic cells of edge `min_cell · ratioᵏ` metres, `k = 0 .. count`, with
-//! `ratio ≥ 2` ([`HashGrid::with_levels`]; [`DEFAULT_RATIO`] is 2). A body lives at the
-//! smallest level whose cell edge is at least its box's largest extent, so its box covers 1
-//! or 2 cells per axis there (3 when rounding puts an end a hair across a boundary): at most
-//! 8 cells, 27 at worst, far from the origin too (`CellRange`). Cell `(i, j, l)` of level
-//! `k` holds the bodies of that level whose box meets it; only occupied cells exist, in a
-//! per-level hash map (`CellHasher`).
-//!
-//! **Oversized bodies.** A body larger than the coarsest cell (and every body before the
-//! levels are chosen, below) goes to the *oversized* list instead: it is tested against every
-//! body, and every body is tested against it. That keeps a few huge bodies (a floor, a
-//! table, a terrain box) from forcing a level whose cells hold everything; many of them make
-//! each of their moves `O(n)`.
-//!
-//! **Choosing the levels.** [`HashGrid::with_levels`] fixes them. [`HashGrid::new`] chooses
-//! them from the first [`AUTO_SAMPLE`] bodies, all oversized until then (all pairs tested,
-//! which is the right algorithm for so few), so that a body's box covers about 3 to 8 cells
-//! of its level (`HashGrid::choose_levels_from_bodies`).
-//!
-//! # Finding a body's pairs
-//! A body at level `L` is listed in the cells its box covers at `L` and, flagged as coming
-//! *from a finer level*, in the cells it covers at every coarser level (at most 8 per level,
-//! as there its box is smaller still than a cell). For a body `b` at level `L` with box `B`,
-//! the candidates are:
-//! - at level `L`: every body listed in the cells `B` covers there: the bodies of level `L`
-//!   and every finer body near `B`;
-//! - at every coarser level that has bodies of its own: those of them listed in the cells `B`
-//!   covers there (the flagged entries are skipped: they are finer bodies, found at their own
-//!   level or at `L`);
-//! - every oversized body (and, for an oversized `b`, every body).
-//!
-//! So a pair is found from either side: the coarser body's own level lists the finer body,
-//! and the finer body looks the coarser one up at the coarser level. Incrementally, a moved
-//! body must also find the bodies that did not move, finer or coarser, and this finds both
-//! with a few look-ups per level at or above its own, never by searching the many small
-//! cells of a finer level. Each candidate is tested once per query (stamps), by
-//! [`Aabb::intersects`] and [`Proxy::may_pair`](super::Proxy::may_pair). A body whose pairs must be
-//! refreshed (inserted, moved, removed) queries its old box and, if it left or entered a cell
-//! at some queried level, its new box too: every old pair shares a cell with the old box and
-//! every new pair with the new box, so testing these candidates against the new box leaves
-//! the set exact. A body that moved within its cells changes no cell list and re-tests only
-//! the bodies in its cells: its close pairs.
-//!
-//! # Ties: touching boxes overlap, exactly
-//! A coordinate `x` is in cell `⌊x / size⌋` of a level, computed as `⌊x · (1/size)⌋` and
-//! clamped to `i64`. That map is monotone (rounded products by a positive constant and floors
-//! never reverse an order), so when two boxes overlap or touch on an axis
-//! (`a.min ≤ b.max`, `b.min ≤ a.max`) their cell ranges on that axis overlap too, whatever the
-//! rounding: a box ending exactly on a boundary is in the cells on both sides of it, and
-//! touching boxes share a cell at every level. `-0.0` and `0.0` fall in the same cell. Cells
-//! only prune; the pair rule is [`Aabb::intersects`] (closed boxes), as in every broad phase.
+//! # Invariants
+//! - Level `k` has cubic cells of edge `min_cell · ratioᵏ` metres, `ratio ≥ 2`
+//!   ([`HashGrid::with_levels`], or chosen by [`HashGrid::new`] from its first
+//!   [`AUTO_SAMPLE`] bodies). A body lives at the finest level whose cell edge is at least
+//!   its box's largest extent, where its box covers at most 8 cells (27 at worst,
+//!   `CellRange`). A body larger than the coarsest cell, and every body while the levels
+//!   are not chosen, is *oversized*: kept in a list, tested against every body.
+//! - A body is listed in the cells its box covers at its own level and, flagged as coming
+//!   *from a finer level*, at every coarser level. So a body `b` at level `L` meets every
+//!   box that can overlap its own among: the bodies listed in its cells at `L` (those of `L`
+//!   and the finer ones near it), the unflagged ones in its cells at every coarser level
+//!   that has bodies of its own, and the oversized ones (for an oversized `b`, every body).
+//!   A pair is found from either side, never by searching the many cells of a finer level.
+//! - Cells only prune, and conservatively: the map from a coordinate to its cell is
+//!   monotone, so boxes that overlap or touch share a cell at every level (`CellRange::of`).
+//!   The pair rule is [`Aabb::intersects`] (closed boxes) and
+//!   [`Proxy::may_pair`](super::Proxy::may_pair), as in every broad phase.
+//! - The pair set holds exactly those pairs of the stored boxes.
 //!
 //! # Costs (`n` bodies, `k` pairs in the set, `c` candidates a body gathers)
 //! - [`update`](HashGrid::update): `O(c)` box tests, each candidate once, and up to 8 hash
@@ -68,9 +34,10 @@
 //!   every body once).
 //! - [`pairs`](HashGrid::pairs): `O(k + e log e)` for `e` pair changes (`pair_set.rs`).
 //!
-//! # Input
+//! # Input, and when to choose it
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant), checked by
-//! `debug_assert!`.
+//! `debug_assert!`. The automatic choice ([`choose`](super::choose)) never takes it: on
+//! every measured class another kind is faster. It stays available as a fixed choice.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hash, Hasher};
@@ -88,10 +55,13 @@ pub const AUTO_SAMPLE: usize = 64;
 /// Most levels a grid may have.
 pub const MAX_LEVELS: usize = 32;
 
-/// `level_of` value of a body in the oversized list.
+/// `level_of` value of a body in the oversized list: larger than the coarsest cell, or
+/// any body while the levels are not chosen. Each is tested against every body, and every
+/// body against it, so a few huge bodies (a floor, a table, a terrain box) do not force a
+/// level whose cells hold everything; many of them make each of their moves `O(n)`.
 const OVERSIZED: u8 = u8::MAX;
 /// Flag on a cell entry: the body is listed there from a finer level (module docs,
-/// "Finding a body's pairs"); the low 31 bits are its slot.
+/// "Invariants"); the low 31 bits are its slot.
 const FROM_FINER: u32 = 1 << 31;
 
 /// Integer coordinates of one cell of one level.
@@ -175,6 +145,13 @@ struct CellRange {
 impl CellRange {
     /// The cells of edge `1 / inv` that the closed box `bounds` meets (conservative: a box
     /// ending exactly on a boundary meets the cells on both sides).
+    ///
+    /// A coordinate `x` is in cell `⌊x / edge⌋`, computed as `⌊x · inv⌋` and clamped to
+    /// `i64`. That map is monotone (rounded products by a positive constant and floors
+    /// never reverse an order), so when two boxes overlap or touch on an axis
+    /// (`a.min ≤ b.max`, `b.min ≤ a.max`) their cell ranges on that axis overlap too,
+    /// whatever the rounding: touching boxes share a cell at every level. `-0.0` and `0.0`
+    /// fall in the same cell.
     #[inline]
     fn of(bounds: &Aabb, inv: f64) -> Self {
         let cell = |x: f64| floor_to_i64(x * inv);
@@ -336,8 +313,9 @@ impl Default for HashGrid {
 }
 
 impl HashGrid {
-    /// An empty grid that chooses its levels from its first [`AUTO_SAMPLE`] bodies (module
-    /// docs, "Choosing the levels").
+    /// An empty grid that chooses its levels from its first [`AUTO_SAMPLE`] bodies, so that
+    /// a body's box covers about 3 to 8 cells of its level; until then every body is
+    /// oversized (all pairs tested: the right algorithm for so few).
     #[must_use]
     pub fn new() -> Self {
         Self {
@@ -567,7 +545,7 @@ impl HashGrid {
     }
 
     /// Adds to `scratch` every body other than `slot` that a body at `level` with box
-    /// `bounds` could overlap (module docs, "Finding a body's pairs"), each once per stamp.
+    /// `bounds` could overlap (module docs, "Invariants"), each once per stamp.
     fn gather(&mut self, slot: usize, bounds: &Aabb, level: u8) {
         let Self {
             levels,
@@ -703,7 +681,12 @@ impl StatefulBroadPhase for HashGrid {
         self.seen.swap_remove(slot);
     }
 
-    /// Refreshes its pairs (module docs, "Finding a body's pairs").
+    /// Refreshes its pairs: gathers the candidates of its old box and, if it changed level
+    /// or left or entered a cell at some level queried, of its new box too. Every old pair
+    /// shares a cell with the old box and every new pair with the new box, so testing these
+    /// candidates against both boxes leaves the set exact ([`refresh`](HashGrid::refresh)).
+    /// A body that moved within its cells changes no cell list and re-tests only the bodies
+    /// in its cells: its close pairs.
     #[inline]
     fn relocate(&mut self, slot: usize, bounds: Aabb) {
         let old = self.bodies.proxies[slot].bounds;

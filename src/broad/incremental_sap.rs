@@ -3,54 +3,41 @@
 //! axis, the sorted list of every body's box endpoints and the set of overlapping pairs
 //! between frames, so that a frame costs only the endpoint swaps its motion causes.
 //!
-//! # How it works
-//! Each axis holds `2n` endpoints (a min and a max per body) sorted by coordinate. On one
-//! axis, the intervals of bodies `a` and `b` overlap exactly when `a`'s min lies before `b`'s
-//! max and `b`'s min before `a`'s max. [`IncrementalSap::update`] moves a body's endpoints
-//! one at a time to their new coordinates by insertion sort (adjacent swaps); a min passing a
-//! max of another body (or back) is the only swap that changes an overlap, and:
+//! # Invariants
+//! - Each axis holds `2n` endpoints (a min and a max per body) sorted by coordinate, every
+//!   min before every max at equal coordinates (`Endpoint::after`). On one axis, the
+//!   intervals of bodies `a` and `b` overlap exactly when `a`'s min lies before `b`'s max
+//!   and `b`'s min before `a`'s max; so `a.min == b.max` counts as overlapping, as in
+//!   [`Aabb::intersects`] (closed boxes: touching boxes pair, zero-size boxes are points).
+//! - The pair set holds exactly the pairs whose stored boxes overlap on all three axes and
+//!   that may pair, never the `O(n²)` pairs that overlap on one axis (what a per-axis
+//!   overlap count would store for "dice on a table", all sharing one z range).
 //!
+//! # A move
+//! [`IncrementalSap::update`] moves a body's endpoints one at a time to their new
+//! coordinates by insertion sort (adjacent swaps); a min passing a max of another body (or
+//! back) is the only swap that changes an overlap, and:
 //! - when it may *start* one, the pair's full boxes are tested (all three axes, from the
 //!   stored bounds, which the endpoint lists agree with) and the pair enters the set if they
 //!   overlap and may pair;
 //! - when it *ends* one, the pair leaves the set.
 //!
-//! This is the "test on demand" form of the per-axis overlap count (the set holds only the
-//! pairs overlapping on all three axes, never the `O(n²)` pairs that overlap on one axis,
-//! which is what a count would store for "dice on a table", all sharing one z range). It is
-//! exact: during one endpoint's move, each other endpoint is passed at most once, and every
-//! pair whose relation changed ends with an event that leaves it in the set exactly when the
-//! boxes now overlap. A body's min is moved before its max when the min decreases, after it
-//! otherwise, so a stored box is never inverted, not even between the two moves.
-//!
-//! # Ties: touching boxes overlap
-//! [`Aabb::intersects`] uses closed intervals: boxes touching at a face, an edge or a corner
-//! overlap, and zero-size boxes are points. The endpoint order agrees exactly: endpoints
-//! sort by coordinate and, at equal coordinates, every min sorts before every max, so `a.min
-//! == b.max` puts `a`'s min before `b`'s max ("overlapping"). Coordinates are compared with
-//! `<` and `==`, not `total_cmp`, so `-0.0` and `0.0` tie as they do in `intersects`. Equal
-//! endpoints of the same kind keep their relative order; their order changes no overlap.
+//! This is exact: during one endpoint's move, each other endpoint is passed at most once,
+//! and every pair whose relation changed ends with an event that leaves it in the set
+//! exactly when the boxes now overlap. A teleport takes the same path, one swap per
+//! endpoint passed: remove plus insert would be `O(n)` too.
 //!
 //! # Costs (`n` bodies, `k` pairs in the set)
-//! - [`update`](IncrementalSap::update): `O(1 + s)` for `s` swaps, linear in how far
-//!   the body moved through the lists. A body that is not updated costs nothing.
-//! - [`insert`](IncrementalSap::insert) and [`remove`](IncrementalSap::remove): `O(n)`:
-//!   binary search of the endpoint positions, a `Vec` insert or remove (memmove) and
-//!   renumbering of the shifted endpoints on each axis, and the body's pairs found by one
-//!   direct scan of the axis where the fewest endpoints precede its max.
-//! - [`pairs`](IncrementalSap::pairs): `O(k + e log e)` for `e` pair changes since the
-//!   last call: the set is a `PairSet` (`pair_set.rs`), whose edits are logged in `O(1)` and merged here.
+//! - [`update`](IncrementalSap::update): `O(1 + s)` for `s` swaps, linear in how far the
+//!   body moved through the lists (up to `O(n)` per axis for a jump). A body that is not
+//!   updated costs nothing.
+//! - [`insert`](IncrementalSap::insert) and [`remove`](IncrementalSap::remove): `O(n)`.
+//! - [`pairs`](IncrementalSap::pairs): `O(k + e log e)` for `e` pair changes (`pair_set.rs`).
 //!
-//! # Teleports
-//! A body that jumps far is moved by the same insertion sort, paying one swap per endpoint
-//! passed (up to `O(n)` per axis). Treating it as remove plus insert would not be cheaper:
-//! both of those are `O(n)` too (memmove and renumbering), so there is one path for all
-//! motion and no threshold to tune.
-//!
-//! # Input
 //! Bounds are trusted: finite with `min <= max` (the [`Aabb`] invariant; the daemon
-//! validates poses before they reach the broad phase), checked by `debug_assert!`. A NaN
-//! would break the sort order and is never allowed in.
+//! validates poses before they reach the broad phase; a NaN would break the sort order),
+//! checked by `debug_assert!`. The automatic choice ([`choose`](super::choose)) never takes
+//! it: on every measured class another kind is faster.
 
 use super::body_map::Bodies;
 use super::pair_set::PairSet;
@@ -99,6 +86,9 @@ impl Endpoint {
 
     /// Whether `self` sorts strictly after `other`: a larger coordinate, or the same
     /// coordinate with `self` a max and `other` a min (mins first, so touching overlaps).
+    /// Coordinates are compared with `>` and `==`, not `total_cmp`, so `-0.0` and `0.0` tie
+    /// as they do in [`Aabb::intersects`]. Equal endpoints of the same kind keep their
+    /// relative order; their order changes no overlap.
     #[inline]
     fn after(self, other: Self) -> bool {
         self.value > other.value || (self.value == other.value && self.kind() > other.kind())
@@ -257,7 +247,9 @@ impl StatefulBroadPhase for IncrementalSap {
     }
 
     /// Its endpoints inserted at their sorted places and its pairs found directly, without
-    /// re-sorting the other bodies.
+    /// re-sorting the other bodies: `O(n)`, a binary search of the endpoint positions, a
+    /// `Vec` insert (memmove) and renumbering of the shifted endpoints on each axis, and
+    /// one scan for the pairs ([`edit_pairs_of`](IncrementalSap::edit_pairs_of)).
     fn file(&mut self, slot: usize) {
         let proxy = self.bodies.proxies[slot];
         let bounds = proxy.bounds;
@@ -277,6 +269,8 @@ impl StatefulBroadPhase for IncrementalSap {
         self.edit_pairs_of(slot, PairSet::insert);
     }
 
+    /// Its pairs dropped by one scan, then its endpoints removed (memmove) and the shifted
+    /// ones renumbered on each axis: `O(n)`.
     fn unfile(&mut self, slot: usize) {
         self.edit_pairs_of(slot, PairSet::remove);
         for axis in 0..3 {
@@ -301,7 +295,8 @@ impl StatefulBroadPhase for IncrementalSap {
     }
 
     /// Each endpoint moved by insertion sort, the pair set updated by the swaps the move
-    /// causes.
+    /// causes. On each axis the min is moved before the max when it decreases, after it
+    /// otherwise, so a stored box is never inverted, not even between the two moves.
     #[inline]
     fn relocate(&mut self, slot: usize, bounds: Aabb) {
         for axis in 0..3 {

@@ -1,79 +1,41 @@
 //! Skin grid: the [`ColumnGrid`] over every body's box grown by a *skin*, with each body's
 //! skin neighbours listed, so that a body that moves within its grown box re-tests only
-//! the few bodies on its list, and the grid hears of it only when it leaves that box.
+//! the few bodies on its list, and the grid hears of it only when it leaves that box
+//! (Verlet lists in molecular dynamics, fat boxes in Bullet's dynamic tree).
 //!
-//! # Why
-//! With a tenth of 100,000 bodies moving a little each frame, the column grid spends about
-//! half a microsecond per move reading the columns around the body from the last-level
-//! cache, although the body's pairs hardly change. Molecular dynamics keeps *Verlet
-//! lists* for this, and Bullet's dynamic tree *fat boxes*: each body is filed under a box
-//! larger than it by a skin, and the pairs of the larger boxes are a superset of the true
-//! pairs that stays one until some body leaves its larger box.
+//! # Invariants
+//! - Every body's true box lies inside its *fat box*: its box when last filed, grown on
+//!   every side by a skin sized at that filing (`Record::refile`). The grid holds the fat
+//!   boxes.
+//! - The *skin neighbours* are the pairs of overlapping fat boxes that may pair, listed on
+//!   both sides, each entry flagged with whether the two true boxes overlap now. As every
+//!   true box lies inside its fat box, two overlapping true boxes are neighbours: the
+//!   flagged neighbours, the pairs reported, are exactly those of
+//!   [`pairs_brute_force`](super::pairs_brute_force).
+//! - Two boxes keep their relation (overlapping or apart) while their corners move less, in
+//!   total, than the pair's *room*. Each pair shares its room between its two bodies as
+//!   budgets of travel (`Share`), and what the two may still travel without a re-test fits
+//!   in the room the pair has now.
 //!
-//! # How
-//! - The grid holds each body's *fat box*: its box when last filed, grown on every side by
-//!   its *skin*. Its pairs (fat boxes overlapping) are the *skin neighbours*; each body
-//!   keeps the list of its own, each entry with whether the two true boxes overlap now.
-//! - A moved body whose box is still inside its fat box re-tests only the neighbours its
-//!   travel has made due (below, "Travel budgets"), and logs the pairs whose overlap
-//!   changed. One that left it is filed again under a new fat box (a column grid move,
-//!   whose pair changes add and remove neighbours), then re-tests all its neighbours.
-//! - The pairs reported are the neighbours whose true boxes overlap: exactly the pairs of
-//!   [`pairs_brute_force`](super::pairs_brute_force), since every true box lies inside its
-//!   fat box, so two overlapping true boxes have overlapping fat boxes.
+//! [`SkinGrid`]'s docs list every invariant its `validate` checks.
 //!
-//! # The skin
-//! A thick skin means few refilings but more neighbours; a skin where the body is not
-//! going is wasted. So each refiling sizes the skin anew, per axis and side, from the
-//! velocity of the body's centre since it was last filed: *ahead* of the motion along an
-//! axis, as far as that velocity goes in [`SKIN_FRAMES`] batches plus the skin behind, at
-//! least [`MIN_SKIN`] of its largest extent; *behind* it, and on an axis it does not move
-//! along, [`BACK_SKIN`]; the two together at most twice [`MAX_SKIN`]. Never so much that
-//! the fat box outgrows the reach of the grid level the true box belongs at (a bigger box
-//! would be filed one level up, where every query of the level below meets it): an axis
-//! without the room shares it in proportion. A body filed for the first time gets
-//! [`FIRST_SKIN`] of its extent on every side, within the same level room. Each refiling's
-//! [`SKIN_FRAMES`] is divided by a number between 0.5 and 1.5 drawn from the body's id and
-//! the batch ([`SKIN_SPREAD`]), so that bodies which start moving together do not keep
-//! leaving their skins in the same frames. First skins are not spread: a thicker one
-//! would bridge gaps a resting body never crosses.
-//!
-//! # Travel budgets
-//! Two boxes keep their relation (overlapping or apart) while their corners move less, in
-//! total, than the pair's *room*: for overlapping boxes the least overlap of their
-//! intervals over the axes, for separate ones the widest gap on an axis. So each pair
-//! shares its room, as a budget, between its two bodies: each entry records the *travel*
-//! of its owner (the running sum of the largest change of a corner coordinate per move) at
-//! which its share runs out. A move adds to the body's travel and re-tests only the
-//! entries it has made due. The shares follow who moves:
-//! - a pair whose bodies rest but for one gives it the *whole* room, and the resting side
-//!   is always due: a re-test by the mover renews its own entry only, and writes the twin
-//!   only when the overlap changed. A body moving among resting ones therefore reads its
-//!   own record and, for the few pairs due, its neighbours' boxes, and nothing else of
-//!   theirs;
-//! - when the other side moves (it is always due), its re-test splits the room, *half*
-//!   each, writing both entries, if the holder moved in this batch or the last; so does
-//!   every re-test of a pair split so. If the holder rests, the re-tester takes it all
-//!   instead.
-//!
-//! A move compares its in-place entries' due travels all at once, without a branch, and
-//! branches only on the entries due.
-//!
-//! A new pair gives the whole room to a body refiled in the batch (the mover). Travel and
-//! budgets are `f32`, rounded towards re-testing, with a relative allowance
-//! (`BUDGET_ROUNDING`) for the roundings before.
-//!
-//! Halves only where both sides move: a split pair's every re-test writes both lists.
+//! # A move
+//! - Inside its fat box: the body's travel grows by the move, and it re-tests only the
+//!   neighbours whose budget that spends, logging the pairs whose overlap changed.
+//! - Out of it: the body is filed again under a new fat box (a column grid move, whose pair
+//!   changes add and remove neighbours), then re-tests all its neighbours.
 //!
 //! # Costs (`d` neighbours a body has)
-//! - A move inside the skin: `O(d)` budget checks on the body's record (fat box and the
+//! - A move inside the skin: `O(d)` budget checks on the body's own record (fat box and
 //!   first neighbours side by side), and a box test for each pair due, reading the
-//!   neighbour's box; in a batch of a large grid the records are prefetched a few moves
-//!   ahead, and each re-test waits in a queue of `RETEST_AHEAD` while what it reads is
-//!   fetched; in a smaller one it runs at once, not through the queue.
-//! - A move out of it: a column grid move (module docs of [`ColumnGrid`]) of the fat box,
-//!   plus constant work per neighbour gained or lost (each entry knows its twin).
-//! - Teleports leave the skin every time: the column grid alone is the better choice then.
+//!   neighbour's box.
+//! - A move out of it: a column grid move of the fat box ([`ColumnGrid`]'s costs), a
+//!   re-test of every neighbour, constant work per neighbour gained, and per neighbour lost
+//!   a search of the shorter of the two lists.
+//!
+//! # When to choose it
+//! When few bodies move, or they creep for their size ([`choose`](super::choose)). Every
+//! teleport leaves its skin: the [`ColumnGrid`] alone is the better choice then.
 
 use super::body_map::Bodies;
 use super::column_grid::ColumnGrid;
@@ -85,11 +47,13 @@ use crate::math::{DVec3, splitmix64};
 use std::collections::{BTreeMap, VecDeque};
 
 /// Skin on every side of a box filed for the first time, as a fraction of its largest
-/// extent.
+/// extent, within the room of its grid level (`Record::first`). Not spread as
+/// [`SKIN_SPREAD`] spreads refilings: a thicker first skin would bridge gaps a resting body
+/// never crosses.
 pub const FIRST_SKIN: f64 = 0.1;
 /// Frames a refiled box's skin reaches ahead of its motion, at the velocity the body
-/// moved at since it was last filed (module docs, "The skin"), within [`MAX_SKIN`] and the
-/// level's room: at 64, a body moving steadily gets about the most those allow.
+/// moved at since it was last filed (`Record::refile` sizes the skin), within [`MAX_SKIN`]
+/// and the level's room: at 64, a body moving steadily gets about the most those allow.
 /// Fewer refilings (each a column-grid query) outweigh the neighbours the longer skins
 /// add (`examples/broad_bench`, `--speed-scale`).
 pub const SKIN_FRAMES: f64 = 64.0;
@@ -110,7 +74,7 @@ pub const BACK_SKIN: f64 = 0.05;
 pub const MAX_SKIN: f64 = 2.0;
 /// Width of the spread of skin thicknesses: each refiling's [`SKIN_FRAMES`] is divided by
 /// a number drawn uniformly from `[1 − SKIN_SPREAD / 2, 1 + SKIN_SPREAD / 2)`
-/// by a hash of the body's id and the batch (module docs, "The skin"). Dividing, not
+/// by a hash of the body's id and the batch (`skin_factor`). Dividing, not
 /// multiplying: a body leaves its skin at a rate inversely proportional to its thickness,
 /// so the mean rate of refilings stays what [`SKIN_FRAMES`] asks for.
 ///
@@ -138,8 +102,8 @@ struct Neighbour {
     /// Where the twin entry is in the neighbour's list.
     twin: u32,
     /// The owner's [`Record::travel`] from which the pair is due a re-test when the owner
-    /// moves (module docs, "Travel budgets"); `−∞` on the side that does not hold the
-    /// pair's budget: any move re-tests.
+    /// moves: where its share of the pair's budget runs out ([`Share`]); `−∞` on the side
+    /// that does not hold the pair's budget: any move re-tests.
     due_at: f32,
     /// This side's share of the pair's budget: the twins hold `Whole` and `None`, or
     /// `Half` each.
@@ -148,7 +112,24 @@ struct Neighbour {
     overlaps: bool,
 }
 
-/// A side's share of a pair's budget (module docs, "Travel budgets").
+/// A side's share of a pair's budget. Two boxes keep their relation while their corners
+/// move less, in total, than the pair's room ([`relation`]), so each pair shares its room
+/// between its two bodies as budgets: each entry's [`Neighbour::due_at`] is the
+/// [`Record::travel`] of its owner at which its share runs out, and a move re-tests only
+/// the entries it has made due. The shares follow who moves ([`SkinGrid::retest`]):
+/// - a pair whose bodies rest but for one gives it the *whole* room, and the resting side
+///   is always due: a re-test by the mover renews its own entry only, and writes the twin
+///   only when the overlap changed. A body moving among resting ones therefore reads its
+///   own record and, for the few pairs due, its neighbours' boxes, and nothing else of
+///   theirs;
+/// - when the other side moves (it is always due), its re-test splits the room, *half*
+///   each, writing both entries, if the holder moved in this batch or the last; so does
+///   every re-test of a pair split so. If the holder rests, the re-tester takes it all
+///   instead. Halves only where both sides move: a split pair's every re-test writes both
+///   lists.
+///
+/// A new pair gives the whole room to the body refiled in the batch, the mover
+/// ([`SkinGrid::apply_grid_edits`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 enum Share {
     /// Always due: the twin holds the whole budget.
@@ -181,7 +162,7 @@ struct Record {
     filed_centre: DVec3,
     /// How far the body's box has travelled (metres, rounded up): the sum over its moves of
     /// the largest change of a corner coordinate. Set back to 0 now and then, its entries'
-    /// [`Neighbour::due_at`] with it (module docs, "Travel budgets").
+    /// [`Neighbour::due_at`] with it ([`REBASE_AFTER_EXTENTS`]).
     travel: f32,
     /// The batch the body last moved in (or was inserted in).
     moved_at: u32,
@@ -190,7 +171,8 @@ struct Record {
 
 impl Record {
     /// A body filed for the first time with box `bounds`, in batch `batch`, in a grid whose
-    /// level for it reaches `reach` metres (module docs, "The skin").
+    /// level for it reaches `reach` metres: [`FIRST_SKIN`] of its largest extent on every
+    /// side, within the room below `reach` ([`grown_within`]).
     fn first(bounds: &Aabb, batch: u32, reach: f64) -> Self {
         let skin = DVec3::splat(FIRST_SKIN * bounds.extents().max_element());
         Self {
@@ -203,10 +185,20 @@ impl Record {
         }
     }
 
-    /// Files the body again with box `bounds` in batch `batch`: the skin reaches ahead of
-    /// the body's motion as far as it would go in `factor` × [`SKIN_FRAMES`] batches at the
-    /// velocity of its centre since the last filing, within the room below `reach`
-    /// (module docs, "The skin").
+    /// Files the body again with box `bounds` in batch `batch`, its skin sized anew, per
+    /// axis and side, from the velocity of its centre since the last filing:
+    /// - *ahead* of the motion along an axis, as far as that velocity goes in `factor` ×
+    ///   [`SKIN_FRAMES`] batches plus the skin behind, at least [`MIN_SKIN`] of the box's
+    ///   largest extent;
+    /// - *behind* it, and on an axis it does not move along, [`BACK_SKIN`];
+    /// - the two together at most twice [`MAX_SKIN`];
+    /// - all within the room below `reach`, the reach of the grid level the true box belongs
+    ///   at ([`grown_within`]): a bigger fat box would be filed one level up, where every
+    ///   query of the level below meets it. An axis without the room shares it in
+    ///   proportion.
+    ///
+    /// A thick skin means few refilings but more neighbours; a skin where the body is not
+    /// going is wasted. `factor` is [`skin_factor`]'s draw ([`SKIN_SPREAD`]).
     fn refile(&mut self, bounds: &Aabb, batch: u32, reach: f64, factor: f64) {
         let centre = bounds.center();
         let batches = f64::from(batch.wrapping_sub(self.filed_at).max(1));
@@ -273,14 +265,16 @@ fn grown_within(bounds: &Aabb, below: DVec3, above: DVec3, reach: f64) -> Aabb {
     *bounds
 }
 
-/// How many moves ahead a batch's retests prefetch (module docs, "Costs").
+/// How many moves ahead a batch's retests prefetch a move's record, in grids of
+/// [`PREFETCH_FROM_BODIES`] bodies or more.
 const PREFETCH_AHEAD: usize = 4;
 /// Fewest bodies for which a batch's retests prefetch (below, the records and boxes stay
 /// in the caches).
 const PREFETCH_FROM_BODIES: usize = 30_000;
 
 /// Re-tests a batch keeps waiting while what they read is fetched, in grids large enough
-/// to prefetch (module docs, "Costs").
+/// to prefetch ([`PREFETCH_FROM_BODIES`]); in smaller ones each re-test runs at once
+/// ([`SkinGrid::queue_retest`]).
 const RETEST_AHEAD: usize = 8;
 
 /// A body's travel is set back to 0 once it exceeds this many extents of its fat box, so
@@ -572,7 +566,7 @@ impl SkinGrid {
     }
 
     /// Queues the re-test of every entry of `slot`'s list that its travel has made due
-    /// (module docs, "Travel budgets"), first setting its travel back to 0 if it has grown
+    /// ([`Share`]), first setting its travel back to 0 if it has grown
     /// past [`REBASE_AFTER_EXTENTS`] fat-box extents.
     fn queue_due(&mut self, slot: usize, prefetching: bool) {
         let record = &mut self.records[slot];
@@ -629,11 +623,11 @@ impl SkinGrid {
     }
 
     /// Re-tests entry `i` of `slot`'s list against the two true boxes as they are now,
-    /// logs the pair if its overlap changed, and renews the budget (module docs, "Travel
-    /// budgets"): a side holding the whole of it keeps it, and writes the twin entry only
-    /// when the overlap changed; a side that moved while the twin held all or half of it
-    /// splits it, half each, if the twin moved in this batch or the last, and else takes
-    /// it all; either way writing the twin.
+    /// logs the pair if its overlap changed, and renews the budget ([`Share`]): a side
+    /// holding the whole of it keeps it, and writes the twin entry only when the overlap
+    /// changed; a side that moved while the twin held all or half of it splits it, half
+    /// each, if the twin moved in this batch or the last, and else takes it all; either way
+    /// writing the twin.
     fn retest(&mut self, slot: usize, i: usize) {
         let Neighbour {
             slot: other,
@@ -800,8 +794,8 @@ impl StatefulBroadPhase for SkinGrid {
                     return Err(format!("{}–{} overlap flag stale", p.body, q.body));
                 }
                 // What the two may still travel without a re-test must fit in the room
-                // the pair has now (module docs, "Travel budgets"); the side without the
-                // budget re-tests on any move.
+                // the pair has now (`Share`); the side without the budget re-tests on any
+                // move.
                 let left = |entry: &Neighbour, owner: usize| {
                     f64::from(entry.due_at) - f64::from(self.records[owner].travel)
                 };
@@ -834,8 +828,9 @@ fn encloses(outer: &Aabb, inner: &Aabb) -> bool {
 }
 
 /// Relative allowance for rounding in the travel budgets: far more than the few roundings
-/// of a coordinate difference, a sum and a conversion to `f32` (module docs, "Travel
-/// budgets").
+/// of a coordinate difference, a sum and a conversion to `f32`. Travel and budgets are
+/// `f32`, rounded towards re-testing: travel up ([`travelled`]), budgets down
+/// ([`due_at`]).
 const BUDGET_ROUNDING: f64 = 1e-6;
 
 /// Whether boxes `a` and `b` overlap (touching counts, as [`Aabb::intersects`]), and their
@@ -853,7 +848,7 @@ fn relation(a: &Aabb, b: &Aabb) -> (bool, f64) {
 
 /// The [`Neighbour::due_at`] of an entry with share `share` of a pair's budget, its
 /// owner having travelled `travel` when the pair is tested with room `room`: that share of
-/// the room ahead, rounded down (module docs, "Travel budgets"); `−∞` for no share. With
+/// the room ahead, rounded down ([`Share`]); `−∞` for no share. With
 /// no room it is below `travel`: any move re-tests.
 fn due_at(travel: f32, room: f64, share: Share) -> f32 {
     let fraction = match share {

@@ -3,68 +3,41 @@
 //! two axes, so a proxy meets only the proxies near it on all three axes. A stateless broad
 //! phase: it takes the whole proxy list every frame and keeps only scratch space, its
 //! order of the proxies on the sweep axis and its measure of their spread and size, so it
-//! costs about the same whatever moved (the automatic choice uses it when most bodies move
-//! fast for their size).
+//! costs about the same whatever moved. The automatic choice ([`choose`](super::choose))
+//! takes it when most bodies move fast for their size.
 //!
-//! # Why columns
-//! A plain one-axis sweep tests every pair whose intervals overlap on that axis: for `n`
-//! boxes spread through a cube, about `n^(2/3)` per box, `n^(5/3)` in all (2 million tests
-//! for 10,000 uniform boxes, 16 ms a frame). In a column of edge `c` a box meets only the
-//! boxes of its column whose intervals overlap its own: a few, for `c` about twice the
-//! typical box. It keeps the one-axis sweep's robustness to "dice on a table" (all boxes
-//! sharing one z range): the widest-spread axis is never the shared one there, and the
-//! shared range does not matter to the columns.
+//! A plain one-axis sweep meets about `n^(2/3)` boxes per box for `n` spread through a
+//! cube; a column a few typical boxes wide holds only a few that overlap a box's interval.
+//! Boxes sharing one range on an axis ("dice on a table") cost no more: that axis is never
+//! the widest-spread one, and the shared range does not matter to the columns.
 //!
 //! # One frame
 //! 1. The sweep axis `s` (largest variance of the centres) and the column axes `u`, `v`.
-//! 2. The column edge `c`: [`COLUMN_EDGE_PER_BOX`] times the 75th percentile of the
-//!    boxes' larger extent on `u`, `v`, raised until the grid over the boxes has at most
-//!    [`MAX_COLUMNS_PER_PROXY`] × `n` columns (so tiny far-apart boxes do not make a huge
-//!    empty grid). The grid is kept from frame to frame while the shape is (below) and the
-//!    boxes stay within a column of it; else it is laid on the boxes' overall bounds as
-//!    the last frame's pass over the proxies measured them, or on this frame's when they
-//!    have left those by more than a column. A box beyond the grid is listed in its edge
-//!    columns, which is exact. Boxes wider than [`BIG_COLUMNS`]
-//!    columns on `u` or `v` are *big*: tested against every proxy instead. The axis and
-//!    the percentile are measured again every [`RESHAPE_FRAMES`] frames, or when the
-//!    proxy count changes: a stale one only costs time, as any grid lists every box in
-//!    every column it meets.
-//! 3. Under the same grid and proxy count, with at most one proxy in [`KEPT_MOVES_PER`]
-//!    listed in other columns than last frame, the columns are *kept*: each entry's box is
-//!    read again from its proxy, the proxies that changed columns leave their old ones
-//!    and join their new ones, and each column is sorted by insertion (its entries keep
-//!    close to their last order, and a column holds a few dozen at most). Otherwise they
-//!    are *listed*: the kept order of the proxies by their low end on `s` is brought up
-//!    to date by insertion sort while few proxies change places, by a radix sort of the
-//!    keys when many do (`key_sort.rs`, whose docs give the rule),
-//!    and every other box is listed in each column its `u`, `v` extent meets (1 to 4
-//!    mostly), by a counting sort on the column filled in that order, so each column
-//!    comes out sorted by low end with no sort of its own.
+//! 2. The column grid (`lay_grid`), kept while its shape (axis and column edge) is and the
+//!    boxes stay within a column of it; the shape is measured again after
+//!    [`RESHAPE_FRAMES`] frames or when the proxy count changes: a stale one only costs
+//!    time, as any grid lists every box in every column it meets. A box beyond the grid is
+//!    listed in its edge columns, which is exact; one wider than [`BIG_COLUMNS`] columns on
+//!    `u` or `v` is *big*: tested against every proxy instead.
+//! 3. The columns, each ascending by low end on `s`: *kept* from the last frame's when at
+//!    most one proxy in [`KEPT_MOVES_PER`] changed columns (`relist_kept_columns`), else
+//!    *listed* afresh in the kept order of the proxies on `s` (`refresh_order`,
+//!    `list_in_columns`).
 //! 4. Each column is swept: entry `i` meets the entries after it whose low end is at most
 //!    its high end. A pair meeting in several columns is reported from one only: the column
-//!    holding the low corner of the two boxes' `u`, `v` overlap, which is the column pair of
-//!    the larger of their first columns on each axis (a floor of a maximum is the maximum of
-//!    the floors). The entries carry each box rounded outward to `f32` (a rounded gap is an
-//!    exact one), so the sweep and the `u`, `v` test read only the column; the proxies are
-//!    read for the pairs that pass, for the exact box test and [`Proxy::may_pair`].
-//!    The sweep's cost is its mispredicted branches, so the column rule and the `u`, `v`
-//!    test are one branch.
-//!
-//!    The sweep tests an entry against the next `LANES` (16) entries of its column at
-//!    once, every test of every lane without a branch (the column entries are stored one
-//!    array per field, so the compares vectorise), and branches only on the lanes that
-//!    pass and on whether the run goes on past the block, which it rarely does
-//!    (`examples/broad_bench` measures the block width).
+//!    holding the low corner of the two boxes' `u`, `v` overlap. The entries carry each box
+//!    rounded outward to `f32` (a rounded gap is an exact one), so the sweep and the `u`,
+//!    `v` test read only the column, branch-free over blocks of entries
+//!    (`ColumnEntries::candidates`); the proxies are read for the pairs that pass, for the
+//!    exact box test and [`Proxy::may_pair`].
 //! 5. Big proxies against everything, the pairs sorted (`pair_sort.rs`: a radix sort).
 //!
-//! Ties: cells are `⌊(x − origin) / c⌋` of non-negative values (a truncating conversion),
-//! monotone in `x`, so boxes touching on a column boundary share the column on its upper
-//! side; the pair rule is [`Aabb::intersects`](crate::bounding::Aabb::intersects) (closed
-//! boxes), as in every broad phase.
-//!
-//! Costs: `O(n + s + columns + e + t + k)` for `s` insertion-sort shifts (at most `n`:
-//! beyond, the linear radix sort takes over), `e` column entries, `t` interval tests in
-//! the columns and `k` pairs; no allocation once the scratch has grown.
+//! Ties: a column index is `⌊(x − origin) / c⌋`, computed by a map monotone in `x`, so boxes
+//! touching on a column boundary share a column; the pair rule is
+//! [`Aabb::intersects`](crate::bounding::Aabb::intersects) (closed boxes), as in every
+//! broad phase. Costs: `O(n + s + columns + e + t + k)` for `s` insertion-sort shifts (the
+//! order's `O(n)`: past a cap the radix sort takes over), `e` column entries, `t` interval
+//! tests in the columns and `k` pairs; no allocation once the scratch has grown.
 
 use super::key_sort::KeySort;
 use super::pair_sort::sort_pairs;
@@ -79,7 +52,8 @@ use crate::math::{DVec3, f32_round_down, f32_round_up};
 /// pairs met twice) but give each entry more sweep candidates; the sweep's cost is its
 /// mispredicted branches more than its candidates (`examples/broad_bench`).
 pub const COLUMN_EDGE_PER_BOX: f64 = 4.0;
-/// The column grid is at most this many columns per proxy.
+/// The column grid is at most this many columns per proxy: the column edge is raised until
+/// it is (`lay_grid`), so tiny far-apart boxes do not make a huge empty grid.
 pub const MAX_COLUMNS_PER_PROXY: usize = 4;
 /// A box spanning more columns than this on a column axis is tested against every proxy.
 pub const BIG_COLUMNS: u64 = 4;
@@ -167,7 +141,10 @@ fn rounded_box(ends: &[f64; 6]) -> RoundedBox {
 }
 
 /// Lanes of the sweep's blocks: it tests an entry against this many later entries of its
-/// column at once, branch-free, and branches only on the pairs that pass.
+/// column at once, every test of every lane without a branch (the entries are stored one
+/// array per field, so the compares vectorise), and branches only on the lanes that pass
+/// and on whether the run goes on past the block, which it rarely does
+/// (`examples/broad_bench` measures the block width).
 const LANES: usize = 16;
 // The block's lane mask is a `u32`, and `1 << LANES` must not overflow it.
 const _: () = assert!(LANES < u32::BITS as usize);
@@ -252,7 +229,8 @@ impl ColumnEntries {
     /// Bit `k` set when entry `i` and entry `j + k` may be a pair reported from this
     /// column: the later entry's interval on the sweep axis starts within `i`'s, the
     /// column is the first of both on each column axis for at least one of them (the
-    /// column of the overlap's low corner, see [`SortAndSweep`]), and their rounded boxes
+    /// column of the overlap's low corner: on each axis the larger of their first columns,
+    /// as the floor of a maximum is the maximum of the floors), and their rounded boxes
     /// meet on `u` and `v`. Entries at `end` and past it (another column, or padding) are
     /// masked off. Branch-free: the lanes' compares vectorise.
     #[inline]
@@ -346,8 +324,9 @@ pub struct SortAndSweep {
     sorted: RadixScratch<CandidatePair>,
     /// Scratch of `order`'s sort.
     order_sort: KeySort<(Slot, u32)>,
-    /// The proxies' overall bounds, as the last frame's slots measured them: a kept shape's
-    /// grid is laid on them, sparing a pass over the proxies.
+    /// The proxies' overall bounds, as the last [`Self::measure_slots`] measured them: when
+    /// a kept shape's grid no longer holds the boxes, the new grid is laid on the bounds
+    /// that measurement found, sparing a pass over the proxies.
     bounds_seen: Option<(DVec3, DVec3)>,
 }
 
@@ -393,8 +372,8 @@ impl SortAndSweep {
         }
         let (axis, p75, kept) = self.shape_for(proxies);
         // A kept shape keeps the grid while the boxes stay within a column of it (measured
-        // on it first); else it is laid on the bounds the last frame's slots measured, or
-        // on this frame's.
+        // on it first); else it is laid on the bounds that measurement found, or, for a
+        // shape measured anew, on this frame's overall bounds.
         let grid_kept = kept && self.listed.is_some() && self.measure_slots(proxies);
         if !grid_kept {
             let (low, high) = match self.bounds_seen.filter(|_| kept) {
@@ -526,8 +505,9 @@ impl SortAndSweep {
         })
     }
 
-    /// Fills `starts` and `entries` from `slots`: a counting sort of the column entries,
-    /// filled in sweep order so each column comes out ascending.
+    /// Fills `starts` and `entries` from `slots`: a counting sort of the column entries
+    /// (each box is listed in every column its `u`, `v` extent meets, 1 to 4 mostly),
+    /// filled in sweep order so each column comes out ascending with no sort of its own.
     fn list_in_columns(&mut self) {
         let grid = self.grid;
         let columns = (grid.count[0] * grid.count[1]) as usize;
@@ -684,7 +664,7 @@ impl SortAndSweep {
     /// read again (entries are indices, so a proxy that changed place, e.g. by a caller's
     /// `swap_remove`, is simply re-read) and new indices appended. Then sorted by
     /// [`KeySort`]: by insertion while the proxies keep close to their last order, by a
-    /// radix sort when they do not (module docs, step 3).
+    /// radix sort when they do not (`key_sort.rs` gives the rule).
     fn refresh_order(&mut self, n: usize) {
         let slots = &self.slots;
         let rebuild = self.grid.axis != self.order_axis || self.order.is_empty();
