@@ -97,3 +97,115 @@ impl Completeness {
         }
     }
 }
+
+/// When a [`WorkClock`] stops the work it is polled for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Stop {
+    /// Never: the work runs to its exact answer.
+    #[default]
+    Never,
+    /// At a wall-clock instant (a frame's deadline less what follows the work).
+    At(Instant),
+    /// Once this many units of work were counted (deterministic, for tests).
+    AfterWork(u64),
+}
+
+/// The clock a frame's interruptible work polls between bounded steps (a leaf of a mesh
+/// walk, an EPA expansion, a pair of the pair loop): it counts units of work and says
+/// whether more may be done. Reading the wall clock costs about 25 ns, so an
+/// [`Stop::At`] clock reads it only once [`WORK_PER_CLOCK_READ`] units have passed since
+/// the last read; a unit is about the cost of a closed-form pair (tens of ns), and a step
+/// that costs more counts more. Once stopped, it stays stopped.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct WorkClock {
+    stop: Stop,
+    work: u64,
+    /// `work` at which an [`Stop::At`] clock next reads the time.
+    next_read: u64,
+    stopped: bool,
+}
+
+/// Units of work between two reads of the wall clock by a [`WorkClock`].
+pub const WORK_PER_CLOCK_READ: u64 = 8;
+
+impl WorkClock {
+    /// A clock that stops as `stop` says.
+    #[must_use]
+    pub fn new(stop: Stop) -> Self {
+        Self {
+            stop,
+            work: 0,
+            next_read: 0,
+            stopped: false,
+        }
+    }
+
+    /// Counts `units` more units of work about to be done; whether they may be. The first
+    /// call reads the clock, so work never starts past the instant.
+    pub fn allows(&mut self, units: u64) -> bool {
+        if self.stopped {
+            return false;
+        }
+        let before = self.work;
+        self.work = before.saturating_add(units);
+        self.stopped = match self.stop {
+            Stop::Never => false,
+            Stop::AfterWork(limit) => before >= limit,
+            Stop::At(instant) if before >= self.next_read => {
+                self.next_read = before + WORK_PER_CLOCK_READ;
+                Instant::now() >= instant
+            }
+            Stop::At(_) => false,
+        };
+        !self.stopped
+    }
+
+    /// Whether the clock has stopped the work.
+    #[must_use]
+    pub fn stopped(&self) -> bool {
+        self.stopped
+    }
+
+    /// Whether the clock never stops.
+    #[must_use]
+    pub fn is_unlimited(&self) -> bool {
+        self.stop == Stop::Never
+    }
+
+    /// Units of work counted so far.
+    #[must_use]
+    pub fn work(&self) -> u64 {
+        self.work
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Duration;
+
+    #[test]
+    fn a_counted_clock_allows_exactly_its_work_and_stays_stopped() {
+        let mut clock = WorkClock::new(Stop::AfterWork(3));
+        assert!(clock.allows(1) && clock.allows(1) && clock.allows(1));
+        assert!(!clock.allows(1));
+        assert!(clock.stopped());
+        assert!(!clock.allows(0), "a stopped clock never restarts");
+        // A step started below the limit is allowed whatever it costs.
+        let mut clock = WorkClock::new(Stop::AfterWork(2));
+        assert!(clock.allows(1) && clock.allows(100));
+        assert!(!clock.allows(1));
+    }
+
+    #[test]
+    fn a_deadline_clock_reads_the_time_at_once_then_every_few_units() {
+        let past = Instant::now().checked_sub(Duration::from_millis(1));
+        let mut late = WorkClock::new(Stop::At(past.unwrap_or_else(Instant::now)));
+        assert!(!late.allows(1), "the first poll reads the clock");
+        let mut early = WorkClock::new(Stop::At(Instant::now() + Duration::from_secs(3600)));
+        assert!((0..1000).all(|_| early.allows(3)));
+        assert_eq!(early.work(), 3000);
+        let mut never = WorkClock::default();
+        assert!(never.is_unlimited() && (0..1000).all(|_| never.allows(u64::MAX / 2)));
+    }
+}
