@@ -118,6 +118,28 @@ impl DistanceBound {
     }
 }
 
+/// A pair's signed distance as far as the frame's clock let its query go
+/// ([`dispatch::distance_within`](super::dispatch::distance_within)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reached {
+    /// The query finished: its exact answer.
+    Exact(ShapeDistance),
+    /// The clock stopped it: bounds on the signed distance (`upper` may be `+∞` when it
+    /// found no candidate yet), with the axis and witness of the best answer found.
+    Bounded(DistanceBound),
+}
+
+impl Reached {
+    /// The same answer seen from B (see [`ShapeDistance::flipped`]).
+    #[must_use]
+    pub fn flipped(&self, pose_ba: &crate::math::Isometry) -> Self {
+        match self {
+            Self::Exact(d) => Self::Exact(d.flipped(pose_ba)),
+            Self::Bounded(b) => Self::Bounded(b.flipped(pose_ba)),
+        }
+    }
+}
+
 /// One point of a contact manifold, A's frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ManifoldPoint {

@@ -18,12 +18,15 @@
 //! shape reaches through some triangle. A shape entirely inside a closed mesh without
 //! touching its surface is apart from it, as for mesh–mesh.
 
+use crate::budget::WorkClock;
 use crate::math::{DVec3, Isometry, Pose};
-use crate::narrow::contact::{DistanceBound, Manifold, ShapeDistance};
+use crate::narrow::contact::{DistanceBound, Manifold, Reached, ShapeDistance};
 use crate::narrow::convex_manifold::manifold_convex_convex;
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
 use crate::narrow::convex_mesh::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
-use crate::narrow::gjk::{EpaWorkspace, GjkCache, GjkParams, Rounded, signed_distance_convex};
+use crate::narrow::gjk::{
+    EpaWorkspace, GjkCache, GjkParams, Rounded, signed_distance_convex_within,
+};
 use crate::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
 use crate::narrow::pairs;
 use crate::narrow::shape::{core_of, features_of};
@@ -71,6 +74,9 @@ impl PathCounts {
 /// Scratch of the dispatcher for one thread (no allocation once grown).
 #[derive(Debug, Default)]
 pub struct NarrowScratch {
+    /// The frame's clock, polled by [`distance_within`]'s long steps (unlimited unless the
+    /// pipeline sets one for a budgeted frame).
+    pub clock: WorkClock,
     /// Paths taken since the pipeline last reset it (once per frame).
     pub(crate) paths: PathCounts,
     pub(crate) epa: EpaWorkspace,
@@ -151,6 +157,7 @@ pub fn distance_bound(
 /// lower bound from the separating axes of cuboid–cuboid pairs, or an upper bound,
 /// possibly `+∞`, from a convex shape's walk of a mesh stopped early. Mesh–mesh pairs get a
 /// cold exact distance here; the pipeline sends them down [`Route::MeshMesh`] instead.
+/// Runs to the end whatever `scratch.clock` says ([`distance_within`] polls it).
 pub fn distance(
     a: &Shape,
     b: &Shape,
@@ -158,16 +165,30 @@ pub fn distance(
     limit: f64,
     scratch: &mut NarrowScratch,
 ) -> ShapeDistance {
+    let clock = std::mem::take(&mut scratch.clock);
+    let reached = distance_within(a, b, pose_ab, limit, scratch);
+    scratch.clock = clock;
+    exact(reached)
+}
+
+/// [`distance`] under the frame's clock `scratch.clock`, polled by the steps that can take
+/// long (a convex shape's walk of a mesh, EPA): exact when it finished, else bounds.
+pub fn distance_within(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Pose,
+    limit: f64,
+    scratch: &mut NarrowScratch,
+) -> Reached {
     use Shape::Mesh as M;
     match (a, b) {
-        (convex!(), convex!()) => distance_convex(a, b, &pose_ab.to_isometry(), limit, scratch),
+        (convex!(), convex!()) => convex_reach(a, b, &pose_ab.to_isometry(), limit, scratch),
         (convex!(), M(mesh)) => {
             scratch.paths.convex_mesh += 1;
             shape_mesh_distance(a, mesh, pose_ab, limit, scratch)
         }
-        (M(_), convex!()) => {
-            distance(b, a, &pose_ab.inverse(), limit, scratch).flipped(&pose_ab.to_isometry())
-        }
+        (M(_), convex!()) => distance_within(b, a, &pose_ab.inverse(), limit, scratch)
+            .flipped(&pose_ab.to_isometry()),
         (M(x), M(y)) => {
             scratch.paths.mesh_mesh += 1;
             let d = x.distance_to(
@@ -176,12 +197,12 @@ pub fn distance(
                 &mut DistanceCache::new(),
                 &mut scratch.mesh_mesh,
             );
-            ShapeDistance {
+            Reached::Exact(ShapeDistance {
                 distance: d.distance,
                 point_a: d.point_a,
                 point_b: d.point_b,
                 normal: (d.point_b - d.point_a).try_normalize().unwrap_or(DVec3::X),
-            }
+            })
         }
     }
 }
@@ -195,30 +216,41 @@ pub fn distance_convex(
     limit: f64,
     scratch: &mut NarrowScratch,
 ) -> ShapeDistance {
+    let clock = std::mem::take(&mut scratch.clock);
+    let reached = convex_reach(a, b, pose_ab, limit, scratch);
+    scratch.clock = clock;
+    exact(reached)
+}
+
+/// The answer of a query run on an unlimited clock, which never stops it.
+fn exact(reached: Reached) -> ShapeDistance {
+    match reached {
+        Reached::Exact(d) => d,
+        Reached::Bounded(bound) => bound.at_lower(),
+    }
+}
+
+/// The convex pairs' arms of [`distance_within`].
+fn convex_reach(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    limit: f64,
+    scratch: &mut NarrowScratch,
+) -> Reached {
     use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
     let paths = &mut scratch.paths;
+    let closed = |paths: &mut PathCounts, d| {
+        paths.closed_form += 1;
+        Reached::Exact(d)
+    };
     match (a, b) {
-        (S(x), S(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_sphere_sphere(x, y, pose_ab)
-        }
-        (S(x), C(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_sphere_capsule(x, y, pose_ab)
-        }
-        (S(x), B(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_sphere_cuboid(x, y, pose_ab)
-        }
+        (S(x), S(y)) => closed(paths, pairs::distance_sphere_sphere(x, y, pose_ab)),
+        (S(x), C(y)) => closed(paths, pairs::distance_sphere_capsule(x, y, pose_ab)),
+        (S(x), B(y)) => closed(paths, pairs::distance_sphere_cuboid(x, y, pose_ab)),
         // No early-out for a capsule: its closed form costs what the separating axes would.
-        (C(x), C(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_capsule_capsule(x, y, pose_ab)
-        }
-        (C(x), B(y)) => {
-            paths.closed_form += 1;
-            pairs::distance_capsule_cuboid(x, y, pose_ab)
-        }
+        (C(x), C(y)) => closed(paths, pairs::distance_capsule_capsule(x, y, pose_ab)),
+        (C(x), B(y)) => closed(paths, pairs::distance_capsule_cuboid(x, y, pose_ab)),
         (B(x), B(y)) => {
             let (d, beyond_limit) = pairs::distance_cuboid_cuboid_within(x, y, pose_ab, limit);
             if beyond_limit {
@@ -226,16 +258,16 @@ pub fn distance_convex(
             } else {
                 paths.closed_form += 1;
             }
-            d
+            Reached::Exact(d)
         }
         (C(_), S(_)) | (B(_), S(_) | C(_)) => {
-            distance_convex(b, a, &pose_ab.inverse(), limit, scratch).flipped(pose_ab)
+            convex_reach(b, a, &pose_ab.inverse(), limit, scratch).flipped(pose_ab)
         }
         (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
             convex_distance(a, b, pose_ab, scratch)
         }
-        (M(_), _) | (_, M(_)) => distance(a, b, &pose_ab.to_pose(), limit, scratch),
+        (M(_), _) | (_, M(_)) => distance_within(a, b, &pose_ab.to_pose(), limit, scratch),
     }
 }
 
@@ -312,7 +344,7 @@ fn convex_distance(
     b: &Shape,
     pose_ab: &Isometry,
     scratch: &mut NarrowScratch,
-) -> ShapeDistance {
+) -> Reached {
     let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_of(a), core_of(b)) else {
         unreachable!("the dispatcher sends only convex pairs here");
     };
@@ -320,15 +352,16 @@ fn convex_distance(
         Rounded::new(core_a.support_map(), radius_a),
         Rounded::new(core_b.support_map(), radius_b),
     );
-    let (distance, outcome) = signed_distance_convex(
+    let (reached, outcome) = signed_distance_convex_within(
         &ra,
         &rb,
         pose_ab,
         &GJK,
         &mut GjkCache::default(),
         &mut scratch.epa,
+        &mut scratch.clock,
     );
     scratch.paths.gjk += 1;
     scratch.paths.epa += u32::from(outcome.epa.is_some());
-    distance
+    reached
 }

@@ -42,7 +42,9 @@ pub mod toi;
 mod triangle_overlap;
 pub mod triangle_triangle;
 
-pub use contact::{DistanceBound, MANIFOLD_POINTS, Manifold, ManifoldPoint, ShapeDistance};
+pub use contact::{
+    DistanceBound, MANIFOLD_POINTS, Manifold, ManifoldPoint, Reached, ShapeDistance,
+};
 pub use convex_manifold::{ContactFeatures, manifold_convex_convex};
 pub use gjk::{
     GjkCache, GjkOutcome, GjkParams, GjkResult, Rounded, gjk_distance, signed_distance_convex,

@@ -13,7 +13,7 @@ use super::{ContactPoint, PairResult, Query};
 use crate::bounding::Aabb;
 use crate::broad::CandidatePair;
 use crate::math::{DVec3, Pose, conservative_slack};
-use crate::narrow::contact::{Manifold, ShapeDistance};
+use crate::narrow::contact::{DistanceBound, Manifold, Reached, ShapeDistance};
 use crate::narrow::dispatch::{self, NarrowScratch};
 use crate::narrow::mesh_mesh::frontier::FrontierAnswer;
 use crate::narrow::mesh_mesh::{
@@ -76,7 +76,18 @@ pub(super) fn direct(
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     let pose_ab = Pose::relative(&a.pose, &b.pose);
-    let d = dispatch::distance(sa, sb, &pose_ab, reporting_limit(query, a, b), scratch);
+    let limit = reporting_limit(query, a, b);
+    let d = match dispatch::distance_within(sa, sb, &pose_ab, limit, scratch) {
+        Reached::Exact(d) => d,
+        Reached::Bounded(bound) if bound.upper.is_finite() => {
+            return from_bound(pair, (a, b), &bound, query, contacts);
+        }
+        // Stopped before it found anything: the world boxes say more.
+        Reached::Bounded(_) => {
+            let grown = |body: &Body| body.world_bounds.grown(body.margin);
+            return boxes(pair, &grown(a), &grown(b), query, contacts);
+        }
+    };
     let scale = d
         .point_a
         .abs()
@@ -504,6 +515,21 @@ pub(super) fn conservative(
         return boxes(pair, &grown(a), &grown(b), query, contacts);
     };
     scratch.paths.separating_axes += 1;
+    from_bound(pair, (a, b), &bound, query, contacts)
+}
+
+/// The conservative answer from bounds on a pair's signed distance (A's frame): the
+/// distance is the lower bound less the rounding of the relative pose (a pair is reported
+/// close whenever the truth may be), the error bound reaches the upper bound, the normal
+/// and witnesses are the bounds'. It may touch when the lower bound is `≤ 0`; its contact
+/// (when asked) is one point at that bound.
+fn from_bound(
+    pair: &CandidatePair,
+    (a, b): (&Body, &Body),
+    bound: &DistanceBound,
+    query: Query,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
     let slack = conservative_slack(
         a.pose.position.abs().max_element() + b.pose.position.abs().max_element(),
     );

@@ -489,10 +489,14 @@ pub fn step(
 /// others their margin-grown world boxes' answer (distance between the boxes, their
 /// diagonals as error bound, "may touch" when they touch). A sphere against a
 /// sphere, capsule or cuboid stays exact: its closed form costs no more than a box answer.
-/// Counted budgets leave them exact. Not yet budgeted: the broad phase, the exact contacts
-/// of finished touching mesh pairs and time of impact run to completion whatever the
-/// budget (the frontier's reserve is for them). The worker pool is not used for a
-/// budgeted frontier (one thread).
+/// A pair already started keeps to the same clock inside its query
+/// ([`NarrowScratch::clock`](crate::narrow::dispatch::NarrowScratch::clock)): a convex
+/// shape's walk of a mesh and EPA stop there with bounds on the distance
+/// ([`Reached::Bounded`](crate::narrow::Reached)), answered as the separating-axis bounds
+/// are. Counted budgets leave them exact. Not yet budgeted: the broad phase, the exact
+/// contacts of finished touching mesh pairs and time of impact's single searches run to
+/// completion whatever the budget (the frontier's reserve is for them). The worker pool is
+/// not used for a budgeted frontier (one thread).
 ///
 /// # Allocation
 /// As [`step`], plus, with a limited budget, one list of the frame's frontier pairs (it
@@ -515,6 +519,7 @@ pub fn step_within(
     let broad_ns = elapsed_ns(started);
     let started = Instant::now();
     let mut plan = FramePlan::new(&*budget, query);
+    workspace.narrow.clock = plan.narrow_clock();
     let (hull_tests, frontier) = mid_phase(scene, query, budget, &plan, started, workspace);
     let mid_ns = if plan.limited { elapsed_ns(started) } else { 0 };
     // Unbudgeted, the hull tests answer pairs as the narrow phase does: its time.

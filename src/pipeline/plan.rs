@@ -3,7 +3,7 @@
 //! work after it) and, per candidate pair, which route answers it ([`PairPlan`]).
 
 use super::{MIN_PARALLEL_MESH_PAIRS, Query};
-use crate::budget::Budget;
+use crate::budget::{Budget, Stop, WorkClock};
 pub use crate::budget::{Deadline, Unlimited, VisitBudget};
 use crate::narrow::dispatch::{self, Route};
 use crate::narrow::{MeshShape, Shape};
@@ -77,7 +77,9 @@ pub(super) struct FramePlan {
     pub(super) pool: bool,
     /// Pairs off the frontier's route keep to the frame's deadline: once it is near, the
     /// rest get conservative answers.
-    pair_clock: PairClock,
+    pair_clock: WorkClock,
+    /// The frame's deadline, when it keeps to one (`limited`).
+    deadline: Option<Instant>,
 }
 
 impl FramePlan {
@@ -85,11 +87,19 @@ impl FramePlan {
     /// [`wants_pool`](Self::wants_pool)).
     pub(super) fn new(budget: &dyn Budget, query: Query) -> Self {
         let limited = !budget.is_unlimited() && query.at_current_poses();
+        let deadline = budget.deadline().filter(|_| limited);
         Self {
             limited,
             pool: false,
-            pair_clock: PairClock::new(budget.deadline().filter(|_| limited)),
+            pair_clock: pair_clock(deadline),
+            deadline,
         }
+    }
+
+    /// The clock the narrow routes poll inside one pair (a convex shape's walk of a mesh,
+    /// EPA): the pairs' deadline, so a pair started just before it stops soon after.
+    pub(super) fn narrow_clock(&self) -> WorkClock {
+        pair_clock(self.deadline)
     }
 
     /// Whether a frame with these mesh pairs to answer uses the worker pool: never under a
@@ -112,7 +122,7 @@ impl FramePlan {
             _ if separated => PairPlan::Separated,
             Route::Direct
                 if !dispatch::exact_costs_no_more_than_boxes(sa, sb)
-                    && self.pair_clock.expired() =>
+                    && !self.pair_clock.allows(1) =>
             {
                 PairPlan::Conservative
             }
@@ -130,41 +140,13 @@ impl FramePlan {
 /// value.
 pub const PUBLISH_RESERVE: Duration = Duration::from_micros(30);
 
-/// Pairs answered between two looks at the clock by [`PairClock`]: a closed form costs
-/// tens of nanoseconds, GJK or a convex–mesh walk a few microseconds.
-const PAIRS_PER_CLOCK_CHECK: u32 = 8;
-
-/// The deadline of the per-pair loop: [`PUBLISH_RESERVE`] before the frame's, checked every
-/// [`PAIRS_PER_CLOCK_CHECK`] pairs; once passed, it stays passed.
-pub(super) struct PairClock {
-    deadline: Option<Instant>,
-    count: u32,
-    pub(super) expired: bool,
-}
-
-impl PairClock {
-    pub(super) fn new(frame_deadline: Option<Instant>) -> Self {
-        Self {
-            deadline: frame_deadline.map(|d| d.checked_sub(PUBLISH_RESERVE).unwrap_or(d)),
-            count: 0,
-            expired: false,
-        }
-    }
-
-    /// Whether the next pair must take the conservative box answer.
-    pub(super) fn expired(&mut self) -> bool {
-        if self.expired {
-            return true;
-        }
-        let Some(deadline) = self.deadline else {
-            return false;
-        };
-        self.count += 1;
-        if self.count.is_multiple_of(PAIRS_PER_CLOCK_CHECK) || self.count == 1 {
-            self.expired = Instant::now() >= deadline;
-        }
-        self.expired
-    }
+/// The clock of the work after the frontier (the per-pair loop, the narrow routes' long
+/// steps, time of impact): it stops [`PUBLISH_RESERVE`] before the frame's deadline, reading
+/// the time every few pairs ([`WorkClock`]); unlimited without a deadline.
+pub(super) fn pair_clock(frame_deadline: Option<Instant>) -> WorkClock {
+    WorkClock::new(frame_deadline.map_or(Stop::Never, |d| {
+        Stop::At(d.checked_sub(PUBLISH_RESERVE).unwrap_or(d))
+    }))
 }
 
 #[cfg(test)]

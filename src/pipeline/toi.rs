@@ -30,7 +30,7 @@
 //! lower bound) and those boxes' witnesses and normal. No pair that comes within contact
 //! is ever left out, and none is reported later than its first contact.
 
-use super::plan::PairClock;
+use super::plan::pair_clock;
 use super::{FrameResults, PipelineWorkspace, Query, body, shape};
 use crate::broad::CandidatePair;
 use crate::budget::Budget;
@@ -192,18 +192,18 @@ pub(super) fn answer_tois(
         narrow,
         ..
     } = workspace;
-    let mut toi_clock = PairClock::new(budget.deadline());
+    let mut toi_clock = pair_clock(budget.deadline());
     let mut truncated = 0;
     for pair in toi_candidates.iter() {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        if toi_clock.expired() {
+        if !toi_clock.allows(1) {
             truncated += 1;
             results.tois.push(unsearched(scene, pair, a, b));
             continue;
         }
         let shapes = (shape(scene, a), shape(scene, b));
         let searched = pair_toi(scene, pair, (a, shapes.0), (b, shapes.1), narrow, || {
-            !toi_clock.expired()
+            toi_clock.allows(1)
         });
         if let Some(toi) = searched {
             results.tois.push(toi);
@@ -212,6 +212,6 @@ pub(super) fn answer_tois(
     // Set once a candidate went unsearched or a search stopped at the deadline.
     ToiTally {
         truncated,
-        expired: toi_clock.expired,
+        expired: toi_clock.stopped(),
     }
 }

@@ -49,7 +49,7 @@
 //! shapes whose triangle manifold is one point (spheres and the GJK shapes). A pair beyond
 //! contact (distance `> 0`) gets an empty manifold with no walk at all.
 
-use super::walk::{for_each_overlapping_triangle, nearest_triangle};
+use super::walk::{for_each_overlapping_triangle, nearest_triangle_within};
 use crate::bounding::BoundingVolume;
 use crate::bounding::{Obb, Rss};
 use crate::geometry::SupportMap;
@@ -57,7 +57,7 @@ use crate::geometry::Triangle;
 use crate::geometry::mesh::{EdgeKind, NO_NEIGHBOUR};
 use crate::math::DMat3;
 use crate::math::{DVec3, Isometry, Pose};
-use crate::narrow::contact::{Manifold, ManifoldPoint, ShapeDistance};
+use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, Reached, ShapeDistance};
 use crate::narrow::dispatch::{GJK, NarrowScratch};
 use crate::narrow::gjk::{EpaWorkspace, GjkCache, Rounded, signed_distance_convex};
 use crate::narrow::pairs;
@@ -111,16 +111,18 @@ impl WalkKey {
 }
 
 /// A convex shape against a mesh's triangles: the nearest (or deepest) triangle's signed
-/// distance, exact when at most `limit` (see [`nearest_triangle`]). Records the triangles
-/// it finds touching for [`shape_mesh_manifold`].
+/// distance, exact when at most `limit` (see [`nearest_triangle_within`]), or bounds when
+/// `scratch.clock` stopped the walk. Records the triangles it finds touching for
+/// [`shape_mesh_manifold`] (only when the walk finished).
 pub(crate) fn shape_mesh_distance(
     shape: &Shape,
     mesh: &MeshShape,
     pose_ab: &Pose,
     limit: f64,
     scratch: &mut NarrowScratch,
-) -> ShapeDistance {
+) -> Reached {
     let NarrowScratch {
+        clock,
         epa,
         convex_mesh,
         mesh_contacts,
@@ -136,11 +138,12 @@ pub(crate) fn shape_mesh_distance(
     let Some((core, radius)) = core_of(shape) else {
         unreachable!("the dispatcher sends only convex shapes here");
     };
-    let found = nearest_triangle(
+    let walk = nearest_triangle_within(
         &Rss::around(shape),
         &mesh.distance_tree,
         pose_ab,
         limit,
+        clock,
         convex_mesh,
         |id, triangle, threshold| {
             if plane_separation(core.support_map(), radius, triangle) > threshold {
@@ -155,18 +158,44 @@ pub(crate) fn shape_mesh_distance(
             Some((d.distance, d))
         },
     );
-    // With a negative limit the walk may skip touching triangles: no record then.
-    *walked = (limit >= 0.0).then(|| WalkKey::new(shape, mesh, pose_ab));
-    found.map_or(
+    // With a negative limit the walk may skip touching triangles, and a stopped walk skips
+    // some: no record then.
+    let finished = walk.unvisited_lower.is_none();
+    *walked = (limit >= 0.0 && finished).then(|| WalkKey::new(shape, mesh, pose_ab));
+    let best = walk.best.map(|(_, d)| d);
+    // The volumes' bounds are distances, 0 where they overlap; a triangle left there may
+    // be reached through by up to the shape's width along its normal, at most the
+    // diagonal of the shape's local box.
+    let unvisited_lower = walk.unvisited_lower.map(|left| {
+        if left > 0.0 {
+            left
+        } else {
+            let local = shape.local_bounds();
+            -(local.max - local.min).length()
+        }
+    });
+    match (unvisited_lower, best) {
+        (None, Some(d)) => Reached::Exact(d),
         // A mesh without triangles, or nothing within the limit.
-        ShapeDistance {
+        (None, None) => Reached::Exact(ShapeDistance {
             distance: f64::INFINITY,
             point_a: DVec3::ZERO,
             point_b: DVec3::ZERO,
             normal: DVec3::X,
-        },
-        |(_, d)| d,
-    )
+        }),
+        (Some(left), Some(d)) => Reached::Bounded(DistanceBound::new(
+            left.min(d.distance),
+            d.distance,
+            d.normal,
+            d.point_b,
+        )),
+        (Some(left), None) => Reached::Bounded(DistanceBound::new(
+            left,
+            f64::INFINITY,
+            DVec3::X,
+            DVec3::ZERO,
+        )),
+    }
 }
 
 /// How far apart the shape (a core swept by `radius`, at the origin of A's frame) and the

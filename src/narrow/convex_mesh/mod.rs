@@ -11,4 +11,7 @@ mod walk;
 
 pub(crate) use contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 pub use contacts::{shape_triangle_distance, shape_triangle_manifold};
-pub use walk::{ConvexMeshWorkspace, for_each_overlapping_triangle, nearest_triangle};
+pub use walk::{
+    ConvexMeshWorkspace, TRIANGLE_WORK, Walk, for_each_overlapping_triangle, nearest_triangle,
+    nearest_triangle_within,
+};

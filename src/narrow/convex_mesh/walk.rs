@@ -8,12 +8,17 @@
 //! is the minimum over its triangles.
 
 use crate::bounding::BoundingVolume;
+use crate::budget::WorkClock;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::RankedPair;
 use crate::geometry::Triangle;
 use crate::math::{Isometry, Pose};
 use std::collections::BinaryHeap;
 use std::ops::ControlFlow;
+
+/// Units of [`WorkClock`] work one triangle query counts for (a closed-form
+/// shape–triangle test costs a few closed-form pairs; GJK more).
+pub const TRIANGLE_WORK: u64 = 4;
 
 /// Scratch of the traversals (no allocation once grown).
 #[derive(Debug, Default)]
@@ -52,20 +57,66 @@ pub fn nearest_triangle<B, T>(
     pose_ab: &Pose,
     limit: f64,
     workspace: &mut ConvexMeshWorkspace,
-    mut triangle_value: impl FnMut(u32, &Triangle, f64) -> Option<(f64, T)>,
+    triangle_value: impl FnMut(u32, &Triangle, f64) -> Option<(f64, T)>,
 ) -> Option<(f64, T)>
 where
     B: BoundingVolume,
 {
+    let walk = nearest_triangle_within(
+        shape_bv,
+        tree,
+        pose_ab,
+        limit,
+        &mut WorkClock::default(),
+        workspace,
+        triangle_value,
+    );
+    debug_assert!(
+        walk.unvisited_lower.is_none(),
+        "an unlimited clock never stops"
+    );
+    walk.best
+}
+
+/// What [`nearest_triangle_within`] found before it finished or its clock stopped it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Walk<T> {
+    /// The smallest value found, with its answer (as [`nearest_triangle`]'s).
+    pub best: Option<(f64, T)>,
+    /// When the clock stopped the walk: the least lower bound of the subtrees it left,
+    /// metres, so the true minimum is at least the smaller of this and `best`'s value.
+    /// `None` when the walk finished.
+    pub unvisited_lower: Option<f64>,
+}
+
+/// [`nearest_triangle`], polling `clock` before each leaf ([`TRIANGLE_WORK`] units per
+/// triangle). Stopped, it returns what it found and the least lower bound of what it left:
+/// the leaves are visited nearest first, so that bound only grows with more work.
+pub fn nearest_triangle_within<B, T>(
+    shape_bv: &B,
+    tree: &Bvh<B>,
+    pose_ab: &Pose,
+    limit: f64,
+    clock: &mut WorkClock,
+    workspace: &mut ConvexMeshWorkspace,
+    mut triangle_value: impl FnMut(u32, &Triangle, f64) -> Option<(f64, T)>,
+) -> Walk<T>
+where
+    B: BoundingVolume,
+{
+    let mut walk = Walk {
+        best: None,
+        unvisited_lower: None,
+    };
     if tree.triangle_count() == 0 {
-        return None;
+        return walk;
     }
     let iso_ab = pose_ab.to_isometry();
     // The node volumes live in B's frame; the shape's volume is placed in it by `pose_ba`.
     let iso_ba = pose_ab.inverse().to_isometry();
     let nodes = tree.nodes();
     let bound = |node: usize| nodes[node].bv.distance_lower_bound(shape_bv, &iso_ba);
-    let mut best: Option<(f64, T)> = None;
+    let best = &mut walk.best;
     let heap = &mut workspace.ranked;
     heap.clear();
     heap.push(RankedPair {
@@ -79,28 +130,37 @@ where
             .map_or(limit, |(value, _)| value.max(0.0).min(limit))
     };
     let prune = |bound: f64, best: &Option<(f64, T)>| bound > threshold(best);
+    // The largest bound popped so far bounds everything left: each entry left was in the
+    // heap, hence no nearer, when that one was popped, or descends from one that was (a
+    // fitted child volume may reach nearer than its parent's, but its triangles cannot).
+    let mut floor = f64::NEG_INFINITY;
     while let Some(entry) = heap.pop() {
-        if prune(entry.bound, &best) {
+        if prune(entry.bound, best) {
             break;
         }
+        floor = floor.max(entry.bound);
         let node = &nodes[entry.a as usize];
         if node.is_leaf() {
+            if !clock.allows(TRIANGLE_WORK * node.slots().len() as u64) {
+                walk.unvisited_lower = Some(floor);
+                break;
+            }
             for slot in node.slots() {
                 let triangle = tree.triangles()[slot].transformed(&iso_ab);
                 let Some((value, answer)) =
-                    triangle_value(tree.triangle_id(slot), &triangle, threshold(&best))
+                    triangle_value(tree.triangle_id(slot), &triangle, threshold(best))
                 else {
                     continue;
                 };
                 if best.as_ref().is_none_or(|(b, _)| value < *b) {
-                    best = Some((value, answer));
+                    *best = Some((value, answer));
                 }
             }
             continue;
         }
         for child in node.children() {
             let child_bound = bound(child);
-            if !prune(child_bound, &best) {
+            if !prune(child_bound, best) {
                 heap.push(RankedPair {
                     bound: child_bound,
                     a: child as u32,
@@ -109,7 +169,7 @@ where
             }
         }
     }
-    best
+    walk
 }
 
 /// Calls `visit` with every triangle (A's frame, with its id in the mesh) whose leaf volume

@@ -26,8 +26,13 @@
 
 use super::simplex::{Simplex, SupportPoint};
 use super::{GjkParams, ROUNDING_ULPS, support};
+use crate::budget::WorkClock;
 use crate::geometry::SupportMap;
 use crate::math::{DVec3, Isometry, orthonormal_basis};
+
+/// Units of [`WorkClock`] work one expansion counts for (a support query and a scan of up
+/// to [`MAX_FACES`] faces).
+pub const EXPANSION_WORK: u64 = 16;
 
 /// Most polytope vertices.
 const MAX_VERTICES: usize = 256;
@@ -39,6 +44,10 @@ const MAX_FACES: usize = 2 * MAX_VERTICES;
 pub enum EpaOutcome {
     /// The nearest face was confirmed to tolerance.
     Converged,
+    /// Its clock stopped it first: the answer is the fallback's (an over-estimated depth
+    /// along a valid direction), and [`EpaResult::depth_lower`] the polytope's nearest face
+    /// distance, an under-estimate.
+    Stopped,
     /// See the [module docs](self): an upper bound on the depth along a valid direction.
     Fallback,
 }
@@ -58,6 +67,9 @@ pub struct EpaResult {
     pub point_b: DVec3,
     /// Polytope expansions.
     pub iterations: u32,
+    /// A lower bound on the depth, metres: `depth` when converged, the polytope's nearest
+    /// face distance when stopped (the polytope lies inside `A − B`), 0 for a fallback.
+    pub depth_lower: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -127,6 +139,18 @@ impl Fallback {
             point_a: self.a,
             point_b: self.a - self.normal * depth,
             iterations,
+            depth_lower: 0.0,
+        }
+    }
+
+    /// The fallback's answer for an EPA its clock stopped with the polytope's nearest face
+    /// at `face_distance` from the origin.
+    fn stopped(&self, iterations: u32, face_distance: f64) -> EpaResult {
+        let depth_lower = face_distance.max(0.0);
+        EpaResult {
+            outcome: EpaOutcome::Stopped,
+            depth_lower: depth_lower.min(self.h.max(0.0)),
+            ..self.result(iterations)
         }
     }
 }
@@ -154,6 +178,9 @@ fn face(vs: &[SupportPoint], v: [u32; 3]) -> Face {
 ///
 /// Never NaN for finite input; see the module docs for the fallback.
 #[must_use]
+///
+/// `clock` is polled before each expansion ([`EXPANSION_WORK`] units); stopped, the answer
+/// is [`EpaOutcome::Stopped`].
 pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     a: &A,
     b: &B,
@@ -161,6 +188,7 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     simplex: &Simplex,
     params: &GjkParams,
     ws: &mut EpaWorkspace,
+    clock: &mut WorkClock,
 ) -> EpaResult {
     let mut hints = [0; 2];
     let mut sup = |d: DVec3| support(a, b, pose_ab, d, &mut hints);
@@ -193,6 +221,9 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         };
         if !best.dist.is_finite() {
             break;
+        }
+        if !clock.allows(EXPANSION_WORK) {
+            return fallback.stopped(iterations - 1, best.dist);
         }
         let p = sup(best.normal);
         if !p.w.is_finite() {
@@ -456,6 +487,7 @@ fn converged(vs: &[SupportPoint], f: &Face, iterations: u32) -> EpaResult {
         point_a,
         point_b,
         iterations,
+        depth_lower: f.dist.max(0.0),
     }
 }
 
@@ -469,7 +501,15 @@ mod tests {
         let params = GjkParams::default();
         let g = gjk_distance(a, b, pose, &params, &mut GjkCache::default());
         assert_eq!(g.outcome, GjkOutcome::Penetrating);
-        penetration(a, b, pose, &g.simplex, &params, &mut EpaWorkspace::new())
+        penetration(
+            a,
+            b,
+            pose,
+            &g.simplex,
+            &params,
+            &mut EpaWorkspace::new(),
+            &mut WorkClock::default(),
+        )
     }
 
     #[test]
@@ -514,8 +554,24 @@ mod tests {
             if g.outcome != GjkOutcome::Penetrating {
                 continue;
             }
-            let reused = penetration(&a, &b, &pose, &g.simplex, &params, &mut ws);
-            let fresh = penetration(&a, &b, &pose, &g.simplex, &params, &mut EpaWorkspace::new());
+            let reused = penetration(
+                &a,
+                &b,
+                &pose,
+                &g.simplex,
+                &params,
+                &mut ws,
+                &mut WorkClock::default(),
+            );
+            let fresh = penetration(
+                &a,
+                &b,
+                &pose,
+                &g.simplex,
+                &params,
+                &mut EpaWorkspace::new(),
+                &mut WorkClock::default(),
+            );
             assert_eq!(reused, fresh);
         }
     }

@@ -25,9 +25,10 @@
 pub mod epa;
 pub mod simplex;
 
+use crate::budget::WorkClock;
 use crate::geometry::{Capsule, Segment, Sphere, SupportMap};
 use crate::math::{DVec3, Isometry};
-use crate::narrow::contact::ShapeDistance;
+use crate::narrow::contact::{DistanceBound, Reached, ShapeDistance};
 pub use epa::{EpaOutcome, EpaResult, EpaWorkspace};
 pub use simplex::{Simplex, SupportPoint};
 
@@ -410,8 +411,32 @@ pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     cache: &mut GjkCache,
     workspace: &mut EpaWorkspace,
 ) -> (ShapeDistance, ConvexOutcome) {
+    let clock = &mut WorkClock::default();
+    let (reached, outcome) =
+        signed_distance_convex_within(a, b, pose_ab, params, cache, workspace, clock);
+    let distance = match reached {
+        Reached::Exact(d) => d,
+        // An unlimited clock never stops EPA.
+        Reached::Bounded(bound) => bound.at_lower(),
+    };
+    (distance, outcome)
+}
+
+/// [`signed_distance_convex`] with EPA polling `clock` ([`epa::penetration`]): exact, or,
+/// when the clock stopped EPA, bounds between its fallback's depth (the lower bound of the
+/// signed distance, with its normal and witnesses) and its polytope's (the upper bound).
+pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    a: &Rounded<'_, A>,
+    b: &Rounded<'_, B>,
+    pose_ab: &Isometry,
+    params: &GjkParams,
+    cache: &mut GjkCache,
+    workspace: &mut EpaWorkspace,
+    clock: &mut WorkClock,
+) -> (Reached, ConvexOutcome) {
     let g = gjk_distance(a.core, b.core, pose_ab, params, cache);
     let g_normal = g.normal();
+    let mut depth_lower = None;
     let (core, normal, epa) = match g.outcome {
         GjkOutcome::Separated | GjkOutcome::DidNotConverge => (
             (g.distance, g.point_a, g.point_b),
@@ -425,7 +450,12 @@ pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             ((g.distance, g.point_a, g.point_b), g_normal, None)
         }
         GjkOutcome::Touching | GjkOutcome::Penetrating => {
-            let e = epa::penetration(a.core, b.core, pose_ab, &g.simplex, params, workspace);
+            let e = epa::penetration(
+                a.core, b.core, pose_ab, &g.simplex, params, workspace, clock,
+            );
+            if e.outcome == EpaOutcome::Stopped {
+                depth_lower = Some(e.depth_lower);
+            }
             if g.outcome == GjkOutcome::Touching && e.depth <= 0.0 {
                 (
                     (g.distance, g.point_a, g.point_b),
@@ -447,14 +477,25 @@ pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         DVec3::X
     };
     let (d, pa, pb) = core;
+    let radii = a.radius + b.radius;
     let answer = ShapeDistance {
-        distance: d - a.radius - b.radius,
+        distance: d - radii,
         point_a: pa + normal * a.radius,
         point_b: pb - normal * b.radius,
         normal,
     };
+    let reached = match depth_lower {
+        None => Reached::Exact(answer),
+        Some(lower) => Reached::Bounded(DistanceBound {
+            lower: answer.distance,
+            upper: (-lower - radii).max(answer.distance),
+            normal,
+            point_a: answer.point_a,
+            point_b: answer.point_b,
+        }),
+    };
     (
-        answer,
+        reached,
         ConvexOutcome {
             gjk: g.outcome,
             epa,

@@ -1,0 +1,166 @@
+//! The narrow routes a frame's clock can stop (`dispatch::distance_within`): a convex
+//! shape's walk of a mesh and EPA. Each is stopped after every count of work units from 0
+//! to what its whole run takes (a counted clock, `Stop::AfterWork`, never wall time), and
+//! every stopped answer must be conservative against the same query run to the end:
+//!
+//! - `Bounded { lower, upper }` holds the exact signed distance (`lower ≤ exact ≤ upper`,
+//!   to rounding), so a pair that touches is never reported apart;
+//! - more work never loosens the bounds (`lower` never falls, `upper` never rises);
+//! - enough work gives the exact answer, bit for bit.
+//!
+//! The seeded cases include both outcomes of the query (touching and apart) and both kinds
+//! of answer (stopped and finished), and the test asserts they all occur.
+
+#[path = "support/mod.rs"]
+mod support;
+
+use proxima::budget::{Stop, WorkClock};
+use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Sphere};
+use proxima::math::{DVec3, Pose};
+use proxima::narrow::dispatch::{self, NarrowScratch};
+use proxima::narrow::{MeshShape, Reached, Shape, ShapeDistance};
+use rand::Rng;
+use std::sync::Arc;
+use support::{TestRng, meshes, point_in_cube, rng, rotation};
+
+/// Relative slack of the bounds against the exact answer (rounding of the bounds' sums).
+const RELATIVE: f64 = 1e-9;
+
+/// How often each outcome occurred over a test's cases.
+#[derive(Debug, Default)]
+struct Seen {
+    touching: usize,
+    apart: usize,
+    stopped: usize,
+    finished: usize,
+}
+
+/// Runs the pair's query under every counted clock from 0 up, until it finishes, checking
+/// each answer against the exact one.
+fn check_every_stop(a: &Shape, b: &Shape, pose_ab: &Pose, seen: &mut Seen, case: usize) {
+    let scratch = &mut NarrowScratch::default();
+    let exact = dispatch::distance(a, b, pose_ab, f64::INFINITY, scratch);
+    let tol = RELATIVE * (1.0 + exact.distance.abs());
+    if exact.distance <= 0.0 {
+        seen.touching += 1;
+    } else {
+        seen.apart += 1;
+    }
+    let (mut lower_before, mut upper_before) = (f64::NEG_INFINITY, f64::INFINITY);
+    for work in 0.. {
+        scratch.clock = WorkClock::new(Stop::AfterWork(work));
+        match dispatch::distance_within(a, b, pose_ab, f64::INFINITY, scratch) {
+            Reached::Exact(d) => {
+                assert_same(&d, &exact, case, work);
+                seen.finished += 1;
+                return;
+            }
+            Reached::Bounded(bound) => {
+                seen.stopped += 1;
+                assert!(
+                    bound.lower <= exact.distance + tol && exact.distance <= bound.upper + tol,
+                    "case {case}, stopped after {work} units: {bound:?} does not hold the \
+                     exact {}",
+                    exact.distance
+                );
+                assert!(
+                    bound.lower >= lower_before - tol && bound.upper <= upper_before + tol,
+                    "case {case}, stopped after {work} units: bounds [{}, {}] looser than \
+                     [{lower_before}, {upper_before}] with less work",
+                    bound.lower,
+                    bound.upper
+                );
+                assert!(
+                    (bound.normal.length() - 1.0).abs() < 1e-9 || bound.upper.is_infinite(),
+                    "case {case}: normal {:?}",
+                    bound.normal
+                );
+                (lower_before, upper_before) = (bound.lower, bound.upper);
+            }
+        }
+        assert!(work < 1_000_000, "case {case}: the query never finished");
+    }
+}
+
+fn assert_same(d: &ShapeDistance, exact: &ShapeDistance, case: usize, work: u64) {
+    assert_eq!(
+        d, exact,
+        "case {case}: finished after {work} units with another answer than the exact run"
+    );
+}
+
+/// A random convex shape 5–30 cm across.
+fn convex_shape(r: &mut TestRng) -> Shape {
+    let size = r.random_range(0.05..0.3);
+    match r.random_range(0..5) {
+        0 => Shape::Sphere(Sphere::new(size / 2.0)),
+        1 => Shape::Capsule(Capsule::new(size / 2.0, size / 4.0)),
+        2 => Shape::Cuboid(Cuboid::new(DVec3::new(size / 2.0, size / 3.0, size / 4.0))),
+        3 => Shape::Cylinder(Cylinder::new(size / 2.0, size / 3.0)),
+        _ => Shape::Convex(Arc::new(hull(r, size / 2.0, 40))),
+    }
+}
+
+/// The hull of `n` random points in a ball of radius `radius`.
+fn hull(r: &mut TestRng, radius: f64, n: usize) -> ConvexPolyhedron {
+    let points: Vec<DVec3> = (0..n)
+        .map(|_| {
+            let d = DVec3::new(
+                r.random_range(-1.0..1.0),
+                r.random_range(-1.0..1.0),
+                r.random_range(-1.0..1.0),
+            );
+            d.normalize_or_zero() * radius * r.random_range(0.6..1.0)
+        })
+        .collect();
+    ConvexPolyhedron::try_from_points(&points).expect("a hull of random points in a ball")
+}
+
+#[test]
+fn a_stopped_walk_of_a_mesh_holds_the_exact_distance_and_tightens_with_work() {
+    let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.5, 0.15, 48, 16))));
+    let mut r = rng(2901);
+    let mut seen = Seen::default();
+    for case in 0..300 {
+        let shape = convex_shape(&mut r);
+        // Near the tube (radius 0.35–0.65 from the axis, |z| < 0.2): touching and apart.
+        let angle = r.random_range(0.0..std::f64::consts::TAU);
+        let rho = r.random_range(0.3..0.7);
+        let position = DVec3::new(
+            rho * angle.cos(),
+            rho * angle.sin(),
+            r.random_range(-0.25..0.25),
+        );
+        let pose = Pose::new(position, rotation(&mut r));
+        // Both orders: the shape first, and the mesh first (the flipped route).
+        if case % 2 == 0 {
+            check_every_stop(&shape, &torus, &pose, &mut seen, case);
+        } else {
+            check_every_stop(&torus, &shape, &pose.inverse(), &mut seen, case);
+        }
+    }
+    println!("{seen:?}");
+    assert!(seen.touching > 30 && seen.apart > 30, "{seen:?}");
+    assert!(seen.stopped > 300 && seen.finished == 300, "{seen:?}");
+}
+
+#[test]
+fn a_stopped_epa_holds_the_exact_depth_and_tightens_with_work() {
+    let mut r = rng(2902);
+    let mut seen = Seen::default();
+    for case in 0..300 {
+        let n = r.random_range(20..60);
+        let a = Shape::Convex(Arc::new(hull(&mut r, 0.2, n)));
+        let n = r.random_range(20..60);
+        let b = match case % 3 {
+            0 => Shape::Convex(Arc::new(hull(&mut r, 0.15, n))),
+            1 => Shape::Cylinder(Cylinder::new(0.1, 0.08)),
+            _ => Shape::Cuboid(Cuboid::new(DVec3::new(0.1, 0.05, 0.2))),
+        };
+        let pose = Pose::new(point_in_cube(&mut r, 0.3), rotation(&mut r));
+        check_every_stop(&a, &b, &pose, &mut seen, case);
+    }
+    println!("{seen:?}");
+    assert!(seen.touching > 30 && seen.apart > 30, "{seen:?}");
+    assert!(seen.stopped > 100 && seen.finished == 300, "{seen:?}");
+}
