@@ -164,3 +164,55 @@ fn a_stopped_epa_holds_the_exact_depth_and_tightens_with_work() {
     assert!(seen.touching > 30 && seen.apart > 30, "{seen:?}");
     assert!(seen.stopped > 100 && seen.finished == 300, "{seen:?}");
 }
+
+#[test]
+fn stopped_mesh_contacts_are_the_first_of_the_full_set_and_grow_with_work() {
+    use proxima::narrow::mesh_mesh::{MeshMeshWorkspace, contacts_mesh_mesh_within};
+    let a = MeshShape::new(meshes::torus(0.5, 0.15, 32, 12));
+    let b = MeshShape::new(meshes::uv_sphere(0.3, 16, 10));
+    let mut r = rng(2903);
+    let workspace = &mut MeshMeshWorkspace::default();
+    let (mut intersecting, mut apart, mut stopped) = (0, 0, 0);
+    for case in 0..200 {
+        let pose = Pose::new(point_in_cube(&mut r, 0.8), rotation(&mut r));
+        let mut collect = |work: Stop| {
+            let mut found = Vec::new();
+            let finished = contacts_mesh_mesh_within(
+                &a.overlap_tree,
+                &b.overlap_tree,
+                &pose,
+                workspace,
+                &mut WorkClock::new(work),
+                |c| {
+                    found.push(c.triangles);
+                    std::ops::ControlFlow::Continue(())
+                },
+            );
+            (finished, found)
+        };
+        let (finished, all) = collect(Stop::Never);
+        assert!(finished, "case {case}");
+        if all.is_empty() {
+            apart += 1;
+        } else {
+            intersecting += 1;
+        }
+        let mut before = 0;
+        for work in 0.. {
+            let (finished, found) = collect(Stop::AfterWork(work));
+            assert!(
+                found.len() >= before && all.starts_with(&found),
+                "case {case}, {work} units: not the first contacts of the full set"
+            );
+            before = found.len();
+            if finished {
+                assert_eq!(found, all, "case {case}: finished with another set");
+                break;
+            }
+            stopped += 1;
+            assert!(work < 10_000_000, "case {case}: never finished");
+        }
+    }
+    println!("{intersecting} intersecting, {apart} apart, {stopped} stopped runs");
+    assert!(intersecting > 30 && apart > 30 && stopped > 200);
+}

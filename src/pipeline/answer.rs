@@ -12,12 +12,13 @@
 use super::{ContactPoint, PairResult, Query};
 use crate::bounding::Aabb;
 use crate::broad::CandidatePair;
+use crate::budget::WorkClock;
 use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::contact::{DistanceBound, Manifold, Reached, ShapeDistance};
 use crate::narrow::dispatch::{self, NarrowScratch};
 use crate::narrow::mesh_mesh::frontier::FrontierAnswer;
 use crate::narrow::mesh_mesh::{
-    DistanceCache, MeshMeshWorkspace, Proximity, contacts_mesh_mesh, intersects_mesh_mesh,
+    DistanceCache, MeshMeshWorkspace, Proximity, contacts_mesh_mesh_within, intersects_mesh_mesh,
 };
 use crate::narrow::{MANIFOLD_POINTS, reduce_manifold};
 use crate::narrow::{MeshShape, Shape};
@@ -41,6 +42,8 @@ pub(super) struct Answer {
 #[derive(Debug, Default)]
 pub(super) struct MeshScratch {
     pub traversal: MeshMeshWorkspace,
+    /// The clock the exact contacts poll (unlimited unless the pipeline sets the frame's).
+    pub clock: WorkClock,
     /// Every intersection segment end of the pair being answered, A's frame.
     points: Vec<DVec3>,
     /// The contact normal (A's triangle normal) of each entry of `points`.
@@ -214,9 +217,9 @@ pub(super) fn mesh_mesh(
         }
     });
     mesh_mesh_tail(
-        empty_record(pair),
+        pair,
         (a, ma),
-        mb,
+        (b, mb),
         &pose_ab,
         query,
         known,
@@ -239,15 +242,16 @@ struct KnownDistance {
 /// touching decision.
 #[allow(clippy::too_many_arguments)]
 fn mesh_mesh_tail(
-    mut result: PairResult,
+    pair: &CandidatePair,
     (a, ma): (&Body, &MeshShape),
-    mb: &MeshShape,
+    (b, mb): (&Body, &MeshShape),
     pose_ab: &Pose,
     query: Query,
     known: Option<KnownDistance>,
     scratch: &mut MeshScratch,
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
+    let mut result = empty_record(pair);
     let mut touching = None;
     if let Some(d) = known {
         result.distance = d.distance;
@@ -261,15 +265,37 @@ fn mesh_mesh_tail(
     }
     if query.contacts && touching != Some(false) {
         let first = contacts.len();
-        mesh_manifold(a, ma, mb, pose_ab, scratch, contacts);
+        let finished = mesh_manifold(a, ma, mb, pose_ab, scratch, contacts);
         if let Some(c) = contacts.get(first) {
             touching = Some(true);
             if !(query.close || query.distance) {
                 (result.point_a, result.point_b, result.normal) = (c.point_a, c.point_b, c.normal);
             }
+        } else if !finished {
+            // Stopped before any intersection was found: the pair may touch; its one
+            // contact is the record's witnesses (its distance's, or its boxes').
+            touching = Some(true);
+            if result.normal == DVec3::ZERO {
+                let boxes = boxes(
+                    pair,
+                    &a.world_bounds,
+                    &b.world_bounds,
+                    Query::NONE,
+                    &mut Vec::new(),
+                );
+                (result.point_a, result.point_b, result.normal) = (
+                    boxes.result.point_a,
+                    boxes.result.point_b,
+                    boxes.result.normal,
+                );
+                result.error_bound = result.error_bound.max(boxes.result.error_bound);
+            }
+            contacts.push(witness_contact(&result, 0.0));
         } else if touching.is_none() {
             touching = Some(false);
         }
+        // Stopped, the contacts found are real but perhaps not all of them.
+        result.exact &= finished;
     }
     let touching = touching.unwrap_or_else(|| {
         intersects_mesh_mesh(
@@ -341,9 +367,9 @@ pub(super) fn mesh_mesh_finished(
         return apart(pair, Some(frontier.distance_lower - rounding));
     }
     mesh_mesh_tail(
-        empty_record(pair),
+        pair,
         (a, ma),
-        mb,
+        (b, mb),
         &pose_ab,
         query,
         known.filter(|_| wants_distance),
@@ -442,21 +468,22 @@ fn mesh_manifold(
     pose_ab: &Pose,
     scratch: &mut MeshScratch,
     contacts: &mut Vec<ContactPoint>,
-) {
+) -> bool {
     let MeshScratch {
         traversal,
+        clock,
         points,
         normals,
         kept,
-        ..
     } = scratch;
     points.clear();
     normals.clear();
-    contacts_mesh_mesh(
+    let finished = contacts_mesh_mesh_within(
         &ma.overlap_tree,
         &mb.overlap_tree,
         pose_ab,
         traversal,
+        clock,
         |c| {
             for end in c.segment {
                 points.push(end);
@@ -467,7 +494,7 @@ fn mesh_manifold(
     );
     reduce_manifold(points, kept);
     let Some(&first) = kept.first() else {
-        return;
+        return finished;
     };
     debug_assert!(kept.len() <= MANIFOLD_POINTS);
     let normal_a = normals
@@ -487,6 +514,7 @@ fn mesh_manifold(
             error_bound: conservative_slack(point.abs().max_element()),
         });
     }
+    finished
 }
 
 /// The conservative answer of a pair left no time for its exact one (not a mesh–mesh pair):

@@ -520,6 +520,7 @@ pub fn step_within(
     let started = Instant::now();
     let mut plan = FramePlan::new(&*budget, query);
     workspace.narrow.clock = plan.narrow_clock();
+    workspace.mesh.clock = plan.narrow_clock();
     let (hull_tests, frontier) = mid_phase(scene, query, budget, &plan, started, workspace);
     let mid_ns = if plan.limited { elapsed_ns(started) } else { 0 };
     // Unbudgeted, the hull tests answer pairs as the narrow phase does: its time.
@@ -702,8 +703,7 @@ fn answer_candidates(
             &mut results.contacts,
         );
         tally.separated += u32::from(matches!(pair_plan, PairPlan::Separated));
-        tally.truncated += u32::from(matches!(pair_plan, PairPlan::Conservative))
-            + u32::from(truncated_level.is_some());
+        tally.truncated += u32::from(!answer.result.exact);
         if pair_plan.searches_mesh_pair() {
             memory.remember_search(scene, pair, (a, b), answer.apart_by);
         }

@@ -2,6 +2,7 @@
 
 use super::{FALLBACK_NORMAL, MeshMeshWorkspace, TriangleContact, for_each_triangle_pair};
 use crate::bounding::BoundingVolume;
+use crate::budget::WorkClock;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::for_each_leaf_pair;
 use crate::math::Pose;
@@ -50,18 +51,48 @@ pub fn contacts_mesh_mesh<B, S>(
     b: &Bvh<B>,
     pose_ab: &Pose,
     workspace: &mut MeshMeshWorkspace,
-    mut sink: S,
+    sink: S,
 ) where
     B: BoundingVolume,
     S: FnMut(TriangleContact) -> ControlFlow<()>,
 {
+    let finished =
+        contacts_mesh_mesh_within(a, b, pose_ab, workspace, &mut WorkClock::default(), sink);
+    debug_assert!(finished, "an unlimited clock never stops");
+}
+
+/// Units of [`WorkClock`] work one triangle pair's intersection test counts for.
+pub const TRIANGLE_PAIR_WORK: u64 = 2;
+
+/// [`contacts_mesh_mesh`], polling `clock` before each pair of leaves
+/// ([`TRIANGLE_PAIR_WORK`] units per triangle pair); returns `false` when the clock stopped
+/// it, with the pairs reported so far (a subset of the intersecting ones, each real).
+pub fn contacts_mesh_mesh_within<B, S>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    workspace: &mut MeshMeshWorkspace,
+    clock: &mut WorkClock,
+    mut sink: S,
+) -> bool
+where
+    B: BoundingVolume,
+    S: FnMut(TriangleContact) -> ControlFlow<()>,
+{
     let iso = pose_ab.to_isometry();
+    let (na, nb) = (a.nodes(), b.nodes());
+    let mut stopped = false;
     let _ = for_each_leaf_pair(
         a,
         b,
         &mut workspace.pairs,
         |x, y| x.overlaps(y, &iso),
         |la, lb| {
+            let tests = na[la].slots().len() * nb[lb].slots().len();
+            if !clock.allows(TRIANGLE_PAIR_WORK * tests as u64) {
+                stopped = true;
+                return ControlFlow::Break(());
+            }
             for_each_triangle_pair(a, b, [la, lb], &iso, |sa, tri_a, sb, tri_b| {
                 let Some((p, q)) = intersection_segment_triangle_triangle(tri_a, tri_b) else {
                     return ControlFlow::Continue(());
@@ -79,4 +110,5 @@ pub fn contacts_mesh_mesh<B, S>(
             })
         },
     );
+    !stopped
 }

@@ -32,7 +32,9 @@ mod collide;
 mod distance;
 pub mod frontier;
 
-pub use collide::{contacts_mesh_mesh, intersects_mesh_mesh};
+pub use collide::{
+    TRIANGLE_PAIR_WORK, contacts_mesh_mesh, contacts_mesh_mesh_within, intersects_mesh_mesh,
+};
 pub use distance::{
     Proximity, distance_mesh_mesh, precedes_in_ties, proximity_mesh_mesh, rounding_bound,
     within_distance_mesh_mesh,
