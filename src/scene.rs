@@ -120,13 +120,22 @@ pub struct SceneLimits {
     pub max_shapes: u32,
     /// Most live bodies in one scene.
     pub max_bodies: u32,
+    /// Most candidate pairs one frame answers (and, with `TOI`, most swept candidates): a
+    /// frame whose broad phase finds more answers the first this many in its order and
+    /// says how many it dropped ([`StepReport::dropped_candidates`]), so an n² pile-up
+    /// costs bounded time and memory past the broad phase.
+    ///
+    /// [`StepReport::dropped_candidates`]: crate::pipeline::StepReport::dropped_candidates
+    pub max_pairs_per_frame: u32,
 }
 
 impl SceneLimits {
-    /// 4,096 shapes and 100,000 bodies.
+    /// 4,096 shapes, 100,000 bodies and 16,384 pairs a frame (a result frame of at most
+    /// 16,384 pairs with 4 contacts each: 9 MB).
     pub const STANDARD: Self = Self {
         max_shapes: 4_096,
         max_bodies: 100_000,
+        max_pairs_per_frame: 16_384,
     };
 }
 
@@ -247,6 +256,12 @@ impl Scene {
             edits_at_frame_start: 0,
             broad_phase: BroadPhaseChoice::Auto,
         })
+    }
+
+    /// The scene's limits.
+    #[must_use]
+    pub fn limits(&self) -> SceneLimits {
+        self.limits
     }
 
     /// Registers `shape` for bodies of this scene.
@@ -668,6 +683,7 @@ mod tests {
             SceneLimits {
                 max_shapes: 4,
                 max_bodies: 3,
+                ..SceneLimits::STANDARD
             },
         )
         .unwrap()

@@ -18,7 +18,7 @@ use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPor
 use proxima_ipc::client::{Client, Primitive};
 use proxima_ipc::error::ControlError;
 use proxima_ipc::scene_link::SceneLink;
-use proxima_ipc::wire::{ErrorCode, PoseFrameHeader, PoseRecord, query};
+use proxima_ipc::wire::{ErrorCode, PoseFrameHeader, PoseRecord, frame_flags, query};
 use proxima_ipc::{EVENT_POSES_SENT, PROTOCOL_VERSION};
 use std::io::Read;
 use std::path::PathBuf;
@@ -247,6 +247,48 @@ fn the_config_files_default_margin_reaches_new_scenes() {
     assert_eq!(scene.close_pairs_with_body_1_at(1.12), Vec::<f64>::new());
     // And the 0.08 gap is close again (the answer follows the poses, not a stale state).
     assert_eq!(scene.close_pairs_with_body_1_at(1.08).len(), 1);
+}
+
+#[test]
+fn a_frame_beyond_the_pair_limit_answers_the_limit_and_says_how_many_it_dropped() {
+    let file = ConfigFile::new("[limits]\nmax_pairs_per_frame = 10\n");
+    let daemon = Daemon::start_with(&["--config", file.path()]);
+    let client = daemon.client();
+    let scene = client.create_scene().unwrap();
+    let sphere = client
+        .register_primitive(scene, Primitive::Sphere { radius: RADIUS })
+        .unwrap();
+    // Eight spheres at nearly one place: 28 overlapping pairs, 18 over the limit.
+    for i in 0..8 {
+        client
+            .add_body(scene, &body(sphere, 0.001 * f64::from(i)))
+            .unwrap();
+    }
+    let link = client.open_scene(scene).unwrap();
+    let records: Vec<PoseRecord> = (0..8).map(|i| pose_at(i, 0.001 * f64::from(i))).collect();
+    for (seq, expected_drop) in [(1, 18), (2, 18)] {
+        link.publish_poses(seq, 0, query::CLOSE, &records).unwrap();
+        let answer = link
+            .receive_results_for(seq, TIMEOUT)
+            .unwrap()
+            .expect("an answer");
+        let header = answer.header();
+        assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
+        assert_eq!((header.pair_count, answer.pairs().len()), (10, 10));
+        assert_eq!(header.dropped_candidates, expected_drop);
+        assert_ne!(header.flags & frame_flags::PAIRS_CAPPED, 0);
+    }
+    // Apart, no pair is found and nothing is dropped.
+    let apart: Vec<PoseRecord> = (0..8).map(|i| pose_at(i, 10.0 * f64::from(i))).collect();
+    link.publish_poses(3, 0, query::CLOSE, &apart).unwrap();
+    let answer = link
+        .receive_results_for(3, TIMEOUT)
+        .unwrap()
+        .expect("an answer");
+    assert_eq!(
+        (answer.header().dropped_candidates, answer.header().flags),
+        (0, 0)
+    );
 }
 
 #[test]

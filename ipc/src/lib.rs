@@ -38,7 +38,7 @@ use iceoryx2::service::service_name::{ServiceName, ServiceNameError};
 
 /// The protocol version. A client and a daemon whose versions differ refuse to talk; bump it
 /// on any change to a wire record's layout or meaning.
-pub const PROTOCOL_VERSION: u32 = 7;
+pub const PROTOCOL_VERSION: u32 = 8;
 
 /// The default root prefix of every service name (`<root>/control`, `<root>/<scene>/poses`…).
 pub const DEFAULT_ROOT: &str = "proxima";

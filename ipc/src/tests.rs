@@ -173,9 +173,12 @@ fn a_pose_frame_and_a_result_frame_cross_a_real_service_unchanged() {
     sample.user_header_mut().frame_seq = 42;
     sample.user_header_mut().pair_count = 1;
     sample.user_header_mut().contact_count = 1;
+    sample.user_header_mut().flags = wire::frame_flags::PAIRS_CAPPED;
+    sample.user_header_mut().dropped_candidates = 7;
+    let sent = *sample.user_header();
     sample.write_from_slice(&[pair, contact]).send().unwrap();
     let received = subscriber.receive().unwrap().expect("a result frame");
-    assert_eq!(received.user_header().frame_seq, 42);
+    assert_eq!(*received.user_header(), sent);
     assert_eq!(received.payload(), &[pair, contact]);
 }
 

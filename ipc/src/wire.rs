@@ -279,6 +279,20 @@ pub struct ResultFrameHeader {
     pub elapsed_ns: u64,
     /// Time per pipeline stage, nanoseconds, indexed by [`stage`].
     pub stage_ns: [u64; stage::COUNT],
+    /// Bits of [`frame_flags`] (undefined bits 0; since protocol version 8).
+    pub flags: u32,
+    /// Candidate pairs the broad phase found beyond the daemon's per-frame limit and did not
+    /// answer (with [`frame_flags::PAIRS_CAPPED`]); 0 otherwise.
+    pub dropped_candidates: u32,
+}
+
+/// Bits of [`ResultFrameHeader::flags`].
+pub mod frame_flags {
+    /// The broad phase found more candidate pairs than the daemon answers in one frame
+    /// (its `max_pairs_per_frame` limit): the frame answers the first of them and counts
+    /// the rest in `dropped_candidates`. Its pairs are a sample, and a pair left out may
+    /// touch.
+    pub const PAIRS_CAPPED: u32 = 1 << 0;
 }
 
 /// Bits of [`ResultRecord::flags`]; undefined bits are 0.
@@ -623,5 +637,5 @@ const _: () = assert!(size_of::<ControlRequest>() == 144);
 const _: () = assert!(size_of::<ControlReply>() == 128);
 const _: () = assert!(size_of::<PoseFrameHeader>() == 32);
 const _: () = assert!(size_of::<PoseRecord>() == 64);
-const _: () = assert!(size_of::<ResultFrameHeader>() == 104);
+const _: () = assert!(size_of::<ResultFrameHeader>() == 112);
 const _: () = assert!(size_of::<ResultRecord>() == 120);

@@ -13,6 +13,7 @@
 //! max_scenes = 64
 //! max_shapes_per_scene = 4096
 //! max_bodies_per_scene = 100000
+//! max_pairs_per_frame = 16384     # candidate pairs a frame answers; more are dropped and counted
 //! max_mesh_vertices = 4194304
 //! max_mesh_triangles = 4194304
 //! max_convex_points = 65536
@@ -78,6 +79,8 @@ pub struct LimitsSection {
     pub max_shapes_per_scene: Option<u32>,
     /// Most live bodies in one scene.
     pub max_bodies_per_scene: Option<u32>,
+    /// Most candidate pairs one frame answers.
+    pub max_pairs_per_frame: Option<u32>,
     /// Largest vertex count of a registered mesh.
     pub max_mesh_vertices: Option<usize>,
     /// Largest triangle count of a registered mesh.
@@ -189,6 +192,11 @@ impl ConfigFile {
             &mut out.scene_limits.max_bodies,
             l.max_bodies_per_scene,
             "limits.max_bodies_per_scene",
+        )?;
+        set_positive(
+            &mut out.scene_limits.max_pairs_per_frame,
+            l.max_pairs_per_frame,
+            "limits.max_pairs_per_frame",
         )?;
         set_positive(
             &mut out.mesh_limits.max_vertices,

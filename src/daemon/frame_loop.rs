@@ -12,8 +12,9 @@
 //! The header carries the pipeline's own [`StepReport`]: its completeness (with
 //! `Truncated`, the shallowest level any pair stopped at in `deepest_level`), broad, mid
 //! (the budgeted frontier, 0 without a budget) and narrow timings (`stage_ns[BROAD]`,
-//! `stage_ns[MID]`, `stage_ns[NARROW]`), candidate, pair and contact counts; ingest and
-//! publish are timed here. The plan stage the pipeline does not have yet stays 0.
+//! `stage_ns[MID]`, `stage_ns[NARROW]`), candidate, pair and contact counts, and the
+//! candidates dropped beyond the scene's pair limit (`flags` says `PAIRS_CAPPED`); ingest
+//! and publish are timed here. The plan stage the pipeline does not have yet stays 0.
 //!
 //! # Allocation
 //! After a scene's first frames, none: the pipeline workspace and the result lists are
@@ -232,6 +233,10 @@ fn fill_header(header: &mut ResultFrameHeader, report: &StepReport) {
     header.pair_count = report.pairs;
     header.contact_count = report.contacts;
     header.toi_count = report.tois;
+    header.dropped_candidates = report.dropped_candidates;
+    if report.dropped_candidates > 0 {
+        header.flags |= wire::frame_flags::PAIRS_CAPPED;
+    }
 }
 
 fn pair_record(r: &PairResult) -> ResultRecord {

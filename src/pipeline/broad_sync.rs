@@ -68,6 +68,16 @@ pub(super) struct BroadOutcome {
     pub(super) updates: usize,
     /// The scene's statistics, on the frames that measured them.
     pub(super) stats: Option<BroadPhaseStats>,
+    /// Candidates found beyond the scene's [`SceneLimits::max_pairs_per_frame`](crate::scene::SceneLimits::max_pairs_per_frame) and
+    /// dropped, both lists together.
+    pub(super) dropped: usize,
+}
+
+/// Keeps the first `cap` pairs of `list`; returns how many it dropped.
+fn cap_list(list: &mut Vec<CandidatePair>, cap: usize) -> usize {
+    let dropped = list.len().saturating_sub(cap);
+    list.truncate(cap);
+    dropped
 }
 
 impl BroadSync {
@@ -96,10 +106,13 @@ impl BroadSync {
         } else {
             toi_candidates.clear();
         }
+        let cap = scene.limits().max_pairs_per_frame as usize;
+        let dropped = cap_list(candidates, cap) + cap_list(toi_candidates, cap);
         BroadOutcome {
             kind,
             updates,
             stats,
+            dropped,
         }
     }
 

@@ -339,6 +339,11 @@ pub struct StepReport {
     /// boxes ([`PairToi::exact`] `false`); a search the deadline stopped is not counted
     /// here (it reports `reached = false`) but makes the frame truncated too.
     pub truncated_tois: u32,
+    /// Candidate pairs (and swept candidates) the broad phase found beyond the scene's
+    /// [`SceneLimits::max_pairs_per_frame`](crate::scene::SceneLimits::max_pairs_per_frame),
+    /// not answered this frame: the frame's pairs are then a sample, and a pair left out
+    /// may touch.
+    pub dropped_candidates: u32,
 }
 
 /// State of [`step`] kept across frames: scratch space (no allocation once grown), the
@@ -557,6 +562,7 @@ pub fn step_within(
         frontier,
         truncated_pairs: tally.truncated,
         truncated_tois: tois.truncated,
+        dropped_candidates: index(broad.dropped),
     }
 }
 

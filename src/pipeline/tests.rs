@@ -653,3 +653,48 @@ fn a_frame_is_truncated_at_the_shallowest_level_of_its_pairs() {
         assert_eq!(c, Completeness::Truncated { level: expected });
     }
 }
+
+/// A pile-up with more candidate pairs than the scene's per-frame limit: the frame answers
+/// the first `max_pairs_per_frame` of the broad phase's list, exactly as an uncapped frame
+/// answers them, and counts the rest as dropped; under the limit nothing is dropped.
+#[test]
+fn a_frame_answers_at_most_its_pair_limit_and_counts_what_it_dropped() {
+    let build = |max_pairs_per_frame| {
+        let limits = SceneLimits {
+            max_pairs_per_frame,
+            ..SceneLimits::STANDARD
+        };
+        let mut scene = Scene::try_new(0.0, limits).unwrap();
+        let mut rng = rng(2904);
+        for _ in 0..60 {
+            let at = point_in_cube(&mut rng, 0.2);
+            add(&mut scene, Shape::Sphere(Sphere::new(0.3)), at, 0.0);
+        }
+        scene
+    };
+    let run = |scene: &Scene| {
+        let mut results = FrameResults::default();
+        let report = step(
+            scene,
+            Query::CLOSE.union(Query::CONTACTS),
+            &mut PipelineWorkspace::default(),
+            &mut results,
+        );
+        (report, results)
+    };
+    let (whole, all) = run(&build(u32::MAX));
+    let every = whole.candidates as usize;
+    assert_eq!(every, 60 * 59 / 2, "every sphere overlaps every other");
+    assert_eq!((whole.dropped_candidates, all.pairs.len()), (0, every));
+    for cap in [0, 1, 100, every as u32 - 1, every as u32] {
+        let (report, capped) = run(&build(cap));
+        assert_eq!(report.candidates, cap, "cap {cap}");
+        assert_eq!(report.dropped_candidates as usize, every - cap as usize);
+        assert_eq!(capped.pairs, all.pairs[..cap as usize], "cap {cap}");
+        assert_eq!(
+            capped.contacts.len(),
+            capped.pairs.len(),
+            "one contact each"
+        );
+    }
+}
