@@ -74,9 +74,10 @@ impl Budget for Unlimited {
 
 /// Whether an answer is final: one pair's, or a whole frame's (the shallowest of its
 /// pairs').
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Completeness {
     /// The traversal finished: the answer is the exact one (every pair's, for a frame).
+    #[default]
     Exact,
     /// The budget ran out with work left; `level` is the shallowest depth (descents from
     /// the root pair; 0 = the world boxes) of the waiting node pairs.

@@ -18,7 +18,7 @@ use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPor
 use proxima_ipc::client::{Client, Primitive};
 use proxima_ipc::error::ControlError;
 use proxima_ipc::scene_link::SceneLink;
-use proxima_ipc::wire::{ErrorCode, PoseFrameHeader, PoseRecord, frame_flags, query};
+use proxima_ipc::wire::{Completeness, ErrorCode, PoseFrameHeader, PoseRecord, frame_flags, query};
 use proxima_ipc::{EVENT_POSES_SENT, PROTOCOL_VERSION};
 use std::io::Read;
 use std::path::PathBuf;
@@ -289,6 +289,41 @@ fn a_frame_beyond_the_pair_limit_answers_the_limit_and_says_how_many_it_dropped(
         (answer.header().dropped_candidates, answer.header().flags),
         (0, 0)
     );
+}
+
+#[test]
+fn a_frame_whose_budget_cannot_hold_the_broad_phase_and_publishing_says_what_it_needs() {
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let scene = TwoSpheres::new(&client, 0.5);
+    let answer = |seq: u64, budget_ns: u64| {
+        scene
+            .link
+            .publish_poses(seq, budget_ns, query::CLOSE, &[pose_at(1, 0.5)])
+            .unwrap();
+        let frame = scene
+            .link
+            .receive_results_for(seq, TIMEOUT)
+            .unwrap()
+            .expect("an answer");
+        (*frame.header(), frame.pairs().len())
+    };
+    // The first 1 ns frame runs (nothing measured yet) and is late; the next is not started.
+    let (first, pairs) = answer(1, 1);
+    assert_eq!((first.flags & frame_flags::BUDGET_TOO_SMALL, pairs), (0, 1));
+    assert_eq!(first.budget_met, 0);
+    let (refused, pairs) = answer(2, 1);
+    assert_eq!(ErrorCode::from_u32(refused.status), Some(ErrorCode::Ok));
+    assert_ne!(refused.flags & frame_flags::BUDGET_TOO_SMALL, 0);
+    assert!(refused.min_budget_ns > 1, "{}", refused.min_budget_ns);
+    assert_eq!((refused.pair_count, pairs), (0, 0));
+    assert_eq!(refused.completeness, Completeness::Truncated as u32);
+    // The budget it names (with room to spare) and no budget at all are answered in full.
+    let (served, pairs) = answer(3, 1_000 * refused.min_budget_ns);
+    assert_eq!((served.flags, served.min_budget_ns, pairs), (0, 0, 1));
+    let (unbudgeted, pairs) = answer(4, 0);
+    assert_eq!((unbudgeted.flags, pairs), (0, 1));
+    drop(scene);
 }
 
 #[test]

@@ -284,6 +284,10 @@ pub struct ResultFrameHeader {
     /// Candidate pairs the broad phase found beyond the daemon's per-frame limit and did not
     /// answer (with [`frame_flags::PAIRS_CAPPED`]); 0 otherwise.
     pub dropped_candidates: u32,
+    /// With [`frame_flags::BUDGET_TOO_SMALL`]: the smallest budget the daemon measured for
+    /// this scene's frames, nanoseconds (its ingest plus the recent worst of the stages no
+    /// deadline can interrupt: the broad phase and publishing). 0 otherwise.
+    pub min_budget_ns: u64,
 }
 
 /// Bits of [`ResultFrameHeader::flags`].
@@ -293,6 +297,11 @@ pub mod frame_flags {
     /// the rest in `dropped_candidates`. Its pairs are a sample, and a pair left out may
     /// touch.
     pub const PAIRS_CAPPED: u32 = 1 << 0;
+    /// The frame's budget could not hold the work no deadline can interrupt, as measured on
+    /// this scene: the daemon did not start it and answers nothing (`completeness`
+    /// `Truncated`, no records), on time, with the budget it would need in
+    /// `min_budget_ns`. The scene's state is unchanged but for the frame's poses.
+    pub const BUDGET_TOO_SMALL: u32 = 1 << 1;
 }
 
 /// Bits of [`ResultRecord::flags`]; undefined bits are 0.
@@ -637,5 +646,5 @@ const _: () = assert!(size_of::<ControlRequest>() == 144);
 const _: () = assert!(size_of::<ControlReply>() == 128);
 const _: () = assert!(size_of::<PoseFrameHeader>() == 32);
 const _: () = assert!(size_of::<PoseRecord>() == 64);
-const _: () = assert!(size_of::<ResultFrameHeader>() == 112);
+const _: () = assert!(size_of::<ResultFrameHeader>() == 120);
 const _: () = assert!(size_of::<ResultRecord>() == 120);

@@ -169,20 +169,27 @@ impl<S: Service> SceneFrames<S> {
                     };
                     scene.end_frame();
                     fill_header(&mut result, &report);
+                    if let Some(needed) = report.budget_too_small {
+                        result.flags |= wire::frame_flags::BUDGET_TOO_SMALL;
+                        result.min_budget_ns = ingest_ns.saturating_add(needed);
+                    }
                 }
             }
-            self.publish(result, received, header.budget_ns)?;
+            let publish_ns = self.publish(result, received, header.budget_ns)?;
+            self.workspace.note_publish(publish_ns);
             served += 1;
         }
         Ok(served)
     }
 
+    /// Writes and publishes the result frame and notifies; returns how long that took,
+    /// nanoseconds.
     fn publish(
         &self,
         mut header: ResultFrameHeader,
         received: Instant,
         budget_ns: u64,
-    ) -> Result<(), String> {
+    ) -> Result<u64, String> {
         let publish_started = Instant::now();
         let FrameResults {
             pairs,
@@ -207,7 +214,7 @@ impl<S: Service> SceneFrames<S> {
         self.notifier
             .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
             .map_err(|e| format!("results notify: {e:?}"))?;
-        Ok(())
+        Ok(elapsed_ns(publish_started))
     }
 }
 

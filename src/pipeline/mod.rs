@@ -70,6 +70,7 @@
 
 mod answer;
 mod broad_sync;
+mod costs;
 mod frontier_run;
 mod pair_memory;
 mod plan;
@@ -79,10 +80,11 @@ pub mod workers;
 
 pub use crate::budget::Budget;
 pub use crate::narrow::dispatch::PathCounts;
+pub use costs::FrameCosts;
 pub use plan::{
     Deadline, FRONTIER_RESERVE, PUBLISH_RESERVE, Unlimited, VisitBudget, frontier_deadline,
 };
-use plan::{FramePlan, PairPlan};
+use plan::{FramePlan, PairPlan, mandatory_work_fits};
 pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{BroadPhaseKind, BroadPhaseStats, CandidatePair};
@@ -278,7 +280,7 @@ pub struct FrameResults {
 pub use crate::budget::Completeness;
 
 /// What [`step`] did: completeness, stage timings, counts.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepReport {
     /// Whether every answer is exact.
     pub completeness: Completeness,
@@ -344,6 +346,11 @@ pub struct StepReport {
     /// not answered this frame: the frame's pairs are then a sample, and a pair left out
     /// may touch.
     pub dropped_candidates: u32,
+    /// Set when the frame was not started: its budget could not hold the scene's
+    /// uninterruptible work (the broad phase and publishing, [`FrameCosts`]), whose
+    /// measured nanoseconds this is. The frame answers nothing and is `Truncated` at level
+    /// 0; a budget of at least this (plus ingest) lets the next frames run.
+    pub budget_too_small: Option<u64>,
 }
 
 /// State of [`step`] kept across frames: scratch space (no allocation once grown), the
@@ -380,6 +387,8 @@ pub struct PipelineWorkspace {
     frontier_pairs: Vec<CandidatePair>,
     /// What the frontier last ran over, to resume it next frame.
     frontier_run: FrontierRun,
+    /// The scene's uninterruptible stages, measured (the daemon adds its publishing).
+    costs: FrameCosts,
 }
 
 impl PipelineWorkspace {
@@ -391,6 +400,12 @@ impl PipelineWorkspace {
         results.contacts.clear();
         results.tois.clear();
         self.narrow.paths = PathCounts::default();
+    }
+
+    /// Records how long the caller took to write and publish a frame's results,
+    /// nanoseconds: part of the work a frame of this scene cannot skip ([`FrameCosts`]).
+    pub fn note_publish(&mut self, ns: u64) {
+        self.costs.note_publish(ns);
     }
 
     /// A workspace that answers mesh–mesh pairs on `workers` too (when a frame has at least
@@ -515,6 +530,14 @@ pub fn step_within(
 ) -> StepReport {
     let started = Instant::now();
     workspace.begin_frame(results);
+    let bodies = scene.body_count();
+    if let Err(needed) = mandatory_work_fits(&*budget, query, &workspace.costs, bodies) {
+        return StepReport {
+            completeness: Completeness::Truncated { level: 0 },
+            budget_too_small: Some(needed),
+            ..StepReport::default()
+        };
+    }
     let broad = workspace.broad.candidates(
         scene,
         query,
@@ -522,6 +545,7 @@ pub fn step_within(
         &mut workspace.toi_candidates,
     );
     let broad_ns = elapsed_ns(started);
+    workspace.costs.note_broad(bodies, broad_ns);
     let started = Instant::now();
     let mut plan = FramePlan::new(&*budget, query);
     workspace.narrow.clock = plan.narrow_clock();
@@ -563,6 +587,7 @@ pub fn step_within(
         truncated_pairs: tally.truncated,
         truncated_tois: tois.truncated,
         dropped_candidates: index(broad.dropped),
+        budget_too_small: None,
     }
 }
 

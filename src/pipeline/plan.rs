@@ -2,6 +2,7 @@
 //! starts: how its budget is split (the frontier's deadline, the time kept back for the
 //! work after it) and, per candidate pair, which route answers it ([`PairPlan`]).
 
+use super::costs::FrameCosts;
 use super::{MIN_PARALLEL_MESH_PAIRS, Query};
 use crate::budget::{Budget, Stop, WorkClock};
 pub use crate::budget::{Deadline, Unlimited, VisitBudget};
@@ -38,6 +39,24 @@ pub fn frontier_deadline(start: Instant, frame_deadline: Instant) -> Deadline {
             .checked_sub(reserve)
             .unwrap_or(frame_deadline),
     )
+}
+
+/// Whether a frame asking `query` under `budget` can hold its uninterruptible work
+/// (`costs`, measured on its scene of `bodies` bodies) from now: `Err` with that work's
+/// nanoseconds when its deadline comes first. Frames without a deadline, or not at the
+/// current poses, and scenes not measured yet always fit.
+pub(super) fn mandatory_work_fits(
+    budget: &dyn Budget,
+    query: Query,
+    costs: &FrameCosts,
+    bodies: usize,
+) -> Result<(), u64> {
+    let (Some(deadline), Some(needed)) = (budget.deadline(), costs.mandatory_ns(bodies)) else {
+        return Ok(());
+    };
+    let fits =
+        !query.at_current_poses() || Instant::now() + Duration::from_nanos(needed) <= deadline;
+    if fits { Ok(()) } else { Err(needed) }
 }
 
 /// How a frame answers one candidate pair that no kept answer covers; decided before any of

@@ -13,6 +13,7 @@ use crate::test_support::{meshes, point_in_cube, rng, rotation};
 use rand::Rng;
 use std::ops::ControlFlow;
 use std::sync::Arc;
+use std::time::Duration;
 
 fn add(scene: &mut Scene, shape: Shape, at: DVec3, margin: f64) -> BodyId {
     let shape = scene.register_shape(shape).unwrap();
@@ -697,4 +698,45 @@ fn a_frame_answers_at_most_its_pair_limit_and_counts_what_it_dropped() {
             "one contact each"
         );
     }
+}
+
+/// A frame whose deadline cannot hold the scene's measured uninterruptible work is not
+/// started: it answers nothing, says so with that work's nanoseconds, and leaves the next
+/// frames (with a budget that fits, or none) exactly as they would have been.
+#[test]
+fn a_frame_too_short_for_the_broad_phase_and_publishing_is_not_started() {
+    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let mut rng = rng(2905);
+    for _ in 0..50 {
+        let at = point_in_cube(&mut rng, 1.0);
+        add(&mut scene, Shape::Sphere(Sphere::new(0.2)), at, 0.0);
+    }
+    let query = Query::CLOSE.union(Query::CONTACTS);
+    let workspace = &mut PipelineWorkspace::default();
+    let results = &mut FrameResults::default();
+    let (exact, exact_results) = {
+        let mut fresh = FrameResults::default();
+        let report = step(&scene, query, &mut PipelineWorkspace::default(), &mut fresh);
+        (report, fresh)
+    };
+    assert!(exact.pairs > 0);
+    let in_an_hour = || Deadline(Instant::now() + Duration::from_secs(3600));
+    let already_due = || Deadline(Instant::now());
+    // Not measured yet: even a frame already due starts (and is measured).
+    let first = step_within(&scene, query, &mut already_due(), workspace, results);
+    assert_eq!(first.budget_too_small, None);
+    workspace.note_publish(1_000);
+    // Measured: a due frame is not started.
+    let skipped = step_within(&scene, query, &mut already_due(), workspace, results);
+    let needed = skipped.budget_too_small.expect("the frame is not started");
+    assert!(needed >= 1_000, "publishing is part of it: {needed}");
+    assert_eq!(skipped.completeness, Completeness::Truncated { level: 0 });
+    assert!(results.pairs.is_empty() && results.contacts.is_empty());
+    // A frame with room, and an unbudgeted one, answer as the exact run does.
+    let roomy = step_within(&scene, query, &mut in_an_hour(), workspace, results);
+    assert_eq!(roomy.budget_too_small, None);
+    assert_eq!(results.pairs, exact_results.pairs);
+    let unbudgeted = step(&scene, query, workspace, results);
+    assert_eq!(unbudgeted.budget_too_small, None);
+    assert_eq!(results.contacts, exact_results.contacts);
 }

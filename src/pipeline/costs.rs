@@ -1,0 +1,103 @@
+//! What a scene's frames must spend whatever their budget: the stages that cannot be
+//! interrupted (the broad phase, and the daemon's writing and publishing of the result),
+//! measured on the scene's own frames. The plan reads it before any work starts: a frame
+//! whose budget cannot hold this work is not started, and says so with the smallest
+//! budget measured ([`FrameCosts::mandatory_ns`]).
+//!
+//! Each estimate is the recent worst: a new sample above it replaces it, one below lowers
+//! it by a sixteenth of the gap, so one quick frame does not hide a slow stage and an old
+//! spike fades. A scene whose body count changed by more than an eighth since the
+//! estimates were taken is measured afresh.
+
+/// The uninterruptible stages' recent worst times for one scene.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FrameCosts {
+    /// Broad phase, nanoseconds.
+    broad_ns: u64,
+    /// Writing and publishing the result frame, nanoseconds (told by the caller).
+    publish_ns: u64,
+    /// Body count of the scene when the estimates were taken (0: none yet).
+    bodies: usize,
+}
+
+impl FrameCosts {
+    /// Records a frame's broad phase on a scene of `bodies` bodies.
+    pub fn note_broad(&mut self, bodies: usize, ns: u64) {
+        self.forget_if_changed(bodies);
+        self.broad_ns = recent_worst(self.broad_ns, ns);
+    }
+
+    /// Records how long the caller took to write and publish a frame's result.
+    pub fn note_publish(&mut self, ns: u64) {
+        self.publish_ns = recent_worst(self.publish_ns, ns);
+    }
+
+    /// The time a frame of a scene of `bodies` bodies must spend after its ingest,
+    /// nanoseconds: `None` before a frame of about that size was measured.
+    #[must_use]
+    pub fn mandatory_ns(&self, bodies: usize) -> Option<u64> {
+        (self.bodies != 0 && !changed(self.bodies, bodies))
+            .then(|| self.broad_ns.saturating_add(self.publish_ns))
+    }
+
+    fn forget_if_changed(&mut self, bodies: usize) {
+        if changed(self.bodies, bodies) {
+            *self = Self {
+                bodies,
+                ..Self::default()
+            };
+        }
+    }
+}
+
+/// Whether a body count moved from `then` by more than an eighth.
+fn changed(then: usize, now: usize) -> bool {
+    then.abs_diff(now) > then / 8
+}
+
+/// The estimate after `sample`: the sample if higher, else a sixteenth of the way down.
+fn recent_worst(estimate: u64, sample: u64) -> u64 {
+    if sample >= estimate {
+        sample
+    } else {
+        estimate - (estimate - sample) / 16
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_estimate_jumps_to_a_slow_sample_and_fades_slowly() {
+        let mut costs = FrameCosts::default();
+        assert_eq!(costs.mandatory_ns(100), None, "nothing measured yet");
+        costs.note_broad(100, 1_000);
+        costs.note_publish(500);
+        assert_eq!(costs.mandatory_ns(100), Some(1_500));
+        costs.note_broad(100, 17_000);
+        assert_eq!(costs.mandatory_ns(100), Some(17_500));
+        costs.note_broad(100, 1_000);
+        assert_eq!(costs.mandatory_ns(100), Some(16_000 + 500));
+        for _ in 0..200 {
+            costs.note_broad(100, 1_000);
+        }
+        assert!(costs.mandatory_ns(100).unwrap() < 1_600);
+    }
+
+    #[test]
+    fn a_scene_that_grew_or_shrank_by_more_than_an_eighth_is_measured_afresh() {
+        let mut costs = FrameCosts::default();
+        costs.note_broad(800, 9_000);
+        costs.note_publish(1_000);
+        assert_eq!(costs.mandatory_ns(900), Some(10_000), "within an eighth");
+        assert_eq!(costs.mandatory_ns(901), None);
+        assert_eq!(costs.mandatory_ns(699), None);
+        costs.note_broad(1_000, 2_000);
+        assert_eq!(
+            costs.mandatory_ns(1_000),
+            Some(2_000),
+            "publish forgotten too"
+        );
+    }
+}
