@@ -21,38 +21,30 @@
 //!
 //! Every pair is answered exactly (closed forms for spheres, capsules and boxes, the tori's
 //! BVHs against everything else), so the frames say `exact`.
+//!
+//! The scene and its integration live in `examples/scenes/` (`falling.rs`, `point_mass.rs`),
+//! shared with `deadline_bench`.
+
+#[path = "scenes/falling.rs"]
+mod falling;
+#[path = "scenes/point_mass.rs"]
+mod point_mass;
+// The scene description also builds in-process copies (`deadline_bench` checks against
+// one); this program only registers it with the daemon.
+#[allow(dead_code)]
+#[path = "scenes/spec.rs"]
+mod spec;
 
 use clap::Parser;
-use glam::{DQuat, DVec3};
+use falling::{BIN_HALF, falling_scene, falling_world};
 use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
-use proxima::geometry::TriMesh;
-use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion, Primitive};
+use proxima_ipc::client::ClientBuilder;
 use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation};
 use proxima_ipc::tools::latency::LatencyRecorder;
-use proxima_ipc::wire::{Completeness, ErrorCode, PoseRecord, ResultRecord, query};
+use proxima_ipc::wire::{Completeness, ErrorCode, query};
 use std::error::Error;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
-
-/// Gravity, m/s², along −Z.
-const GRAVITY: f64 = 9.81;
-/// Fraction of the approach speed kept after a bounce.
-const RESTITUTION: f64 = 0.4;
-/// Bin: floor half extent and wall height, metres.
-const BIN_HALF: f64 = 4.0;
-const WALL_HEIGHT: f64 = 3.0;
-/// Close-pair margin of every body, metres.
-const MARGIN: f64 = 0.02;
-/// A body whose speed stays under this for 30 frames counts as resting, m/s (a body at
-/// rest on the floor still gains g·dt ≈ 0.08 m/s each frame before its contact stops it).
-const REST_SPEED: f64 = 0.15;
-/// A body resting this many frames falls asleep: it is no longer integrated, so its pose
-/// stays bit for bit the same and the daemon reuses the answers of its pairs with other
-/// sleepers. An awake body hitting it faster than [`WAKE_SPEED`] wakes it; slower contact
-/// (a body settling on it) treats it as immovable.
-const SLEEP_FRAMES: u32 = 60;
-/// Approach speed along the contact normal that wakes a sleeper, m/s.
-const WAKE_SPEED: f64 = 0.3;
 
 #[derive(Debug, Parser)]
 #[command(about = "Bodies falling into a bin, bounced with proximad's contacts")]
@@ -109,11 +101,12 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
     let client = builder.connect::<ipc::Service>()?;
     let scene_id = client.create_scene()?;
-    let mut world = World::build(&client, scene_id, args.bodies)?;
+    let spec = falling_scene(args.bodies);
+    let mut world = falling_world(&spec, &spec.register(&client, scene_id)?);
     let link = client.open_scene(scene_id)?;
     println!(
         "falling_bodies: scene {scene_id}, {} falling bodies in a {:.0} m bin, {} Hz",
-        world.bodies.len(),
+        world.moving_count(),
         2.0 * BIN_HALF,
         args.rate_hz
     );
@@ -134,7 +127,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             seq,
             args.budget_us * 1000,
             query::CLOSE | query::CONTACTS,
-            world.bodies.len(),
+            world.moving_count(),
             |i| world.pose(i),
         )?;
         let Some(frame) = link.receive_results_for(seq, Duration::from_secs(1))? else {
@@ -159,7 +152,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                 header.contact_count,
                 bounced,
                 world.resting(),
-                world.bodies.len(),
+                world.moving_count(),
                 sent.elapsed().as_secs_f64() * 1e6
             );
         }
@@ -171,7 +164,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         "{frames} frames: {truncated} truncated, {missed} over budget, {lost} lost; {} of {} \
          bodies at rest",
         world.resting(),
-        world.bodies.len()
+        world.moving_count()
     );
     client.drop_scene(scene_id)?;
     Ok(())
@@ -193,241 +186,4 @@ fn sibling_daemon() -> Result<PathBuf, Box<dyn Error>> {
         .into());
     }
     Ok(path)
-}
-
-/// A falling body as this simulation integrates it.
-#[derive(Debug, Clone, Copy)]
-struct Body {
-    id: u32,
-    position: DVec3,
-    orientation: DQuat,
-    velocity: DVec3,
-    spin: DVec3,
-    inverse_mass: f64,
-    slow_frames: u32,
-    /// Not integrated until an awake body pushes it.
-    asleep: bool,
-}
-
-/// The bodies, and which daemon id is which body (`None`: a bin wall).
-struct World {
-    bodies: Vec<Body>,
-    index_of: Vec<Option<usize>>,
-}
-
-impl World {
-    fn build(
-        client: &Client<ipc::Service>,
-        scene: u32,
-        count: usize,
-    ) -> Result<Self, Box<dyn Error>> {
-        let mut world = Self {
-            bodies: Vec::with_capacity(count),
-            index_of: Vec::new(),
-        };
-        // The bin: a floor and four walls, static boxes.
-        let floor = client.register_primitive(
-            scene,
-            Primitive::Cuboid {
-                half_extents: [BIN_HALF, BIN_HALF, 0.25],
-            },
-        )?;
-        let wall_x = client.register_primitive(
-            scene,
-            Primitive::Cuboid {
-                half_extents: [0.25, BIN_HALF, WALL_HEIGHT / 2.0],
-            },
-        )?;
-        let wall_y = client.register_primitive(
-            scene,
-            Primitive::Cuboid {
-                half_extents: [BIN_HALF, 0.25, WALL_HEIGHT / 2.0],
-            },
-        )?;
-        let h = WALL_HEIGHT / 2.0;
-        for (shape, at) in [
-            (floor, DVec3::new(0.0, 0.0, -0.25)),
-            (wall_x, DVec3::new(-BIN_HALF - 0.25, 0.0, h)),
-            (wall_x, DVec3::new(BIN_HALF + 0.25, 0.0, h)),
-            (wall_y, DVec3::new(0.0, -BIN_HALF - 0.25, h)),
-            (wall_y, DVec3::new(0.0, BIN_HALF + 0.25, h)),
-        ] {
-            let id = client.add_body(scene, &spec(shape, at, DQuat::IDENTITY, Motion::Static))?;
-            world.note(id, None);
-        }
-        // What falls: spheres, capsules, boxes and small tori, a quarter each.
-        let torus = TriMesh::torus(0.3, 0.1, 16, 8);
-        let vertices: Vec<[f64; 3]> = torus.vertices().iter().map(|v| v.to_array()).collect();
-        let shapes = [
-            client.register_primitive(scene, Primitive::Sphere { radius: 0.2 })?,
-            client.register_primitive(
-                scene,
-                Primitive::Capsule {
-                    radius: 0.12,
-                    half_height: 0.2,
-                },
-            )?,
-            client.register_primitive(
-                scene,
-                Primitive::Cuboid {
-                    half_extents: [0.18, 0.18, 0.18],
-                },
-            )?,
-            client.register_mesh(scene, &vertices, torus.triangles())?,
-        ];
-        let side = (count as f64).sqrt().ceil() as usize;
-        let spacing = (2.0 * BIN_HALF - 1.0) / side as f64;
-        for i in 0..count {
-            let (gx, gy) = (i % side, i / side % side);
-            let layer = i / (side * side);
-            let position = DVec3::new(
-                -BIN_HALF + 0.5 + (gx as f64 + 0.5) * spacing,
-                -BIN_HALF + 0.5 + (gy as f64 + 0.5) * spacing,
-                2.0 + 1.0 * layer as f64 + 0.37 * ((i * 7) % 5) as f64,
-            );
-            let orientation =
-                DQuat::from_euler(glam::EulerRot::XYZ, i as f64 * 0.7, i as f64 * 1.3, 0.0);
-            let id = client.add_body(
-                scene,
-                &spec(
-                    shapes[i % shapes.len()],
-                    position,
-                    orientation,
-                    Motion::Dynamic,
-                ),
-            )?;
-            world.note(id, Some(world.bodies.len()));
-            world.bodies.push(Body {
-                id,
-                position,
-                orientation,
-                velocity: DVec3::ZERO,
-                spin: DVec3::new(0.3, -0.2, 0.5) * ((i % 3) as f64 - 1.0),
-                inverse_mass: 1.0,
-                slow_frames: 0,
-                asleep: false,
-            });
-        }
-        Ok(world)
-    }
-
-    fn note(&mut self, id: u32, index: Option<usize>) {
-        let id = id as usize;
-        if self.index_of.len() <= id {
-            self.index_of.resize(id + 1, None);
-        }
-        self.index_of[id] = index;
-    }
-
-    fn pose(&self, i: usize) -> PoseRecord {
-        let b = &self.bodies[i];
-        PoseRecord {
-            body: b.id,
-            reserved: 0,
-            position: b.position.to_array(),
-            orientation: b.orientation.to_array(),
-        }
-    }
-
-    /// Gravity, then velocities (semi-implicit Euler); spin decays.
-    fn integrate(&mut self, dt: f64) {
-        for b in self.bodies.iter_mut().filter(|b| !b.asleep) {
-            b.velocity.z -= GRAVITY * dt;
-            b.position += b.velocity * dt;
-            let turn = b.spin * dt;
-            if turn.length_squared() > 0.0 {
-                b.orientation = (DQuat::from_scaled_axis(turn) * b.orientation).normalize();
-            }
-            b.spin *= 0.995;
-            let slow = b.velocity.length() < REST_SPEED;
-            b.slow_frames = if slow { b.slow_frames + 1 } else { 0 };
-            if b.slow_frames > SLEEP_FRAMES {
-                (b.asleep, b.velocity, b.spin) = (true, DVec3::ZERO, DVec3::ZERO);
-            }
-        }
-    }
-
-    /// For each pair with contacts, an impulse at its deepest contact along the normal (A→B)
-    /// if the bodies approach, and a push apart by the depth. Returns how many pairs bounced.
-    fn resolve(&mut self, pairs: &[ResultRecord], contacts: &[ResultRecord]) -> usize {
-        let mut bounced = 0;
-        for pair in pairs {
-            let first = (pair.index as usize).min(contacts.len());
-            let end = (first + pair.count as usize).min(contacts.len());
-            let Some(deepest) = contacts[first..end]
-                .iter()
-                .min_by(|x, y| x.distance.total_cmp(&y.distance))
-            else {
-                continue;
-            };
-            bounced += usize::from(self.bounce(pair.body_a, pair.body_b, deepest));
-        }
-        bounced
-    }
-
-    fn bounce(&mut self, a: u32, b: u32, contact: &ResultRecord) -> bool {
-        let index = |id: u32| self.index_of.get(id as usize).copied().flatten();
-        let (ia, ib) = (index(a), index(b));
-        let (inv_a, inv_b) = (
-            ia.map_or(0.0, |i| self.bodies[i].inverse_mass),
-            ib.map_or(0.0, |i| self.bodies[i].inverse_mass),
-        );
-        let asleep = |i: Option<usize>| i.is_none_or(|i| self.bodies[i].asleep);
-        if asleep(ia) && asleep(ib) {
-            // Sleepers (and walls) stay put against each other.
-            return false;
-        }
-        let n = DVec3::from_array(contact.normal);
-        let depth = (-contact.distance).max(0.0);
-        let velocity = |i: Option<usize>| i.map_or(DVec3::ZERO, |i| self.bodies[i].velocity);
-        let approach = (velocity(ib) - velocity(ia)).dot(n);
-        // A hard hit wakes a sleeper; a soft one leaves it asleep and immovable.
-        let mut immovable = |i: Option<usize>, inv: f64| match i {
-            Some(i) if self.bodies[i].asleep && -approach > WAKE_SPEED => {
-                (self.bodies[i].asleep, self.bodies[i].slow_frames) = (false, 0);
-                inv
-            }
-            Some(i) if self.bodies[i].asleep => 0.0,
-            _ => inv,
-        };
-        let (inv_a, inv_b) = (immovable(ia, inv_a), immovable(ib, inv_b));
-        let total = inv_a + inv_b;
-        if total == 0.0 {
-            return false;
-        }
-        let impulse = if approach < 0.0 {
-            -(1.0 + RESTITUTION) * approach / total
-        } else {
-            0.0
-        };
-        let correction = depth * 0.8 / total;
-        if let Some(i) = ia {
-            self.bodies[i].velocity -= n * impulse * inv_a;
-            self.bodies[i].position -= n * correction * inv_a;
-        }
-        if let Some(i) = ib {
-            self.bodies[i].velocity += n * impulse * inv_b;
-            self.bodies[i].position += n * correction * inv_b;
-        }
-        impulse > 0.0
-    }
-
-    fn resting(&self) -> usize {
-        self.bodies
-            .iter()
-            .filter(|b| b.asleep || b.slow_frames > 30)
-            .count()
-    }
-}
-
-fn spec(shape: u32, position: DVec3, orientation: DQuat, motion: Motion) -> BodySpec {
-    BodySpec {
-        shape,
-        position: position.to_array(),
-        orientation: orientation.to_array(),
-        motion,
-        group: u32::MAX,
-        mask: u32::MAX,
-        margin: Some(MARGIN),
-    }
 }
