@@ -1,0 +1,135 @@
+//! The hostile client: a second control connection (a thread of this process with a node
+//! of its own) that keeps the daemon's control path busy while the victim's frames run.
+//! Round after round it creates a scene of its own, registers a 1,000,000-triangle mesh
+//! (a flat 1,000 × 500 grid of quads, 2 m × 1 m) and the hull of 32,768 points on a
+//! sphere, and drops the scene again (so the daemon's memory stays bounded). DESIGN §8:
+//! the frame path never waits for control work, so the victim's deadlines should not move.
+
+use iceoryx2::prelude::ipc;
+use proxima_ipc::client::ClientBuilder;
+use proxima_ipc::tools::latency::{LatencyRecorder, LatencySummary};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// Quads of the grid mesh along X and Y (two triangles each: 1,000,000 triangles).
+const GRID_QUADS: (u32, u32) = (1_000, 500);
+/// Points of the convex shape.
+const CONVEX_POINTS: usize = 32_768;
+/// How long one registration may take before the client gives up on it.
+const REPLY_TIMEOUT: Duration = Duration::from_secs(300);
+
+/// What the hostile client did.
+#[derive(Debug, Clone, Copy)]
+pub struct HostileReport {
+    /// Rounds begun (each registers one mesh and one convex).
+    pub rounds: u32,
+    /// Registration round trips (request to reply), both kinds.
+    pub registrations: Option<LatencySummary>,
+    /// Requests the daemon refused or that timed out.
+    pub failures: u32,
+}
+
+/// The running hostile client.
+pub struct Hostile {
+    stop: Arc<AtomicBool>,
+    thread: JoinHandle<Result<HostileReport, String>>,
+}
+
+impl Hostile {
+    /// Starts the client against the daemon at `root` and iceoryx2 `prefix`.
+    #[must_use]
+    pub fn start(root: &str, prefix: &str) -> Self {
+        let stop = Arc::new(AtomicBool::new(false));
+        let (root, prefix, flag) = (root.to_owned(), prefix.to_owned(), Arc::clone(&stop));
+        let thread = std::thread::spawn(move || run(&root, &prefix, &flag));
+        Self { stop, thread }
+    }
+
+    /// Asks the client to stop after its current request and waits for it.
+    ///
+    /// # Errors
+    /// It could not connect, or its thread panicked.
+    pub fn stop(self) -> Result<HostileReport, String> {
+        self.stop.store(true, Ordering::Relaxed);
+        self.thread
+            .join()
+            .map_err(|_| "the hostile client panicked".to_owned())?
+    }
+}
+
+fn run(root: &str, prefix: &str, stop: &AtomicBool) -> Result<HostileReport, String> {
+    let client = ClientBuilder::new()
+        .root(root)
+        .iceoryx_prefix(prefix)
+        .reply_timeout(REPLY_TIMEOUT)
+        .connect::<ipc::Service>()
+        .map_err(|e| format!("hostile client: {e}"))?;
+    let (vertices, triangles) = grid_mesh();
+    let points = sphere_points();
+    let mut report = HostileReport {
+        rounds: 0,
+        registrations: None,
+        failures: 0,
+    };
+    let mut times = LatencyRecorder::with_capacity(64);
+    let mut timed = |result: Result<u32, _>, started: Instant, failures: &mut u32| {
+        times.record(started.elapsed());
+        *failures += u32::from(result.is_err());
+    };
+    while !stop.load(Ordering::Relaxed) {
+        report.rounds += 1;
+        let Ok(scene) = client.create_scene() else {
+            report.failures += 1;
+            std::thread::sleep(Duration::from_millis(100));
+            continue;
+        };
+        let started = Instant::now();
+        let mesh = client.register_mesh(scene, &vertices, &triangles);
+        timed(mesh, started, &mut report.failures);
+        if stop.load(Ordering::Relaxed) {
+            let _ = client.drop_scene(scene);
+            break;
+        }
+        let started = Instant::now();
+        let convex = client.register_convex(scene, &points);
+        timed(convex, started, &mut report.failures);
+        report.failures += u32::from(client.drop_scene(scene).is_err());
+    }
+    report.registrations = times.summary();
+    Ok(report)
+}
+
+/// The flat grid: `(X + 1) · (Y + 1)` vertices on z = 0, two triangles per quad.
+fn grid_mesh() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let (nx, ny) = GRID_QUADS;
+    let step = 2.0 / f64::from(nx);
+    let vertices = (0..=ny)
+        .flat_map(|j| (0..=nx).map(move |i| [f64::from(i) * step, f64::from(j) * step, 0.0]))
+        .collect();
+    let at = |i: u32, j: u32| j * (nx + 1) + i;
+    let triangles = (0..ny)
+        .flat_map(|j| {
+            (0..nx).flat_map(move |i| {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                [[a, b, c], [a, c, d]]
+            })
+        })
+        .collect();
+    (vertices, triangles)
+}
+
+/// Points spread evenly over a sphere of radius 0.5 m (a Fibonacci lattice): every one is
+/// a hull vertex.
+fn sphere_points() -> Vec<[f64; 3]> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..CONVEX_POINTS)
+        .map(|k| {
+            let z = 1.0 - 2.0 * (k as f64 + 0.5) / CONVEX_POINTS as f64;
+            let r = (1.0 - z * z).sqrt();
+            let phi = golden * k as f64;
+            [0.5 * r * phi.cos(), 0.5 * r * phi.sin(), 0.5 * z]
+        })
+        .collect()
+}
