@@ -26,7 +26,11 @@
 //!   be 0), over the `checked` frames (`sphere-swarm` checks every 5th).
 //!
 //! `--hostile-registration` runs every row a second time with a hostile client registering
-//! huge shapes meanwhile (`hostile.rs`), stopped after `--hostile-seconds`.
+//! huge shapes meanwhile (`hostile.rs`): its frames start as the client sends its first
+//! registration and stop after `--frames` or `--hostile-seconds`; the row then waits for
+//! the registration in flight, so the next row starts on an idle daemon. A daemon whose
+//! control work stalls the frame path shows it as lost frames and long round trips (the
+//! header's `elapsed_ns` starts when the daemon takes the frame, so it cannot see the wait).
 //!
 //! Writes `DIR/deadlines.csv` (one line per frame) and `DIR/overrun.svg` (the overruns of
 //! each scene and budget), `DIR` from `--out`. `robot-chain` needs FCL's meshes from the
@@ -67,6 +71,7 @@ use oracle::{Oracle, possibly_touching};
 use proxima_ipc::client::{Client, ClientBuilder};
 use proxima_ipc::scene_link::SceneLink;
 use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation};
+use proxima_ipc::tools::latency::LatencySummary;
 use proxima_ipc::wire::ErrorCode;
 use report::{Answer, FrameRecord, Row};
 use std::error::Error;
@@ -330,7 +335,8 @@ fn drive(
     driver.first_frame()?;
     let hostile = plan
         .hostile
-        .then(|| Hostile::start(&session.isolation.root, &session.isolation.prefix));
+        .then(|| Hostile::start(&session.isolation.root, &session.isolation.prefix))
+        .transpose()?;
     let mut row = Row {
         scene: class.name,
         budget_us: plan.budget_us,
@@ -442,23 +448,28 @@ fn refused(status: u32, seq: u64) -> Result<(), Box<dyn Error>> {
 }
 
 fn print_hostile(h: &HostileReport) {
-    let times = h.registrations.map_or_else(
-        || "none finished".to_owned(),
-        |s| {
-            let seconds = |ns: u64| ns as f64 / 1e9;
-            format!(
-                "{} took min {:.2} s, median {:.2} s, max {:.2} s",
-                s.count,
-                seconds(s.min_ns),
-                seconds(s.p50_ns),
-                seconds(s.max_ns)
-            )
-        },
-    );
+    let times = |summary: Option<LatencySummary>| {
+        summary.map_or_else(
+            || "none finished".to_owned(),
+            |s| {
+                let seconds = |ns: u64| ns as f64 / 1e9;
+                format!(
+                    "{} in {:.2}-{:.2} s",
+                    s.count,
+                    seconds(s.min_ns),
+                    seconds(s.max_ns)
+                )
+            },
+        )
+    };
     println!(
-        "{:<19} hostile client: {} rounds (1M-triangle mesh, then 32,768-point hull), {} \
-         requests failed; registrations: {times}",
-        "", h.rounds, h.failures
+        "{:<19} hostile client: {} rounds, {} requests failed; 32,768-point hulls registered: {}; \
+         1M-triangle meshes registered: {}",
+        "",
+        h.rounds,
+        h.failures,
+        times(h.convex),
+        times(h.mesh)
     );
 }
 
