@@ -14,8 +14,8 @@
 //! without a budget (the daemon's exact answer must equal the mirror's), then `--frames`
 //! frames back to back (heavy scenes default to fewer; the output says so), each moving
 //! the bodies as the scene's client does (simulations bounce theirs with the returned
-//! contacts), publishing every moving body's pose and waiting for the answer. Rows print
-//! as they finish:
+//! contacts), publishing every moving body's pose and waiting for the answer; the oracle
+//! runs between frames, outside the timed round trip. Rows print as they finish:
 //! - `met %`: frames the daemon answered within the budget (header `elapsed_ns`, receipt
 //!   to publish, ≤ budget), of the frames sent (a lost frame, unanswered within
 //!   `--frame-timeout-ms`, counts as missed);
