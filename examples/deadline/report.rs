@@ -32,6 +32,9 @@ pub struct Answer {
     pub pairs: u32,
     /// Contact records.
     pub contacts: u32,
+    /// The header's `flags`: a frame with `PAIRS_CAPPED` or `BUDGET_TOO_SMALL` declares
+    /// itself partial (its pairs a sample, or none), and is not checked by the oracle.
+    pub flags: u32,
 }
 
 impl Answer {
@@ -45,6 +48,7 @@ impl Answer {
             stage_ns: header.stage_ns,
             pairs: header.pair_count,
             contacts: header.contact_count,
+            flags: header.flags,
         }
     }
 }
@@ -85,6 +89,8 @@ pub struct RowFigures {
     pub missed: u64,
     /// See `missed`.
     pub checked: usize,
+    /// Answered frames whose header declared them partial (`flags` not 0).
+    pub partial: usize,
 }
 
 impl Row {
@@ -125,6 +131,7 @@ impl Row {
                 .map(u64::from)
                 .sum(),
             checked: self.frames.iter().filter(|f| f.missed.is_some()).count(),
+            partial: answers.iter().filter(|a| a.flags != 0).count(),
         }
     }
 
@@ -154,7 +161,7 @@ impl Row {
 #[must_use]
 pub fn table_head() -> String {
     format!(
-        "{:<19} {:>7} {:>8} {:>6} {:>6} {:>8} {:>9} {:>9} {:>10} {:>7} {:>7} {:>9} {:>9} {:>7} {:>9}",
+        "{:<19} {:>7} {:>8} {:>6} {:>6} {:>8} {:>9} {:>9} {:>10} {:>7} {:>7} {:>9} {:>9} {:>7} {:>9} {:>7}",
         "scene",
         "budget",
         "hostile",
@@ -169,7 +176,8 @@ pub fn table_head() -> String {
         "rt p50",
         "rt p99",
         "missed",
-        "checked"
+        "checked",
+        "partial"
     )
 }
 
@@ -183,7 +191,7 @@ pub fn table_line(row: &Row) -> String {
     let round_trip =
         |pick: fn(&LatencySummary) -> u64| f.round_trip.as_ref().map_or(0.0, |s| us(pick(s)));
     format!(
-        "{:<19} {:>5}µs {:>8} {:>6} {:>6} {:>8.1} {:>9.1} {:>9.1} {:>10.1} {:>7.1} {:>7.1} {:>9.1} {:>9.1} {:>7} {:>9}",
+        "{:<19} {:>5}µs {:>8} {:>6} {:>6} {:>8.1} {:>9.1} {:>9.1} {:>10.1} {:>7.1} {:>7.1} {:>9.1} {:>9.1} {:>7} {:>9} {:>7}",
         row.scene,
         row.budget_us,
         if row.hostile { "yes" } else { "no" },
@@ -198,7 +206,8 @@ pub fn table_line(row: &Row) -> String {
         round_trip(|s| s.p50_ns),
         round_trip(|s| s.p99_ns),
         f.missed,
-        format!("{}/{}", f.checked, f.sent)
+        format!("{}/{}", f.checked, f.sent),
+        f.partial
     ) + &row
         .end_state
         .as_ref()

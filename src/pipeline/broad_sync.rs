@@ -66,6 +66,9 @@ pub(super) struct BroadOutcome {
     pub(super) kind: Option<BroadPhaseKind>,
     /// Bodies it re-read.
     pub(super) updates: usize,
+    /// Whether it built the broad phase afresh (a new scene or kind, or a skipped frame)
+    /// instead of syncing the kept one.
+    pub(super) rebuilt: bool,
     /// The scene's statistics, on the frames that measured them.
     pub(super) stats: Option<BroadPhaseStats>,
     /// Candidates found beyond the scene's [`SceneLimits::max_pairs_per_frame`](crate::scene::SceneLimits::max_pairs_per_frame) and
@@ -91,14 +94,14 @@ impl BroadSync {
         toi_candidates: &mut Vec<CandidatePair>,
     ) -> BroadOutcome {
         let mut stats = None;
-        let (kind, updates) = if query.at_current_poses() {
-            let updates = self.sync(scene, &mut stats);
+        let (kind, updates, rebuilt) = if query.at_current_poses() {
+            let (updates, rebuilt) = self.sync(scene, &mut stats);
             let broad = self.broad.as_mut().expect("synced");
             broad.pairs(candidates);
-            (Some(broad.kind()), updates)
+            (Some(broad.kind()), updates, rebuilt)
         } else {
             candidates.clear();
-            (None, 0)
+            (None, 0, false)
         };
         if query.toi {
             scene.swept_proxies(&mut self.swept);
@@ -111,15 +114,16 @@ impl BroadSync {
         BroadOutcome {
             kind,
             updates,
+            rebuilt,
             stats,
             dropped,
         }
     }
 
     /// Brings the kept broad phase up to date with `scene` (module docs); returns how
-    /// many bodies it re-read, and sets `measured` when it measured the scene for the
-    /// automatic choice.
-    fn sync(&mut self, scene: &Scene, measured: &mut Option<BroadPhaseStats>) -> usize {
+    /// many bodies it re-read and whether it rebuilt the broad phase, and sets `measured`
+    /// when it measured the scene for the automatic choice.
+    fn sync(&mut self, scene: &Scene, measured: &mut Option<BroadPhaseStats>) -> (usize, bool) {
         let changes = self.synced.and_then(|point| scene.changes_since(point));
         let mut listed = false;
         let kind = match scene.broad_phase() {
@@ -169,12 +173,12 @@ impl BroadSync {
                 }
             }
             broad.set_all(proxies);
-            return changes.len();
+            return (changes.len(), false);
         }
         if !listed {
             scene.proxies(proxies);
         }
         *broad = Some(BroadPhase::from_proxies(kind, proxies));
-        proxies.len()
+        (proxies.len(), true)
     }
 }

@@ -6,8 +6,12 @@
 //!
 //! Each estimate is the recent worst: a new sample above it replaces it, one below lowers
 //! it by a sixteenth of the gap, so one quick frame does not hide a slow stage and an old
-//! spike fades. A scene whose body count changed by more than an eighth since the
-//! estimates were taken is measured afresh.
+//! spike fades. Only broad phases that synced the kept one count (a rebuild, after a new
+//! scene or a frame not started, costs more than the frames that follow). A frame not
+//! started lowers both estimates by a sixty-fourth, so an estimate grown stale (the scene
+//! got cheaper) lets a frame run and be measured again after a few dozen refusals. A scene
+//! whose body count changed by more than an eighth since the estimates were taken is
+//! measured afresh.
 
 /// The uninterruptible stages' recent worst times for one scene.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -30,6 +34,13 @@ impl FrameCosts {
     /// Records how long the caller took to write and publish a frame's result.
     pub fn note_publish(&mut self, ns: u64) {
         self.publish_ns = recent_worst(self.publish_ns, ns);
+    }
+
+    /// Records a frame not started for lack of budget: both estimates fade by a
+    /// sixty-fourth.
+    pub fn note_skipped(&mut self) {
+        self.broad_ns -= self.broad_ns / 64;
+        self.publish_ns -= self.publish_ns / 64;
     }
 
     /// The time a frame of a scene of `bodies` bodies must spend after its ingest,
@@ -83,6 +94,18 @@ mod tests {
             costs.note_broad(100, 1_000);
         }
         assert!(costs.mandatory_ns(100).unwrap() < 1_600);
+    }
+
+    #[test]
+    fn frames_not_started_let_a_stale_estimate_fade_until_one_runs() {
+        let mut costs = FrameCosts::default();
+        costs.note_broad(100, 64_000);
+        let mut skips = 0;
+        while costs.mandatory_ns(100).unwrap() > 32_000 {
+            costs.note_skipped();
+            skips += 1;
+        }
+        assert!((40..50).contains(&skips), "{skips} refusals halve it");
     }
 
     #[test]

@@ -532,6 +532,7 @@ pub fn step_within(
     workspace.begin_frame(results);
     let bodies = scene.body_count();
     if let Err(needed) = mandatory_work_fits(&*budget, query, &workspace.costs, bodies) {
+        workspace.costs.note_skipped();
         return StepReport {
             completeness: Completeness::Truncated { level: 0 },
             budget_too_small: Some(needed),
@@ -545,7 +546,9 @@ pub fn step_within(
         &mut workspace.toi_candidates,
     );
     let broad_ns = elapsed_ns(started);
-    workspace.costs.note_broad(bodies, broad_ns);
+    if !broad.rebuilt {
+        workspace.costs.note_broad(bodies, broad_ns);
+    }
     let started = Instant::now();
     let mut plan = FramePlan::new(&*budget, query);
     workspace.narrow.clock = plan.narrow_clock();

@@ -722,9 +722,13 @@ fn a_frame_too_short_for_the_broad_phase_and_publishing_is_not_started() {
     assert!(exact.pairs > 0);
     let in_an_hour = || Deadline(Instant::now() + Duration::from_secs(3600));
     let already_due = || Deadline(Instant::now());
-    // Not measured yet: even a frame already due starts (and is measured).
-    let first = step_within(&scene, query, &mut already_due(), workspace, results);
-    assert_eq!(first.budget_too_small, None);
+    // Not measured yet: even a frame already due starts. The first builds the broad phase
+    // (a rebuild is not what later frames cost, so it is not measured); the second syncs
+    // it and is measured.
+    for _ in 0..2 {
+        let unmeasured = step_within(&scene, query, &mut already_due(), workspace, results);
+        assert_eq!(unmeasured.budget_too_small, None);
+    }
     workspace.note_publish(1_000);
     // Measured: a due frame is not started.
     let skipped = step_within(&scene, query, &mut already_due(), workspace, results);
