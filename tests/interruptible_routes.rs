@@ -57,6 +57,7 @@ fn check_every_stop(a: &Shape, b: &Shape, pose_ab: &Pose, seen: &mut Seen, case:
             }
             Reached::Bounded(bound) => {
                 seen.stopped += 1;
+                assert!(bound.lower.is_finite(), "case {case}: {bound:?}");
                 assert!(
                     bound.lower <= exact.distance + tol && exact.distance <= bound.upper + tol,
                     "case {case}, stopped after {work} units: {bound:?} does not hold the \

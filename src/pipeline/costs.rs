@@ -4,9 +4,10 @@
 //! whose budget cannot hold this work is not started, and says so with the smallest
 //! budget measured ([`FrameCosts::mandatory_ns`]).
 //!
-//! Each estimate is the recent worst: a new sample above it replaces it, one below lowers
-//! it by a sixteenth of the gap, so one quick frame does not hide a slow stage and an old
-//! spike fades. Only broad phases that synced the kept one count (a rebuild, after a new
+//! Each estimate is the recent worst: a new sample above it replaces it (rising at most
+//! twofold a frame, so one frame the OS descheduled does not refuse the next ones), one
+//! below lowers it by a sixteenth of the gap, so one quick frame does not hide a slow stage
+//! and an old spike fades. Only broad phases that synced the kept one count (a rebuild, after a new
 //! scene or a frame not started, costs more than the frames that follow). A frame not
 //! started lowers both estimates by a sixty-fourth, so an estimate grown stale (the scene
 //! got cheaper) lets a frame run and be measured again after a few dozen refusals. A scene
@@ -66,10 +67,14 @@ fn changed(then: usize, now: usize) -> bool {
     then.abs_diff(now) > then / 8
 }
 
-/// The estimate after `sample`: the sample if higher, else a sixteenth of the way down.
+/// The estimate after `sample`: the sample if higher, but at most twice the estimate (one
+/// frame descheduled by the OS must not refuse the frames after it; a scene that really got
+/// slower is followed within a few frames), else a sixteenth of the way down.
 fn recent_worst(estimate: u64, sample: u64) -> u64 {
-    if sample >= estimate {
+    if estimate == 0 {
         sample
+    } else if sample >= estimate {
+        sample.min(estimate.saturating_mul(2))
     } else {
         estimate - (estimate - sample) / 16
     }
@@ -86,6 +91,16 @@ mod tests {
         costs.note_broad(100, 1_000);
         costs.note_publish(500);
         assert_eq!(costs.mandatory_ns(100), Some(1_500));
+        costs.note_broad(100, 17_000);
+        assert_eq!(
+            costs.mandatory_ns(100),
+            Some(2_000 + 500),
+            "at most twofold a frame"
+        );
+        costs.note_broad(100, 17_000);
+        costs.note_broad(100, 17_000);
+        costs.note_broad(100, 17_000);
+        assert_eq!(costs.mandatory_ns(100), Some(16_000 + 500));
         costs.note_broad(100, 17_000);
         assert_eq!(costs.mandatory_ns(100), Some(17_500));
         costs.note_broad(100, 1_000);

@@ -222,10 +222,14 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         if !best.dist.is_finite() {
             break;
         }
+        let p = sup(best.normal);
         if !clock.allows(EXPANSION_WORK) {
+            // The nearest face's direction is always offered, so the answer is finite.
+            if p.w.is_finite() {
+                fallback.offer(best.normal, &p, face_point_a(&ws.vertices, &best));
+            }
             return fallback.stopped(iterations - 1, best.dist);
         }
-        let p = sup(best.normal);
         if !p.w.is_finite() {
             break;
         }
