@@ -285,7 +285,7 @@ pub struct ResultFrameHeader {
     /// answer (with [`frame_flags::PAIRS_CAPPED`]); 0 otherwise.
     pub dropped_candidates: u32,
     /// With [`frame_flags::BUDGET_TOO_SMALL`]: the smallest budget the daemon measured for
-    /// this scene's frames, nanoseconds (its ingest plus the recent worst of the stages no
+    /// this scene's frames, nanoseconds (its ingest plus the typical time of the stages no
     /// deadline can interrupt: the broad phase and publishing). 0 otherwise.
     pub min_budget_ns: u64,
 }

@@ -4,17 +4,17 @@
 //! whose budget cannot hold this work is not started, and says so with the smallest
 //! budget measured ([`FrameCosts::mandatory_ns`]).
 //!
-//! Each estimate is the recent worst: a new sample above it replaces it (rising at most
-//! twofold a frame, so one frame the OS descheduled does not refuse the next ones), one
-//! below lowers it by a sixteenth of the gap, so one quick frame does not hide a slow stage
-//! and an old spike fades. Only broad phases that synced the kept one count (a rebuild, after a new
+//! Each estimate is the typical cost, a running mean moving an eighth of the way to each
+//! sample, a sample counting at most twice the estimate: a frame is refused only when the
+//! scene's usual uninterruptible work cannot fit, never for one frame the OS descheduled
+//! (a frame whose broad phase runs long is late instead, and its stage times say why). Only broad phases that synced the kept one count (a rebuild, after a new
 //! scene or a frame not started, costs more than the frames that follow). A frame not
 //! started lowers both estimates by a sixty-fourth, so an estimate grown stale (the scene
 //! got cheaper) lets a frame run and be measured again after a few dozen refusals. A scene
 //! whose body count changed by more than an eighth since the estimates were taken is
 //! measured afresh.
 
-/// The uninterruptible stages' recent worst times for one scene.
+/// The uninterruptible stages' typical times for one scene.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FrameCosts {
     /// Broad phase, nanoseconds.
@@ -29,12 +29,12 @@ impl FrameCosts {
     /// Records a frame's broad phase on a scene of `bodies` bodies.
     pub fn note_broad(&mut self, bodies: usize, ns: u64) {
         self.forget_if_changed(bodies);
-        self.broad_ns = recent_worst(self.broad_ns, ns);
+        self.broad_ns = typical(self.broad_ns, ns);
     }
 
     /// Records how long the caller took to write and publish a frame's result.
     pub fn note_publish(&mut self, ns: u64) {
-        self.publish_ns = recent_worst(self.publish_ns, ns);
+        self.publish_ns = typical(self.publish_ns, ns);
     }
 
     /// Records a frame not started for lack of budget: both estimates fade by a
@@ -67,16 +67,18 @@ fn changed(then: usize, now: usize) -> bool {
     then.abs_diff(now) > then / 8
 }
 
-/// The estimate after `sample`: the sample if higher, but at most twice the estimate (one
-/// frame descheduled by the OS must not refuse the frames after it; a scene that really got
-/// slower is followed within a few frames), else a sixteenth of the way down.
-fn recent_worst(estimate: u64, sample: u64) -> u64 {
+/// The estimate after `sample`: an eighth of the way towards it, the sample counted at
+/// most twice the estimate (one frame the OS descheduled must not refuse the frames after
+/// it; a scene that really got slower is followed within a few frames).
+fn typical(estimate: u64, sample: u64) -> u64 {
     if estimate == 0 {
-        sample
-    } else if sample >= estimate {
-        sample.min(estimate.saturating_mul(2))
+        return sample;
+    }
+    let sample = sample.min(estimate.saturating_mul(2));
+    if sample >= estimate {
+        estimate + (sample - estimate) / 8
     } else {
-        estimate - (estimate - sample) / 16
+        estimate - (estimate - sample) / 8
     }
 }
 
@@ -85,30 +87,28 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_estimate_jumps_to_a_slow_sample_and_fades_slowly() {
+    fn the_estimate_follows_the_typical_cost_and_one_slow_sample_moves_it_little() {
         let mut costs = FrameCosts::default();
         assert_eq!(costs.mandatory_ns(100), None, "nothing measured yet");
-        costs.note_broad(100, 1_000);
-        costs.note_publish(500);
-        assert_eq!(costs.mandatory_ns(100), Some(1_500));
-        costs.note_broad(100, 17_000);
+        costs.note_broad(100, 8_000);
+        costs.note_publish(800);
         assert_eq!(
             costs.mandatory_ns(100),
-            Some(2_000 + 500),
-            "at most twofold a frame"
+            Some(8_800),
+            "the first sample is taken whole"
         );
-        costs.note_broad(100, 17_000);
-        costs.note_broad(100, 17_000);
-        costs.note_broad(100, 17_000);
-        assert_eq!(costs.mandatory_ns(100), Some(16_000 + 500));
-        costs.note_broad(100, 17_000);
-        assert_eq!(costs.mandatory_ns(100), Some(17_500));
-        costs.note_broad(100, 1_000);
-        assert_eq!(costs.mandatory_ns(100), Some(16_000 + 500));
-        for _ in 0..200 {
-            costs.note_broad(100, 1_000);
+        costs.note_broad(100, 1_000_000);
+        assert_eq!(
+            costs.mandatory_ns(100),
+            Some(9_000 + 800),
+            "one stall counts as 2×"
+        );
+        for _ in 0..100 {
+            costs.note_broad(100, 24_000);
+            costs.note_publish(800);
         }
-        assert!(costs.mandatory_ns(100).unwrap() < 1_600);
+        let settled = costs.mandatory_ns(100).unwrap();
+        assert!((24_700..=24_800).contains(&settled), "{settled}");
     }
 
     #[test]
