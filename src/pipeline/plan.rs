@@ -4,7 +4,7 @@
 
 use super::costs::FrameCosts;
 use super::{MIN_PARALLEL_MESH_PAIRS, Query};
-use crate::budget::{Budget, Stop, WorkClock};
+use crate::budget::{Budget, Stop, WORK_PER_CLOCK_READ, WorkClock};
 pub use crate::budget::{Deadline, Unlimited, VisitBudget};
 use crate::narrow::dispatch::{self, Route};
 use crate::narrow::{MeshShape, Shape};
@@ -141,7 +141,7 @@ impl FramePlan {
             _ if separated => PairPlan::Separated,
             Route::Direct
                 if !dispatch::exact_costs_no_more_than_boxes(sa, sb)
-                    && !self.pair_clock.allows(1) =>
+                    && !self.pair_clock.allows(pair_work(sa, sb)) =>
             {
                 PairPlan::Conservative
             }
@@ -150,6 +150,17 @@ impl FramePlan {
             Route::MeshMesh(..) if self.pool => PairPlan::Pooled,
             Route::MeshMesh(ma, mb) => PairPlan::MeshMesh(ma, mb),
         }
+    }
+}
+
+/// Units of [`WorkClock`] work a direct pair counts for: 1 for the closed forms of capsules
+/// and cuboids (about 100 ns), a whole clock read's worth for GJK/EPA and convex–mesh walks
+/// (microseconds to tens of them), so the clock is read before each of those.
+fn pair_work(a: &Shape, b: &Shape) -> u64 {
+    use Shape::{Capsule as C, Cuboid as B, Sphere as S};
+    match (a, b) {
+        (S(_) | C(_) | B(_), S(_) | C(_) | B(_)) => 1,
+        _ => WORK_PER_CLOCK_READ,
     }
 }
 
