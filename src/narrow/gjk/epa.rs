@@ -31,7 +31,7 @@ use crate::geometry::SupportMap;
 use crate::math::{DVec3, Isometry, orthonormal_basis};
 
 /// Units of [`WorkClock`] work one expansion counts for (a support query and a scan of up
-/// to [`MAX_FACES`] faces).
+/// to 512 faces).
 pub const EXPANSION_WORK: u64 = 16;
 
 /// Most polytope vertices.
