@@ -269,11 +269,20 @@ impl Scene {
     /// # Errors
     /// [`SceneError::TooManyShapes`] at the limit.
     pub fn register_shape(&mut self, shape: Shape) -> Result<ShapeId, SceneError> {
+        self.register_prepared(PreparedShape::new(shape))
+    }
+
+    /// Registers a shape whose local box was measured beforehand: O(1), so a scene shared
+    /// between threads can take it under a short lock.
+    ///
+    /// # Errors
+    /// [`SceneError::TooManyShapes`] at the limit.
+    pub fn register_prepared(&mut self, prepared: PreparedShape) -> Result<ShapeId, SceneError> {
         if self.shapes.len() >= self.limits.max_shapes as usize {
             return Err(SceneError::TooManyShapes(self.limits.max_shapes));
         }
-        self.shape_boxes.push(LocalBox::of(&shape));
-        self.shapes.push(shape);
+        self.shape_boxes.push(prepared.local);
+        self.shapes.push(prepared.shape);
         Ok(ShapeId(self.shapes.len() as u32 - 1))
     }
 
@@ -613,6 +622,24 @@ fn proxy_of(id: BodyId, body: &Body) -> Proxy {
         bounds: body.world_bounds.grown(body.margin),
         is_static: body.motion == Motion::Static,
         filter: body.filter,
+    }
+}
+
+/// A shape with its local box measured ([`Scene::register_prepared`]): the O(n) part of
+/// registering a convex or mesh shape (its farthest vertex), done before the scene is
+/// touched.
+#[derive(Debug, Clone)]
+pub struct PreparedShape {
+    shape: Shape,
+    local: LocalBox,
+}
+
+impl PreparedShape {
+    /// Measures `shape`'s local box.
+    #[must_use]
+    pub fn new(shape: Shape) -> Self {
+        let local = LocalBox::of(&shape);
+        Self { shape, local }
     }
 }
 

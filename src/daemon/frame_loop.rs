@@ -1,4 +1,5 @@
-//! The frame path of one scene: receive a pose frame, ingest it (poses and query), run the
+//! The frame path of one scene: take a pose frame (stamped with its receipt; it then waits
+//! for its turn, see [`schedule`](super::schedule)), ingest it (poses and query), run the
 //! pipeline for that query, write the result frame — pair records, then contact records,
 //! then time-of-impact records — straight into a loaned shared-memory sample, publish,
 //! notify. An answered frame ends the scene's frame ([`Scene::end_frame`]): its poses are
@@ -24,32 +25,42 @@
 use super::convert::Rejection;
 use super::ingest::{FrameRejection, apply_pose_frame};
 use super::log::{Cause, Level, Logger, Subject};
+use super::schedule::FrameKey;
 use crate::math::Pose;
 use crate::pipeline::{
     self, Completeness, ContactPoint, Deadline, FrameResults, PairResult, PairToi,
-    PipelineWorkspace, StepReport, WorkerPool,
+    PipelineWorkspace, Query, StepReport, WorkerPool,
 };
 use crate::scene::{BodyId, Scene};
+use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
+use iceoryx2::sample::Sample;
 use proxima_ipc::wire::{
     self, ErrorCode, PoseFrameHeader, PoseRecord, RecordKind, ResultFrameHeader, ResultRecord,
     record_flags,
 };
 use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Initial number of result records a result sample can hold (grows by powers of two).
 const INITIAL_RESULT_RECORDS: usize = 1024;
 
-/// A scene's ports and per-frame scratch space.
+/// A received pose frame, still in shared memory.
+type PoseSample<S> = Sample<S, [PoseRecord], PoseFrameHeader>;
+
+/// A scene's ports, the frame waiting for its turn and per-frame scratch space.
 pub struct SceneFrames<S: Service> {
     poses: Subscriber<S, [PoseRecord], PoseFrameHeader>,
     results: Publisher<S, [ResultRecord], ResultFrameHeader>,
     notifier: Notifier<S>,
+    /// Wakes the frame path when a client has published a pose frame.
+    poses_ready: Listener<S>,
+    /// The oldest pose frame taken from `poses` and not answered yet, with its receipt.
+    waiting: Option<(PoseSample<S>, FrameKey)>,
     workspace: PipelineWorkspace,
     output: FrameResults,
     validated: Vec<(BodyId, Pose)>,
@@ -89,97 +100,142 @@ impl<S: Service> SceneFrames<S> {
             .notifier_builder()
             .create()
             .map_err(|e| format!("events notifier: {e:?}"))?;
+        let poses_ready = proxima_ipc::poses_ready_service_builder(node, root, scene)
+            .map_err(|e| format!("{e:?}"))?
+            .open_or_create()
+            .map_err(|e| format!("poses-ready service: {e:?}"))?
+            .listener_builder()
+            .create()
+            .map_err(|e| format!("poses-ready listener: {e:?}"))?;
         Ok(Self {
             poses,
             results,
             notifier,
+            poses_ready,
+            waiting: None,
             workspace: PipelineWorkspace::with_workers(Arc::clone(workers)),
             output: FrameResults::default(),
             validated: Vec::new(),
         })
     }
 
-    /// Answers every waiting pose frame of scene `scene_id`; returns how many.
+    /// The listener clients notify after publishing a pose frame.
+    pub fn poses_ready(&self) -> &Listener<S> {
+        &self.poses_ready
+    }
+
+    /// Takes the next pose frame from the subscriber, stamped with its receipt, unless one
+    /// is already waiting.
+    ///
+    /// # Errors
+    /// The iceoryx2 failure, as text.
+    pub fn take_next(&mut self) -> Result<(), String> {
+        if self.waiting.is_none()
+            && let Some(sample) = self
+                .poses
+                .receive()
+                .map_err(|e| format!("poses receive: {e:?}"))?
+        {
+            let key = FrameKey {
+                received: Instant::now(),
+                budget_ns: sample.user_header().budget_ns,
+            };
+            self.waiting = Some((sample, key));
+        }
+        Ok(())
+    }
+
+    /// The receipt and budget of the frame waiting for its turn.
+    pub fn waiting(&self) -> Option<FrameKey> {
+        self.waiting.as_ref().map(|&(_, key)| key)
+    }
+
+    /// Answers the waiting frame (see [`take_next`](Self::take_next)) over `scene` (id
+    /// `scene_id`); returns whether there was one.
     ///
     /// # Errors
     /// The iceoryx2 failure, as text (client mistakes are answered in the result header).
-    pub fn serve(
+    pub fn answer_waiting(
         &mut self,
         scene_id: u32,
         scene: &mut Scene,
         log: &mut Logger,
-    ) -> Result<usize, String> {
-        let mut served = 0;
-        while let Some(sample) = self
-            .poses
-            .receive()
-            .map_err(|e| format!("poses receive: {e:?}"))?
-        {
-            let received = Instant::now();
-            let header = *sample.user_header();
-            let outcome = apply_pose_frame(
-                scene_id,
-                scene,
-                &header,
-                sample.payload(),
-                &mut self.validated,
-            );
-            drop(sample);
-            let ingest_ns = elapsed_ns(received);
-            let mut result = ResultFrameHeader {
-                protocol_version: PROTOCOL_VERSION,
-                frame_seq: header.frame_seq,
-                error_body: u32::MAX,
-                ..ResultFrameHeader::default()
-            };
-            result.stage_ns[wire::stage::INGEST] = ingest_ns;
-            self.output.pairs.clear();
-            self.output.contacts.clear();
-            self.output.tois.clear();
-            match outcome {
-                Err(FrameRejection {
-                    rejection: Rejection { code, reason },
-                    body,
-                }) => {
-                    let seq = header.frame_seq;
-                    log.once(
-                        Level::Warn,
-                        Subject::Scene(scene_id),
-                        Cause {
-                            what: "refused pose frame",
-                            code: code as u32,
-                        },
-                        || format!("frame {seq} refused: {reason}"),
-                    );
-                    result.status = code as u32;
-                    result.error_body = body.unwrap_or(u32::MAX);
-                }
-                Ok(query) => {
-                    let report = if header.budget_ns == 0 {
-                        pipeline::step(scene, query, &mut self.workspace, &mut self.output)
-                    } else {
-                        let deadline = received + Duration::from_nanos(header.budget_ns);
-                        pipeline::step_within(
-                            scene,
-                            query,
-                            &mut Deadline(deadline),
-                            &mut self.workspace,
-                            &mut self.output,
-                        )
-                    };
-                    scene.end_frame();
-                    fill_header(&mut result, &report);
-                    if let Some(needed) = report.budget_too_small {
-                        result.flags |= wire::frame_flags::BUDGET_TOO_SMALL;
-                        result.min_budget_ns = ingest_ns.saturating_add(needed);
-                    }
+    ) -> Result<bool, String> {
+        let Some((sample, key)) = self.waiting.take() else {
+            return Ok(false);
+        };
+        let ingest_started = Instant::now();
+        let header = *sample.user_header();
+        let outcome = apply_pose_frame(
+            scene_id,
+            scene,
+            &header,
+            sample.payload(),
+            &mut self.validated,
+        );
+        drop(sample);
+        let mut result = ResultFrameHeader {
+            protocol_version: PROTOCOL_VERSION,
+            frame_seq: header.frame_seq,
+            error_body: u32::MAX,
+            ..ResultFrameHeader::default()
+        };
+        let ingest_ns = elapsed_ns(ingest_started);
+        result.stage_ns[wire::stage::INGEST] = ingest_ns;
+        self.output.pairs.clear();
+        self.output.contacts.clear();
+        self.output.tois.clear();
+        match outcome {
+            Err(FrameRejection {
+                rejection: Rejection { code, reason },
+                body,
+            }) => {
+                let seq = header.frame_seq;
+                log.once(
+                    Level::Warn,
+                    Subject::Scene(scene_id),
+                    Cause {
+                        what: "refused pose frame",
+                        code: code as u32,
+                    },
+                    || format!("frame {seq} refused: {reason}"),
+                );
+                result.status = code as u32;
+                result.error_body = body.unwrap_or(u32::MAX);
+            }
+            Ok(query) => {
+                let report = self.step(scene, query, key);
+                scene.end_frame();
+                fill_header(&mut result, &report);
+                if let Some(needed) = report.budget_too_small {
+                    result.flags |= wire::frame_flags::BUDGET_TOO_SMALL;
+                    result.min_budget_ns = ingest_ns.saturating_add(needed);
                 }
             }
-            let publish_ns = self.publish(result, received, header.budget_ns)?;
-            self.workspace.note_publish(publish_ns);
-            served += 1;
         }
-        Ok(served)
+        let publish_ns = self.publish(result, key.received, header.budget_ns)?;
+        self.workspace.note_publish(publish_ns);
+        Ok(true)
+    }
+
+    /// Drops the waiting frame unanswered (its scene is gone).
+    pub fn discard_waiting(&mut self) {
+        self.waiting = None;
+    }
+
+    /// Runs the pipeline for `query`: exact without a deadline (no budget, or one beyond
+    /// what an [`Instant`] holds), else within the frame's deadline.
+    fn step(&mut self, scene: &Scene, query: Query, key: FrameKey) -> StepReport {
+        match key.deadline() {
+            None => pipeline::step(scene, query, &mut self.workspace, &mut self.output),
+            Some(deadline) => pipeline::step_within(
+                scene,
+                query,
+                &mut Deadline(deadline),
+                &mut self.workspace,
+                &mut self.output,
+            ),
+        }
     }
 
     /// Writes and publishes the result frame and notifies; returns how long that took,

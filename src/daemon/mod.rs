@@ -22,6 +22,7 @@ mod frame_loop;
 mod ingest;
 pub mod liveness;
 pub mod log;
+mod schedule;
 mod service_loop;
 
 pub use config::DaemonConfig;

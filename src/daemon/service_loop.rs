@@ -28,6 +28,7 @@ use super::error::{DaemonRunError, DaemonStartError};
 use super::frame_loop::SceneFrames;
 use super::liveness::{Liveness, OwnerId};
 use super::log::{Cause, Level, Logger, Subject};
+use super::schedule::most_urgent;
 use crate::pipeline::WorkerPool;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::server::Server;
@@ -41,12 +42,6 @@ use std::time::{Duration, Instant};
 /// How late a due sweep may be postponed while frames keep the loop busy.
 const MAX_SWEEP_DELAY: Duration = Duration::from_secs(1);
 
-/// A scene's ports: its frame path and the listener that wakes the loop for its frames.
-struct ScenePorts<S: Service> {
-    frames: SceneFrames<S>,
-    poses_ready: Listener<S>,
-}
-
 /// Whether the loop goes on after a blocking wait.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Wake {
@@ -59,8 +54,8 @@ pub struct Daemon<S: Service> {
     // Fields drop in order: ports before their services, all before the node.
     control: Server<S, [u8], ControlRequest, ControlReply, ()>,
     control_events: Listener<S>,
-    /// Scene id → its ports (`None` for dropped scenes).
-    scenes: Vec<Option<ScenePorts<S>>>,
+    /// Scene id → its frame path (`None` for dropped scenes).
+    scenes: Vec<Option<SceneFrames<S>>>,
     waitset: WaitSet<S>,
     control_service: RequestResponseFactory<S, [u8], ControlRequest, ControlReply, ()>,
     node: Node<S>,
@@ -231,23 +226,35 @@ where
         Ok(served)
     }
 
-    /// Answers every scene's waiting pose frames; returns how many.
+    /// Answers every scene's waiting pose frames, the most urgent first
+    /// ([`schedule`](super::schedule)); returns how many.
     ///
     /// # Errors
     /// [`DaemonRunError`] when iceoryx2 fails to move a frame.
     pub fn serve_frames(&mut self) -> Result<usize, DaemonRunError> {
         let mut served = 0;
-        for (id, ports) in self.scenes.iter_mut().enumerate() {
-            let (Some(ports), Some(scene)) = (ports.as_mut(), self.state.scene_mut(id as u32))
-            else {
-                continue;
+        loop {
+            for frames in self.scenes.iter_mut().flatten() {
+                frames.take_next().map_err(DaemonRunError::Ipc)?;
+            }
+            let waiting = self.scenes.iter().enumerate();
+            let next =
+                most_urgent(waiting.filter_map(|(id, f)| Some((id, f.as_ref()?.waiting()?))));
+            let Some(id) = next else {
+                return Ok(served);
             };
-            served += ports
-                .frames
-                .serve(id as u32, scene, &mut self.log)
-                .map_err(DaemonRunError::Ipc)?;
+            let frames = self.scenes[id]
+                .as_mut()
+                .expect("a waiting frame's scene has ports");
+            if let Some(scene) = self.state.scene_mut(id as u32) {
+                frames
+                    .answer_waiting(id as u32, scene, &mut self.log)
+                    .map_err(DaemonRunError::Ipc)?;
+                served += 1;
+            } else {
+                frames.discard_waiting();
+            }
         }
-        Ok(served)
     }
 
     /// Whether SIGINT or SIGTERM arrived (checked without sleeping).
@@ -264,7 +271,7 @@ where
         let attach_error = |e| DaemonRunError::Ipc(format!("wait set attach: {e:?}"));
         let listeners = || {
             std::iter::once(&self.control_events)
-                .chain(self.scenes.iter().flatten().map(|p| &p.poses_ready))
+                .chain(self.scenes.iter().flatten().map(SceneFrames::poses_ready))
         };
         // One small allocation per blocking wait, never on the polled path.
         let guards = listeners()
@@ -396,19 +403,8 @@ where
     }
 
     /// Opens scene `id`'s frame ports and poses-ready listener.
-    fn open_scene(&self, id: u32) -> Result<ScenePorts<S>, String> {
-        let frames = SceneFrames::open(&self.node, &self.root, id, &self.workers)?;
-        let poses_ready = proxima_ipc::poses_ready_service_builder(&self.node, &self.root, id)
-            .map_err(|e| format!("{e:?}"))?
-            .open_or_create()
-            .map_err(|e| format!("poses-ready service: {e:?}"))?
-            .listener_builder()
-            .create()
-            .map_err(|e| format!("poses-ready listener: {e:?}"))?;
-        Ok(ScenePorts {
-            frames,
-            poses_ready,
-        })
+    fn open_scene(&self, id: u32) -> Result<SceneFrames<S>, String> {
+        SceneFrames::open(&self.node, &self.root, id, &self.workers)
     }
 
     /// The scenes' state (for tests and tools in the same process).
