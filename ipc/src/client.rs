@@ -32,6 +32,17 @@
 //! # }
 //! ```
 //!
+//! # Shapes that take time to build
+//! The daemon builds convex and mesh shapes apart from the frames: their registration is
+//! answered at once, and the shape becomes usable once built (seconds for a few hundred
+//! thousand triangles). [`Client::register_convex`] and [`Client::register_mesh`] wait for
+//! that, up to the build timeout ([`ClientBuilder::build_timeout`]), so the id they return
+//! takes bodies at once. [`Client::register_mesh_no_wait`] and
+//! [`Client::register_convex_no_wait`] return as soon as the daemon has accepted the
+//! geometry; [`Client::shape_state`] and [`Client::wait_shape`] follow the build, and
+//! [`Client::add_body`] on a shape not built yet is refused with
+//! [`ErrorCode::ShapeNotReady`].
+//!
 //! Request–response ports cannot join a WaitSet, so a reply is awaited by polling with a
 //! short back-off: a spin of [`CONTROL_REPLY_SPIN`], then sleeps of [`CONTROL_REPLY_SLEEP`].
 //! After each request the client notifies the control event service, which wakes a daemon
@@ -61,14 +72,37 @@ use iceoryx2::service::port_factory::request_response::PortFactory;
 
 use crate::error::{ClientConnectError, ControlError, SceneOpenError};
 use crate::scene_link::SceneLink;
-use crate::transport::{CONTROL_REPLY_SLEEP, CONTROL_REPLY_SPIN};
+use crate::transport::{CONTROL_REPLY_SLEEP, CONTROL_REPLY_SPIN, SHAPE_POLL_FIRST, SHAPE_POLL_MAX};
 use crate::wire::{
     BroadPhaseCode, Command, ControlReply, ControlRequest, ErrorCode, MotionCode, ShapeKindCode,
+    reply_flags,
 };
 use crate::{CONTROL_INITIAL_MAX_SLICE_LEN, DEFAULT_ROOT, EVENT_CONTROL_SENT, PROTOCOL_VERSION};
 
 /// The default reply timeout of [`ClientBuilder`].
 pub const DEFAULT_REPLY_TIMEOUT: Duration = Duration::from_secs(2);
+/// The default build timeout of [`ClientBuilder`]: long enough for the largest mesh the
+/// daemon's default limits admit.
+pub const DEFAULT_BUILD_TIMEOUT: Duration = Duration::from_secs(600);
+
+/// A convex or mesh shape the daemon has accepted, built or not
+/// ([`Client::register_mesh_no_wait`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Registration {
+    /// The shape's id.
+    pub shape: u32,
+    /// Whether bodies may use it already; if not, see [`Client::wait_shape`].
+    pub ready: bool,
+}
+
+/// Whether a registered shape may take bodies yet ([`Client::shape_state`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ShapeState {
+    /// The daemon is still building it.
+    Building,
+    /// Built: bodies may use it.
+    Ready,
+}
 
 /// A primitive shape, dimensions in metres in the shape's local frame; round shapes' axes
 /// run along local Z.
@@ -188,6 +222,7 @@ pub struct ClientBuilder {
     root: String,
     prefix: Option<String>,
     reply_timeout: Duration,
+    build_timeout: Duration,
 }
 
 impl Default for ClientBuilder {
@@ -198,13 +233,14 @@ impl Default for ClientBuilder {
 
 impl ClientBuilder {
     /// Root [`DEFAULT_ROOT`], iceoryx2's global config, reply timeout
-    /// [`DEFAULT_REPLY_TIMEOUT`].
+    /// [`DEFAULT_REPLY_TIMEOUT`], build timeout [`DEFAULT_BUILD_TIMEOUT`].
     #[must_use]
     pub fn new() -> Self {
         Self {
             root: DEFAULT_ROOT.to_owned(),
             prefix: None,
             reply_timeout: DEFAULT_REPLY_TIMEOUT,
+            build_timeout: DEFAULT_BUILD_TIMEOUT,
         }
     }
 
@@ -227,6 +263,14 @@ impl ClientBuilder {
     #[must_use]
     pub fn reply_timeout(mut self, timeout: Duration) -> Self {
         self.reply_timeout = timeout;
+        self
+    }
+
+    /// How long [`Client::register_mesh`], [`Client::register_convex`] and
+    /// [`Client::wait_shape`] wait for a shape to be built.
+    #[must_use]
+    pub fn build_timeout(mut self, timeout: Duration) -> Self {
+        self.build_timeout = timeout;
         self
     }
 
@@ -274,6 +318,7 @@ impl ClientBuilder {
         let mut client = Client {
             root: self.root,
             reply_timeout: self.reply_timeout,
+            build_timeout: self.build_timeout,
             daemon: None,
             port,
             notifier,
@@ -348,6 +393,7 @@ fn check_hello(reply: &ControlReply) -> Result<(), ClientConnectError> {
 pub struct Client<S: Service> {
     root: String,
     reply_timeout: Duration,
+    build_timeout: Duration,
     /// The server port of the daemon that answered `Hello` (`None` only during connect).
     daemon: Option<UniqueServerId>,
     // Fields drop in order: the ports before their services, all before the node.
@@ -379,6 +425,12 @@ impl<S: Service> Client<S> {
     #[must_use]
     pub fn reply_timeout(&self) -> Duration {
         self.reply_timeout
+    }
+
+    /// How long a registration waits for its shape to be built.
+    #[must_use]
+    pub fn build_timeout(&self) -> Duration {
+        self.build_timeout
     }
 
     /// The iceoryx2 node that owns this client's ports (for opening scene services).
@@ -427,27 +479,103 @@ impl<S: Service> Client<S> {
     }
 
     /// Registers the convex hull of `points` (metres, the shape's local frame) for scene
-    /// `scene`; returns the shape id.
+    /// `scene` and waits until the daemon has built it; returns the shape id.
     ///
     /// # Errors
-    /// See [`ControlError`]; [`ControlError::TooLarge`] beyond `u32::MAX` points.
+    /// See [`ControlError`]; [`ControlError::TooLarge`] beyond `u32::MAX` points;
+    /// [`ControlError::BuildTimeout`] when it is not built within the build timeout.
     pub fn register_convex(&self, scene: u32, points: &[[f64; 3]]) -> Result<u32, ControlError> {
+        let registration = self.register_convex_no_wait(scene, points)?;
+        self.wait_registered(scene, registration)
+    }
+
+    /// Registers the convex hull of `points` like [`register_convex`](Self::register_convex),
+    /// returning once the daemon has accepted the points, before the hull is built.
+    ///
+    /// # Errors
+    /// As [`register_convex`](Self::register_convex), except that a geometry refused while
+    /// building is told by [`shape_state`](Self::shape_state) instead.
+    pub fn register_convex_no_wait(
+        &self,
+        scene: u32,
+        points: &[[f64; 3]],
+    ) -> Result<Registration, ControlError> {
         self.register_geometry(scene, ShapeKindCode::Convex, points, &[])
     }
 
     /// Registers a triangle mesh (vertices in metres, the shape's local frame; triangles as
-    /// vertex indices) for scene `scene`; returns the shape id.
+    /// vertex indices) for scene `scene` and waits until the daemon has built it; returns
+    /// the shape id.
     ///
     /// # Errors
     /// See [`ControlError`]; [`ControlError::TooLarge`] beyond `u32::MAX` vertices or
-    /// indices.
+    /// indices; [`ControlError::BuildTimeout`] when it is not built within the build
+    /// timeout.
     pub fn register_mesh(
         &self,
         scene: u32,
         vertices: &[[f64; 3]],
         triangles: &[[u32; 3]],
     ) -> Result<u32, ControlError> {
+        let registration = self.register_mesh_no_wait(scene, vertices, triangles)?;
+        self.wait_registered(scene, registration)
+    }
+
+    /// Registers a triangle mesh like [`register_mesh`](Self::register_mesh), returning once
+    /// the daemon has accepted the geometry, before its BVHs are built.
+    ///
+    /// # Errors
+    /// As [`register_mesh`](Self::register_mesh), except that a geometry refused while
+    /// building (an index out of range, no triangles) is told by
+    /// [`shape_state`](Self::shape_state) instead.
+    pub fn register_mesh_no_wait(
+        &self,
+        scene: u32,
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+    ) -> Result<Registration, ControlError> {
         self.register_geometry(scene, ShapeKindCode::Mesh, vertices, triangles)
+    }
+
+    /// Whether shape `shape` of scene `scene` is built.
+    ///
+    /// # Errors
+    /// See [`ControlError`]: a build that failed is [`ControlError::Rejected`] with its
+    /// code and reason.
+    pub fn shape_state(&self, scene: u32, shape: u32) -> Result<ShapeState, ControlError> {
+        let reply = self.request(
+            &ControlRequest {
+                target: shape,
+                ..self.header(Command::ShapeState, scene)
+            },
+            &[],
+        )?;
+        let (_, flags) = accepted(&reply)?;
+        Ok(if flags & reply_flags::SHAPE_BUILDING == 0 {
+            ShapeState::Ready
+        } else {
+            ShapeState::Building
+        })
+    }
+
+    /// Waits until shape `shape` of scene `scene` is built, up to the build timeout, asking
+    /// after pauses from [`SHAPE_POLL_FIRST`] doubling to [`SHAPE_POLL_MAX`].
+    ///
+    /// # Errors
+    /// As [`shape_state`](Self::shape_state); [`ControlError::BuildTimeout`] when it is
+    /// still being built at the timeout.
+    pub fn wait_shape(&self, scene: u32, shape: u32) -> Result<(), ControlError> {
+        let deadline = Instant::now() + self.build_timeout;
+        let mut pause = SHAPE_POLL_FIRST;
+        while self.shape_state(scene, shape)? == ShapeState::Building {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return Err(ControlError::BuildTimeout { shape });
+            }
+            std::thread::sleep(pause.min(left));
+            pause = (pause * 2).min(SHAPE_POLL_MAX);
+        }
+        Ok(())
     }
 
     /// Adds a body to scene `scene`; returns the body id.
@@ -586,7 +714,7 @@ impl<S: Service> Client<S> {
         kind: ShapeKindCode,
         vertices: &[[f64; 3]],
         triangles: &[[u32; 3]],
-    ) -> Result<u32, ControlError> {
+    ) -> Result<Registration, ControlError> {
         let count = |n: usize| u32::try_from(n).map_err(|_| ControlError::TooLarge(n));
         let header = ControlRequest {
             shape_kind: kind as u32,
@@ -598,7 +726,19 @@ impl<S: Service> Client<S> {
         let fill = |out: &mut [u8]| encode_geometry(out, vertices, triangles);
         let (reply, _) =
             self.request_until(&header, len, fill, Instant::now() + self.reply_timeout)?;
-        reply_id(&reply)
+        let (shape, flags) = accepted(&reply)?;
+        Ok(Registration {
+            shape,
+            ready: flags & reply_flags::SHAPE_BUILDING == 0,
+        })
+    }
+
+    /// The id of an accepted registration, once its shape is built.
+    fn wait_registered(&self, scene: u32, registration: Registration) -> Result<u32, ControlError> {
+        if !registration.ready {
+            self.wait_shape(scene, registration.shape)?;
+        }
+        Ok(registration.shape)
     }
 
     /// One request with an empty payload; the reply's id on success.
@@ -654,8 +794,13 @@ impl<S: Service> Client<S> {
 
 /// The id of a success reply, or the reply's error.
 fn reply_id(reply: &ControlReply) -> Result<u32, ControlError> {
+    accepted(reply).map(|(id, _)| id)
+}
+
+/// The id and [`reply_flags`] of a success reply, or the reply's error.
+fn accepted(reply: &ControlReply) -> Result<(u32, u32), ControlError> {
     match ErrorCode::from_u32(reply.status) {
-        Some(ErrorCode::Ok) => Ok(reply.id),
+        Some(ErrorCode::Ok) => Ok((reply.id, reply.flags)),
         Some(code) => Err(ControlError::Rejected {
             code,
             reason: reply.reason(),

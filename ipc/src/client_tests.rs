@@ -648,3 +648,101 @@ fn bad_roots_and_prefixes_are_refused_before_anything_is_sent() {
         ClientConnectError::InvalidPrefix("a/b".into())
     );
 }
+
+/// Answers a geometry registration with shape 5, still building, and `ShapeState` with
+/// "building" twice, then "ready".
+fn builds_after_two_asks(header: &ControlRequest, _: &[u8]) -> Option<ControlReply> {
+    static ASKED: AtomicU32 = AtomicU32::new(0);
+    let building = ControlReply::ok_with(5, reply_flags::SHAPE_BUILDING);
+    Some(match Command::from_u32(header.command) {
+        Some(Command::Hello) => ControlReply::ok(PROTOCOL_VERSION),
+        Some(Command::RegisterShape) => building,
+        Some(Command::ShapeState) if ASKED.fetch_add(1, Ordering::SeqCst) < 2 => building,
+        Some(Command::ShapeState) => ControlReply::ok(5),
+        _ => ControlReply::error(ErrorCode::MalformedMessage, "not in this test"),
+    })
+}
+
+#[test]
+fn a_registration_waits_for_its_shape_to_be_built_unless_told_not_to() {
+    let root = root("build-wait");
+    let responder = Responder::start::<local::Service>(&root, None, builds_after_two_asks);
+    let client = connect(&root);
+    responder.next(); // Hello
+    let triangle = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    assert_eq!(
+        client.register_mesh_no_wait(2, &triangle, &[[0, 1, 2]]),
+        Ok(Registration {
+            shape: 5,
+            ready: false
+        })
+    );
+    assert_eq!(responder.next().0.command, Command::RegisterShape as u32);
+    // Waiting asks until the shape is built: two "building" answers, then "ready".
+    assert_eq!(client.register_mesh(2, &triangle, &[[0, 1, 2]]), Ok(5));
+    assert_eq!(responder.next().0.command, Command::RegisterShape as u32);
+    for _ in 0..3 {
+        let (header, payload) = responder.next();
+        let expected = ControlRequest {
+            target: 5,
+            ..base(Command::ShapeState, 2)
+        };
+        assert_eq!((header, payload.len()), (expected, 0));
+    }
+    assert_eq!(client.shape_state(2, 5), Ok(ShapeState::Ready));
+    // A shape ready in the registration's reply is not asked about.
+    let ready = ControlReply::ok(5);
+    assert_eq!((ready.flags, accepted(&ready)), (0, Ok((5, 0))));
+}
+
+#[test]
+fn a_failed_build_reaches_the_waiting_registration_with_its_code() {
+    let root = root("build-fails");
+    let _responder = Responder::start::<local::Service>(&root, None, |header, _| {
+        Some(match Command::from_u32(header.command) {
+            Some(Command::Hello) => ControlReply::ok(PROTOCOL_VERSION),
+            Some(Command::RegisterShape) => ControlReply::ok_with(3, reply_flags::SHAPE_BUILDING),
+            _ => ControlReply::error(ErrorCode::MeshIndexOutOfRange, "index 7 of 3 vertices"),
+        })
+    });
+    let client = connect(&root);
+    let triangle = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    assert_eq!(
+        client.register_mesh(1, &triangle, &[[0, 1, 7]]),
+        Err(ControlError::Rejected {
+            code: ErrorCode::MeshIndexOutOfRange,
+            reason: "index 7 of 3 vertices".into()
+        })
+    );
+}
+
+#[test]
+fn a_shape_still_building_at_the_build_timeout_is_a_build_timeout() {
+    let root = root("build-timeout");
+    let _responder = Responder::start::<local::Service>(&root, None, |header, _| {
+        Some(if header.command == Command::Hello as u32 {
+            ControlReply::ok(PROTOCOL_VERSION)
+        } else {
+            ControlReply::ok_with(4, reply_flags::SHAPE_BUILDING)
+        })
+    });
+    let client = ClientBuilder::new()
+        .root(&root)
+        .build_timeout(Duration::from_millis(5))
+        .connect::<local::Service>()
+        .unwrap();
+    assert_eq!(client.build_timeout(), Duration::from_millis(5));
+    let points = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    assert_eq!(
+        client.register_convex(1, &points),
+        Err(ControlError::BuildTimeout { shape: 4 })
+    );
+    assert_eq!(client.shape_state(1, 4), Ok(ShapeState::Building));
+    assert!(
+        client
+            .wait_shape(1, 4)
+            .unwrap_err()
+            .to_string()
+            .contains("shape 4")
+    );
+}

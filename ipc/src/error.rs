@@ -81,6 +81,12 @@ pub enum ControlError {
     /// The geometry has more points or indices than a `u32` count can carry; carries the
     /// offending count.
     TooLarge(usize),
+    /// The shape was still being built when the client's build timeout passed (it may
+    /// still become usable: wait again with `Client::wait_shape`).
+    BuildTimeout {
+        /// The shape's id.
+        shape: u32,
+    },
     /// iceoryx2 failed to loan, send or receive; carries its error text.
     Transport(String),
 }
@@ -100,6 +106,12 @@ impl std::fmt::Display for ControlError {
             ),
             Self::TooLarge(count) => {
                 write!(f, "{count} points or indices exceed the u32 wire count")
+            }
+            Self::BuildTimeout { shape } => {
+                write!(
+                    f,
+                    "shape {shape} was still being built at the build timeout"
+                )
             }
             Self::Transport(text) => write!(f, "iceoryx2 failure on the control service: {text}"),
         }

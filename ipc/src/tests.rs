@@ -75,7 +75,7 @@ fn every_error_code_survives_the_wire_and_unknown_values_are_refused() {
             known += 1;
         }
     }
-    assert_eq!(known, 12);
+    assert_eq!(known, 13);
     assert_eq!(ErrorCode::from_u32(u32::MAX), None);
 }
 
@@ -86,7 +86,7 @@ fn every_command_shape_kind_and_motion_survives_the_wire_and_unknown_values_are_
             .filter(|&v| known(v).inspect(|&back| assert_eq!(back, v)).is_some())
             .count()
     };
-    assert_eq!(count(&|v| wire::Command::from_u32(v).map(|c| c as u32)), 8);
+    assert_eq!(count(&|v| wire::Command::from_u32(v).map(|c| c as u32)), 9);
     assert_eq!(
         count(&|v| wire::BroadPhaseCode::from_u32(v).map(|c| c as u32)),
         6

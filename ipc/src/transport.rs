@@ -16,6 +16,12 @@ use crate::error::SceneOpenError;
 pub const CONTROL_REPLY_SPIN: Duration = Duration::from_micros(20);
 /// One sleep of the control reply wait after [`CONTROL_REPLY_SPIN`].
 pub const CONTROL_REPLY_SLEEP: Duration = Duration::from_micros(50);
+/// The first pause between two `ShapeState` asks while the client waits for a shape to be
+/// built; each pause doubles, up to [`SHAPE_POLL_MAX`]. A small shape is ready within a
+/// pause or two; a large one costs a request every [`SHAPE_POLL_MAX`].
+pub const SHAPE_POLL_FIRST: Duration = Duration::from_micros(200);
+/// The longest pause between two `ShapeState` asks.
+pub const SHAPE_POLL_MAX: Duration = Duration::from_millis(20);
 /// How long a receive polls the result subscriber before it blocks on the scene's
 /// results-ready listener: it catches the answers that come sooner than a wake-up.
 pub const RESULTS_SPIN: Duration = Duration::from_micros(50);

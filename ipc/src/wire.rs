@@ -17,7 +17,14 @@
 //!
 //! Control commands ([`Command`]): `Hello`, `CreateScene`, `DropScene`, `RegisterShape`,
 //! `AddBody`, `RemoveBody`, `UpdateBody`, `SetSceneParams` (the scene's broad phase,
-//! [`BroadPhaseCode`]).
+//! [`BroadPhaseCode`]), `ShapeState`.
+//!
+//! Shapes are built apart from the frames: a convex or mesh shape's `RegisterShape` is
+//! answered as soon as its header is checked, with its id and
+//! [`reply_flags::SHAPE_BUILDING`]; the shape becomes usable once built, which `ShapeState`
+//! tells. Until then `AddBody` on it is refused with [`ErrorCode::ShapeNotReady`] (nothing is
+//! queued: a body exists from the reply that gives its id on). Frames of every scene go on
+//! meanwhile.
 
 use iceoryx2::prelude::ZeroCopySend;
 
@@ -166,6 +173,11 @@ pub enum ErrorCode {
     MalformedMessage = 10,
     /// The daemon failed internally (logged); the request may be retried.
     Internal = 11,
+    /// `AddBody` named a shape that is still being built (its registration was answered
+    /// with [`reply_flags::SHAPE_BUILDING`]); nothing changed. Wait until
+    /// [`Command::ShapeState`] says it is built, then send the request again (since
+    /// protocol version 8).
+    ShapeNotReady = 12,
 }
 
 impl ErrorCode {
@@ -185,6 +197,7 @@ impl ErrorCode {
             9 => Self::LimitExceeded,
             10 => Self::MalformedMessage,
             11 => Self::Internal,
+            12 => Self::ShapeNotReady,
             _ => return None,
         })
     }
@@ -205,6 +218,7 @@ impl std::fmt::Display for ErrorCode {
             Self::LimitExceeded => "configured limit exceeded",
             Self::MalformedMessage => "malformed message",
             Self::Internal => "internal error",
+            Self::ShapeNotReady => "shape not built yet",
         };
         f.write_str(text)
     }
@@ -396,10 +410,18 @@ pub enum Command {
     /// Drop scene `scene` with all its bodies.
     DropScene = 2,
     /// Register a shape (kind, dimensions, geometry payload) for use in scene `scene`; the
-    /// reply's `id` is the shape id.
+    /// reply's `id` is the shape id. A primitive is usable at once. A convex or mesh shape is
+    /// decoded and built after the reply, apart from the frames: the reply comes once the
+    /// header is checked (kind, counts against the limits, payload length; such errors
+    /// change nothing), with [`reply_flags::SHAPE_BUILDING`] set; errors found in the
+    /// geometry itself (an index out of range, empty or degenerate geometry) are the
+    /// shape's, told by [`ShapeState`](Self::ShapeState). The builds of all clients queue;
+    /// a full queue refuses the registration with [`ErrorCode::LimitExceeded`].
     RegisterShape = 3,
     /// Add a body of shape `target` to scene `scene` with the request's motion, group,
-    /// mask, margin and pose; the reply's `id` is the body id.
+    /// mask, margin and pose; the reply's `id` is the body id. Refused with
+    /// [`ErrorCode::ShapeNotReady`] while the shape is being built, with
+    /// [`ErrorCode::UnknownShape`] when its build failed.
     AddBody = 4,
     /// Remove body `target` from scene `scene`.
     RemoveBody = 5,
@@ -409,6 +431,12 @@ pub enum Command {
     /// ([`ControlRequest::broad_phase`], a [`BroadPhaseCode`]); from the next frame on.
     /// Results do not depend on it, only their cost. The reply's `id` is the scene id.
     SetSceneParams = 7,
+    /// Ask whether shape `target` of scene `scene` is built; changes nothing. Success with
+    /// `id` = `target`, and [`reply_flags::SHAPE_BUILDING`] set while it is being built,
+    /// clear once bodies may use it. A build that failed is answered with its error code
+    /// and reason (the same each time); an id never handed out with
+    /// [`ErrorCode::UnknownShape`] (since protocol version 8).
+    ShapeState = 8,
 }
 
 /// Shape kinds of [`ControlRequest::shape_kind`], with the meaning of `dimensions` (metres)
@@ -448,6 +476,7 @@ impl Command {
             5 => Self::RemoveBody,
             6 => Self::UpdateBody,
             7 => Self::SetSceneParams,
+            8 => Self::ShapeState,
             _ => return None,
         })
     }
@@ -551,7 +580,8 @@ pub struct ControlRequest {
     pub command: u32,
     /// The scene the command acts on (ignored by `Hello`, `CreateScene`).
     pub scene: u32,
-    /// The shape (`AddBody`) or body (`RemoveBody`, `UpdateBody`) the command acts on.
+    /// The shape (`AddBody`, `ShapeState`) or body (`RemoveBody`, `UpdateBody`) the command
+    /// acts on.
     pub target: u32,
     /// [`ShapeKindCode`] as `u32` (`RegisterShape`).
     pub shape_kind: u32,
@@ -580,6 +610,14 @@ pub struct ControlRequest {
     pub orientation: [f64; 4],
 }
 
+/// Bits of [`ControlReply::flags`]; undefined bits are 0.
+pub mod reply_flags {
+    /// `RegisterShape` and `ShapeState` of a convex or mesh shape: the shape (the reply's
+    /// `id`) is still being built; bodies may not use it yet. Ask again with
+    /// [`Command::ShapeState`](super::Command::ShapeState) (since protocol version 8).
+    pub const SHAPE_BUILDING: u32 = 1 << 0;
+}
+
 /// Bytes of [`ControlReply::reason`].
 pub const REASON_BYTES: usize = 112;
 
@@ -594,8 +632,8 @@ pub struct ControlReply {
     pub status: u32,
     /// The new scene, shape or body id (see [`Command`]); `u32::MAX` on error.
     pub id: u32,
-    /// Always 0.
-    pub reserved: u32,
+    /// [`reply_flags`] bits; 0 on error (since protocol version 8; before, reserved and 0).
+    pub flags: u32,
     /// Why the request failed: UTF-8, padded with zero bytes (empty on success).
     pub reason: [u8; REASON_BYTES],
 }
@@ -608,8 +646,17 @@ impl ControlReply {
             protocol_version: crate::PROTOCOL_VERSION,
             status: ErrorCode::Ok as u32,
             id,
-            reserved: 0,
+            flags: 0,
             reason: [0; REASON_BYTES],
+        }
+    }
+
+    /// A success reply carrying `id` and the [`reply_flags`] bits `flags`.
+    #[must_use]
+    pub fn ok_with(id: u32, flags: u32) -> Self {
+        Self {
+            flags,
+            ..Self::ok(id)
         }
     }
 

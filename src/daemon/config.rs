@@ -21,6 +21,10 @@ pub struct DaemonConfig {
     pub mesh_limits: MeshLimits,
     /// Most points of a registered convex shape.
     pub max_convex_points: u32,
+    /// Most convex and mesh shapes waiting to be built, besides the one being built (of all
+    /// clients together); a registration beyond is refused with `LimitExceeded`. Each holds
+    /// a copy of its geometry payload.
+    pub max_queued_builds: usize,
     /// Close-pair margin of bodies that do not set one, metres.
     pub default_margin: f64,
     /// How long the service loop keeps polling after its last piece of work before it
@@ -53,6 +57,7 @@ impl Default for DaemonConfig {
                 max_triangles: 1 << 22,
             },
             max_convex_points: 1 << 16,
+            max_queued_builds: 4,
             default_margin: 0.0,
             spin: Duration::from_micros(50),
             sweep_interval: Duration::from_millis(100),

@@ -17,6 +17,7 @@
 //! max_mesh_vertices = 4194304
 //! max_mesh_triangles = 4194304
 //! max_convex_points = 65536
+//! max_queued_builds = 4           # convex and mesh shapes waiting for the builder
 //!
 //! [scene]
 //! default_margin_m = 0.0          # close-pair margin of bodies that set none, metres
@@ -87,6 +88,8 @@ pub struct LimitsSection {
     pub max_mesh_triangles: Option<usize>,
     /// Most points of a registered convex shape.
     pub max_convex_points: Option<u32>,
+    /// Most convex and mesh shapes waiting to be built.
+    pub max_queued_builds: Option<usize>,
 }
 
 /// `[scene]`: defaults of every scene.
@@ -213,6 +216,11 @@ impl ConfigFile {
             l.max_convex_points,
             "limits.max_convex_points",
         )?;
+        set_positive(
+            &mut out.max_queued_builds,
+            l.max_queued_builds,
+            "limits.max_queued_builds",
+        )?;
         if let Some(margin) = self.scene.default_margin_m {
             if !(margin.is_finite() && margin >= 0.0) {
                 return Err(ConfigFileError::Invalid {
@@ -282,6 +290,7 @@ mod tests {
             max_mesh_vertices = 30
             max_mesh_triangles = 40
             max_convex_points = 50
+            max_queued_builds = 60
             [scene]
             default_margin_m = 0.25
             [service_loop]
@@ -305,6 +314,7 @@ mod tests {
             (30, 40)
         );
         assert_eq!((c.max_convex_points, c.default_margin), (50, 0.25));
+        assert_eq!(c.max_queued_builds, 60);
         assert_eq!(
             (c.log_level, c.workers),
             (super::super::log::Level::Debug, 13)
@@ -340,6 +350,10 @@ mod tests {
             (
                 "[limits]\nmax_mesh_triangles = 0",
                 "limits.max_mesh_triangles",
+            ),
+            (
+                "[limits]\nmax_queued_builds = 0",
+                "limits.max_queued_builds",
             ),
             ("[scene]\ndefault_margin_m = -0.1", "scene.default_margin_m"),
             ("[scene]\ndefault_margin_m = nan", "scene.default_margin_m"),

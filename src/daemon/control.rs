@@ -1,55 +1,81 @@
 //! The control service's logic: one request in, one reply out, against the daemon's scenes.
 //!
-//! Pure state handling, no IPC: the service loop in [`super`] receives a request, calls
+//! State handling, no IPC: the control thread receives a request, calls
 //! [`ControlState::handle`] and sends the reply. A refused request changes nothing and gets
 //! the error code and reason; it is logged once by the caller.
+//!
+//! Every request is O(1) or a copy: scene edits take the scene's lock
+//! ([`shared_scene`](super::shared_scene)) for one edit; a convex or mesh registration is
+//! checked ([`convert::shape_request`]), gets its shape id, and its payload is copied into a
+//! [`BuildJob`] for the builder thread; the reply says the shape is being built.
 
+use super::builder::{BuildJob, BuildQueue};
 use super::config::DaemonConfig;
-use super::convert::{self, Rejection};
+use super::convert::{self, Rejection, ShapeRequest};
+use super::shape_table::ShapeState;
+use super::shared_scene::{self, SharedScene, lock};
 use crate::broad::{BroadPhaseChoice, BroadPhaseKind};
-use crate::scene::{BodyDesc, BodyId, Scene, ShapeId};
+use crate::scene::{BodyDesc, BodyId, Scene};
 use proxima_ipc::PROTOCOL_VERSION;
-use proxima_ipc::wire::{BroadPhaseCode, Command, ControlReply, ControlRequest, ErrorCode};
+use proxima_ipc::wire::{
+    BroadPhaseCode, Command, ControlReply, ControlRequest, ErrorCode, reply_flags,
+};
+use std::sync::Arc;
 
-/// The scenes a daemon serves, by id (ids are not reused while the daemon runs).
+/// The scenes a daemon serves, by id (ids are not reused while the daemon runs), and the
+/// queue of shapes to build.
 #[derive(Debug)]
 pub struct ControlState {
     config: DaemonConfig,
-    scenes: Vec<Option<Scene>>,
+    scenes: Vec<Option<SharedScene>>,
     live_scenes: u32,
+    builds: BuildQueue,
+}
+
+/// A successful request's reply: the id and the [`reply_flags`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Answer {
+    id: u32,
+    flags: u32,
+}
+
+impl From<u32> for Answer {
+    fn from(id: u32) -> Self {
+        Self { id, flags: 0 }
+    }
 }
 
 impl ControlState {
-    /// No scenes yet.
+    /// No scenes yet; convex and mesh shapes go to `builds`.
     #[must_use]
-    pub fn new(config: DaemonConfig) -> Self {
+    pub fn new(config: DaemonConfig, builds: BuildQueue) -> Self {
         Self {
             config,
             scenes: Vec::new(),
             live_scenes: 0,
+            builds,
         }
     }
 
     /// Scene `id`, if it lives.
     #[must_use]
-    pub fn scene(&self, id: u32) -> Option<&Scene> {
+    pub fn scene(&self, id: u32) -> Option<&SharedScene> {
         self.scenes.get(id as usize).and_then(Option::as_ref)
-    }
-
-    /// Scene `id`, mutable, if it lives.
-    pub fn scene_mut(&mut self, id: u32) -> Option<&mut Scene> {
-        self.scenes.get_mut(id as usize).and_then(Option::as_mut)
     }
 
     /// Answers one request; the state changes only when the reply is a success.
     pub fn handle(&mut self, request: &ControlRequest, payload: &[u8]) -> ControlReply {
         match self.try_handle(request, payload) {
-            Ok(id) => ControlReply::ok(id),
+            Ok(Answer { id, flags }) => ControlReply::ok_with(id, flags),
             Err(r) => ControlReply::error(r.code, &r.reason),
         }
     }
 
-    fn try_handle(&mut self, request: &ControlRequest, payload: &[u8]) -> Result<u32, Rejection> {
+    fn try_handle(
+        &mut self,
+        request: &ControlRequest,
+        payload: &[u8],
+    ) -> Result<Answer, Rejection> {
         if request.protocol_version != PROTOCOL_VERSION {
             return Err(Rejection::new(
                 ErrorCode::ProtocolMismatch,
@@ -72,60 +98,133 @@ impl ControlState {
             ));
         }
         match command {
-            Command::Hello => Ok(PROTOCOL_VERSION),
-            Command::CreateScene => self.create_scene(),
-            Command::DropScene => self.drop_scene(request.scene).map(|()| request.scene),
-            Command::RegisterShape => {
-                let shape = convert::shape(
-                    request,
-                    payload,
-                    &self.config.mesh_limits,
-                    self.config.max_convex_points,
-                )?;
-                let scene = self.live_scene(request.scene)?;
-                Ok(scene.register_shape(shape).map_err(scene_rejection)?.0)
-            }
-            Command::AddBody => {
-                let desc = BodyDesc {
-                    shape: ShapeId(request.target),
-                    pose: convert::pose(request.position, request.orientation)?,
-                    motion: convert::motion(request.motion)?,
-                    filter: convert::filter(request),
-                    margin: convert::margin(request.margin),
+            Command::Hello => Ok(PROTOCOL_VERSION.into()),
+            Command::CreateScene => self.create_scene().map(Answer::from),
+            Command::DropScene => self
+                .drop_scene(request.scene)
+                .map(|()| request.scene.into()),
+            Command::RegisterShape => self.register_shape(request, payload),
+            Command::ShapeState => {
+                let building = match lock(self.live_scene(request.scene)?)
+                    .shapes
+                    .state(request.target)?
+                {
+                    ShapeState::Building => reply_flags::SHAPE_BUILDING,
+                    ShapeState::Ready => 0,
                 };
-                let scene = self.live_scene(request.scene)?;
-                Ok(scene.add_body(&desc).map_err(scene_rejection)?.0)
+                Ok(Answer {
+                    id: request.target,
+                    flags: building,
+                })
+            }
+            Command::AddBody
+            | Command::RemoveBody
+            | Command::UpdateBody
+            | Command::SetSceneParams => self.edit_scene(command, request).map(Answer::from),
+        }
+    }
+
+    /// The commands that edit one scene's bodies or parameters, each under one short lock.
+    fn edit_scene(&self, command: Command, request: &ControlRequest) -> Result<u32, Rejection> {
+        // Everything the request says is checked before the scene is locked.
+        let (motion, filter) = (convert::motion(request.motion), convert::filter(request));
+        let margin = convert::margin(request.margin);
+        let shared = self.live_scene(request.scene)?;
+        match command {
+            Command::AddBody => {
+                let pose = convert::pose(request.position, request.orientation)?;
+                let motion = motion?;
+                let mut cell = lock(shared);
+                let desc = BodyDesc {
+                    shape: cell.shapes.usable(request.target)?,
+                    pose,
+                    motion,
+                    filter,
+                    margin,
+                };
+                Ok(cell.scene.add_body(&desc).map_err(scene_rejection)?.0)
             }
             Command::RemoveBody => {
-                let scene = self.live_scene(request.scene)?;
-                scene
-                    .remove_body(BodyId(request.target))
+                let body = BodyId(request.target);
+                lock(shared)
+                    .scene
+                    .remove_body(body)
                     .map_err(scene_rejection)?;
                 Ok(request.target)
             }
             Command::UpdateBody => {
-                let motion = convert::motion(request.motion)?;
-                let (filter, margin) = (convert::filter(request), convert::margin(request.margin));
-                let scene = self.live_scene(request.scene)?;
-                scene
-                    .update_body(BodyId(request.target), motion, filter, margin)
+                let motion = motion?;
+                let body = BodyId(request.target);
+                let mut cell = lock(shared);
+                cell.scene
+                    .update_body(body, motion, filter, margin)
                     .map_err(scene_rejection)?;
                 Ok(request.target)
             }
-            Command::SetSceneParams => {
+            _ => {
                 let choice = broad_phase(request.broad_phase)?;
-                self.live_scene(request.scene)?.set_broad_phase(choice);
+                lock(shared).scene.set_broad_phase(choice);
                 Ok(request.scene)
             }
         }
     }
 
-    /// Drops scene `id` with all its shapes and bodies.
+    /// A primitive is registered at once; a convex or mesh shape gets its id and goes to
+    /// the builder with a copy of its payload (the reply says it is being built).
+    fn register_shape(
+        &self,
+        request: &ControlRequest,
+        payload: &[u8],
+    ) -> Result<Answer, Rejection> {
+        let config = &self.config;
+        let max_shapes = config.scene_limits.max_shapes;
+        let shape = convert::shape_request(
+            request,
+            payload.len(),
+            &config.mesh_limits,
+            config.max_convex_points,
+        )?;
+        let shared = self.live_scene(request.scene)?;
+        let geometry = match shape {
+            ShapeRequest::Primitive(shape) => {
+                let mut cell = lock(shared);
+                // The table hands out no more ids than the scene takes shapes, so the
+                // scene has room for this one.
+                let id = cell.shapes.reserve(max_shapes)?;
+                let registered = cell.scene.register_shape(shape).map_err(scene_rejection);
+                cell.shapes.finish(id, registered.clone());
+                return registered.map(|_| id.into());
+            }
+            ShapeRequest::Geometry(geometry) => geometry,
+        };
+        // Before an id is handed out for nothing: only this thread queues, so the room
+        // found here is still there below.
+        self.builds.check_room()?;
+        let shape = lock(shared).shapes.reserve(max_shapes)?;
+        let job = BuildJob {
+            scene_id: request.scene,
+            shape,
+            scene: Arc::downgrade(shared),
+            geometry,
+            payload: payload.to_vec(),
+        };
+        if let Err(refused) = self.builds.submit(job) {
+            lock(shared).shapes.finish(shape, Err(refused.clone()));
+            return Err(refused);
+        }
+        Ok(Answer {
+            id: shape,
+            flags: reply_flags::SHAPE_BUILDING,
+        })
+    }
+
+    /// Drops scene `id` with all its shapes and bodies (a frame or build still holding it
+    /// leaves it alone, see [`shared_scene`]).
     ///
     /// # Errors
     /// [`ErrorCode::UnknownScene`] when no such scene lives.
     pub fn drop_scene(&mut self, id: u32) -> Result<(), Rejection> {
-        self.live_scene(id)?;
+        lock(self.live_scene(id)?).dropped = true;
         self.scenes[id as usize] = None;
         self.live_scenes -= 1;
         Ok(())
@@ -143,13 +242,13 @@ impl ControlState {
         }
         let scene = Scene::try_new(self.config.default_margin, self.config.scene_limits)
             .map_err(scene_rejection)?;
-        self.scenes.push(Some(scene));
+        self.scenes.push(Some(shared_scene::share(scene)));
         self.live_scenes += 1;
         Ok(self.scenes.len() as u32 - 1)
     }
 
-    fn live_scene(&mut self, id: u32) -> Result<&mut Scene, Rejection> {
-        self.scene_mut(id)
+    fn live_scene(&self, id: u32) -> Result<&SharedScene, Rejection> {
+        self.scene(id)
             .ok_or_else(|| Rejection::new(ErrorCode::UnknownScene, format!("no scene {id}")))
     }
 }

@@ -1,5 +1,32 @@
+use super::super::builder::{self, BuildJob};
+use super::super::log::{Level, Logger};
 use super::*;
+use crossbeam::channel::Receiver;
 use proxima_ipc::wire::{MotionCode, ShapeKindCode};
+
+/// A control state whose builds wait in a queue of `queued` for [`build_all`].
+fn state_with(config: DaemonConfig, queued: usize) -> (ControlState, Receiver<BuildJob>) {
+    let (builds, jobs) = BuildQueue::bounded(queued);
+    (ControlState::new(config, builds), jobs)
+}
+
+/// Builds every queued shape as the builder thread does; returns how many.
+fn build_all(jobs: &Receiver<BuildJob>) -> usize {
+    let mut log = Logger::in_memory(Level::Debug);
+    let limits = DaemonConfig::default().mesh_limits;
+    jobs.try_iter()
+        .map(|job| builder::build(job, &limits, &mut log))
+        .count()
+}
+
+fn shape_state(state: &mut ControlState, scene: u32, shape: u32) -> ControlReply {
+    let ask = ControlRequest {
+        scene,
+        target: shape,
+        ..request(Command::ShapeState)
+    };
+    state.handle(&ask, &[])
+}
 
 fn request(command: Command) -> ControlRequest {
     ControlRequest {
@@ -48,7 +75,7 @@ const TETRA_INDICES: [u32; 12] = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
 
 #[test]
 fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
-    let mut state = ControlState::new(DaemonConfig::default());
+    let (mut state, jobs) = state_with(DaemonConfig::default(), 4);
     assert_eq!(
         state.handle(&request(Command::Hello), &[]).id,
         PROTOCOL_VERSION
@@ -67,6 +94,8 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
         &mesh_payload(&TETRA, &TETRA_INDICES),
     );
     assert_eq!(code(&mesh), ErrorCode::Ok, "{}", mesh.reason());
+    assert_eq!(sphere.flags, 0, "a primitive is ready at once");
+    assert_eq!(mesh.flags, reply_flags::SHAPE_BUILDING);
     let add = |state: &mut ControlState, shape: u32, x: f64| {
         state.handle(
             &ControlRequest {
@@ -79,11 +108,24 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
         )
     };
     let a = add(&mut state, sphere.id, 0.0);
+    let early = add(&mut state, mesh.id, 2.0);
+    assert_eq!(
+        (code(&a), code(&early)),
+        (ErrorCode::Ok, ErrorCode::ShapeNotReady)
+    );
+    let building = shape_state(&mut state, scene, mesh.id);
+    assert_eq!((code(&building), building.id), (ErrorCode::Ok, mesh.id));
+    assert_eq!(building.flags, reply_flags::SHAPE_BUILDING);
+    assert_eq!(build_all(&jobs), 1);
+    let built = shape_state(&mut state, scene, mesh.id);
+    assert_eq!((code(&built), built.flags), (ErrorCode::Ok, 0));
     let b = add(&mut state, mesh.id, 2.0);
-    assert_eq!((code(&a), code(&b)), (ErrorCode::Ok, ErrorCode::Ok));
-    let s = state.scene(scene).unwrap();
-    assert_eq!(s.body_count(), 2);
-    assert_eq!(s.body(BodyId(b.id)).unwrap().pose.position.x, 2.0);
+    assert_eq!(code(&b), ErrorCode::Ok, "{}", b.reason());
+    {
+        let s = &lock(state.scene(scene).unwrap()).scene;
+        assert_eq!(s.body_count(), 2);
+        assert_eq!(s.body(BodyId(b.id)).unwrap().pose.position.x, 2.0);
+    }
     let update = ControlRequest {
         scene,
         target: a.id,
@@ -93,9 +135,8 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
     };
     assert_eq!(code(&state.handle(&update, &[])), ErrorCode::Ok);
     assert_eq!(
-        state
-            .scene(scene)
-            .unwrap()
+        lock(state.scene(scene).unwrap())
+            .scene
             .body(BodyId(a.id))
             .unwrap()
             .margin,
@@ -123,7 +164,10 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
         };
         let reply = state.handle(&params, &[]);
         assert_eq!((code(&reply), reply.id), (ErrorCode::Ok, scene));
-        assert_eq!(state.scene(scene).unwrap().broad_phase(), choice);
+        assert_eq!(
+            lock(state.scene(scene).unwrap()).scene.broad_phase(),
+            choice
+        );
     }
     let drop = ControlRequest {
         scene,
@@ -136,14 +180,15 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
 
 #[test]
 fn every_bad_request_gets_its_code_and_changes_nothing() {
-    let mut state = ControlState::new(DaemonConfig {
+    let config = DaemonConfig {
         max_scenes: 2,
         mesh_limits: crate::geometry::MeshLimits {
             max_vertices: 8,
             max_triangles: 8,
         },
         ..DaemonConfig::default()
-    });
+    };
+    let (mut state, _jobs) = state_with(config, 4);
     let scene = state.handle(&request(Command::CreateScene), &[]).id;
     let sphere = ControlRequest {
         scene,
@@ -217,23 +262,9 @@ fn every_bad_request_gets_its_code_and_changes_nothing() {
             ErrorCode::MalformedMessage,
         ),
         (
-            mesh_request(scene, 4, 3),
-            mesh_payload(&TETRA, &[0, 1, 9]),
-            ErrorCode::MeshIndexOutOfRange,
-        ),
-        (
             mesh_request(scene, 4, 4),
             mesh_payload(&TETRA, &[0, 1, 2, 3]),
             ErrorCode::MalformedMessage,
-        ),
-        (mesh_request(scene, 0, 0), vec![], ErrorCode::EmptyGeometry),
-        (
-            mesh_request(scene, 3, 3),
-            mesh_payload(
-                &[[0.0, f64::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-                &[0, 1, 2],
-            ),
-            ErrorCode::InvalidShape,
         ),
         (
             mesh_request(scene, 9, 3),
@@ -365,4 +396,116 @@ fn every_bad_request_gets_its_code_and_changes_nothing() {
         &[],
     );
     assert_eq!(code(&again), ErrorCode::Ok);
+}
+
+#[test]
+fn geometry_refused_while_building_is_the_shapes_answer_and_adds_nothing() {
+    let (mut state, jobs) = state_with(DaemonConfig::default(), 8);
+    let scene = state.handle(&request(Command::CreateScene), &[]).id;
+    let infinite = [[0.0, f64::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let no_points = ControlRequest {
+        scene,
+        shape_kind: ShapeKindCode::Convex as u32,
+        ..request(Command::RegisterShape)
+    };
+    let cases = [
+        (
+            mesh_request(scene, 4, 3),
+            mesh_payload(&TETRA, &[0, 1, 9]),
+            ErrorCode::MeshIndexOutOfRange,
+        ),
+        (mesh_request(scene, 0, 0), vec![], ErrorCode::EmptyGeometry),
+        (
+            mesh_request(scene, 3, 3),
+            mesh_payload(&infinite, &[0, 1, 2]),
+            ErrorCode::InvalidShape,
+        ),
+        (no_points, vec![], ErrorCode::EmptyGeometry),
+    ];
+    let mut ids = Vec::new();
+    for (registration, payload, _) in &cases {
+        let accepted = state.handle(registration, payload);
+        assert_eq!(code(&accepted), ErrorCode::Ok, "{}", accepted.reason());
+        assert_eq!(accepted.flags, reply_flags::SHAPE_BUILDING);
+        ids.push(accepted.id);
+    }
+    assert_eq!(ids, [0, 1, 2, 3]);
+    assert_eq!(build_all(&jobs), cases.len());
+    for ((_, _, expected), id) in cases.iter().zip(ids) {
+        // Asked twice, the same answer.
+        for _ in 0..2 {
+            let answer = shape_state(&mut state, scene, id);
+            assert_eq!(code(&answer), *expected, "shape {id}: {}", answer.reason());
+        }
+        let body = state.handle(
+            &ControlRequest {
+                scene,
+                target: id,
+                ..request(Command::AddBody)
+            },
+            &[],
+        );
+        assert_eq!(code(&body), ErrorCode::UnknownShape);
+        assert!(
+            body.reason().contains("failed to build"),
+            "{}",
+            body.reason()
+        );
+    }
+    let cell = lock(state.scene(scene).unwrap());
+    assert_eq!(cell.scene.body_count(), 0);
+    assert!(cell.scene.shape(crate::scene::ShapeId(0)).is_none());
+}
+
+#[test]
+fn a_full_build_queue_refuses_a_registration_and_a_dropped_scenes_builds_change_nothing() {
+    let (mut state, jobs) = state_with(DaemonConfig::default(), 1);
+    let scene = state.handle(&request(Command::CreateScene), &[]).id;
+    let (tetra, payload) = (
+        mesh_request(scene, 4, 12),
+        mesh_payload(&TETRA, &TETRA_INDICES),
+    );
+    let first = state.handle(&tetra, &payload);
+    assert_eq!((code(&first), first.id), (ErrorCode::Ok, 0));
+    let refused = state.handle(&tetra, &payload);
+    assert_eq!(
+        code(&refused),
+        ErrorCode::LimitExceeded,
+        "{}",
+        refused.reason()
+    );
+    // No id was handed out for it.
+    assert_eq!(
+        code(&shape_state(&mut state, scene, 1)),
+        ErrorCode::UnknownShape
+    );
+    // Once the builder has taken a job, there is room again.
+    let taken = jobs.try_recv().unwrap();
+    let second = state.handle(&tetra, &payload);
+    assert_eq!((code(&second), second.id), (ErrorCode::Ok, 1));
+
+    let cell = Arc::clone(state.scene(scene).unwrap());
+    let dropping = ControlRequest {
+        scene,
+        ..request(Command::DropScene)
+    };
+    assert_eq!(code(&state.handle(&dropping, &[])), ErrorCode::Ok);
+    let mut log = Logger::in_memory(Level::Debug);
+    builder::build(taken, &DaemonConfig::default().mesh_limits, &mut log);
+    assert_eq!(build_all(&jobs), 1);
+    let left = lock(&cell);
+    assert!(left.dropped && left.scene.shape(crate::scene::ShapeId(0)).is_none());
+    assert_eq!(left.shapes.state(0), Ok(ShapeState::Building));
+    drop(left);
+
+    // With the builder gone (the daemon stopping), a registration fails inside.
+    drop(jobs);
+    let other = state.handle(&request(Command::CreateScene), &[]).id;
+    let stranded = state.handle(&mesh_request(other, 4, 12), &payload);
+    assert_eq!(
+        code(&stranded),
+        ErrorCode::Internal,
+        "{}",
+        stranded.reason()
+    );
 }

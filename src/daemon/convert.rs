@@ -90,13 +90,37 @@ pub fn margin(value: f64) -> Option<f64> {
     (value >= 0.0 || value.is_nan()).then_some(value)
 }
 
-/// The shape a `RegisterShape` request describes, its geometry decoded from `payload`.
-pub fn shape(
+/// What a `RegisterShape` request asks for, checked without reading its geometry.
+#[derive(Debug, Clone)]
+pub enum ShapeRequest {
+    /// A primitive, built already (O(1)).
+    Primitive(Shape),
+    /// A convex or mesh shape whose payload is to be decoded and built
+    /// ([`geometry_shape`]).
+    Geometry(GeometryRequest),
+}
+
+/// A convex or mesh registration whose counts are within the limits and whose payload
+/// length matches them (see [`shape_request`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GeometryRequest {
+    /// Whether the points are a convex hull's or a mesh's.
+    pub mesh: bool,
+    /// Points in the payload.
+    pub vertex_count: u32,
+    /// Indices after the points (a multiple of 3; none for a convex shape).
+    pub index_count: u32,
+}
+
+/// Checks a `RegisterShape` request in O(1): its kind, a primitive's dimensions, a convex
+/// or mesh shape's counts against the limits and `payload_len` against the counts. The
+/// geometry itself is [`geometry_shape`]'s to check.
+pub fn shape_request(
     request: &ControlRequest,
-    payload: &[u8],
+    payload_len: usize,
     mesh_limits: &MeshLimits,
     max_convex_points: u32,
-) -> Result<Shape, Rejection> {
+) -> Result<ShapeRequest, Rejection> {
     let Some(kind) = ShapeKindCode::from_u32(request.shape_kind) else {
         return Err(Rejection::new(
             ErrorCode::MalformedMessage,
@@ -106,14 +130,16 @@ pub fn shape(
     let [d0, d1, d2, _] = request.dimensions;
     let primitive = |result: Result<Shape, crate::geometry::ShapeError>| {
         let has_geometry =
-            !payload.is_empty() || request.vertex_count != 0 || request.index_count != 0;
+            payload_len != 0 || request.vertex_count != 0 || request.index_count != 0;
         if has_geometry {
             return Err(Rejection::new(
                 ErrorCode::MalformedMessage,
                 "a primitive shape carries no geometry payload",
             ));
         }
-        result.map_err(|e| Rejection::new(ErrorCode::InvalidShape, e.to_string()))
+        result
+            .map(ShapeRequest::Primitive)
+            .map_err(|e| Rejection::new(ErrorCode::InvalidShape, e.to_string()))
     };
     match kind {
         ShapeKindCode::Sphere => primitive(Sphere::try_new(d0).map(Shape::Sphere)),
@@ -123,27 +149,110 @@ pub fn shape(
         }
         ShapeKindCode::Cylinder => primitive(Cylinder::try_new(d1, d0).map(Shape::Cylinder)),
         ShapeKindCode::Cone => primitive(Cone::try_new(d1, d0).map(Shape::Cone)),
-        ShapeKindCode::Convex => convex(request, payload, max_convex_points),
-        ShapeKindCode::Mesh => mesh(request, payload, mesh_limits),
+        ShapeKindCode::Convex => convex_request(request, payload_len, max_convex_points),
+        ShapeKindCode::Mesh => mesh_request(request, payload_len, mesh_limits),
     }
 }
 
-/// A convex shape: the hull of the payload's points (no indices allowed).
-fn convex(request: &ControlRequest, payload: &[u8], max_points: u32) -> Result<Shape, Rejection> {
+/// A convex registration: at most `max_points` points, no indices.
+fn convex_request(
+    request: &ControlRequest,
+    payload_len: usize,
+    max_points: u32,
+) -> Result<ShapeRequest, Rejection> {
     if request.vertex_count > max_points {
         return Err(Rejection::new(
             ErrorCode::LimitExceeded,
             format!("{} points, the limit is {max_points}", request.vertex_count),
         ));
     }
-    let (points, indices) = geometry(request, payload)?;
-    if !indices.is_empty() {
+    check_payload_len(request.vertex_count, request.index_count, payload_len)?;
+    if request.index_count != 0 {
         return Err(Rejection::new(
             ErrorCode::MalformedMessage,
             "a convex shape carries no indices",
         ));
     }
-    ConvexPolyhedron::try_from_points(&points)
+    Ok(ShapeRequest::Geometry(GeometryRequest {
+        mesh: false,
+        vertex_count: request.vertex_count,
+        index_count: 0,
+    }))
+}
+
+/// A mesh registration: index triples, vertex and triangle counts within `limits`.
+fn mesh_request(
+    request: &ControlRequest,
+    payload_len: usize,
+    limits: &MeshLimits,
+) -> Result<ShapeRequest, Rejection> {
+    check_payload_len(request.vertex_count, request.index_count, payload_len)?;
+    if !request.index_count.is_multiple_of(3) {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            "mesh indices are not a multiple of 3",
+        ));
+    }
+    let (vertices, triangles) = (
+        request.vertex_count as usize,
+        request.index_count as usize / 3,
+    );
+    if vertices > limits.max_vertices || triangles > limits.max_triangles {
+        return Err(Rejection::new(
+            ErrorCode::LimitExceeded,
+            format!(
+                "{vertices} vertices and {triangles} triangles, the limits are {} and {}",
+                limits.max_vertices, limits.max_triangles
+            ),
+        ));
+    }
+    Ok(ShapeRequest::Geometry(GeometryRequest {
+        mesh: true,
+        vertex_count: request.vertex_count,
+        index_count: request.index_count,
+    }))
+}
+
+/// Refuses a payload whose length is not `24·vertex_count + 4·index_count` bytes.
+fn check_payload_len(
+    vertex_count: u32,
+    index_count: u32,
+    payload_len: usize,
+) -> Result<(), Rejection> {
+    let (points, indices) = (vertex_count as usize, index_count as usize);
+    let expected = points
+        .checked_mul(24)
+        .and_then(|v| indices.checked_mul(4).and_then(|i| v.checked_add(i)));
+    if expected != Some(payload_len) {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            format!(
+                "{points} points and {indices} indices need {expected:?} bytes, the payload has {payload_len}"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Decodes and builds the shape of a checked registration ([`shape_request`]) from its
+/// `payload`: the hull of a convex shape's points, a mesh (checked against `mesh_limits`)
+/// with its BVHs. O(n log n) and more: the builder thread's work.
+pub fn geometry_shape(
+    geometry: GeometryRequest,
+    payload: &[u8],
+    mesh_limits: &MeshLimits,
+) -> Result<Shape, Rejection> {
+    let (points, indices) = decode(geometry, payload)?;
+    if geometry.mesh {
+        mesh(points, &indices, mesh_limits)
+    } else {
+        convex(&points)
+    }
+}
+
+/// The convex hull of `points`.
+fn convex(points: &[DVec3]) -> Result<Shape, Rejection> {
+    ConvexPolyhedron::try_from_points(points)
         .map(|hull| Shape::Convex(Arc::new(hull)))
         .map_err(|e| {
             let code = match e {
@@ -155,15 +264,8 @@ fn convex(request: &ControlRequest, payload: &[u8], max_points: u32) -> Result<S
         })
 }
 
-/// A triangle mesh from the payload's points and index triples, with its BVHs.
-fn mesh(request: &ControlRequest, payload: &[u8], limits: &MeshLimits) -> Result<Shape, Rejection> {
-    let (vertices, indices) = geometry(request, payload)?;
-    if indices.len() % 3 != 0 {
-        return Err(Rejection::new(
-            ErrorCode::MalformedMessage,
-            "mesh indices are not a multiple of 3",
-        ));
-    }
+/// A triangle mesh of `vertices` and index triples `indices`, with its BVHs.
+fn mesh(vertices: Vec<DVec3>, indices: &[u32], limits: &MeshLimits) -> Result<Shape, Rejection> {
     let triangles = indices
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])
@@ -184,20 +286,9 @@ fn mesh(request: &ControlRequest, payload: &[u8], limits: &MeshLimits) -> Result
 }
 
 /// Decodes the geometry payload: `vertex_count` points, then `index_count` indices.
-fn geometry(request: &ControlRequest, payload: &[u8]) -> Result<(Vec<DVec3>, Vec<u32>), Rejection> {
-    let (points, indices) = (request.vertex_count as usize, request.index_count as usize);
-    let expected = points
-        .checked_mul(24)
-        .and_then(|v| indices.checked_mul(4).and_then(|i| v.checked_add(i)));
-    if expected != Some(payload.len()) {
-        return Err(Rejection::new(
-            ErrorCode::MalformedMessage,
-            format!(
-                "{points} points and {indices} indices need {expected:?} bytes, the payload has {}",
-                payload.len()
-            ),
-        ));
-    }
+fn decode(geometry: GeometryRequest, payload: &[u8]) -> Result<(Vec<DVec3>, Vec<u32>), Rejection> {
+    check_payload_len(geometry.vertex_count, geometry.index_count, payload.len())?;
+    let points = geometry.vertex_count as usize;
     let (vertex_bytes, index_bytes) = payload.split_at(points * 24);
     let coordinate = |b: &[u8]| f64::from_ne_bytes(b.try_into().expect("8 bytes"));
     let vertices = vertex_bytes

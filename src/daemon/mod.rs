@@ -13,6 +13,8 @@
 //! - [`log`]: leveled stderr lines, once per (scene or client, cause);
 //! - `error`: start-up and run failures (client mistakes are wire error codes instead).
 
+mod build_gate;
+mod builder;
 pub mod config;
 pub mod config_file;
 mod control;
@@ -24,10 +26,12 @@ pub mod liveness;
 pub mod log;
 mod schedule;
 mod service_loop;
+mod shape_table;
+mod shared_scene;
 
+pub use build_gate::BuildGate;
 pub use config::DaemonConfig;
-pub use control::ControlState;
 pub use convert::Rejection;
 pub use error::{DaemonRunError, DaemonStartError};
 pub use ingest::{FrameRejection, apply_pose_frame};
-pub use service_loop::Daemon;
+pub use service_loop::{Daemon, StopHandle};

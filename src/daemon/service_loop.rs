@@ -22,6 +22,8 @@
 //! up, and scenes whose creating control client is gone are orphaned and, after
 //! [`DaemonConfig::dead_client_grace`], dropped ([`Liveness`]).
 
+use super::build_gate::BuildGate;
+use super::builder::{self, BuildJob, BuildQueue};
 use super::config::DaemonConfig;
 use super::control::ControlState;
 use super::error::{DaemonRunError, DaemonStartError};
@@ -29,7 +31,10 @@ use super::frame_loop::SceneFrames;
 use super::liveness::{Liveness, OwnerId};
 use super::log::{Cause, Level, Logger, Subject};
 use super::schedule::most_urgent;
+use super::shared_scene::lock;
+use crate::geometry::MeshLimits;
 use crate::pipeline::WorkerPool;
+use crossbeam::channel::Receiver;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
@@ -37,6 +42,7 @@ use iceoryx2::service::port_factory::request_response::PortFactory as RequestRes
 use iceoryx2::waitset::WaitSetRunResult;
 use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// How late a due sweep may be postponed while frames keep the loop busy.
@@ -64,11 +70,35 @@ pub struct Daemon<S: Service> {
     log: Logger,
     /// Answers the mesh–mesh pairs of every scene's frames alongside the service loop.
     workers: Arc<WorkerPool>,
+    /// The builder thread's end of the build queue, until `run` starts it.
+    build_jobs: Option<Receiver<BuildJob>>,
+    build_gate: Option<BuildGate>,
+    mesh_limits: MeshLimits,
+    log_level: Level,
     root: String,
     spin: Duration,
     sweep_interval: Duration,
     /// Scratch list of the connected control clients, refilled at each sweep.
     connected: Vec<OwnerId>,
+    stop: StopHandle,
+}
+
+/// Stops a running daemon from another thread of the same process (SIGINT and SIGTERM stop
+/// the process's daemon the same way); clones stop the same daemon.
+#[derive(Debug, Clone, Default)]
+pub struct StopHandle(Arc<AtomicBool>);
+
+impl StopHandle {
+    /// Asks the daemon to stop; it does within about one sweep interval.
+    pub fn stop(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`stop`](Self::stop) was called.
+    #[must_use]
+    pub fn is_stopped(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
 }
 
 impl<S: Service> Daemon<S>
@@ -110,6 +140,7 @@ where
             .listener_builder()
             .create()
             .map_err(|e| DaemonStartError::Ipc(format!("control event listener: {e:?}")))?;
+        let (builds, build_jobs) = BuildQueue::bounded(config.max_queued_builds);
         let waitset = WaitSetBuilder::new()
             .create::<S>()
             .map_err(|e| DaemonStartError::Ipc(format!("wait set: {e:?}")))?;
@@ -123,11 +154,16 @@ where
             liveness: Liveness::new(config.dead_client_grace),
             log: Logger::new(config.log_level),
             workers: Arc::new(WorkerPool::new(config.workers)),
+            build_jobs: Some(build_jobs),
+            build_gate: None,
+            mesh_limits: config.mesh_limits,
+            log_level: config.log_level,
             root: config.root.clone(),
             spin: config.spin,
             sweep_interval: config.sweep_interval,
             connected: Vec::new(),
-            state: ControlState::new(config),
+            stop: StopHandle::default(),
+            state: ControlState::new(config, builds),
         })
     }
 
@@ -140,6 +176,11 @@ where
         // The first check installs iceoryx2's SIGINT/SIGTERM handler.
         if self.termination_requested() {
             return Ok(());
+        }
+        if let Some(jobs) = self.build_jobs.take() {
+            let gate = self.build_gate.clone();
+            builder::spawn(jobs, self.mesh_limits, gate, self.log_level)
+                .map_err(|e| DaemonRunError::Ipc(format!("starting the builder thread: {e}")))?;
         }
         self.log.info(format_args!(
             "root {:?}, spin {:?}, sweep every {:?}, dead-client grace {:?}",
@@ -243,23 +284,36 @@ where
             let Some(id) = next else {
                 return Ok(served);
             };
-            let frames = self.scenes[id]
-                .as_mut()
-                .expect("a waiting frame's scene has ports");
-            if let Some(scene) = self.state.scene_mut(id as u32) {
-                frames
-                    .answer_waiting(id as u32, scene, &mut self.log)
-                    .map_err(DaemonRunError::Ipc)?;
-                served += 1;
-            } else {
+            let Some(frames) = self.scenes[id].as_mut() else {
+                continue;
+            };
+            let Some(shared) = self.state.scene(id as u32) else {
                 frames.discard_waiting();
+                continue;
+            };
+            let mut cell = lock(shared);
+            if cell.dropped {
+                frames.discard_waiting();
+                continue;
             }
+            frames
+                .answer_waiting(id as u32, &mut cell.scene, &mut self.log)
+                .map_err(DaemonRunError::Ipc)?;
+            served += 1;
         }
     }
 
-    /// Whether SIGINT or SIGTERM arrived (checked without sleeping).
+    /// Whether SIGINT or SIGTERM arrived (checked without sleeping), or the daemon was
+    /// stopped through a [`StopHandle`].
     fn termination_requested(&self) -> bool {
-        self.node.wait(Duration::ZERO).is_err()
+        self.node.wait(Duration::ZERO).is_err() || self.stop.is_stopped()
+    }
+
+    /// A handle that stops [`run`](Self::run) from another thread, as SIGTERM does, within
+    /// about one [`DaemonConfig::sweep_interval`].
+    #[must_use]
+    pub fn stop_handle(&self) -> StopHandle {
+        self.stop.clone()
     }
 
     /// Blocks until a client notifies the control or a poses-ready event, `timeout` passes
@@ -407,9 +461,10 @@ where
         SceneFrames::open(&self.node, &self.root, id, &self.workers)
     }
 
-    /// The scenes' state (for tests and tools in the same process).
-    #[must_use]
-    pub fn state(&self) -> &ControlState {
-        &self.state
+    /// Holds every shape build at `gate` until it is opened (a test hook: a registration
+    /// in progress for as long as a test likes). Takes effect when [`run`](Self::run)
+    /// starts the builder thread.
+    pub fn set_build_gate(&mut self, gate: BuildGate) {
+        self.build_gate = Some(gate);
     }
 }
