@@ -409,7 +409,7 @@ fn run_daemon(root: &str, prefix: &str) -> Result<(), Box<dyn Error>> {
         iceoryx_prefix: Some(prefix.to_owned()),
         ..DaemonConfig::default()
     };
-    Daemon::<ipc::Service>::new(config)?.run()?;
+    Daemon::new(config)?.run()?;
     Ok(())
 }
 

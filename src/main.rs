@@ -5,7 +5,7 @@
 mod demo;
 
 use clap::{Parser, Subcommand};
-use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
+use iceoryx2::prelude::{LogLevel, set_log_level_from_env_or};
 use proxima::daemon::config_file::ConfigFile;
 use proxima::daemon::log::Level;
 use proxima::daemon::{Daemon, DaemonConfig};
@@ -101,6 +101,6 @@ fn main() -> Result<(), Box<dyn Error>> {
     if let Some(Command::Demo(args)) = &cli.command {
         return demo::run(args);
     }
-    Daemon::<ipc::Service>::new(cli.config()?)?.run()?;
+    Daemon::new(cli.config()?)?.run()?;
     Ok(())
 }

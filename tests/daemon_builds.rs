@@ -1,9 +1,10 @@
-//! Shape builds run apart from the frames: `proximad`'s real service loop runs in this
-//! process on a thread of its own, with a test hook that holds every shape build at a gate,
-//! and clients drive it over real iceoryx2 shared memory. While a registration is held in
-//! its build, other scenes' frames and cheap control requests are answered; the shape
-//! becomes usable once built; a body on it before then is refused with `ShapeNotReady`.
-//! Nothing here measures time: each test holds the build for as long as it needs.
+//! Control requests and shape builds run apart from the frames: `proximad`'s real threads
+//! run in this process, with test hooks that hold every shape build, or every control
+//! request, at a gate, and clients drive them over real iceoryx2 shared memory. While a
+//! registration is held in its build, other scenes' frames and cheap control requests are
+//! answered; the shape becomes usable once built; a body on it before then is refused with
+//! `ShapeNotReady`. While a control request is held, frames are answered. Nothing here
+//! measures time: each test holds the work for as long as it needs.
 
 #[path = "support/daemon.rs"]
 mod daemon_harness;
@@ -12,7 +13,7 @@ mod support;
 use daemon_harness::{body, pose_at};
 use iceoryx2::prelude::ipc;
 use proxima::daemon::log::Level;
-use proxima::daemon::{BuildGate, Daemon, DaemonConfig, DaemonRunError, StopHandle};
+use proxima::daemon::{Daemon, DaemonConfig, DaemonRunError, Gate, StopHandle};
 use proxima_ipc::client::{Client, ClientBuilder, Primitive, Registration, ShapeState};
 use proxima_ipc::error::ControlError;
 use proxima_ipc::scene_link::SceneLink;
@@ -24,11 +25,13 @@ use std::time::Duration;
 /// Generous: only a broken daemon takes this long.
 const TIMEOUT: Duration = Duration::from_secs(20);
 
-/// The daemon's service loop on a thread of this process, its builds held at `gate`;
-/// stopped and its shared memory removed on drop (the gate opened first).
+/// The daemon on a thread of this process, its builds held at `gate` (closed at the
+/// start), its control requests at `control` (open at the start); stopped and its shared
+/// memory removed on drop (the gates opened first).
 struct InProcessDaemon {
     isolation: Isolation,
-    gate: BuildGate,
+    gate: Gate,
+    control: Gate,
     stop: StopHandle,
     thread: Option<JoinHandle<Result<(), DaemonRunError>>>,
 }
@@ -40,16 +43,17 @@ impl InProcessDaemon {
             root: isolation.root.clone(),
             iceoryx_prefix: Some(isolation.prefix.clone()),
             sweep_interval: Duration::from_millis(10),
-            log_level: Level::Warn,
+            log_level: Level::Error,
             max_queued_builds,
             ..DaemonConfig::default()
         };
-        let gate = BuildGate::closed();
+        let (gate, control) = (Gate::closed(), Gate::opened());
         let (stop_tx, stop_rx) = std::sync::mpsc::channel();
-        let held = gate.clone();
+        let (builds, requests) = (gate.clone(), control.clone());
         let thread = std::thread::spawn(move || {
-            let mut daemon = Daemon::<ipc::Service>::new(config).expect("the daemon starts");
-            daemon.set_build_gate(held);
+            let mut daemon = Daemon::new(config).expect("the daemon starts");
+            daemon.set_build_gate(builds);
+            daemon.set_control_gate(requests);
             stop_tx.send(daemon.stop_handle()).expect("the test waits");
             daemon.run()
         });
@@ -57,6 +61,7 @@ impl InProcessDaemon {
         Self {
             isolation,
             gate,
+            control,
             stop,
             thread: Some(thread),
         }
@@ -76,6 +81,7 @@ impl InProcessDaemon {
 impl Drop for InProcessDaemon {
     fn drop(&mut self) {
         self.gate.open();
+        self.control.open();
         self.stop.stop();
         if let Some(thread) = self.thread.take() {
             let stopped = thread.join();
@@ -112,6 +118,43 @@ fn close_pairs(link: &SceneLink<ipc::Service>, seq: u64, x: &[f64]) -> Vec<(u32,
     frame.pairs().iter().map(|p| (p.body_a, p.body_b)).collect()
 }
 
+/// A scene of two balls of radius 0.5, its sphere shape and its link; its first frame,
+/// with the balls touching, answered.
+struct TwoBalls {
+    scene: u32,
+    ball: u32,
+    link: SceneLink<ipc::Service>,
+}
+
+impl TwoBalls {
+    fn new(client: &Client<ipc::Service>) -> Self {
+        let scene = client.create_scene().unwrap();
+        let ball = client
+            .register_primitive(scene, Primitive::Sphere { radius: 0.5 })
+            .unwrap();
+        for x in [0.0, 0.9] {
+            client.add_body(scene, &body(ball, x)).unwrap();
+        }
+        let link = client.open_scene(scene).unwrap();
+        assert_eq!(close_pairs(&link, 1, &[0.0, 0.9]), [(0, 1)]);
+        Self { scene, ball, link }
+    }
+}
+
+/// Frames 2 to 39 of a [`TwoBalls`] scene, the balls apart and touching by turns: each is
+/// answered right, and answered while work is still held at `gate`.
+fn frames_are_answered_while_held(link: &SceneLink<ipc::Service>, gate: &Gate) {
+    for seq in 2..40u64 {
+        let apart = 0.9 + if seq % 2 == 0 { 0.5 } else { 0.0 };
+        let pairs = close_pairs(link, seq, &[0.0, apart]);
+        assert_eq!(pairs.len(), usize::from(seq % 2 == 1), "frame {seq}");
+        assert!(
+            gate.is_holding(),
+            "frame {seq} was answered while work was held"
+        );
+    }
+}
+
 fn refusal<T: std::fmt::Debug>(result: Result<T, ControlError>) -> ErrorCode {
     match result {
         Err(ControlError::Rejected { code, reason }) => {
@@ -126,15 +169,7 @@ fn refusal<T: std::fmt::Debug>(result: Result<T, ControlError>) -> ErrorCode {
 fn frames_and_control_requests_are_answered_while_another_scenes_build_is_held() {
     let daemon = InProcessDaemon::start(4);
     let (framed, builder) = (daemon.client(), daemon.client());
-    let scene = framed.create_scene().unwrap();
-    let ball = framed
-        .register_primitive(scene, Primitive::Sphere { radius: 0.5 })
-        .unwrap();
-    for x in [0.0, 0.9] {
-        framed.add_body(scene, &body(ball, x)).unwrap();
-    }
-    let link = framed.open_scene(scene).unwrap();
-    assert_eq!(close_pairs(&link, 1, &[0.0, 0.9]), [(0, 1)]);
+    let TwoBalls { scene, ball, link } = TwoBalls::new(&framed);
 
     let other = builder.create_scene().unwrap();
     let (vertices, triangles) = grid(16);
@@ -148,15 +183,7 @@ fn frames_and_control_requests_are_answered_while_another_scenes_build_is_held()
     );
 
     // The build is held: the other scene's frames are answered all the same.
-    for seq in 2..40u64 {
-        let apart = 0.9 + if seq % 2 == 0 { 0.5 } else { 0.0 };
-        let pairs = close_pairs(&link, seq, &[0.0, apart]);
-        assert_eq!(pairs.len(), usize::from(seq % 2 == 1), "frame {seq}");
-        assert!(
-            daemon.gate.is_holding(),
-            "frame {seq} was answered while the build was held"
-        );
-    }
+    frames_are_answered_while_held(&link, &daemon.gate);
     // So are control requests, of this client and of the one whose shape is building.
     assert_eq!(
         builder.shape_state(other, registration.shape),
@@ -230,4 +257,46 @@ fn the_build_queue_is_bounded_and_a_dropped_scenes_held_build_changes_nothing() 
     let mesh = client.register_mesh(fresh, &vertices, &triangles).unwrap();
     assert_eq!(mesh, 0);
     assert_eq!(client.add_body(fresh, &body(mesh, 0.0)), Ok(0));
+}
+
+#[test]
+fn frames_are_answered_while_a_control_request_is_held() {
+    let daemon = InProcessDaemon::start(4);
+    let framed = daemon.client();
+    let TwoBalls { scene, link, .. } = TwoBalls::new(&framed);
+
+    let (ready_tx, ready) = std::sync::mpsc::channel();
+    let (go, go_rx) = std::sync::mpsc::channel();
+    let (done_tx, done) = std::sync::mpsc::channel();
+    std::thread::scope(|s| {
+        let (isolation, ready_tx, done_tx) = (&daemon.isolation, ready_tx, done_tx);
+        s.spawn(move || {
+            let other = ClientBuilder::new()
+                .root(&isolation.root)
+                .iceoryx_prefix(&isolation.prefix)
+                .reply_timeout(TIMEOUT)
+                .connect::<ipc::Service>()
+                .expect("the daemon answers Hello");
+            ready_tx.send(()).unwrap();
+            go_rx.recv().unwrap();
+            done_tx.send(other.create_scene()).unwrap();
+        });
+        ready
+            .recv_timeout(TIMEOUT)
+            .expect("the other client connected");
+        daemon.control.close();
+        go.send(()).unwrap();
+        assert!(
+            daemon.control.wait_until_holding(TIMEOUT),
+            "the request is held"
+        );
+        frames_are_answered_while_held(&link, &daemon.control);
+        assert!(
+            done.try_recv().is_err(),
+            "the held request is not answered yet"
+        );
+        daemon.control.open();
+        let created = done.recv_timeout(TIMEOUT).expect("the request is answered");
+        assert_eq!(created, Ok(scene + 1));
+    });
 }

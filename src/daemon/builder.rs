@@ -10,8 +10,8 @@
 //! not interrupted, but a job whose scene was dropped before it started is skipped, and one
 //! finished after is thrown away.
 
-use super::build_gate::BuildGate;
 use super::convert::{self, GeometryRequest, Rejection};
+use super::gate::Gate;
 use super::log::{Cause, Level, Logger, Subject};
 use super::shared_scene::{SceneCell, lock};
 use crate::geometry::MeshLimits;
@@ -100,7 +100,7 @@ impl BuildQueue {
 pub fn spawn(
     jobs: Receiver<BuildJob>,
     mesh_limits: MeshLimits,
-    gate: Option<BuildGate>,
+    gate: Option<Gate>,
     level: Level,
 ) -> std::io::Result<std::thread::JoinHandle<()>> {
     std::thread::Builder::new()

@@ -61,6 +61,16 @@ fn mesh_request(scene: u32, vertices: usize, indices: usize) -> ControlRequest {
     }
 }
 
+/// A `RegisterShape` request of a sphere of radius 0.5 in `scene`.
+fn sphere_request(scene: u32) -> ControlRequest {
+    ControlRequest {
+        scene,
+        shape_kind: ShapeKindCode::Sphere as u32,
+        dimensions: [0.5, 0.0, 0.0, 0.0],
+        ..request(Command::RegisterShape)
+    }
+}
+
 fn code(reply: &ControlReply) -> ErrorCode {
     ErrorCode::from_u32(reply.status).expect("a defined code")
 }
@@ -81,21 +91,14 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
         PROTOCOL_VERSION
     );
     let scene = state.handle(&request(Command::CreateScene), &[]).id;
-    let sphere = ControlRequest {
-        scene,
-        shape_kind: ShapeKindCode::Sphere as u32,
-        dimensions: [0.5, 0.0, 0.0, 0.0],
-        ..request(Command::RegisterShape)
-    };
-    let sphere = state.handle(&sphere, &[]);
+    let sphere = state.handle(&sphere_request(scene), &[]);
     assert_eq!(code(&sphere), ErrorCode::Ok, "{}", sphere.reason());
     let mesh = state.handle(
         &mesh_request(scene, 4, 12),
         &mesh_payload(&TETRA, &TETRA_INDICES),
     );
     assert_eq!(code(&mesh), ErrorCode::Ok, "{}", mesh.reason());
-    assert_eq!(sphere.flags, 0, "a primitive is ready at once");
-    assert_eq!(mesh.flags, reply_flags::SHAPE_BUILDING);
+    assert_eq!(build_all(&jobs), 1);
     let add = |state: &mut ControlState, shape: u32, x: f64| {
         state.handle(
             &ControlRequest {
@@ -108,19 +111,8 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
         )
     };
     let a = add(&mut state, sphere.id, 0.0);
-    let early = add(&mut state, mesh.id, 2.0);
-    assert_eq!(
-        (code(&a), code(&early)),
-        (ErrorCode::Ok, ErrorCode::ShapeNotReady)
-    );
-    let building = shape_state(&mut state, scene, mesh.id);
-    assert_eq!((code(&building), building.id), (ErrorCode::Ok, mesh.id));
-    assert_eq!(building.flags, reply_flags::SHAPE_BUILDING);
-    assert_eq!(build_all(&jobs), 1);
-    let built = shape_state(&mut state, scene, mesh.id);
-    assert_eq!((code(&built), built.flags), (ErrorCode::Ok, 0));
     let b = add(&mut state, mesh.id, 2.0);
-    assert_eq!(code(&b), ErrorCode::Ok, "{}", b.reason());
+    assert_eq!((code(&a), code(&b)), (ErrorCode::Ok, ErrorCode::Ok));
     {
         let s = &lock(state.scene(scene).unwrap()).scene;
         assert_eq!(s.body_count(), 2);
@@ -507,5 +499,49 @@ fn a_full_build_queue_refuses_a_registration_and_a_dropped_scenes_builds_change_
         ErrorCode::Internal,
         "{}",
         stranded.reason()
+    );
+}
+
+#[test]
+fn a_mesh_refuses_bodies_until_it_is_built_and_a_primitive_is_ready_at_once() {
+    let (mut state, jobs) = state_with(DaemonConfig::default(), 4);
+    let scene = state.handle(&request(Command::CreateScene), &[]).id;
+    let sphere = state.handle(&sphere_request(scene), &[]);
+    let mesh = state.handle(
+        &mesh_request(scene, 4, 12),
+        &mesh_payload(&TETRA, &TETRA_INDICES),
+    );
+    assert_eq!((code(&sphere), sphere.flags), (ErrorCode::Ok, 0));
+    assert_eq!(
+        (code(&mesh), mesh.flags),
+        (ErrorCode::Ok, reply_flags::SHAPE_BUILDING)
+    );
+    let ready = shape_state(&mut state, scene, sphere.id);
+    assert_eq!(
+        (code(&ready), ready.id, ready.flags),
+        (ErrorCode::Ok, sphere.id, 0)
+    );
+    let add = |state: &mut ControlState| {
+        let body = ControlRequest {
+            scene,
+            target: mesh.id,
+            ..request(Command::AddBody)
+        };
+        state.handle(&body, &[])
+    };
+    let early = add(&mut state);
+    assert_eq!(code(&early), ErrorCode::ShapeNotReady, "{}", early.reason());
+    let building = shape_state(&mut state, scene, mesh.id);
+    assert_eq!((code(&building), building.id), (ErrorCode::Ok, mesh.id));
+    assert_eq!(building.flags, reply_flags::SHAPE_BUILDING);
+    assert_eq!(lock(state.scene(scene).unwrap()).scene.body_count(), 0);
+
+    assert_eq!(build_all(&jobs), 1);
+    let built = shape_state(&mut state, scene, mesh.id);
+    assert_eq!((code(&built), built.flags), (ErrorCode::Ok, 0));
+    assert_eq!(code(&add(&mut state)), ErrorCode::Ok);
+    assert_eq!(
+        code(&shape_state(&mut state, scene, 7)),
+        ErrorCode::UnknownShape
     );
 }

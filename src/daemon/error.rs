@@ -13,6 +13,13 @@ pub enum DaemonStartError {
     Ipc(String),
 }
 
+impl DaemonStartError {
+    /// The error of iceoryx2 failing to create `what`, as a `map_err` argument.
+    pub(crate) fn ipc<E: fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> Self {
+        move |e| Self::Ipc(format!("{what}: {e:?}"))
+    }
+}
+
 impl fmt::Display for DaemonStartError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

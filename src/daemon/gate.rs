@@ -1,13 +1,15 @@
-//! A test hook: a gate every shape build waits at until it is opened, so a test can hold a
-//! registration in progress for as long as it likes and watch what else the daemon does
-//! meanwhile (see [`Daemon::set_build_gate`](super::Daemon::set_build_gate)).
+//! A test hook: a gate that work of one kind (every shape build, or every control request)
+//! waits at while it is closed, so a test can hold that work in progress for as long as it
+//! likes and watch what else the daemon does meanwhile (see
+//! [`Daemon::set_build_gate`](super::Daemon::set_build_gate) and
+//! [`Daemon::set_control_gate`](super::Daemon::set_control_gate)).
 
 use std::sync::{Arc, Condvar, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
-/// A gate shape builds wait at (see the module docs); clones share one gate.
+/// A gate work waits at while it is closed (see the module docs); clones share one gate.
 #[derive(Debug, Clone, Default)]
-pub struct BuildGate {
+pub struct Gate {
     shared: Arc<(Mutex<GateState>, Condvar)>,
 }
 
@@ -18,21 +20,38 @@ struct GateState {
     held: usize,
 }
 
-impl BuildGate {
-    /// A closed gate: every build waits until [`open`](Self::open).
+impl Gate {
+    /// A closed gate: work waits until [`open`](Self::open).
     #[must_use]
     pub fn closed() -> Self {
         Self::default()
     }
 
-    /// Opens the gate for good: held builds go on, later ones pass.
+    /// An open gate: work passes until [`close`](Self::close).
+    #[must_use]
+    pub fn opened() -> Self {
+        let gate = Self::default();
+        gate.open();
+        gate
+    }
+
+    /// Opens the gate: held work goes on, later work passes.
     pub fn open(&self) {
+        self.set_open(true);
+    }
+
+    /// Closes the gate: work that comes to it from now on waits.
+    pub fn close(&self) {
+        self.set_open(false);
+    }
+
+    fn set_open(&self, open: bool) {
         let (state, changed) = &*self.shared;
-        state.lock().unwrap_or_else(PoisonError::into_inner).open = true;
+        state.lock().unwrap_or_else(PoisonError::into_inner).open = open;
         changed.notify_all();
     }
 
-    /// Waits until a build is held at the gate, at most `timeout`; whether one is.
+    /// Waits until work is held at the gate, at most `timeout`; whether one is.
     #[must_use]
     pub fn wait_until_holding(&self, timeout: Duration) -> bool {
         let (state, changed) = &*self.shared;
@@ -51,14 +70,14 @@ impl BuildGate {
         true
     }
 
-    /// Whether a build is held at the gate now.
+    /// Whether work is held at the gate now.
     #[must_use]
     pub fn is_holding(&self) -> bool {
         let (state, _) = &*self.shared;
         state.lock().unwrap_or_else(PoisonError::into_inner).held > 0
     }
 
-    /// Waits (counted as held) until the gate is open.
+    /// Waits (counted as held) while the gate is closed.
     pub(super) fn pass(&self) {
         let (state, changed) = &*self.shared;
         let mut guard = state.lock().unwrap_or_else(PoisonError::into_inner);
@@ -76,8 +95,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_build_is_held_until_the_gate_opens() {
-        let gate = BuildGate::closed();
+    fn work_is_held_while_the_gate_is_closed() {
+        let gate = Gate::closed();
         assert!(!gate.wait_until_holding(Duration::from_millis(1)));
         let passed = std::sync::atomic::AtomicBool::new(false);
         std::thread::scope(|s| {
@@ -92,7 +111,14 @@ mod tests {
         });
         assert!(passed.into_inner());
         assert!(!gate.is_holding());
-        // An open gate lets builds through at once.
+        // An open gate lets work through at once; closed again, it holds again.
         gate.pass();
+        gate.close();
+        std::thread::scope(|s| {
+            s.spawn(|| gate.pass());
+            assert!(gate.wait_until_holding(Duration::from_secs(10)));
+            gate.open();
+        });
+        Gate::opened().pass();
     }
 }

@@ -1,0 +1,341 @@
+//! The control thread: the control server (requests in, replies out), the scenes' frame
+//! ports opened and closed, the periodic sweep, termination signals.
+//!
+//! Each request is answered by [`ControlState`] against the shared scenes (an O(1) edit under
+//! a scene's lock, or a registration queued for the builder). A created scene's ports are
+//! opened here, not on the frame thread, and handed over with [`FrameCommand::Open`]; a
+//! dropped scene is marked dropped at once and its ports come back
+//! ([`FrameCommand::Close`]) to be closed here too. Each hand-over notifies the frame thread's
+//! wake-up listener, so a frame thread blocked without the new scene's listener wakes for it.
+//!
+//! # Waiting (hybrid)
+//! After the last request the thread keeps polling for [`DaemonConfig::spin`] (a client's
+//! next request usually follows its reply within µs), then blocks in its WaitSet on the
+//! control event listener (clients notify it after each request) until a notification, the
+//! next sweep or a termination signal.
+//!
+//! # Sweeps
+//! Every [`DaemonConfig::sweep_interval`]: termination signals are checked (a thread that
+//! never runs out of requests never blocks), the nodes of crashed processes are cleaned up
+//! (hundreds of µs, off the frame path), and scenes whose creating control client is gone
+//! are orphaned and, after [`DaemonConfig::dead_client_grace`], dropped ([`Liveness`]).
+
+use super::Ipc;
+use super::config::DaemonConfig;
+use super::control::ControlState;
+use super::error::{DaemonRunError, DaemonStartError};
+use super::frame_loop::SceneFrames;
+use super::gate::Gate;
+use super::liveness::{Liveness, OwnerId};
+use super::log::{Cause, Level, Logger, Subject};
+use super::shared_scene::SharedScene;
+use super::stop::StopHandle;
+use super::wait::{Wake, wait_for_events};
+use crate::pipeline::WorkerPool;
+use crossbeam::channel::{Receiver, Sender};
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::server::Server;
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::request_response::PortFactory as RequestResponseFactory;
+use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// What the control thread tells the frame thread.
+pub enum FrameCommand {
+    /// Serve scene `id` from now on, with these ports.
+    Open {
+        /// The scene's id.
+        id: u32,
+        /// The scene.
+        scene: SharedScene,
+        /// Its frame ports, opened by the control thread.
+        frames: Box<SceneFrames<Ipc>>,
+    },
+    /// Stop serving scene `id` and hand its ports back.
+    Close(u32),
+}
+
+/// The control thread's ends of its links to the frame thread.
+pub struct FrameLinks {
+    /// Scenes to serve and to stop serving.
+    pub commands: Sender<FrameCommand>,
+    /// Wakes the frame thread after a command.
+    pub wake: Notifier<Ipc>,
+    /// The ports of closed scenes, to close here.
+    pub retired: Receiver<Box<SceneFrames<Ipc>>>,
+}
+
+/// The control thread's state: node, control server, scenes (see the module docs).
+pub struct ControlThread {
+    // Fields drop in order: ports before their services, all before the node.
+    server: Server<Ipc, [u8], ControlRequest, ControlReply, ()>,
+    requests_sent: Listener<Ipc>,
+    frames: FrameLinks,
+    control_service: RequestResponseFactory<Ipc, [u8], ControlRequest, ControlReply, ()>,
+    node: Node<Ipc>,
+    state: ControlState,
+    liveness: Liveness,
+    log: Logger,
+    /// Answers mesh–mesh pairs for the frame thread; each scene's workspace shares it.
+    workers: Arc<WorkerPool>,
+    gate: Option<Gate>,
+    root: String,
+    spin: Duration,
+    sweep_interval: Duration,
+    /// Scratch list of the connected control clients, refilled at each sweep.
+    connected: Vec<OwnerId>,
+}
+
+impl ControlThread {
+    /// Creates the control service, its server and the control event listener on `node`.
+    ///
+    /// # Errors
+    /// [`DaemonStartError`] when the root is invalid or iceoryx2 fails.
+    pub fn new(
+        node: Node<Ipc>,
+        config: &DaemonConfig,
+        state: ControlState,
+        frames: FrameLinks,
+        workers: Arc<WorkerPool>,
+    ) -> Result<Self, DaemonStartError> {
+        let bad_root =
+            |e| DaemonStartError::Config(format!("service root {:?}: {e:?}", config.root));
+        let control_service = proxima_ipc::control_service_builder(&node, &config.root)
+            .map_err(bad_root)?
+            .open_or_create()
+            .map_err(DaemonStartError::ipc("control service"))?;
+        let server = control_service
+            .server_builder()
+            .create()
+            .map_err(DaemonStartError::ipc("control server"))?;
+        let requests_sent = proxima_ipc::control_events_service_builder(&node, &config.root)
+            .map_err(bad_root)?
+            .open_or_create()
+            .map_err(DaemonStartError::ipc("control event service"))?
+            .listener_builder()
+            .create()
+            .map_err(DaemonStartError::ipc("control event listener"))?;
+        Ok(Self {
+            server,
+            requests_sent,
+            frames,
+            control_service,
+            node,
+            state,
+            liveness: Liveness::new(config.dead_client_grace),
+            log: Logger::new(config.log_level),
+            workers,
+            gate: None,
+            root: config.root.clone(),
+            spin: config.spin,
+            sweep_interval: config.sweep_interval,
+            connected: Vec::new(),
+        })
+    }
+
+    /// Holds every control request at `gate` before it is handled (a test hook).
+    pub fn set_gate(&mut self, gate: Gate) {
+        self.gate = Some(gate);
+    }
+
+    /// Whether SIGINT or SIGTERM arrived (checked without sleeping). The first check
+    /// installs iceoryx2's signal handler.
+    pub fn termination_requested(&self) -> bool {
+        self.node.wait(Duration::ZERO).is_err()
+    }
+
+    /// Serves until `stop`, a termination signal or an error; then stops the daemon and
+    /// wakes the frame thread so it sees it.
+    ///
+    /// # Errors
+    /// [`DaemonRunError`] when iceoryx2 fails to move a request or to wait.
+    pub fn run(&mut self, stop: &StopHandle) -> Result<(), DaemonRunError> {
+        let result = WaitSetBuilder::new()
+            .create::<Ipc>()
+            .map_err(|e| DaemonRunError::Ipc(format!("wait set: {e:?}")))
+            .and_then(|waitset| self.serve(stop, &waitset));
+        stop.stop();
+        let _ = self.frames.wake.notify();
+        result
+    }
+
+    fn serve(&mut self, stop: &StopHandle, waitset: &WaitSet<Ipc>) -> Result<(), DaemonRunError> {
+        let start = Instant::now();
+        let (mut next_sweep, mut last_work) = (start + self.sweep_interval, start);
+        loop {
+            let served = self.serve_requests()?;
+            // Closing a scene's ports unmaps its shared memory: done here, not by frames.
+            self.frames.retired.try_iter().for_each(drop);
+            let now = Instant::now();
+            if served > 0 {
+                last_work = now;
+            }
+            if now >= next_sweep {
+                // About 2 µs; the loop may never block, so it checks itself.
+                if self.termination_requested() {
+                    return Ok(());
+                }
+                self.sweep(now);
+                next_sweep = Instant::now() + self.sweep_interval;
+            }
+            if stop.is_stopped() {
+                return Ok(());
+            }
+            if now.duration_since(last_work) < self.spin {
+                std::hint::spin_loop();
+                continue;
+            }
+            let listeners = || std::iter::once(&self.requests_sent);
+            let timeout = next_sweep.saturating_duration_since(now);
+            if wait_for_events(waitset, listeners, timeout)? == Wake::Stop {
+                return Ok(());
+            }
+            last_work = Instant::now();
+        }
+    }
+
+    /// Answers every waiting control request; returns how many.
+    fn serve_requests(&mut self) -> Result<usize, DaemonRunError> {
+        let mut served = 0;
+        while let Some(active) = self
+            .server
+            .receive()
+            .map_err(|e| DaemonRunError::Ipc(format!("control receive: {e:?}")))?
+        {
+            if let Some(gate) = &self.gate {
+                gate.pass();
+            }
+            let request = *active.user_header();
+            let origin = active.origin().value();
+            let mut reply = self.state.handle(&request, active.payload());
+            if reply.status == ErrorCode::Ok as u32 {
+                reply = self.follow_scene_changes(&request, reply, origin);
+            } else {
+                self.log_refusal(&request, &reply, origin);
+            }
+            // A client that went away no longer wants the reply: not an error of the daemon.
+            let _ = active.send_copy(reply);
+            served += 1;
+        }
+        Ok(served)
+    }
+
+    /// Logs a refused request once per client and cause.
+    fn log_refusal(&mut self, request: &ControlRequest, reply: &ControlReply, origin: OwnerId) {
+        let cause = Cause {
+            what: "refused control request",
+            code: reply.status,
+        };
+        self.log
+            .once(Level::Warn, Subject::Client(origin), cause, || {
+                let name = Command::from_u32(request.command).map_or_else(
+                    || format!("command {}", request.command),
+                    |c| format!("{c:?}"),
+                );
+                format!("refused {name}: {}", reply.reason())
+            });
+    }
+
+    /// Cleans up crashed processes' nodes, then orphans the scenes whose creating client is
+    /// gone and drops those orphaned for the grace period.
+    fn sweep(&mut self, now: Instant) {
+        let cleanup = self.node.try_cleanup_dead_nodes();
+        if cleanup.cleanups > 0 || cleanup.failed_cleanups > 0 {
+            self.log.debug(format_args!(
+                "cleaned up {} dead nodes ({} failed)",
+                cleanup.cleanups, cleanup.failed_cleanups
+            ));
+        }
+        self.connected.clear();
+        let connected = &mut self.connected;
+        self.control_service
+            .dynamic_config()
+            .list_clients(|client| {
+                connected.push(client.client_id.value());
+                CallbackProgression::Continue
+            });
+        let connected = &self.connected;
+        let outcome = self.liveness.sweep(now, |owner| connected.contains(&owner));
+        self.log.release_if(|subject| match subject {
+            Subject::Client(id) => !connected.contains(&id),
+            Subject::Scene(_) => false,
+        });
+        for &id in &outcome.orphaned {
+            self.log.warn(format_args!(
+                "scene {id}: the client that created it is gone; the scene is dropped after a \
+                 grace period of {:?}",
+                self.liveness.grace()
+            ));
+        }
+        for &id in &outcome.expired {
+            self.release_scene(id);
+            self.log.info(format_args!(
+                "scene {id} released: its client has been gone for {:?}",
+                self.liveness.grace()
+            ));
+        }
+    }
+
+    /// Drops scene `id`'s state (if it still lives) and takes its ports off the frame thread.
+    fn release_scene(&mut self, id: u32) {
+        // A scene already dropped by request has nothing left to release.
+        let _ = self.state.drop_scene(id);
+        self.tell_frames(FrameCommand::Close(id));
+        self.liveness.forget(id);
+        self.log.release(Subject::Scene(id));
+    }
+
+    /// Sends `command` to the frame thread and wakes it. Once the frame thread is gone (the
+    /// daemon is stopping) there is no one left to tell.
+    fn tell_frames(&self, command: FrameCommand) {
+        if self.frames.commands.send(command).is_ok() {
+            let _ = self.frames.wake.notify();
+        }
+    }
+
+    /// Opens a created scene's ports, hands them to the frame thread and records the scene's
+    /// owner; closes a dropped one's. A scene whose ports cannot be opened is dropped again
+    /// and the reply becomes an error.
+    fn follow_scene_changes(
+        &mut self,
+        request: &ControlRequest,
+        reply: ControlReply,
+        origin: OwnerId,
+    ) -> ControlReply {
+        if request.command == Command::DropScene as u32 {
+            self.release_scene(request.scene);
+            let scene = request.scene;
+            self.log
+                .info(format_args!("scene {scene} dropped by its client"));
+        }
+        if request.command != Command::CreateScene as u32 {
+            return reply;
+        }
+        let id = reply.id;
+        let opened = SceneFrames::open(&self.node, &self.root, id, &self.workers);
+        match (opened, self.state.scene(id)) {
+            (Ok(frames), Some(scene)) => {
+                let scene = Arc::clone(scene);
+                let frames = Box::new(frames);
+                self.tell_frames(FrameCommand::Open { id, scene, frames });
+                self.liveness.adopt(id, origin);
+                self.log
+                    .info(format_args!("scene {id} created by client {origin:x}"));
+                reply
+            }
+            (opened, _) => {
+                let why = opened
+                    .err()
+                    .unwrap_or_else(|| "the scene is gone".to_owned());
+                // The scene was just created, so dropping it cannot fail.
+                let _ = self.state.drop_scene(id);
+                self.log.error(format_args!(
+                    "scene {id}: opening its services failed: {why}"
+                ));
+                ControlReply::error(ErrorCode::Internal, &format!("scene services: {why}"))
+            }
+        }
+    }
+}
