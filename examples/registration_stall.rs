@@ -1,7 +1,8 @@
 //! What a heavy shape registration costs another scene's frames: one client runs frames of a
 //! small scene of spheres at a fixed rate while a second client registers a large flat grid
 //! mesh in a scene of its own. Prints the first client's round trips while the registration
-//! runs and outside it.
+//! runs and outside it, how many frames missed their budget, and when the worst came (from
+//! the registration's start); and when the registration was accepted and the shape built.
 //!
 //! ```text
 //! cargo build --release && \
@@ -83,6 +84,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let link = client.open_scene(scene)?;
     // When the registration started and ended (`None` while it runs), from `start`.
     let span = Mutex::new((None::<Duration>, None::<Duration>));
+    let accepted = Mutex::new(Duration::ZERO);
     let start = Instant::now();
     let (during, outside) = std::thread::scope(|s| -> Result<_, Box<dyn Error + Send + Sync>> {
         let registrar = s.spawn(|| -> Result<(), String> {
@@ -92,18 +94,20 @@ fn main() -> Result<(), Box<dyn Error>> {
             let own = other.create_scene().map_err(|e| e.to_string())?;
             let (vertices, triangles) = grid(args.triangles);
             std::thread::sleep(Duration::from_secs_f64(args.settle_s));
-            span.lock().unwrap().0 = Some(start.elapsed());
+            let began = start.elapsed();
+            span.lock().unwrap().0 = Some(began);
+            let registration = other
+                .register_mesh_no_wait(own, &vertices, &triangles)
+                .map_err(|e| e.to_string())?;
+            *accepted.lock().unwrap() = start.elapsed() - began;
             other
-                .register_mesh(own, &vertices, &triangles)
+                .wait_shape(own, registration.shape)
                 .map_err(|e| e.to_string())?;
             span.lock().unwrap().1 = Some(start.elapsed());
             Ok(())
         });
         let period = Duration::from_secs(1) / args.rate_hz;
-        let (mut during, mut outside) = (
-            LatencyRecorder::with_capacity(1 << 16),
-            LatencyRecorder::with_capacity(1 << 16),
-        );
+        let (mut during, mut outside) = (Phase::default(), Phase::default());
         for seq in 1u64.. {
             std::thread::sleep(period.saturating_sub(Duration::from_micros(60)));
             let sent = Instant::now();
@@ -120,14 +124,17 @@ fn main() -> Result<(), Box<dyn Error>> {
                     ..PoseRecord::default()
                 },
             )?;
-            link.receive_results_for(seq, Duration::from_secs(600))?
+            let frame = link
+                .receive_results_for(seq, Duration::from_secs(600))?
                 .ok_or("a frame went unanswered")?;
-            let rtt = sent.elapsed();
+            let (rtt, met) = (sent.elapsed(), frame.header().budget_met != 0);
+            drop(frame);
             let (began, ended) = *span.lock().unwrap();
+            let since = at.saturating_sub(began.unwrap_or_default());
             match (began, ended) {
-                (Some(b), None) if at >= b => during.record(rtt),
-                (Some(b), Some(e)) if at >= b && at <= e => during.record(rtt),
-                _ => outside.record(rtt),
+                (Some(b), None) if at >= b => during.record(rtt, met, since),
+                (Some(b), Some(e)) if at >= b && at <= e => during.record(rtt, met, since),
+                _ => outside.record(rtt, met, since),
             }
             if ended.is_some_and(|e| (sent - start).saturating_sub(e).as_secs_f64() > args.settle_s)
             {
@@ -140,19 +147,45 @@ fn main() -> Result<(), Box<dyn Error>> {
     .map_err(|e| e.to_string())?;
     let (began, ended) = *span.lock().unwrap();
     println!(
-        "registration of a {}-triangle grid took {:.2} s",
+        "registration of a {}-triangle grid: accepted after {:.3} s, built after {:.2} s",
         args.triangles,
+        accepted.lock().unwrap().as_secs_f64(),
         (ended.unwrap_or_default() - began.unwrap_or_default()).as_secs_f64()
     );
-    println!("round trips during it:  {}", summary(&during));
-    println!("round trips outside it: {}", summary(&outside));
+    println!("during it:  {during}");
+    println!("outside it: {outside}");
     Ok(())
 }
 
-fn summary(recorder: &LatencyRecorder) -> String {
-    recorder
-        .summary()
-        .map_or_else(|| "none".to_owned(), |s| s.to_string())
+/// The frames of one phase: round trips, how many missed their budget, the worst and when
+/// it was sent (from the registration's start).
+#[derive(Default)]
+struct Phase {
+    round_trips: LatencyRecorder,
+    over_budget: u64,
+    worst: (Duration, Duration),
+}
+
+impl Phase {
+    fn record(&mut self, rtt: Duration, met: bool, since: Duration) {
+        self.round_trips.record(rtt);
+        self.over_budget += u64::from(!met);
+        self.worst = self.worst.max((rtt, since));
+    }
+}
+
+impl std::fmt::Display for Phase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let Some(summary) = self.round_trips.summary() else {
+            return f.write_str("no frames");
+        };
+        write!(
+            f,
+            "{summary}; {} over budget; worst sent at {:.3} s",
+            self.over_budget,
+            self.worst.1.as_secs_f64()
+        )
+    }
 }
 
 /// A flat square grid in the z = 0 plane with about `triangles` triangles.
