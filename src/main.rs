@@ -40,15 +40,15 @@ struct Cli {
     /// Milliseconds a scene outlives the client that created it [default: 2000].
     #[arg(long)]
     grace_ms: Option<u64>,
-    /// Microseconds the service loop keeps polling after its last work before it blocks
-    /// [default: 50].
+    /// Microseconds the frame and control threads keep polling after their last work
+    /// before they block [default: 50].
     #[arg(long)]
     spin_us: Option<u64>,
     /// The least important messages written to stderr: error, warn, info or debug
     /// [default: info].
     #[arg(long)]
     log_level: Option<Level>,
-    /// Worker threads answering mesh pairs beside the service loop [default: cores − 1].
+    /// Worker threads answering mesh pairs beside the frame thread [default: cores − 1].
     #[arg(long)]
     workers: Option<usize>,
 }

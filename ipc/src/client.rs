@@ -1,6 +1,7 @@
 //! The control half of the client: connect to a `proximad` daemon, create scenes, register
 //! shapes, and add, remove and update bodies. Each call is one request on the control
-//! service (`<root>/control`) and one reply, waited for up to the client's reply timeout.
+//! service (`<root>/control`) and one reply, waited for up to the client's reply timeout
+//! (a registration that waits for its shape's build asks again until it is built, see below).
 //!
 //! ```no_run
 //! use proxima_ipc::client::{BodySpec, ClientBuilder, Motion, Primitive};

@@ -11,7 +11,8 @@
 //!   open every service with ([`control_service_builder`], [`poses_service_builder`],
 //!   [`results_service_builder`], the event services), and the event ids;
 //! - [`client`]: [`ClientBuilder`](client::ClientBuilder) → [`Client`](client::Client), one
-//!   control request and its reply per call;
+//!   control request and its reply per call (a convex or mesh registration that waits for
+//!   its build asks again until the shape is built);
 //! - [`scene_link`]: a scene's pose frames out and its result frames back;
 //!   [`result_feed`] is the receiving half alone, for monitors;
 //! - [`error`]: one error enum per operation.

@@ -27,12 +27,14 @@ pub struct DaemonConfig {
     pub max_queued_builds: usize,
     /// Close-pair margin of bodies that do not set one, metres.
     pub default_margin: f64,
-    /// How long the service loop keeps polling after its last piece of work before it
-    /// blocks on the event listeners (the hybrid wait: a spin of tens of µs catches the next
-    /// request or frame without the 60–120 µs cost of waking a halted vCPU).
+    /// How long the frame thread (after its last frame) and the control thread (after its
+    /// last request) keep polling before they block on their event listeners (the hybrid
+    /// wait: a spin of tens of µs catches the next frame or request without the 60–120 µs
+    /// cost of waking a halted vCPU).
     pub spin: Duration,
-    /// How often the loop checks for dead clients and termination signals (it also bounds
-    /// each blocking wait).
+    /// How often the control thread checks for dead clients and termination signals; it
+    /// also bounds each blocking wait of the frame and control threads (how soon they see a
+    /// stop).
     pub sweep_interval: Duration,
     /// How long a scene outlives the control client that created it (its process died or
     /// it disconnected) before the daemon drops it; a client port that comes back within it
@@ -40,8 +42,8 @@ pub struct DaemonConfig {
     pub dead_client_grace: Duration,
     /// The least important messages written to stderr.
     pub log_level: Level,
-    /// Worker threads answering mesh–mesh pairs beside the service loop's thread (0: the
-    /// loop answers everything itself). Default: one fewer than the cores, at least one.
+    /// Worker threads answering mesh–mesh pairs beside the frame thread (0: the frame
+    /// thread answers everything itself). Default: one fewer than the cores, at least one.
     pub workers: usize,
 }
 

@@ -24,7 +24,7 @@
 //!
 //! [service_loop]
 //! spin_us = 50                    # polling after the last work before blocking
-//! sweep_interval_ms = 100         # dead-client and signal checks
+//! sweep_interval_ms = 100         # dead-client and signal checks, longest blocking wait
 //! dead_client_grace_ms = 2000     # a dead client's scenes live this long
 //! workers = 1                     # threads answering mesh pairs (default: cores − 1)
 //! ```

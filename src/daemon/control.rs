@@ -117,56 +117,45 @@ impl ControlState {
                     flags: building,
                 })
             }
-            Command::AddBody
-            | Command::RemoveBody
-            | Command::UpdateBody
-            | Command::SetSceneParams => self.edit_scene(command, request).map(Answer::from),
+            Command::AddBody => self.add_body(request).map(Answer::from),
+            Command::RemoveBody => {
+                let body = BodyId(request.target);
+                let mut cell = lock(self.live_scene(request.scene)?);
+                cell.scene.remove_body(body).map_err(scene_rejection)?;
+                Ok(request.target.into())
+            }
+            Command::UpdateBody => {
+                let motion = convert::motion(request.motion)?;
+                let (filter, margin) = (convert::filter(request), convert::margin(request.margin));
+                let mut cell = lock(self.live_scene(request.scene)?);
+                cell.scene
+                    .update_body(BodyId(request.target), motion, filter, margin)
+                    .map_err(scene_rejection)?;
+                Ok(request.target.into())
+            }
+            Command::SetSceneParams => {
+                let choice = broad_phase(request.broad_phase)?;
+                lock(self.live_scene(request.scene)?)
+                    .scene
+                    .set_broad_phase(choice);
+                Ok(request.scene.into())
+            }
         }
     }
 
-    /// The commands that edit one scene's bodies or parameters, each under one short lock.
-    fn edit_scene(&self, command: Command, request: &ControlRequest) -> Result<u32, Rejection> {
-        // Everything the request says is checked before the scene is locked.
-        let (motion, filter) = (convert::motion(request.motion), convert::filter(request));
-        let margin = convert::margin(request.margin);
-        let shared = self.live_scene(request.scene)?;
-        match command {
-            Command::AddBody => {
-                let pose = convert::pose(request.position, request.orientation)?;
-                let motion = motion?;
-                let mut cell = lock(shared);
-                let desc = BodyDesc {
-                    shape: cell.shapes.usable(request.target)?,
-                    pose,
-                    motion,
-                    filter,
-                    margin,
-                };
-                Ok(cell.scene.add_body(&desc).map_err(scene_rejection)?.0)
-            }
-            Command::RemoveBody => {
-                let body = BodyId(request.target);
-                lock(shared)
-                    .scene
-                    .remove_body(body)
-                    .map_err(scene_rejection)?;
-                Ok(request.target)
-            }
-            Command::UpdateBody => {
-                let motion = motion?;
-                let body = BodyId(request.target);
-                let mut cell = lock(shared);
-                cell.scene
-                    .update_body(body, motion, filter, margin)
-                    .map_err(scene_rejection)?;
-                Ok(request.target)
-            }
-            _ => {
-                let choice = broad_phase(request.broad_phase)?;
-                lock(shared).scene.set_broad_phase(choice);
-                Ok(request.scene)
-            }
-        }
+    /// Adds a body of a built shape: the request is checked before the scene is locked.
+    fn add_body(&self, request: &ControlRequest) -> Result<u32, Rejection> {
+        let pose = convert::pose(request.position, request.orientation)?;
+        let motion = convert::motion(request.motion)?;
+        let mut cell = lock(self.live_scene(request.scene)?);
+        let desc = BodyDesc {
+            shape: cell.shapes.usable(request.target)?,
+            pose,
+            motion,
+            filter: convert::filter(request),
+            margin: convert::margin(request.margin),
+        };
+        Ok(cell.scene.add_body(&desc).map_err(scene_rejection)?.0)
     }
 
     /// A primitive is registered at once; a convex or mesh shape gets its id and goes to

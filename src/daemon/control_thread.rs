@@ -53,8 +53,26 @@ pub enum FrameCommand {
         /// Its frame ports, opened by the control thread.
         frames: Box<SceneFrames<Ipc>>,
     },
-    /// Stop serving scene `id` and hand its ports back.
+    /// Stop serving scene `id` and hand it back ([`Retired`]).
     Close(u32),
+}
+
+/// A closed scene as the frame thread hands it back: its ports and its share of the scene,
+/// so that closing the ports (unmapping shared memory) and freeing the scene (its bodies and
+/// shapes, when no one else holds it) happen on the control thread, not between frames.
+pub struct Retired {
+    /// The scene.
+    pub scene: SharedScene,
+    /// Its frame ports.
+    pub frames: Box<SceneFrames<Ipc>>,
+}
+
+impl Retired {
+    /// Closes the ports, then lets go of the scene (freed if no build still holds it).
+    fn let_go(self) {
+        drop(self.frames);
+        drop(self.scene);
+    }
 }
 
 /// The control thread's ends of its links to the frame thread.
@@ -63,8 +81,8 @@ pub struct FrameLinks {
     pub commands: Sender<FrameCommand>,
     /// Wakes the frame thread after a command.
     pub wake: Notifier<Ipc>,
-    /// The ports of closed scenes, to close here.
-    pub retired: Receiver<Box<SceneFrames<Ipc>>>,
+    /// Closed scenes, to let go of here.
+    pub retired: Receiver<Retired>,
 }
 
 /// The control thread's state: node, control server, scenes (see the module docs).
@@ -166,8 +184,8 @@ impl ControlThread {
         let (mut next_sweep, mut last_work) = (start + self.sweep_interval, start);
         loop {
             let served = self.serve_requests()?;
-            // Closing a scene's ports unmaps its shared memory: done here, not by frames.
-            self.frames.retired.try_iter().for_each(drop);
+            // Closing ports and freeing scenes: done here, not between frames.
+            self.frames.retired.try_iter().for_each(Retired::let_go);
             let now = Instant::now();
             if served > 0 {
                 last_work = now;

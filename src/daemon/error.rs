@@ -31,7 +31,7 @@ impl fmt::Display for DaemonStartError {
 
 impl std::error::Error for DaemonStartError {}
 
-/// Why the service loop stopped with an error (a termination signal is not one).
+/// Why the daemon stopped with an error (a termination signal is not one).
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum DaemonRunError {

@@ -5,8 +5,8 @@
 //! with its receipt), answers the most urgent one ([`schedule`](super::schedule)) under its
 //! scene's lock, and starts over, so a frame that arrives meanwhile competes at once. Scenes
 //! come and go by [`FrameCommand`]s from the control thread, read between frames; their ports
-//! arrive opened and leave to be closed on the control thread. A frame of a scene dropped
-//! since it was taken is dropped unanswered.
+//! arrive opened, and a closed scene goes back whole ([`Retired`]) to be let go of on the
+//! control thread. A frame of a scene dropped since it was taken is dropped unanswered.
 //!
 //! # Waiting (hybrid)
 //! After the last frame the thread keeps polling for [`DaemonConfig::spin`], then blocks in
@@ -21,7 +21,7 @@
 
 use super::Ipc;
 use super::config::DaemonConfig;
-use super::control_thread::FrameCommand;
+use super::control_thread::{FrameCommand, Retired};
 use super::error::DaemonRunError;
 use super::frame_loop::SceneFrames;
 use super::log::{Logger, Subject};
@@ -43,8 +43,8 @@ pub struct ControlLinks {
     pub commands: Receiver<FrameCommand>,
     /// Notified after each command.
     pub wake: Listener<Ipc>,
-    /// Where a closed scene's ports go to be closed.
-    pub retire: Sender<Box<SceneFrames<Ipc>>>,
+    /// Where a closed scene goes to be let go of.
+    pub retire: Sender<Retired>,
 }
 
 /// A scene the frame thread serves.
@@ -118,10 +118,10 @@ impl FrameThread {
                     let Some(index) = self.scenes.iter().position(|s| s.id == id) else {
                         continue;
                     };
-                    let closed = self.scenes.swap_remove(index);
+                    let LiveScene { scene, frames, .. } = self.scenes.swap_remove(index);
                     self.log.release(Subject::Scene(id));
-                    // Should the control thread be gone, the ports close here after all.
-                    let _ = self.control.retire.try_send(closed.frames);
+                    // Should the control thread be gone, the scene is let go of here after all.
+                    let _ = self.control.retire.try_send(Retired { scene, frames });
                 }
             }
         }

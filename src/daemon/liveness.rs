@@ -1,6 +1,6 @@
 //! Which client owns each scene, and which scenes have outlived their owner.
 //!
-//! Pure bookkeeping, no IPC: the service loop tells [`Liveness`] who created each scene
+//! Pure bookkeeping, no IPC: the control thread tells [`Liveness`] who created each scene
 //! ([`adopt`](Liveness::adopt)) and, at every sweep, which owners are still connected
 //! ([`sweep`](Liveness::sweep)). A scene whose owner is no longer connected is *orphaned*;
 //! once it has been orphaned for the grace period without its owner coming back, the sweep
