@@ -5,7 +5,7 @@
 //! the error code and reason; it is logged once by the caller.
 //!
 //! Every request is O(1) or a copy: scene edits take the scene's lock
-//! ([`shared_scene`](super::shared_scene)) for one edit; a convex or mesh registration is
+//! ([`shared_scene`]) for one edit; a convex or mesh registration is
 //! checked ([`convert::shape_request`]), gets its shape id, and its payload is copied into a
 //! [`BuildJob`] for the builder thread; the reply says the shape is being built.
 
