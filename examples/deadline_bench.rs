@@ -72,7 +72,7 @@ use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
 use oracle::{Oracle, possibly_touching};
 use proxima_ipc::client::{Client, ClientBuilder};
 use proxima_ipc::scene_link::SceneLink;
-use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation};
+use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation, sibling_daemon};
 use proxima_ipc::tools::latency::LatencySummary;
 use proxima_ipc::wire::ErrorCode;
 use report::{Answer, FrameRecord, Row};
@@ -485,22 +485,4 @@ fn write_outputs(out: &Path, rows: &[Row]) -> Result<(), Box<dyn Error>> {
         out.display()
     );
     Ok(())
-}
-
-/// `proximad` in the directory above this example's (`target/<profile>/`).
-fn sibling_daemon() -> Result<PathBuf, Box<dyn Error>> {
-    let exe = std::env::current_exe()?;
-    let path = exe
-        .parent()
-        .and_then(|examples| examples.parent())
-        .map(|profile| profile.join("proximad"))
-        .ok_or("cannot locate proximad next to this example")?;
-    if !path.exists() {
-        return Err(format!(
-            "{} does not exist: run `cargo build --release` first, or pass --daemon",
-            path.display()
-        )
-        .into());
-    }
-    Ok(path)
 }

@@ -39,7 +39,7 @@ use clap::Parser;
 use falling::{BIN_HALF, falling_scene, falling_world};
 use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
 use proxima_ipc::client::ClientBuilder;
-use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation};
+use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation, sibling_daemon};
 use proxima_ipc::tools::latency::LatencyRecorder;
 use proxima_ipc::wire::{Completeness, ErrorCode, query};
 use std::error::Error;
@@ -168,22 +168,4 @@ fn main() -> Result<(), Box<dyn Error>> {
     );
     client.drop_scene(scene_id)?;
     Ok(())
-}
-
-/// `proximad` in the directory above this example's (`target/<profile>/`).
-fn sibling_daemon() -> Result<PathBuf, Box<dyn Error>> {
-    let exe = std::env::current_exe()?;
-    let path = exe
-        .parent()
-        .and_then(|examples| examples.parent())
-        .map(|profile| profile.join("proximad"))
-        .ok_or("cannot locate proximad next to this example")?;
-    if !path.exists() {
-        return Err(format!(
-            "{} does not exist: run `cargo build --release` first, or pass --daemon",
-            path.display()
-        )
-        .into());
-    }
-    Ok(path)
 }

@@ -15,7 +15,7 @@
 use clap::Parser;
 use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
 use proxima_ipc::client::{BodySpec, ClientBuilder, Motion, Primitive};
-use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation};
+use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation, sibling_daemon};
 use proxima_ipc::tools::latency::LatencyRecorder;
 use proxima_ipc::wire::{PoseRecord, query};
 use std::error::Error;
@@ -55,7 +55,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     let args = Args::parse();
     set_log_level_from_env_or(LogLevel::Error);
     let Isolation { root, prefix } = Isolation::unique("stall");
-    let exe = args.daemon.clone().unwrap_or(sibling_daemon()?);
+    let exe = match &args.daemon {
+        Some(path) => path.clone(),
+        None => sibling_daemon()?,
+    };
     let _daemon = ChildProcess::spawn(
         &exe,
         ["--root", &root, "--iceoryx-prefix", &prefix],
@@ -206,14 +209,4 @@ fn grid(triangles: usize) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
         })
         .collect();
     (vertices, faces)
-}
-
-/// `proximad` in the directory above this example's (`target/<profile>/`).
-fn sibling_daemon() -> Result<PathBuf, Box<dyn Error>> {
-    let exe = std::env::current_exe()?;
-    exe.parent()
-        .and_then(|examples| examples.parent())
-        .map(|profile| profile.join("proximad"))
-        .filter(|path| path.exists())
-        .ok_or_else(|| "no proximad next to this example: build it or pass --daemon".into())
 }

@@ -7,6 +7,7 @@
 //! process with the same prefix starts, and even a clean exit leaves one small segment.
 
 use std::ffi::OsStr;
+use std::path::PathBuf;
 use std::process::{Child, Command};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Duration;
@@ -133,6 +134,28 @@ pub fn remove_shared_memory(prefix: &str) {
             }
         }
     }
+}
+
+/// `proximad` in the directory above the running example's (`target/<profile>/`), for
+/// tools that start a private daemon.
+///
+/// # Errors
+/// The path cannot be found, or no daemon was built there (run `cargo build --release`
+/// first, or name the daemon explicitly).
+pub fn sibling_daemon() -> Result<PathBuf, String> {
+    let exe = std::env::current_exe().map_err(|e| format!("current executable: {e}"))?;
+    let path = exe
+        .parent()
+        .and_then(|examples| examples.parent())
+        .map(|profile| profile.join("proximad"))
+        .ok_or("cannot locate proximad next to this example")?;
+    if !path.exists() {
+        return Err(format!(
+            "{} does not exist: run `cargo build --release` first, or pass --daemon",
+            path.display()
+        ));
+    }
+    Ok(path)
 }
 
 #[cfg(test)]
