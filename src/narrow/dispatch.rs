@@ -165,10 +165,9 @@ pub fn distance(
     limit: f64,
     scratch: &mut NarrowScratch,
 ) -> ShapeDistance {
-    let clock = std::mem::take(&mut scratch.clock);
-    let reached = distance_within(a, b, pose_ab, limit, scratch);
-    scratch.clock = clock;
-    exact(reached)
+    unlimited(scratch, |scratch| {
+        distance_within(a, b, pose_ab, limit, scratch)
+    })
 }
 
 /// [`distance`] under the frame's clock `scratch.clock`, polled by the steps that can take
@@ -216,14 +215,20 @@ pub fn distance_convex(
     limit: f64,
     scratch: &mut NarrowScratch,
 ) -> ShapeDistance {
-    let clock = std::mem::take(&mut scratch.clock);
-    let reached = convex_reach(a, b, pose_ab, limit, scratch);
-    scratch.clock = clock;
-    exact(reached)
+    unlimited(scratch, |scratch| {
+        convex_reach(a, b, pose_ab, limit, scratch)
+    })
 }
 
-/// The answer of a query run on an unlimited clock, which never stops it.
-fn exact(reached: Reached) -> ShapeDistance {
+/// Runs `query` with `scratch.clock` set aside for an unlimited one, which never stops it,
+/// so its answer is exact.
+fn unlimited(
+    scratch: &mut NarrowScratch,
+    query: impl FnOnce(&mut NarrowScratch) -> Reached,
+) -> ShapeDistance {
+    let clock = std::mem::take(&mut scratch.clock);
+    let reached = query(scratch);
+    scratch.clock = clock;
     match reached {
         Reached::Exact(d) => d,
         Reached::Bounded(bound) => bound.at_lower(),
@@ -294,14 +299,8 @@ pub fn manifold(
             out.flip(&pose_ab.to_isometry());
         }
         // Mesh–mesh off the pipeline's route: the one point of `d`.
-        (M(_), M(_)) => {
-            out.reset(DVec3::ZERO);
-            out.set_from_distance(d);
-        }
-        (convex!(), M(mesh)) => {
-            out.reset(DVec3::ZERO);
-            shape_mesh_manifold(a, mesh, pose_ab, d, scratch, out);
-        }
+        (M(_), M(_)) => out.set_from_distance(d),
+        (convex!(), M(mesh)) => shape_mesh_manifold(a, mesh, pose_ab, d, scratch, out),
     }
 }
 

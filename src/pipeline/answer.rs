@@ -276,19 +276,10 @@ fn mesh_mesh_tail(
             // contact is the record's witnesses (its distance's, or its boxes').
             touching = Some(true);
             if result.normal == DVec3::ZERO {
-                let boxes = boxes(
-                    pair,
-                    &a.world_bounds,
-                    &b.world_bounds,
-                    Query::NONE,
-                    &mut Vec::new(),
-                );
-                (result.point_a, result.point_b, result.normal) = (
-                    boxes.result.point_a,
-                    boxes.result.point_b,
-                    boxes.result.normal,
-                );
-                result.error_bound = result.error_bound.max(boxes.result.error_bound);
+                let boxes = world_boxes(pair, a, b);
+                (result.point_a, result.point_b, result.normal) =
+                    (boxes.point_a, boxes.point_b, boxes.normal);
+                result.error_bound = result.error_bound.max(boxes.error_bound);
             }
             contacts.push(witness_contact(&result, 0.0));
         } else if touching.is_none() {
@@ -395,15 +386,7 @@ pub(super) fn mesh_mesh_truncated(
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     debug_assert!(!frontier.is_exact() && frontier.maybe_close);
-    let mut scratch = Vec::new();
-    let boxes = boxes(
-        pair,
-        &a.world_bounds,
-        &b.world_bounds,
-        Query::NONE,
-        &mut scratch,
-    );
-    let mut result = boxes.result;
+    let mut result = world_boxes(pair, a, b);
     if let Some(w) = frontier.witnesses {
         let (point_a, point_b) = (
             a.pose.transform_point(w.point_a),
@@ -425,6 +408,19 @@ pub(super) fn mesh_mesh_truncated(
         touching,
         apart_by: None,
     }
+}
+
+/// The record of `pair` from its bodies' world boxes alone ([`boxes`]): their witnesses,
+/// normal and error bound, for a mesh pair whose own search left none.
+fn world_boxes(pair: &CandidatePair, a: &Body, b: &Body) -> PairResult {
+    boxes(
+        pair,
+        &a.world_bounds,
+        &b.world_bounds,
+        Query::NONE,
+        &mut Vec::new(),
+    )
+    .result
 }
 
 /// The answer for a pair beyond its margins under a query that does not ask the distance:

@@ -7,12 +7,12 @@
 //! Each estimate is the typical cost, a running mean moving an eighth of the way to each
 //! sample, a sample counting at most twice the estimate: a frame is refused only when the
 //! scene's usual uninterruptible work cannot fit, never for one frame the OS descheduled
-//! (a frame whose broad phase runs long is late instead, and its stage times say why). Only broad phases that synced the kept one count (a rebuild, after a new
-//! scene or a frame not started, costs more than the frames that follow). A frame not
-//! started lowers both estimates by a sixty-fourth, so an estimate grown stale (the scene
-//! got cheaper) lets a frame run and be measured again after a few dozen refusals. A scene
-//! whose body count changed by more than an eighth since the estimates were taken is
-//! measured afresh.
+//! (a frame whose broad phase runs long is late instead, and its stage times say why).
+//! Only broad phases that synced the kept one count (a rebuild, after a new scene or a
+//! frame not started, costs more than the frames that follow). A frame not started lowers
+//! both estimates by a sixty-fourth, so an estimate grown stale (the scene got cheaper)
+//! lets a frame run and be measured again after a few dozen refusals. A scene whose body
+//! count changed by more than an eighth since the estimates were taken is measured afresh.
 
 /// The uninterruptible stages' typical times for one scene.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

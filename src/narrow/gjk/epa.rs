@@ -177,10 +177,10 @@ fn face(vs: &[SupportPoint], v: [u32; 3]) -> Face {
 /// whose convex hull holds the origin (GJK outcome `Penetrating` or `Touching`).
 ///
 /// Never NaN for finite input; see the module docs for the fallback.
-#[must_use]
 ///
 /// `clock` is polled before each expansion ([`EXPANSION_WORK`] units); stopped, the answer
 /// is [`EpaOutcome::Stopped`].
+#[must_use]
 pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     a: &A,
     b: &B,
