@@ -21,7 +21,6 @@ mod support;
 mod common;
 
 use common::cycle::cycle_bench;
-use common::mesh_scenes::data_dir;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use proxima::bounding::Obb;
 use proxima::budget::VisitBudget;
@@ -45,9 +44,11 @@ struct RobotChain {
     frames: Vec<[Pose; LINKS + 1]>,
 }
 
-fn robot_chain() -> RobotChain {
+/// `None`, after a line saying so, without the data folder (`PROXIMA_DATA`).
+fn robot_chain() -> Option<RobotChain> {
+    let data = support::data::data_dir_or_skip("frontier/robot-chain")?;
     let load = |name: &str| {
-        let path = data_dir().join("meshes").join(name);
+        let path = data.join("meshes").join(name);
         TriMesh::load(&path)
             .unwrap_or_else(|e| panic!("cannot load {}: {e}", path.display()))
             .scaled(0.001)
@@ -72,7 +73,7 @@ fn robot_chain() -> RobotChain {
             })
         })
         .collect();
-    RobotChain { env, link, frames }
+    Some(RobotChain { env, link, frames })
 }
 
 impl RobotChain {
@@ -96,7 +97,9 @@ impl RobotChain {
 }
 
 fn frontier(c: &mut Criterion) {
-    let scene = robot_chain();
+    let Some(scene) = robot_chain() else {
+        return;
+    };
     let frames: Vec<_> = scene.frames.iter().map(|f| scene.pairs(f)).collect();
     let mut group = c.benchmark_group("frontier");
     // A counted budget of `u64::MAX` never refuses: the exact answers.

@@ -4,7 +4,7 @@
 //! # Scenes
 //! - `bunny-fandisk`: FCL's protocol, the Stanford bunny (×10, 69,451 triangles) against
 //!   fandisk (×0.3, 12,946 triangles) under the 200 transforms of
-//!   `../shared/data/poses/bunny_fandisk.txt` (see [`common::mesh_scenes::bunny_fandisk`]).
+//!   `poses/bunny_fandisk.txt` in the data folder, `PROXIMA_DATA` (see [`common::mesh_scenes::bunny_fandisk`]).
 //! - `tori`: two tori of 10,000 triangles each under 64 random poses from a fixed seed,
 //!   exactly half of them intersecting (see [`common::mesh_scenes::tori`]).
 //!
@@ -378,10 +378,11 @@ fn exact_classifier(a: &TriMesh, b: &TriMesh) -> impl FnMut(&Pose) -> bool + use
 }
 
 fn mesh_pair(c: &mut Criterion) {
-    let all = [
-        Engines::new(bunny_fandisk()),
-        Engines::new(tori(SEED, TORI_POSES, exact_classifier)),
-    ];
+    let all: Vec<Engines> = bunny_fandisk()
+        .into_iter()
+        .chain([tori(SEED, TORI_POSES, exact_classifier)])
+        .map(Engines::new)
+        .collect();
     let queries: [(&str, QueryBench); 4] = [
         ("collide_bool", bench_collide_bool),
         ("contacts", bench_contacts),

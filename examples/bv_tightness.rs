@@ -7,9 +7,13 @@
 //! OBB volume do not divide by zero). Fit time per triangle is printed too.
 //!
 //! ```text
-//! cargo run --release --example bv_tightness                  # meshes in ../shared/data/meshes
+//! cargo run --release --example bv_tightness                  # meshes in the data folder (PROXIMA_DATA)
 //! cargo run --release --example bv_tightness -- A.obj B.stl   # meshes of your own
 //! ```
+
+#[path = "../tests/support/data.rs"]
+#[allow(dead_code)]
+mod data;
 
 use proxima::bounding::{
     Aabb, BoundingSphere, BoundingVolume, Kdop14, Kdop18, Kdop26, Lss, Obb, Rss,
@@ -31,7 +35,9 @@ const BUCKETS: [(usize, &str); 5] = [
 fn main() -> Result<(), Box<dyn Error>> {
     let mut paths: Vec<PathBuf> = std::env::args().skip(1).map(PathBuf::from).collect();
     if paths.is_empty() {
-        let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
+        let dir = data::data_dir()
+            .ok_or("no meshes given and no data folder: set PROXIMA_DATA or name OBJ files")?
+            .join("meshes");
         paths = std::fs::read_dir(&dir)?
             .filter_map(|e| e.ok().map(|e| e.path()))
             .collect();

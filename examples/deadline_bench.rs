@@ -41,6 +41,9 @@
 
 #[path = "scenes/coincident_meshes.rs"]
 mod coincident_meshes;
+#[path = "../tests/support/data.rs"]
+#[allow(dead_code)]
+mod data;
 #[path = "../src/demo/scene.rs"]
 mod demo_scene;
 #[path = "scenes/falling.rs"]
@@ -79,7 +82,7 @@ use report::{Answer, FrameRecord, Row};
 use std::error::Error;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use workloads::{Built, CLASSES, Class, Workload, data_dir};
+use workloads::{Built, CLASSES, Class, Workload};
 
 #[derive(Debug, Parser)]
 #[command(about = "Deadline scorecard of proximad: every scene class, budget by budget")]
@@ -178,7 +181,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let mut bench = Bench {
         session: Session::start(&exe)?,
         exe,
-        data: data_dir(),
+        data: data::data_dir(),
         rows: Vec::new(),
     };
     for class in classes {

@@ -46,6 +46,10 @@
 //! (or `pair`, `largest`) runs the frontier in plain breadth-first rounds instead of its
 //! default stages by width, to measure what the order buys.
 
+#[path = "../tests/support/data.rs"]
+#[allow(dead_code)]
+mod data;
+
 use clap::Parser;
 use plotters::prelude::*;
 use proxima::geometry::{Capsule, Cuboid, Sphere, TriMesh};
@@ -121,7 +125,7 @@ const SCENES: [(&str, &str); 3] = [
     ),
     (
         "robot-chain",
-        "a chain of 6 links of FCL's rob.obj swinging through FCL's env.obj (scaled to metres; needs ../shared/data)",
+        "a chain of 6 links of FCL's rob.obj swinging through FCL's env.obj (scaled to metres; needs the data folder, PROXIMA_DATA)",
     ),
     (
         "primitives",
@@ -253,16 +257,22 @@ fn mesh_pile() -> Workload {
     w
 }
 
-fn data_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes")
+/// The data folder's `meshes/` (`PROXIMA_DATA`, see `tests/support/data.rs`).
+fn meshes_dir() -> Result<PathBuf, Box<dyn Error>> {
+    let dir = data::data_dir().ok_or(
+        "the robot-chain scene needs the data folder: set PROXIMA_DATA \
+         (a folder with meshes/env.obj and meshes/rob.obj)",
+    )?;
+    Ok(dir.join("meshes"))
 }
 
 fn robot_chain() -> Result<Workload, Box<dyn Error>> {
     let mut w = new_workload("robot-chain");
-    let env = TriMesh::load(data_dir().join("env.obj"))?
+    let meshes = meshes_dir()?;
+    let env = TriMesh::load(meshes.join("env.obj"))?
         .scaled(0.001)
         .centered_on_bounds();
-    let rob = TriMesh::load(data_dir().join("rob.obj"))?
+    let rob = TriMesh::load(meshes.join("rob.obj"))?
         .scaled(0.001)
         .centered_on_bounds();
     let link = Arc::new(MeshShape::new(rob));

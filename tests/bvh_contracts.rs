@@ -239,15 +239,7 @@ fn random_meshes_build_valid_trees_of_bounded_depth() {
     for_each_volume!(random_cases(402));
 }
 
-fn shared_mesh(name: &str) -> TriMesh {
-    let path = format!(
-        "{}/../shared/data/meshes/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    TriMesh::load(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
-}
-
-fn shared_mesh_validates<B: BoundingVolume>(mesh: &TriMesh, name: &str, leaf_sizes: &[u32]) {
+fn real_mesh_validates<B: BoundingVolume>(mesh: &TriMesh, name: &str, leaf_sizes: &[u32]) {
     for preset in PRESETS {
         for &leaf_size in leaf_sizes {
             let params = preset.with_leaf_size(leaf_size);
@@ -259,12 +251,20 @@ fn shared_mesh_validates<B: BoundingVolume>(mesh: &TriMesh, name: &str, leaf_siz
 }
 
 #[test]
-fn shared_meshes_build_valid_trees_with_every_preset() {
-    let spot = shared_mesh("spot.obj");
-    shared_mesh_validates::<Obb>(&spot, "spot", &[1]);
-    shared_mesh_validates::<Rss>(&spot, "spot", &[4]);
-    for name in ["rob.obj", "env.obj"] {
-        let mesh = shared_mesh(name);
-        for_each_volume!(shared_mesh_validates(&mesh, name, &LEAF_SIZES));
-    }
+fn real_meshes_build_valid_trees_with_every_preset() {
+    let spot = meshes::data_mesh("spot.obj");
+    real_mesh_validates::<Obb>(&spot, "spot", &[1]);
+    real_mesh_validates::<Rss>(&spot, "spot", &[4]);
+    let rob = meshes::data_mesh("rob.obj");
+    for_each_volume!(real_mesh_validates(&rob, "rob.obj", &LEAF_SIZES));
+}
+
+#[test]
+fn fcl_room_builds_valid_trees_with_every_preset() {
+    let Some(env) =
+        meshes::shared_data_mesh("fcl_room_builds_valid_trees_with_every_preset", "env.obj")
+    else {
+        return;
+    };
+    for_each_volume!(real_mesh_validates(&env, "env.obj", &LEAF_SIZES));
 }

@@ -352,11 +352,12 @@ fn bad_points_are_rejected_with_their_index() {
 
 #[test]
 fn hulls_of_the_real_meshes_contain_every_vertex() {
-    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
-    if !dir.is_dir() {
-        eprintln!("skipped: ../shared/data/meshes not found");
+    let Some(dir) =
+        support::data::data_dir_or_skip("hulls_of_the_real_meshes_contain_every_vertex")
+    else {
         return;
-    }
+    };
+    let dir = dir.join("meshes");
     let mut r = rng(23);
     for name in [
         "env.obj",

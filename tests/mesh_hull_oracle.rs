@@ -1,9 +1,9 @@
-//! Hull proofs on the real meshes of `../shared/data` (FCL's robot link and room, the
+//! Hull proofs on the real meshes of the data folder (`PROXIMA_DATA`) (FCL's robot link and room, the
 //! fandisk, spot and the Stanford bunny, each scaled to about a metre): a hull gap is
 //! never more than the meshes' exact distance by the tree query (a second algorithm,
 //! within its error bound), over random poses where both outcomes occur, and every vertex
 //! left out of a hull lies within its outside allowance, which stays rounding-sized.
-//! Skipped when the data folder is absent.
+//! Skipped, with a line saying so, when the data folder is absent.
 
 #[path = "support/mod.rs"]
 mod support;
@@ -15,7 +15,7 @@ use proxima::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
 use support::{meshes, point_in_cube, rng, rotation};
 
 /// The shared meshes, each scaled so its largest bounding-box edge is 1 m and centred.
-fn unit_meshes() -> Option<Vec<(&'static str, MeshShape)>> {
+fn unit_meshes(who: &str) -> Option<Vec<(&'static str, MeshShape)>> {
     let mut out = Vec::new();
     for name in [
         "rob.obj",
@@ -24,7 +24,7 @@ fn unit_meshes() -> Option<Vec<(&'static str, MeshShape)>> {
         "spot.obj",
         "stanford-bunny.obj",
     ] {
-        let mesh = meshes::shared_data_mesh(name)?;
+        let mesh = meshes::shared_data_mesh(who, name)?;
         let (lo, hi) = mesh.bounds();
         let unit = mesh
             .scaled(1.0 / (hi - lo).max_element())
@@ -36,8 +36,8 @@ fn unit_meshes() -> Option<Vec<(&'static str, MeshShape)>> {
 
 #[test]
 fn hull_gaps_of_real_meshes_never_exceed_their_exact_distance() {
-    let Some(shapes) = unit_meshes() else {
-        eprintln!("../shared/data absent: skipped");
+    let Some(shapes) = unit_meshes("hull_gaps_of_real_meshes_never_exceed_their_exact_distance")
+    else {
         return;
     };
     for (name, shape) in &shapes {

@@ -7,7 +7,6 @@ use proxima::geometry::mesh::ParseReason;
 use proxima::geometry::{MeshError, MeshLimits, TriMesh};
 use proxima::math::DVec3;
 use rand::Rng;
-use std::path::PathBuf;
 use support::{point_in_cube, rng};
 
 /// A box `[-1, 1]³` with each face split into `n × n` quads (two triangles each), welded.
@@ -348,17 +347,13 @@ fn transforms_move_and_scale_the_bounds() {
     assert!((hi - lo - DVec3::splat(4.0)).abs().max_element() < 1e-12);
 }
 
-fn meshes_dir() -> Option<PathBuf> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/meshes");
-    dir.is_dir().then_some(dir)
-}
-
 #[test]
 fn real_meshes_load_with_their_known_counts() {
-    let Some(dir) = meshes_dir() else {
-        eprintln!("skipped: ../shared/data/meshes not found");
+    let Some(dir) = support::data::data_dir_or_skip("real_meshes_load_with_their_known_counts")
+    else {
         return;
     };
+    let dir = dir.join("meshes");
     let expected = [
         ("env.obj", 2180, 6540),
         ("rob.obj", 216, 648),

@@ -11,10 +11,11 @@
 //!
 //! Scenes: piles of eight tori of three sizes with two spheres and two boxes at seeded
 //! random poses (touching, near and apart pairs, asserted to occur), and the fandisk
-//! against a torus (from `../shared/data`, skipped when absent). Budgets: every visit
-//! budget from 0 to the full traversal's visit count (a dense sample when there are more
-//! than [`MAX_BUDGETS`]), with the frontier polling the budget after every entry, so each
-//! budget is its own interruption point. No test measures time.
+//! against a torus (from the data folder, `PROXIMA_DATA`; skipped with a line saying so
+//! when absent). Budgets: every visit budget from 0 to the full traversal's visit count (a
+//! dense sample when there are more than [`MAX_BUDGETS`]), with the frontier polling the
+//! budget after every entry, so each budget is its own interruption point. No test
+//! measures time.
 
 #[path = "support/mod.rs"]
 mod support;
@@ -154,8 +155,8 @@ fn pile(seed: u64) -> Scene {
 
 /// The fandisk (×0.3, about 1.5 m across, 12,946 triangles) and two tori placed against
 /// it: one through it, one near it.
-fn fandisk_scene() -> Option<Scene> {
-    let fandisk = meshes::shared_data_mesh("fandisk.obj")?
+fn fandisk_scene(who: &str) -> Option<Scene> {
+    let fandisk = meshes::shared_data_mesh(who, "fandisk.obj")?
         .scaled(0.3)
         .centered_on_bounds();
     let mut scene = Scene::try_new(0.03, SceneLimits::STANDARD).unwrap();
@@ -445,8 +446,9 @@ fn every_budget_of_tori_piles_is_conservative_monotone_deterministic_and_exact_a
 
 #[test]
 fn every_sampled_budget_of_the_fandisk_against_tori_is_conservative_and_monotone() {
-    let Some(scene) = fandisk_scene() else {
-        eprintln!("../shared/data absent: skipped");
+    let Some(scene) = fandisk_scene(
+        "every_sampled_budget_of_the_fandisk_against_tori_is_conservative_and_monotone",
+    ) else {
         return;
     };
     let mut tally = Tally::default();

@@ -7,7 +7,6 @@ use crate::support::meshes::torus;
 use crate::support::{point_in_cube, rng, rotation};
 use proxima::geometry::TriMesh;
 use proxima::math::{DMat3, DQuat, DVec3, Pose};
-use std::path::Path;
 
 /// Two meshes and the relative poses to query them under.
 pub struct MeshScene {
@@ -21,20 +20,18 @@ pub struct MeshScene {
     pub poses_ab: Vec<Pose>,
 }
 
-/// The shared data directory (`../shared/data` next to the package root).
-pub fn data_dir() -> &'static Path {
-    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"))
-}
-
 /// The bunny×fandisk protocol (FCL's mesh–mesh benchmark): A = the Stanford bunny scaled by
 /// 10, B = fandisk scaled by 0.3, each centred on its bounding box; the 200 transforms of
 /// `poses/bunny_fandisk.txt` place the bunny in the world while fandisk stays at the
 /// identity, so `pose_ab = transform⁻¹`.
 ///
+/// `None`, after a line saying the scene is skipped, when there is no data folder
+/// (`PROXIMA_DATA`, see [`crate::support::data`]).
+///
 /// # Panics
-/// When a data file is missing or malformed (the bench cannot run without it).
-pub fn bunny_fandisk() -> MeshScene {
-    let dir = data_dir();
+/// When a data file in the data folder is missing or malformed.
+pub fn bunny_fandisk() -> Option<MeshScene> {
+    let dir = crate::support::data::data_dir_or_skip("the bunny-fandisk scene")?;
     let load = |name: &str, scale: f64| {
         let path = dir.join("meshes").join(name);
         TriMesh::load(&path)
@@ -45,12 +42,12 @@ pub fn bunny_fandisk() -> MeshScene {
     let poses_path = dir.join("poses/bunny_fandisk.txt");
     let text = std::fs::read_to_string(&poses_path)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", poses_path.display()));
-    MeshScene {
+    Some(MeshScene {
         name: "bunny-fandisk",
         a: load("stanford-bunny.obj", 10.0),
         b: load("fandisk.obj", 0.3),
         poses_ab: parse_transforms(&text).iter().map(Pose::inverse).collect(),
-    }
+    })
 }
 
 /// Transforms from the protocol's text format: `#` comment lines and blank lines are

@@ -17,7 +17,7 @@ use proxima::scene::Scene;
 use proxima_ipc::client::{Client, Motion, Primitive};
 use proxima_ipc::wire::{PoseRecord, ResultRecord, query};
 use std::error::Error;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 /// A scene's bodies from one frame to the next, as its client moves them.
@@ -124,16 +124,6 @@ pub const CLASSES: [Class; 6] = [
         needs_data: false,
     },
 ];
-
-/// The data folder: `PROXIMA_DATA`, else `<manifest>/../shared/data` when it exists.
-#[must_use]
-pub fn data_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("PROXIMA_DATA").map_or_else(
-        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-        PathBuf::from,
-    );
-    dir.join("meshes").is_dir().then_some(dir)
-}
 
 /// Registers `spec` on the daemon and builds its mirror; checks the ids agree.
 fn register(

@@ -285,11 +285,12 @@ mod tests {
         assert_eq!(choice(meshes::torus(0.4, 0.12, 32, 16)), QueryVolume::Rss);
         let slab = meshes::subdivided_cuboid(DVec3::new(1.0, 0.6, 0.3), 6);
         assert_eq!(choice(slab), QueryVolume::Obb);
-        // The meshes the rule was measured on, when the shared data is present.
-        for file in ["rob.obj", "env.obj"] {
-            if let Some(m) = meshes::shared_data_mesh(file) {
-                assert_eq!(choice(m), QueryVolume::Obb, "{file}");
-            }
+        // The meshes the rule was measured on: FCL's robot link (in the repository) and
+        // room (in the data folder, when present).
+        assert_eq!(choice(meshes::data_mesh("rob.obj")), QueryVolume::Obb);
+        let who = "the_frontier_takes_boxes_for_box_like_meshes (FCL's room)";
+        if let Some(m) = meshes::shared_data_mesh(who, "env.obj") {
+            assert_eq!(choice(m), QueryVolume::Obb);
         }
         let pair = QueryVolume::for_pair;
         assert_eq!(pair(QueryVolume::Obb, QueryVolume::Obb), QueryVolume::Obb);

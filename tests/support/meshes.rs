@@ -233,12 +233,12 @@ pub fn data_mesh(file: &str) -> TriMesh {
     TriMesh::load(&path).unwrap_or_else(|e| panic!("cannot load {}: {e}", path.display()))
 }
 
-/// A mesh of `../shared/data/meshes` (real meshes, not part of the repository; see its
-/// README), or `None` when that folder is not beside the checkout: tests using it skip.
-pub fn shared_data_mesh(file: &str) -> Option<TriMesh> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/meshes")
-        .join(file);
-    path.exists()
-        .then(|| TriMesh::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
+/// A mesh of the data folder's `meshes/` (real meshes, not part of the repository; see
+/// [`super::data`]), or `None` after the visible line saying that the suite `who` skipped.
+///
+/// # Panics
+/// When the data folder exists but the mesh does not load.
+pub fn shared_data_mesh(who: &str, file: &str) -> Option<TriMesh> {
+    let path = super::data::mesh_path_or_skip(who, file)?;
+    Some(TriMesh::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())))
 }

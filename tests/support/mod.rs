@@ -10,6 +10,7 @@ use proxima::math::{DQuat, DVec3, Isometry, Pose};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
+pub mod data;
 pub mod meshes;
 pub mod pair_queries;
 pub mod triangle_pairs;
