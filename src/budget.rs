@@ -27,6 +27,15 @@ pub trait Budget {
     fn is_unlimited(&self) -> bool {
         false
     }
+
+    /// When the [`WorkClock`] of the work polled outside visit counts (the narrow routes,
+    /// the pair loop, time of impact) stops under this budget: at its deadline when it has
+    /// one, else never (a counted budget counts the frontier's visits only, so the narrow
+    /// routes stay exact under it).
+    #[must_use]
+    fn stop(&self) -> Stop {
+        self.deadline().map_or(Stop::Never, Stop::At)
+    }
 }
 
 /// A counted budget: allows work while fewer than `0` visits were made (so `VisitBudget(0)`
@@ -166,6 +175,15 @@ impl WorkClock {
     pub fn stopped(&self) -> bool {
         self.stopped
     }
+
+    /// Moves the instant of a [`Stop::At`] clock (others are left as they are): the frame
+    /// moves it as the work left after the clock stops shrinks or grows. Takes effect at
+    /// the clock's next read of the time; a stopped clock stays stopped.
+    pub fn move_stop(&mut self, instant: Instant) {
+        if let Stop::At(at) = &mut self.stop {
+            *at = instant;
+        }
+    }
 }
 
 #[cfg(test)]
@@ -198,5 +216,25 @@ mod tests {
         assert!((0..1000).all(|_| counted.allows(3)) && !counted.allows(3));
         let mut never = WorkClock::default();
         assert!((0..1000).all(|_| never.allows(u64::MAX / 2)));
+    }
+
+    #[test]
+    fn a_moved_stop_takes_effect_at_the_next_read() {
+        let now = Instant::now();
+        let mut clock = WorkClock::new(Stop::At(now + Duration::from_secs(3600)));
+        assert!(clock.allows(1), "the first read: an hour left");
+        clock.move_stop(now);
+        let allowed = (0..WORK_PER_CLOCK_READ)
+            .take_while(|_| clock.allows(1))
+            .count();
+        assert_eq!(
+            allowed as u64,
+            WORK_PER_CLOCK_READ - 1,
+            "the units before the next read"
+        );
+        assert!(clock.stopped());
+        let mut counted = WorkClock::new(Stop::AfterWork(2));
+        counted.move_stop(now);
+        assert!(counted.allows(1) && counted.allows(1) && !counted.allows(1));
     }
 }

@@ -295,8 +295,8 @@ pub struct ResultFrameHeader {
     pub stage_ns: [u64; stage::COUNT],
     /// Bits of [`frame_flags`] (undefined bits 0; since protocol version 8).
     pub flags: u32,
-    /// Candidate pairs the broad phase found beyond the daemon's per-frame limit and did not
-    /// answer (with [`frame_flags::PAIRS_CAPPED`]); 0 otherwise.
+    /// Candidate pairs the broad phase found beyond the daemon's per-frame limit or the
+    /// frame's budget and did not answer (with [`frame_flags::PAIRS_CAPPED`]); 0 otherwise.
     pub dropped_candidates: u32,
     /// With [`frame_flags::BUDGET_TOO_SMALL`]: the smallest budget the daemon measured for
     /// this scene's frames, nanoseconds (its ingest plus the typical time of the stages no
@@ -307,9 +307,10 @@ pub struct ResultFrameHeader {
 /// Bits of [`ResultFrameHeader::flags`].
 pub mod frame_flags {
     /// The broad phase found more candidate pairs than the daemon answers in one frame
-    /// (its `max_pairs_per_frame` limit): the frame answers the first of them and counts
-    /// the rest in `dropped_candidates`. Its pairs are a sample, and a pair left out may
-    /// touch.
+    /// (its `max_pairs_per_frame` limit, or more than even their conservative answers fit
+    /// in the frame's budget, measured on the scene; at least 256 are always answered):
+    /// the frame answers the first of them and counts the rest in `dropped_candidates`.
+    /// Its pairs are a sample, and a pair left out may touch.
     pub const PAIRS_CAPPED: u32 = 1 << 0;
     /// The frame's budget could not hold the work no deadline can interrupt, as measured on
     /// this scene: the daemon did not start it and answers nothing (`completeness`

@@ -6,9 +6,9 @@
 //! where the next frame's motion starts (refused frames apply no pose and end nothing).
 //!
 //! A frame with a budget (`budget_ns > 0`) runs [`pipeline::step_within`] with a
-//! [`Deadline`] at the frame's receipt plus its budget (the pipeline keeps
-//! [`FRONTIER_RESERVE`](pipeline::FRONTIER_RESERVE) of it for the narrow phase and this
-//! publishing); `budget_ns == 0` runs the exact [`pipeline::step`].
+//! [`Deadline`] at the frame's receipt plus its budget (the pipeline keeps back the time
+//! this publishing takes, measured per record and told it by
+//! [`PipelineWorkspace::note_publish`]); `budget_ns == 0` runs the exact [`pipeline::step`].
 //!
 //! The header carries the pipeline's own [`StepReport`]: its completeness (with
 //! `Truncated`, the shallowest level any pair stopped at in `deepest_level`), broad, mid
@@ -214,7 +214,8 @@ impl<S: Service> SceneFrames<S> {
             }
         }
         let publish_ns = self.publish(result, key.received, header.budget_ns)?;
-        self.workspace.note_publish(publish_ns);
+        let records = self.output.record_count() as u64;
+        self.workspace.note_publish(publish_ns, records);
         Ok(true)
     }
 

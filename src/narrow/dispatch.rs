@@ -118,7 +118,7 @@ pub fn route<'s>(a: &'s Shape, b: &'s Shape) -> Route<'s> {
 /// Whether the pair's exact answer costs about what the conservative answer of its world
 /// boxes costs: a sphere against a sphere, capsule or cuboid, whose closed forms take
 /// 2.5–14 ns (`benches/narrow_phase.rs`, README). Such a pair is answered exactly even once
-/// the frame's deadline is near (`crate::pipeline::PUBLISH_RESERVE`): its box answer would save
+/// the frame's deadline is near (`crate::pipeline::FrameCosts::tail_ns`): its box answer would save
 /// nothing and, for a sphere whose box corners lie outside it, often report it close.
 pub fn exact_costs_no_more_than_boxes(a: &Shape, b: &Shape) -> bool {
     use Shape::{Capsule as C, Cuboid as B, Sphere as S};

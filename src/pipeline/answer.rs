@@ -42,8 +42,6 @@ pub(super) struct Answer {
 #[derive(Debug, Default)]
 pub(super) struct MeshScratch {
     pub traversal: MeshMeshWorkspace,
-    /// The clock the exact contacts poll (unlimited unless the pipeline sets the frame's).
-    pub clock: WorkClock,
     /// Every intersection segment end of the pair being answered, A's frame.
     points: Vec<DVec3>,
     /// The contact normal (A's triangle normal) of each entry of `points`.
@@ -183,7 +181,7 @@ pub(super) fn mesh_mesh(
     (b, mb): (&Body, &MeshShape),
     query: Query,
     cache: &mut DistanceCache,
-    scratch: &mut MeshScratch,
+    (scratch, clock): (&mut MeshScratch, &mut WorkClock),
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     let pose_ab = Pose::relative(&a.pose, &b.pose);
@@ -223,7 +221,7 @@ pub(super) fn mesh_mesh(
         &pose_ab,
         query,
         known,
-        scratch,
+        (scratch, clock),
         contacts,
     )
 }
@@ -248,7 +246,7 @@ fn mesh_mesh_tail(
     pose_ab: &Pose,
     query: Query,
     known: Option<KnownDistance>,
-    scratch: &mut MeshScratch,
+    (scratch, clock): (&mut MeshScratch, &mut WorkClock),
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     let mut result = empty_record(pair);
@@ -265,7 +263,7 @@ fn mesh_mesh_tail(
     }
     if query.contacts && touching != Some(false) {
         let first = contacts.len();
-        let finished = mesh_manifold(a, ma, mb, pose_ab, scratch, contacts);
+        let finished = mesh_manifold(a, (ma, mb), pose_ab, (scratch, clock), contacts);
         if let Some(c) = contacts.get(first) {
             touching = Some(true);
             if !(query.close || query.distance) {
@@ -319,7 +317,7 @@ pub(super) fn mesh_mesh_finished(
     query: Query,
     frontier: &FrontierAnswer,
     cache: &mut DistanceCache,
-    scratch: &mut MeshScratch,
+    (scratch, clock): (&mut MeshScratch, &mut WorkClock),
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     debug_assert!(frontier.is_exact());
@@ -350,7 +348,8 @@ pub(super) fn mesh_mesh_finished(
                 &mut scratch.traversal,
             );
         if query.distance || grazing {
-            return mesh_mesh(pair, (a, ma), (b, mb), query, cache, scratch, contacts);
+            let mesh = (scratch, clock);
+            return mesh_mesh(pair, (a, ma), (b, mb), query, cache, mesh, contacts);
         }
         // The frontier's lower bound may be a triangle distance, which rounding can put
         // above the truth.
@@ -364,7 +363,7 @@ pub(super) fn mesh_mesh_finished(
         &pose_ab,
         query,
         known.filter(|_| wants_distance),
-        scratch,
+        (scratch, clock),
         contacts,
     )
 }
@@ -459,15 +458,13 @@ fn empty_record(pair: &CandidatePair) -> PairResult {
 /// they cancel, the normal of the first kept point's contact.
 fn mesh_manifold(
     a: &Body,
-    ma: &MeshShape,
-    mb: &MeshShape,
+    (ma, mb): (&MeshShape, &MeshShape),
     pose_ab: &Pose,
-    scratch: &mut MeshScratch,
+    (scratch, clock): (&mut MeshScratch, &mut WorkClock),
     contacts: &mut Vec<ContactPoint>,
 ) -> bool {
     let MeshScratch {
         traversal,
-        clock,
         points,
         normals,
         kept,

@@ -1,8 +1,14 @@
-//! What a scene's frames must spend whatever their budget: the stages that cannot be
-//! interrupted (the broad phase, and the daemon's writing and publishing of the result),
-//! measured on the scene's own frames. The plan reads it before any work starts: a frame
-//! whose budget cannot hold this work is not started, and says so with the smallest
-//! budget measured ([`FrameCosts::mandatory_ns`]).
+//! What a scene's frames must spend whatever their budget, measured on the scene's own
+//! frames: the stages that cannot be interrupted (the broad phase, and the daemon's writing
+//! and publishing of the result), and the *tail* of a cut-short frame (each pair left when
+//! the frame's clock stops still gets its conservative answer, and every record is then
+//! published). The plan reads it before and during the work:
+//! - a frame whose budget cannot hold the uninterruptible work is not started, and says so
+//!   with the smallest budget measured ([`FrameCosts::mandatory_ns`]);
+//! - a frame with more candidate pairs than its budget can answer even conservatively
+//!   answers a sample of them ([`FrameCosts::pairs_that_fit`]);
+//! - the frontier and the pair loop stop early enough for the tail
+//!   ([`FrameCosts::tail_ns`]).
 //!
 //! Each estimate is the typical cost, a running mean moving an eighth of the way to each
 //! sample, a sample counting at most twice the estimate: a frame is refused only when the
@@ -10,17 +16,38 @@
 //! (a frame whose broad phase runs long is late instead, and its stage times say why).
 //! Only broad phases that synced the kept one count (a rebuild, after a new scene or a
 //! frame not started, costs more than the frames that follow). A frame not started lowers
-//! both estimates by a sixty-fourth, so an estimate grown stale (the scene got cheaper)
-//! lets a frame run and be measured again after a few dozen refusals. A scene whose body
-//! count changed by more than an eighth since the estimates were taken is measured afresh.
+//! the broad phase and publish estimates by a sixty-fourth, so an estimate grown stale
+//! (the scene got cheaper) lets a frame run and be measured again after a few dozen
+//! refusals. A scene whose body count changed by more than an eighth since the estimates
+//! were taken is measured afresh.
 
-/// The uninterruptible stages' typical times for one scene.
+use std::time::Instant;
+
+/// The cost of one pair in a frame's tail until the scene's own is measured, picoseconds:
+/// a conservative answer from separating axes or world boxes and its record (tens to
+/// hundreds of nanoseconds on the 2-core VM, `benches/narrow_phase.rs`'s `proxima-bound`).
+pub const DEFAULT_TAIL_PS_PER_PAIR: u64 = 250_000;
+
+/// Fewest pairs in a tail for its time to be a sample of the per-pair cost (fewer are
+/// dominated by the clock's reads and the cache misses of the first).
+const MIN_TAIL_SAMPLE_PAIRS: usize = 16;
+
+/// Records a conservative pair adds at most: its pair record and one contact.
+const RECORDS_PER_TAIL_PAIR: u64 = 2;
+
+/// The scene's measured costs (module docs).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FrameCosts {
     /// Broad phase, nanoseconds.
     broad_ns: u64,
-    /// Writing and publishing the result frame, nanoseconds (told by the caller).
+    /// Writing and publishing the result frame, nanoseconds (told by the caller; 0 when it
+    /// publishes nothing, as a library caller does).
     publish_ns: u64,
+    /// Records (pairs, contacts, times of impact) of the frames `publish_ns` was measured
+    /// on, a running mean as `publish_ns`.
+    publish_records: u64,
+    /// A tail pair's answer, picoseconds (0: not measured yet).
+    tail_ps_per_pair: u64,
     /// Body count of the scene when the estimates were taken (0: none yet).
     bodies: usize,
 }
@@ -32,13 +59,23 @@ impl FrameCosts {
         self.broad_ns = typical(self.broad_ns, ns);
     }
 
-    /// Records how long the caller took to write and publish a frame's result.
-    pub fn note_publish(&mut self, ns: u64) {
+    /// Records how long the caller took to write and publish a frame's result of `records`
+    /// records.
+    pub fn note_publish(&mut self, ns: u64, records: u64) {
         self.publish_ns = typical(self.publish_ns, ns);
+        self.publish_records = typical(self.publish_records, records);
     }
 
-    /// Records a frame not started for lack of budget: both estimates fade by a
-    /// sixty-fourth.
+    /// Records the time of a frame's tail: `pairs` pairs answered after its clock stopped.
+    pub fn note_tail(&mut self, ns: u64, pairs: usize) {
+        if pairs >= MIN_TAIL_SAMPLE_PAIRS {
+            let sample = ns.saturating_mul(1000) / pairs as u64;
+            self.tail_ps_per_pair = typical(self.tail_ps_per_pair, sample);
+        }
+    }
+
+    /// Records a frame not started for lack of budget: the broad phase and publish
+    /// estimates fade by a sixty-fourth.
     pub fn note_skipped(&mut self) {
         self.broad_ns -= self.broad_ns / 64;
         self.publish_ns -= self.publish_ns / 64;
@@ -52,12 +89,88 @@ impl FrameCosts {
             .then(|| self.broad_ns.saturating_add(self.publish_ns))
     }
 
+    /// The time publishing `records` records takes, nanoseconds: the typical publish time,
+    /// scaled up in proportion for more records than typical (an upper estimate: the part
+    /// of it that does not grow with the records is scaled too).
+    #[must_use]
+    pub fn publish_estimate_ns(&self, records: u64) -> u64 {
+        if records <= self.publish_records {
+            return self.publish_ns;
+        }
+        let scaled = u128::from(self.publish_ns) * u128::from(records + 1)
+            / u128::from(self.publish_records + 1);
+        u64::try_from(scaled).unwrap_or(u64::MAX)
+    }
+
+    /// The time the tail of a frame takes from here, nanoseconds: `pairs_left` pairs
+    /// answered conservatively, then `records` records and theirs published.
+    #[must_use]
+    pub fn tail_ns(&self, pairs_left: usize, records: usize) -> u64 {
+        let per_pair = match self.tail_ps_per_pair {
+            0 => DEFAULT_TAIL_PS_PER_PAIR,
+            ps => ps,
+        };
+        let pairs = pairs_left as u64;
+        let answers = pairs.saturating_mul(per_pair) / 1000;
+        let records = (records as u64).saturating_add(pairs * RECORDS_PER_TAIL_PAIR);
+        answers.saturating_add(self.publish_estimate_ns(records))
+    }
+
+    /// The most of `candidates` pairs whose tail ([`tail_ns`](Self::tail_ns) from no
+    /// records) fits in `left_ns` nanoseconds: all of them when they fit, else a sample's
+    /// size (at least 0).
+    #[must_use]
+    pub fn pairs_that_fit(&self, candidates: usize, left_ns: u64) -> usize {
+        if self.tail_ns(candidates, 0) <= left_ns {
+            return candidates;
+        }
+        // The tail grows with the pairs: the largest count that fits, by bisection.
+        let (mut fits, mut too_many) = (0, candidates);
+        while too_many - fits > 1 {
+            let mid = fits + (too_many - fits) / 2;
+            if self.tail_ns(mid, 0) <= left_ns {
+                fits = mid;
+            } else {
+                too_many = mid;
+            }
+        }
+        fits
+    }
+
     fn forget_if_changed(&mut self, bodies: usize) {
         if changed(self.bodies, bodies) {
             *self = Self {
                 bodies,
+                // What a pair's conservative answer costs does not depend on the scene's size.
+                tail_ps_per_pair: self.tail_ps_per_pair,
                 ..Self::default()
             };
+        }
+    }
+}
+
+/// Times a frame's tail: from the first pair its clock stopped to the end of its pairs.
+#[derive(Debug, Default)]
+pub(super) struct TailTimer {
+    /// When the tail began, and the pairs left then (that one included).
+    began: Option<(Instant, usize)>,
+}
+
+impl TailTimer {
+    /// Marks a pair answered conservatively because the clock stopped, with `pairs_left`
+    /// pairs left (it included); only the first mark counts.
+    pub(super) fn begin(&mut self, pairs_left: usize) {
+        if self.began.is_none() {
+            self.began = Some((Instant::now(), pairs_left));
+        }
+    }
+
+    /// Ends the frame's pairs: records the tail's time per pair in `costs`, when there was
+    /// one.
+    pub(super) fn end(self, costs: &mut FrameCosts) {
+        if let Some((began, pairs)) = self.began {
+            let ns = u64::try_from(began.elapsed().as_nanos()).unwrap_or(u64::MAX);
+            costs.note_tail(ns, pairs);
         }
     }
 }
@@ -91,7 +204,7 @@ mod tests {
         let mut costs = FrameCosts::default();
         assert_eq!(costs.mandatory_ns(100), None, "nothing measured yet");
         costs.note_broad(100, 8_000);
-        costs.note_publish(800);
+        costs.note_publish(800, 10);
         assert_eq!(
             costs.mandatory_ns(100),
             Some(8_800),
@@ -105,7 +218,7 @@ mod tests {
         );
         for _ in 0..100 {
             costs.note_broad(100, 24_000);
-            costs.note_publish(800);
+            costs.note_publish(800, 10);
         }
         let settled = costs.mandatory_ns(100).unwrap();
         assert!((24_700..=24_800).contains(&settled), "{settled}");
@@ -127,7 +240,7 @@ mod tests {
     fn a_scene_that_grew_or_shrank_by_more_than_an_eighth_is_measured_afresh() {
         let mut costs = FrameCosts::default();
         costs.note_broad(800, 9_000);
-        costs.note_publish(1_000);
+        costs.note_publish(1_000, 10);
         assert_eq!(costs.mandatory_ns(900), Some(10_000), "within an eighth");
         assert_eq!(costs.mandatory_ns(901), None);
         assert_eq!(costs.mandatory_ns(699), None);
@@ -137,5 +250,35 @@ mod tests {
             Some(2_000),
             "publish forgotten too"
         );
+    }
+
+    #[test]
+    fn the_tail_grows_with_its_pairs_and_records_and_bounds_the_sample() {
+        let mut costs = FrameCosts::default();
+        assert_eq!(
+            costs.tail_ns(1000, 0),
+            1000 * DEFAULT_TAIL_PS_PER_PAIR / 1000,
+            "nothing published: the default per pair"
+        );
+        costs.note_publish(2_000, 99);
+        costs.note_tail(10_000, 100);
+        assert_eq!(
+            costs.tail_ns(0, 0),
+            2_000,
+            "typical records: the typical publish"
+        );
+        // 100 ns a pair; 2 records each, 300 in all: 3× the typical 100 records' publish.
+        assert_eq!(costs.tail_ns(100, 100), 10_000 + 2_000 * 301 / 100);
+        costs.note_tail(1_000_000, 4);
+        assert_eq!(
+            costs.tail_ns(1, 0),
+            100 + 2_000,
+            "a tail of 4 pairs is no sample"
+        );
+        let left = 50_000;
+        let fits = costs.pairs_that_fit(10_000, left);
+        assert!(costs.tail_ns(fits, 0) <= left && costs.tail_ns(fits + 1, 0) > left);
+        assert_eq!(costs.pairs_that_fit(10, left), 10, "all of few pairs");
+        assert_eq!(costs.pairs_that_fit(10, 0), 0);
     }
 }

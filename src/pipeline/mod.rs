@@ -81,8 +81,9 @@ pub mod workers;
 pub use crate::budget::Budget;
 pub use crate::narrow::dispatch::PathCounts;
 pub use costs::FrameCosts;
+use costs::TailTimer;
 pub use plan::{
-    Deadline, FRONTIER_RESERVE, PUBLISH_RESERVE, Unlimited, VisitBudget, frontier_deadline,
+    Deadline, FRONTIER_RESERVE, MIN_ANSWERED_PAIRS, Unlimited, VisitBudget, frontier_deadline,
 };
 use plan::{FramePlan, PairPlan, mandatory_work_fits};
 pub use toi::{PairToi, TOI_TOLERANCE};
@@ -102,7 +103,7 @@ use frontier_run::{FrontierRun, run_frontier};
 use pair_memory::PairMemories;
 use separation::mark_separated;
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 use toi::answer_tois;
 pub use workers::{MIN_PARALLEL_MESH_PAIRS, WorkerPool};
 use workers::{MeshJob, MeshOutcome};
@@ -275,6 +276,14 @@ pub struct FrameResults {
     pub tois: Vec<PairToi>,
 }
 
+impl FrameResults {
+    /// Records written so far: pairs, contacts and times of impact.
+    #[must_use]
+    pub fn record_count(&self) -> usize {
+        self.pairs.len() + self.contacts.len() + self.tois.len()
+    }
+}
+
 /// Whether a frame's answers are all exact: `Truncated` at the shallowest level any pair
 /// stopped at (0 = world boxes) when some pairs carry a conservative answer.
 pub use crate::budget::Completeness;
@@ -343,8 +352,9 @@ pub struct StepReport {
     pub truncated_tois: u32,
     /// Candidate pairs (and swept candidates) the broad phase found beyond the scene's
     /// [`SceneLimits::max_pairs_per_frame`](crate::scene::SceneLimits::max_pairs_per_frame),
-    /// not answered this frame: the frame's pairs are then a sample, and a pair left out
-    /// may touch.
+    /// or beyond what the frame's deadline leaves time to answer even conservatively
+    /// ([`FrameCosts::pairs_that_fit`], at least [`MIN_ANSWERED_PAIRS`]), not answered this
+    /// frame: the frame's pairs are then a sample, and a pair left out may touch.
     pub dropped_candidates: u32,
     /// Set when the frame was not started: its budget could not hold the scene's
     /// uninterruptible work (the broad phase and publishing, [`FrameCosts`]), whose
@@ -402,10 +412,11 @@ impl PipelineWorkspace {
         self.narrow.paths = PathCounts::default();
     }
 
-    /// Records how long the caller took to write and publish a frame's results,
-    /// nanoseconds: part of the work a frame of this scene cannot skip ([`FrameCosts`]).
-    pub fn note_publish(&mut self, ns: u64) {
-        self.costs.note_publish(ns);
+    /// Records how long the caller took to write and publish a frame's results of
+    /// `records` records (pairs, contacts, times of impact), nanoseconds: part of the work
+    /// a frame of this scene cannot skip ([`FrameCosts`]).
+    pub fn note_publish(&mut self, ns: u64, records: u64) {
+        self.costs.note_publish(ns, records);
     }
 
     /// A workspace that answers mesh–mesh pairs on `workers` too (when a frame has at least
@@ -475,8 +486,8 @@ pub fn step(
 /// before the leaves and descends every node pair: about 1.5× the visits on the test
 /// piles, and still about 50× those of `CLOSE`: `DISTANCE` is the costly query under a
 /// budget.) The frontier runs on the calling thread under `budget`; a [`Deadline`] is
-/// moved earlier by [`FRONTIER_RESERVE`] or a quarter of the budget ([`frontier_deadline`]) to leave time for the rest
-/// of the frame.
+/// moved earlier ([`frontier_deadline`]) by the frame's tail (below) and by
+/// [`FRONTIER_RESERVE`] or a quarter of the rest, to leave time for the rest of the frame.
 ///
 /// When last frame's frontier was cut short and every one of its pairs is still a
 /// candidate with both bodies unchanged (same scene, same query), it *resumes* where it
@@ -500,7 +511,9 @@ pub fn step(
 /// ([`StepReport::mid_ns`]).
 ///
 /// The pairs outside the frontier (closed forms, GJK/EPA, convex–mesh walks) keep to a
-/// wall-clock deadline too: once it is within [`PUBLISH_RESERVE`] (checked every few
+/// wall-clock deadline too: once it is within the frame's *tail* (the conservative answers
+/// of the pairs left and the publishing of every record, by the scene's measured
+/// [`FrameCosts::tail_ns`], re-estimated before each pair; the clock is read every few
 /// pairs), each remaining one gets a conservative answer (level 0), counted in
 /// [`StepReport::truncated_pairs`]: capsules and cuboids among themselves their
 /// [`DistanceBound`](crate::narrow::contact::DistanceBound)s (exact distances where the
@@ -513,10 +526,12 @@ pub fn step(
 /// ([`NarrowScratch::clock`](crate::narrow::dispatch::NarrowScratch::clock)): a convex
 /// shape's walk of a mesh and EPA stop there with bounds on the distance
 /// ([`Reached::Bounded`](crate::narrow::Reached)), answered as the separating-axis bounds
-/// are. Counted budgets leave them exact. Not yet budgeted: the broad phase, the exact
-/// contacts of finished touching mesh pairs and time of impact's single searches run to
-/// completion whatever the budget (the frontier's reserve is for them). The worker pool is
-/// not used for a budgeted frontier (one thread).
+/// are, and so do the exact contacts of touching mesh pairs. Counted budgets leave them
+/// exact. A frame with more candidates than even their conservative answers fit in the
+/// time left after the broad phase ([`FrameCosts::pairs_that_fit`]) answers the first
+/// that fit, counted in [`StepReport::dropped_candidates`]. Not yet budgeted: the broad
+/// phase and time of impact's single distance queries run to completion whatever the
+/// budget. The worker pool is not used for a budgeted frontier (one thread).
 ///
 /// # Allocation
 /// As [`step`], plus, with a limited budget, one list of the frame's frontier pairs (it
@@ -551,8 +566,12 @@ pub fn step_within(
     }
     let started = Instant::now();
     let mut plan = FramePlan::new(&*budget, query);
-    workspace.narrow.clock = plan.narrow_clock();
-    workspace.mesh.clock = plan.narrow_clock();
+    let over_time = plan.cap_to_time(
+        &workspace.costs,
+        &mut workspace.candidates,
+        &mut workspace.toi_candidates,
+    );
+    workspace.narrow.clock = plan.clock();
     let (hull_tests, frontier) = mid_phase(scene, query, budget, &plan, started, workspace);
     let mid_ns = if plan.limited { elapsed_ns(started) } else { 0 };
     // Unbudgeted, the hull tests answer pairs as the narrow phase does: its time.
@@ -562,8 +581,8 @@ pub fn step_within(
         started
     };
     plan.pool = answer_on_pool(scene, query, &plan, workspace);
-    let tally = answer_candidates(scene, query, &mut plan, workspace, results);
-    let tois = answer_tois(scene, &*budget, workspace, results);
+    let tally = answer_candidates(scene, query, &plan, workspace, results);
+    let tois = answer_tois(scene, &plan, workspace, results);
     let completeness = if tois.expired {
         tally.completeness.truncated_at(0)
     } else {
@@ -589,7 +608,7 @@ pub fn step_within(
         frontier,
         truncated_pairs: tally.truncated,
         truncated_tois: tois.truncated,
-        dropped_candidates: index(broad.dropped),
+        dropped_candidates: index(broad.dropped + over_time),
         budget_too_small: None,
     }
 }
@@ -610,7 +629,11 @@ fn mid_phase(
         let tests = mark_separated(scene, query, None, workspace);
         return (tests, FrontierStats::default());
     }
-    let mut reserved = budget.deadline().map(|d| frontier_deadline(started, d));
+    let pairs = workspace.candidates.len() + workspace.toi_candidates.len();
+    let tail = Duration::from_nanos(workspace.costs.tail_ns(pairs, 0));
+    let mut reserved = budget
+        .deadline()
+        .map(|d| frontier_deadline(started, d, tail));
     let frontier_budget: &mut dyn Budget = match reserved.as_mut() {
         Some(deadline) => deadline,
         None => budget,
@@ -687,7 +710,7 @@ struct PairTally {
 fn answer_candidates(
     scene: &Scene,
     query: Query,
-    plan: &mut FramePlan,
+    plan: &FramePlan,
     workspace: &mut PipelineWorkspace,
     results: &mut FrameResults,
 ) -> PairTally {
@@ -699,6 +722,7 @@ fn answer_candidates(
     };
     let PipelineWorkspace {
         candidates,
+        toi_candidates,
         memory,
         separated,
         frontier_answers,
@@ -707,6 +731,7 @@ fn answer_candidates(
         narrow,
         manifold,
         mesh,
+        costs,
         ..
     } = workspace;
     let mut sources = AnswerSources {
@@ -716,7 +741,15 @@ fn answer_candidates(
         manifold,
         mesh,
     };
+    let mut tail = TailTimer::default();
     for (slot, pair) in candidates.iter().enumerate() {
+        let left = candidates.len() - slot + toi_candidates.len();
+        plan.pace(
+            &mut sources.narrow.clock,
+            costs,
+            left,
+            results.record_count(),
+        );
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let first_contact = results.contacts.len();
         if let Some(k) = memory.visit(scene, pair, query) {
@@ -727,7 +760,15 @@ fn answer_candidates(
             continue;
         }
         let shapes = (shape(scene, a), shape(scene, b));
-        let pair_plan = plan.pair(shapes.0, shapes.1, separated[slot]);
+        let pair_plan = plan.pair(
+            shapes.0,
+            shapes.1,
+            separated[slot],
+            &mut sources.narrow.clock,
+        );
+        if matches!(pair_plan, PairPlan::Conservative) {
+            tail.begin(candidates.len() - slot);
+        }
         let (answer, truncated_level) = sources.answer(
             query,
             (slot, pair),
@@ -755,6 +796,7 @@ fn answer_candidates(
         report(query, answer, (a, b), first_contact, results);
     }
     memory.forget_unvisited();
+    tail.end(costs);
     tally
 }
 
@@ -816,7 +858,7 @@ impl AnswerSources<'_> {
                             query,
                             found,
                             cache,
-                            mesh,
+                            (mesh, &mut narrow.clock),
                             contacts,
                         ),
                         None,
@@ -836,7 +878,8 @@ impl AnswerSources<'_> {
             PairPlan::MeshMesh(ma, mb) => {
                 narrow.paths.mesh_mesh += 1;
                 let cache = &mut memory.entry(pair).mesh_cache;
-                answer::mesh_mesh(pair, (a, ma), (b, mb), query, cache, self.mesh, contacts)
+                let mesh = (&mut *self.mesh, &mut narrow.clock);
+                answer::mesh_mesh(pair, (a, ma), (b, mb), query, cache, mesh, contacts)
             }
         };
         (answer, None)

@@ -1,6 +1,10 @@
 //! The plan of a frame ([`step_within`](super::step_within)), decided before the work
 //! starts: how its budget is split (the frontier's deadline, the time kept back for the
-//! work after it) and, per candidate pair, which route answers it ([`PairPlan`]).
+//! work after it), how many candidates it can answer at all, and, per candidate pair,
+//! which route answers it ([`PairPlan`]). The time kept back comes from the scene's
+//! measured [`FrameCosts`]: the frame's *tail* (each pair left when the clock stops still
+//! gets its conservative answer, and every record is published) is reserved out of the
+//! budget, and re-estimated before each pair.
 
 use super::costs::FrameCosts;
 use super::{MIN_PARALLEL_MESH_PAIRS, Query};
@@ -11,34 +15,38 @@ use crate::narrow::{MeshShape, Shape};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// Time kept back from a frame's deadline for what follows the budgeted mesh–mesh
-/// frontier: the pairs answered outside it (closed forms, GJK/EPA, convex–mesh walks), the
-/// exact contacts of finished touching mesh pairs, the records of truncated pairs, and
-/// the daemon's writing and publishing of the result frame. 100 µs.
+/// Time the budgeted mesh–mesh frontier leaves, besides the frame's tail, for the pairs
+/// answered off it exactly (closed forms, GJK/EPA, convex–mesh walks) and the exact
+/// contacts of finished touching mesh pairs: 100 µs, or a quarter of the time left after
+/// the tail when that is less.
 ///
-/// Why this much: publishing (loan, write, send, notify) is about half a raw iceoryx2 round
-/// trip (`examples/ipc_latency`), and the rest of the narrow phase for a few hundred
-/// primitive pairs is of the same order (`benches/narrow_phase.rs`). The quarter of
-/// [`frontier_deadline`] is the frontier's own slack as much as the tail's: its overrun of
-/// its deadline (a round's sort is not polled) must not push the frame past its own
-/// (`examples/time_vs_error`).
+/// Why this much: the narrow phase of a few hundred primitive pairs takes about that
+/// (`benches/narrow_phase.rs`), and the frontier overruns its deadline by up to a round's
+/// sort, which is not polled (`examples/time_vs_error`). A small budget keeps three
+/// quarters for the frontier (with the whole reserve, a 100 µs frame left it nothing:
+/// every mesh pair at level 0; the pairs off the frontier keep to the deadline on their
+/// own).
 pub const FRONTIER_RESERVE: Duration = Duration::from_micros(100);
 
+/// Candidate pairs a frame with a deadline answers even when their conservative answers do
+/// not fit the time left ([`FramePlan::cap_to_time`]): 256, a few tens of microseconds of
+/// conservative answers. A frame whose deadline is already past when its pairs start (its
+/// receipt waited behind another scene's frame, or the OS descheduled it) is late whatever
+/// it does; with this floor a scene of a few hundred pairs still gets every pair answered,
+/// conservatively, rather than an empty sample. Only pair explosions are cut to the time.
+pub const MIN_ANSWERED_PAIRS: usize = 256;
+
 /// The deadline of a frontier starting at `start` inside a frame ending at
-/// `frame_deadline`: earlier by [`FRONTIER_RESERVE`] or by a quarter of the time left,
-/// whichever is less. A small budget keeps three quarters for the frontier (with
-/// the whole reserve, a 100 µs frame left it nothing: every mesh pair at level 0; the work
-/// after the frontier shrinks with the frame, and the pairs off the frontier keep to the
-/// deadline on their own). A deadline already past stays past.
+/// `frame_deadline` whose tail ([`FrameCosts::tail_ns`]) takes `tail`: earlier by the tail
+/// and by [`FRONTIER_RESERVE`] or a quarter of the time left after the tail, whichever is
+/// less. A deadline already past stays past.
 #[must_use]
-pub fn frontier_deadline(start: Instant, frame_deadline: Instant) -> Deadline {
-    let budget = frame_deadline.saturating_duration_since(start);
-    let reserve = FRONTIER_RESERVE.min(budget / 4);
-    Deadline(
-        frame_deadline
-            .checked_sub(reserve)
-            .unwrap_or(frame_deadline),
-    )
+pub fn frontier_deadline(start: Instant, frame_deadline: Instant, tail: Duration) -> Deadline {
+    let left = frame_deadline
+        .saturating_duration_since(start)
+        .saturating_sub(tail);
+    let reserve = tail + FRONTIER_RESERVE.min(left / 4);
+    Deadline(frame_deadline.checked_sub(reserve).unwrap_or(start))
 }
 
 /// Whether a frame asking `query` under `budget` can hold its uninterruptible work
@@ -87,17 +95,16 @@ impl PairPlan<'_> {
 }
 
 /// The frame's plan: whether its budget is limited, whether the pool answers its mesh
-/// pairs, and the clock of the pairs answered off the frontier.
+/// pairs, and when the work after the frontier stops.
 pub(super) struct FramePlan {
     /// A limited budget on a frame at the current poses: mesh pairs go through the
     /// frontier, and pairs off it keep to the deadline.
     pub(super) limited: bool,
     /// The worker pool answered the frame's mesh pairs.
     pub(super) pool: bool,
-    /// Pairs off the frontier's route keep to the frame's deadline: once it is near, the
-    /// rest get conservative answers.
-    pair_clock: WorkClock,
-    /// The frame's deadline, when it keeps to one (`limited`).
+    /// When the frame's one [`WorkClock`] stops (see [`clock`](Self::clock)).
+    stop: Stop,
+    /// The frame's deadline, when its budget has one.
     deadline: Option<Instant>,
 }
 
@@ -106,19 +113,72 @@ impl FramePlan {
     /// [`wants_pool`](Self::wants_pool)).
     pub(super) fn new(budget: &dyn Budget, query: Query) -> Self {
         let limited = !budget.is_unlimited() && query.at_current_poses();
-        let deadline = budget.deadline().filter(|_| limited);
         Self {
             limited,
             pool: false,
-            pair_clock: pair_clock(deadline),
-            deadline,
+            // Time of impact keeps to the deadline whatever the frame asks.
+            stop: budget.stop(),
+            deadline: budget.deadline(),
         }
     }
 
-    /// The clock the narrow routes poll inside one pair (a convex shape's walk of a mesh,
-    /// EPA): the pairs' deadline, so a pair started just before it stops soon after.
-    pub(super) fn narrow_clock(&self) -> WorkClock {
-        pair_clock(self.deadline)
+    /// The frame's one clock for everything after the frontier: the pair loop, the narrow
+    /// routes' long steps inside a pair (a convex shape's walk of a mesh, EPA, exact
+    /// mesh–mesh contacts) and time of impact. With a deadline, [`pace`](Self::pace) keeps
+    /// its stop the frame's tail before it, so a pair started just before then stops soon
+    /// after; it never stops without a deadline. The pipeline keeps it in
+    /// [`NarrowScratch::clock`](crate::narrow::dispatch::NarrowScratch::clock), where the
+    /// dispatcher's routes poll it.
+    pub(super) fn clock(&self) -> WorkClock {
+        WorkClock::new(self.stop)
+    }
+
+    /// Moves `clock`'s stop to the frame's deadline less its tail from here
+    /// ([`FrameCosts::tail_ns`] of `pairs_left` pairs and `records` records so far): the
+    /// work after the clock stops still ends by the deadline. No effect without a deadline.
+    pub(super) fn pace(
+        &self,
+        clock: &mut WorkClock,
+        costs: &FrameCosts,
+        pairs_left: usize,
+        records: usize,
+    ) {
+        if let Some(deadline) = self.deadline {
+            let tail = Duration::from_nanos(costs.tail_ns(pairs_left, records));
+            clock.move_stop(deadline.checked_sub(tail).unwrap_or_else(Instant::now));
+        }
+    }
+
+    /// The time left for the frame's work from now, nanoseconds (`None` without a
+    /// deadline).
+    fn left_ns(&self) -> Option<u64> {
+        self.deadline.map(|d| {
+            let left = d.saturating_duration_since(Instant::now());
+            u64::try_from(left.as_nanos()).unwrap_or(u64::MAX)
+        })
+    }
+
+    /// Drops the candidates (current ones kept first, then swept ones) whose conservative
+    /// answers and records alone would not fit the time left ([`FrameCosts::pairs_that_fit`]),
+    /// keeping at least [`MIN_ANSWERED_PAIRS`]; returns how many it dropped. The frame then
+    /// answers a sample of its pairs, and says so. No effect without a deadline.
+    pub(super) fn cap_to_time<T>(
+        &self,
+        costs: &FrameCosts,
+        candidates: &mut Vec<T>,
+        swept: &mut Vec<T>,
+    ) -> usize {
+        let Some(left) = self.left_ns() else {
+            return 0;
+        };
+        let all = candidates.len() + swept.len();
+        let fits = costs
+            .pairs_that_fit(all, left)
+            .max(MIN_ANSWERED_PAIRS.min(all));
+        let kept = fits.min(candidates.len());
+        candidates.truncate(kept);
+        swept.truncate(fits - kept);
+        all - fits
     }
 
     /// Whether a frame with these mesh pairs to answer uses the worker pool: never under a
@@ -130,18 +190,19 @@ impl FramePlan {
     }
 
     /// The route of a pair of shapes `sa`, `sb` (`separated` when a kept separation or the
-    /// hulls proved it apart). Reads the pair clock only for pairs it may cut short.
+    /// hulls proved it apart). Polls the frame's `clock` only for pairs it may cut short.
     pub(super) fn pair<'s>(
-        &mut self,
+        &self,
         sa: &'s Shape,
         sb: &'s Shape,
         separated: bool,
+        clock: &mut WorkClock,
     ) -> PairPlan<'s> {
         match dispatch::route(sa, sb) {
             _ if separated => PairPlan::Separated,
             Route::Direct
                 if !dispatch::exact_costs_no_more_than_boxes(sa, sb)
-                    && !self.pair_clock.allows(pair_work(sa, sb)) =>
+                    && !clock.allows(pair_work(sa, sb)) =>
             {
                 PairPlan::Conservative
             }
@@ -164,42 +225,40 @@ fn pair_work(a: &Shape, b: &Shape) -> u64 {
     }
 }
 
-/// Time kept back from a frame's deadline for writing and publishing its results, when the
-/// pairs off the frontier are cut short (`PairClock`). 30 µs: an estimate of the daemon's
-/// publish stage (loan, write, send, notify) on the 2-core VM, to be replaced by a measured
-/// value.
-pub const PUBLISH_RESERVE: Duration = Duration::from_micros(30);
-
-/// The clock of the work after the frontier (the per-pair loop, the narrow routes' long
-/// steps, time of impact): it stops [`PUBLISH_RESERVE`] before the frame's deadline, reading
-/// the time every few pairs ([`WorkClock`]); unlimited without a deadline.
-pub(super) fn pair_clock(frame_deadline: Option<Instant>) -> WorkClock {
-    WorkClock::new(frame_deadline.map_or(Stop::Never, |d| {
-        Stop::At(d.checked_sub(PUBLISH_RESERVE).unwrap_or(d))
-    }))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn the_frontier_deadline_is_the_frame_deadline_less_the_reserve_or_a_quarter_budget() {
+    fn the_frontier_deadline_leaves_the_tail_and_the_reserve_or_a_quarter_of_the_rest() {
         let now = Instant::now();
+        let none = Duration::ZERO;
         let frame = now + Duration::from_millis(2);
-        assert_eq!(frontier_deadline(now, frame).0 + FRONTIER_RESERVE, frame);
         assert_eq!(
-            frontier_deadline(now, frame).deadline(),
-            Some(frame - FRONTIER_RESERVE)
+            frontier_deadline(now, frame, none).0 + FRONTIER_RESERVE,
+            frame
+        );
+        let tail = Duration::from_micros(50);
+        assert_eq!(
+            frontier_deadline(now, frame, tail).0 + FRONTIER_RESERVE + tail,
+            frame
         );
         let small = now + Duration::from_micros(200);
         assert_eq!(
-            frontier_deadline(now, small).0,
+            frontier_deadline(now, small, none).0,
             now + Duration::from_micros(150)
         );
+        // 200 µs, 40 of them the tail: a quarter of the other 160 more.
+        assert_eq!(
+            frontier_deadline(now, small, Duration::from_micros(40)).0,
+            now + Duration::from_micros(120)
+        );
+        // A tail longer than the frame leaves the frontier nothing.
+        let long = Duration::from_micros(300);
+        assert!(frontier_deadline(now, small, long).0 <= now);
         // A deadline already past (before the frame started) stays where it is.
         let past = now.checked_sub(Duration::from_micros(10)).unwrap_or(now);
-        assert_eq!(frontier_deadline(now, past).0, past);
+        assert_eq!(frontier_deadline(now, past, none).0, past);
     }
 
     #[test]

@@ -729,7 +729,7 @@ fn a_frame_too_short_for_the_broad_phase_and_publishing_is_not_started() {
         let unmeasured = step_within(&scene, query, &mut already_due(), workspace, results);
         assert_eq!(unmeasured.budget_too_small, None);
     }
-    workspace.note_publish(1_000);
+    workspace.note_publish(1_000, 0);
     // Measured: a due frame is not started.
     let skipped = step_within(&scene, query, &mut already_due(), workspace, results);
     let needed = skipped.budget_too_small.expect("the frame is not started");

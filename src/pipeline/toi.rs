@@ -23,17 +23,18 @@
 //!
 //! # Under a deadline
 //! A frame with a deadline ([`step_within`](super::step_within)) searches its candidates
-//! in order while time is left before [`PUBLISH_RESERVE`](super::PUBLISH_RESERVE): a
-//! search that meets that point stops where it is, and each candidate after it gets the
+//! in order while time is left before its tail (the conservative answers of the
+//! candidates left and the publishing of every record, measured on the scene:
+//! [`FrameCosts::tail_ns`](super::FrameCosts::tail_ns)): a search that meets that point
+//! stops where it is, and each candidate after it gets the
 //! conservative answer of [`unsearched`]: reported at `t = 0`, `reached = false`, `exact =
 //! false`, with the distance between the two shapes' boxes at the start of the motion (a
 //! lower bound) and those boxes' witnesses and normal. No pair that comes within contact
 //! is ever left out, and none is reported later than its first contact.
 
-use super::plan::pair_clock;
+use super::plan::FramePlan;
 use super::{FrameResults, PipelineWorkspace, Query, body, shape};
 use crate::broad::CandidatePair;
-use crate::budget::Budget;
 use crate::math::{DVec3, Pose};
 use crate::narrow::Shape;
 use crate::narrow::contact::ShapeDistance;
@@ -180,21 +181,26 @@ pub(super) struct ToiTally {
 }
 
 /// The time of impact of every swept-box candidate of the frame, into `results.tois`,
-/// keeping to the frame's deadline ("Under a deadline", module docs).
+/// keeping to the frame's clock (`workspace.narrow.clock`, "Under a deadline", module
+/// docs).
 pub(super) fn answer_tois(
     scene: &Scene,
-    budget: &dyn Budget,
+    plan: &FramePlan,
     workspace: &mut PipelineWorkspace,
     results: &mut FrameResults,
 ) -> ToiTally {
     let PipelineWorkspace {
         toi_candidates,
         narrow,
+        costs,
         ..
     } = workspace;
-    let mut toi_clock = pair_clock(budget.deadline());
+    // Out of the scratch while the searches borrow it; put back below.
+    let mut toi_clock = std::mem::take(&mut narrow.clock);
     let mut truncated = 0;
-    for pair in toi_candidates.iter() {
+    for (slot, pair) in toi_candidates.iter().enumerate() {
+        let left = toi_candidates.len() - slot;
+        plan.pace(&mut toi_clock, costs, left, results.record_count());
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         if !toi_clock.allows(1) {
             truncated += 1;
@@ -210,8 +216,7 @@ pub(super) fn answer_tois(
         }
     }
     // Set once a candidate went unsearched or a search stopped at the deadline.
-    ToiTally {
-        truncated,
-        expired: toi_clock.stopped(),
-    }
+    let expired = toi_clock.stopped();
+    narrow.clock = toi_clock;
+    ToiTally { truncated, expired }
 }

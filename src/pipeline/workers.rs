@@ -30,6 +30,7 @@
 use super::answer::{self, Answer, MeshScratch};
 use super::{ContactPoint, Query};
 use crate::broad::CandidatePair;
+use crate::budget::WorkClock;
 use crate::math::DVec3;
 use crate::narrow::MANIFOLD_POINTS;
 use crate::narrow::MeshShape;
@@ -116,7 +117,8 @@ pub(super) fn run(
         (&job.b, &job.mesh_b),
         job.query,
         &mut cache,
-        scratch,
+        // The pool answers only frames without a limited budget: an unlimited clock.
+        (scratch, &mut WorkClock::default()),
         contacts,
     );
     MeshOutcome::new(job.slot, answer, contacts, cache)
