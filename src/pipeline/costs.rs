@@ -46,8 +46,11 @@ pub struct FrameCosts {
     /// Records (pairs, contacts, times of impact) of the frames `publish_ns` was measured
     /// on, a running mean as `publish_ns`.
     publish_records: u64,
-    /// A tail pair's answer, picoseconds (0: not measured yet).
-    tail_ps_per_pair: u64,
+    /// A tail pair's answer, picoseconds (mean 0: not measured yet).
+    tail_ps_per_pair: Spread,
+    /// The visit of one candidate before the pair loop (its kept answer and separation
+    /// looked up, its hull test when it is a mesh pair), picoseconds (0: not measured).
+    visit_ps_per_pair: u64,
     /// Body count of the scene when the estimates were taken (0: none yet).
     bodies: usize,
 }
@@ -69,8 +72,16 @@ impl FrameCosts {
     /// Records the time of a frame's tail: `pairs` pairs answered after its clock stopped.
     pub fn note_tail(&mut self, ns: u64, pairs: usize) {
         if pairs >= MIN_TAIL_SAMPLE_PAIRS {
+            self.tail_ps_per_pair
+                .note(ns.saturating_mul(1000) / pairs as u64);
+        }
+    }
+
+    /// Records the visits of `pairs` candidates before the pair loop, `ns` in all.
+    pub fn note_visits(&mut self, ns: u64, pairs: usize) {
+        if pairs >= MIN_TAIL_SAMPLE_PAIRS {
             let sample = ns.saturating_mul(1000) / pairs as u64;
-            self.tail_ps_per_pair = typical(self.tail_ps_per_pair, sample);
+            self.visit_ps_per_pair = typical(self.visit_ps_per_pair, sample);
         }
     }
 
@@ -103,12 +114,14 @@ impl FrameCosts {
     }
 
     /// The time the tail of a frame takes from here, nanoseconds: `pairs_left` pairs
-    /// answered conservatively, then `records` records and theirs published.
+    /// answered conservatively, then `records` records and theirs published. Per pair, the
+    /// mean cost plus four times its mean deviation ([`Spread::high`]): a deadline is kept
+    /// by the slow frames, not the typical one.
     #[must_use]
     pub fn tail_ns(&self, pairs_left: usize, records: usize) -> u64 {
-        let per_pair = match self.tail_ps_per_pair {
+        let per_pair = match self.tail_ps_per_pair.mean {
             0 => DEFAULT_TAIL_PS_PER_PAIR,
-            ps => ps,
+            _ => self.tail_ps_per_pair.high(),
         };
         let pairs = pairs_left as u64;
         let answers = pairs.saturating_mul(per_pair) / 1000;
@@ -116,19 +129,23 @@ impl FrameCosts {
         answers.saturating_add(self.publish_estimate_ns(records))
     }
 
-    /// The most of `candidates` pairs whose tail ([`tail_ns`](Self::tail_ns) from no
-    /// records) fits in `left_ns` nanoseconds: all of them when they fit, else a sample's
-    /// size (at least 0).
+    /// The most of `candidates` pairs whose visits and tail ([`tail_ns`](Self::tail_ns)
+    /// from no records) fit in `left_ns` nanoseconds: all of them when they fit, else a
+    /// sample's size (at least 0).
     #[must_use]
     pub fn pairs_that_fit(&self, candidates: usize, left_ns: u64) -> usize {
-        if self.tail_ns(candidates, 0) <= left_ns {
+        let cost = |pairs: usize| {
+            let visits = (pairs as u64).saturating_mul(self.visit_ps_per_pair) / 1000;
+            visits.saturating_add(self.tail_ns(pairs, 0))
+        };
+        if cost(candidates) <= left_ns {
             return candidates;
         }
-        // The tail grows with the pairs: the largest count that fits, by bisection.
+        // The cost grows with the pairs: the largest count that fits, by bisection.
         let (mut fits, mut too_many) = (0, candidates);
         while too_many - fits > 1 {
             let mid = fits + (too_many - fits) / 2;
-            if self.tail_ns(mid, 0) <= left_ns {
+            if cost(mid) <= left_ns {
                 fits = mid;
             } else {
                 too_many = mid;
@@ -141,8 +158,9 @@ impl FrameCosts {
         if changed(self.bodies, bodies) {
             *self = Self {
                 bodies,
-                // What a pair's conservative answer costs does not depend on the scene's size.
+                // What a pair's answer and visit cost does not depend on the scene's size.
                 tail_ps_per_pair: self.tail_ps_per_pair,
+                visit_ps_per_pair: self.visit_ps_per_pair,
                 ..Self::default()
             };
         }
@@ -172,6 +190,39 @@ impl TailTimer {
             let ns = u64::try_from(began.elapsed().as_nanos()).unwrap_or(u64::MAX);
             costs.note_tail(ns, pairs);
         }
+    }
+}
+
+/// A running mean and mean deviation (Jacobson's estimator for round-trip times): the mean
+/// moves an eighth of the way to each sample (counted at most twice the mean, as
+/// [`typical`]), the deviation a quarter of the way to the sample's distance from the mean.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct Spread {
+    mean: u64,
+    deviation: u64,
+}
+
+impl Spread {
+    fn note(&mut self, sample: u64) {
+        if self.mean == 0 {
+            *self = Self {
+                mean: sample,
+                deviation: sample / 2,
+            };
+            return;
+        }
+        let off = sample.min(self.mean.saturating_mul(2)).abs_diff(self.mean);
+        self.deviation = if off >= self.deviation {
+            self.deviation + (off - self.deviation) / 4
+        } else {
+            self.deviation - (self.deviation - off) / 4
+        };
+        self.mean = typical(self.mean, sample);
+    }
+
+    /// A cost few samples exceed: the mean plus four deviations.
+    fn high(&self) -> u64 {
+        self.mean.saturating_add(self.deviation.saturating_mul(4))
     }
 }
 
@@ -267,18 +318,42 @@ mod tests {
             2_000,
             "typical records: the typical publish"
         );
-        // 100 ns a pair; 2 records each, 300 in all: 3× the typical 100 records' publish.
-        assert_eq!(costs.tail_ns(100, 100), 10_000 + 2_000 * 301 / 100);
+        // 100 ns a pair, its deviation taken as half of it at first: 300 ns counted; 2
+        // records each, 300 in all: 3× the typical 100 records' publish.
+        assert_eq!(costs.tail_ns(100, 100), 30_000 + 2_000 * 301 / 100);
         costs.note_tail(1_000_000, 4);
         assert_eq!(
             costs.tail_ns(1, 0),
-            100 + 2_000,
+            300 + 2_000,
             "a tail of 4 pairs is no sample"
         );
+        costs.note_visits(5_000, 100);
         let left = 50_000;
         let fits = costs.pairs_that_fit(10_000, left);
-        assert!(costs.tail_ns(fits, 0) <= left && costs.tail_ns(fits + 1, 0) > left);
+        let cost = |pairs: usize| pairs as u64 * 50 + costs.tail_ns(pairs, 0);
+        assert!(cost(fits) <= left && cost(fits + 1) > left, "{fits}");
         assert_eq!(costs.pairs_that_fit(10, left), 10, "all of few pairs");
         assert_eq!(costs.pairs_that_fit(10, 0), 0);
+    }
+
+    #[test]
+    fn the_high_estimate_settles_on_steady_costs_and_covers_varying_ones() {
+        let mut steady = Spread::default();
+        for _ in 0..100 {
+            steady.note(1_000);
+        }
+        // The deviation decays to the integer rounding of its quarter steps (below 4).
+        assert_eq!(steady.mean, 1_000);
+        assert!(steady.high() < 1_000 + 4 * 4, "{}", steady.high());
+        let mut varying = Spread::default();
+        for i in 0..100 {
+            varying.note(if i % 2 == 0 { 800 } else { 1_200 });
+        }
+        let (mean, high) = (varying.mean, varying.high());
+        assert!((900..=1_100).contains(&mean), "{mean}");
+        assert!(
+            high >= 1_200 + 300,
+            "four deviations above the mean: {high}"
+        );
     }
 }

@@ -640,7 +640,12 @@ fn mid_phase(
     };
     // The hull tests spend the frontier's budget, a visit each: one settles a pair for the
     // price of a few visits.
+    let visits_started = Instant::now();
     let tests = mark_separated(scene, query, Some(&mut *frontier_budget), workspace);
+    let visited = workspace.candidates.len();
+    workspace
+        .costs
+        .note_visits(elapsed_ns(visits_started), visited);
     let stats = run_frontier(scene, query, frontier_budget, tests, workspace);
     (tests, stats)
 }
