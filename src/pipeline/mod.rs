@@ -8,8 +8,9 @@
 //! 3. **mid phase**: kept separations and the meshes' hulls prove mesh pairs apart with no
 //!    traversal (`separation.rs`); under a limited budget the frontier refines the rest
 //!    (`frontier_run.rs`);
-//! 4. **narrow phase** (`answer.rs`, on the worker pool for many mesh pairs, `workers.rs`):
-//!    each candidate's answer by its route, or its kept answer;
+//! 4. **narrow phase** (`pair_loop.rs`; the answers in `answer.rs`, on the worker pool for
+//!    many mesh pairs, `workers.rs`): each candidate's answer by its route, or its kept
+//!    answer;
 //! 5. **time of impact** (`toi.rs`);
 //!
 //! and, across frames, what each pair remembers (`pair_memory.rs`). What each [`Query`] flag
@@ -72,6 +73,7 @@ mod answer;
 mod broad_sync;
 mod costs;
 mod frontier_run;
+mod pair_loop;
 mod pair_memory;
 mod plan;
 mod separation;
@@ -81,11 +83,11 @@ pub mod workers;
 pub use crate::budget::Budget;
 pub use crate::narrow::dispatch::PathCounts;
 pub use costs::FrameCosts;
-use costs::TailTimer;
+use pair_loop::answer_candidates;
 pub use plan::{
     Deadline, FRONTIER_RESERVE, MIN_ANSWERED_PAIRS, Unlimited, VisitBudget, frontier_deadline,
 };
-use plan::{FramePlan, PairPlan, mandatory_work_fits};
+use plan::{FramePlan, mandatory_work_fits};
 pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{BroadPhaseKind, BroadPhaseStats, CandidatePair};
@@ -695,225 +697,6 @@ fn answer_on_pool(
     });
     pool.answer_all(jobs, outcomes, mesh, job_contacts);
     true
-}
-
-/// What the per-pair stage counted.
-struct PairTally {
-    /// The shallowest level of the pairs answered short of exact.
-    completeness: Completeness,
-    /// Pairs answered by their kept answer.
-    reused: u32,
-    /// Pairs answered apart by a kept separation or their hulls.
-    separated: u32,
-    /// Pairs answered short of exact.
-    truncated: u32,
-}
-
-/// Answers every candidate pair by its plan ([`FramePlan::pair`]), reusing kept answers,
-/// and writes the records the query reports to `results`; keeps what each pair remembers
-/// ([`pair_memory`]).
-fn answer_candidates(
-    scene: &Scene,
-    query: Query,
-    plan: &FramePlan,
-    workspace: &mut PipelineWorkspace,
-    results: &mut FrameResults,
-) -> PairTally {
-    let mut tally = PairTally {
-        completeness: Completeness::Exact,
-        reused: 0,
-        separated: 0,
-        truncated: 0,
-    };
-    let PipelineWorkspace {
-        candidates,
-        toi_candidates,
-        memory,
-        separated,
-        frontier_answers,
-        frontier_pairs,
-        outcomes,
-        narrow,
-        manifold,
-        mesh,
-        costs,
-        ..
-    } = workspace;
-    let mut sources = AnswerSources {
-        pooled: outcomes.iter(),
-        frontier: frontier_pairs.iter().zip(frontier_answers.iter()),
-        narrow,
-        manifold,
-        mesh,
-    };
-    let mut tail = TailTimer::default();
-    for (slot, pair) in candidates.iter().enumerate() {
-        let left = candidates.len() - slot + toi_candidates.len();
-        plan.pace(
-            &mut sources.narrow.clock,
-            costs,
-            left,
-            results.record_count(),
-        );
-        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-        let first_contact = results.contacts.len();
-        if let Some(k) = memory.visit(scene, pair, query) {
-            tally.reused += 1;
-            results.contacts.extend_from_slice(&k.contacts);
-            debug_assert!(k.answer.result.exact, "only exact answers are kept");
-            report(query, k.answer, (a, b), first_contact, results);
-            continue;
-        }
-        let shapes = (shape(scene, a), shape(scene, b));
-        let pair_plan = plan.pair(
-            shapes.0,
-            shapes.1,
-            separated[slot],
-            &mut sources.narrow.clock,
-        );
-        if matches!(pair_plan, PairPlan::Conservative) {
-            tail.begin(candidates.len() - slot);
-        }
-        let (answer, truncated_level) = sources.answer(
-            query,
-            (slot, pair),
-            ((a, shapes.0), (b, shapes.1)),
-            &pair_plan,
-            memory,
-            &mut results.contacts,
-        );
-        tally.separated += u32::from(matches!(pair_plan, PairPlan::Separated));
-        tally.truncated += u32::from(!answer.result.exact);
-        if pair_plan.searches_mesh_pair() {
-            memory.remember_search(scene, pair, (a, b), answer.apart_by);
-        }
-        if answer.result.exact {
-            let contacts = &results.contacts[first_contact..];
-            memory.keep_answer(scene, pair, (a, b), query, answer, contacts);
-        } else {
-            // A truncated frontier answer, or the worker pool's fallback box answer (level
-            // 0: world boxes).
-            tally.completeness = tally
-                .completeness
-                .truncated_at(truncated_level.unwrap_or(0));
-            memory.drop_answer(pair);
-        }
-        report(query, answer, (a, b), first_contact, results);
-    }
-    memory.forget_unvisited();
-    tail.end(costs);
-    tally
-}
-
-/// Where a pair's answer comes from besides its own query: the pool's outcomes and the
-/// frontier's answers, both in candidate order, and this thread's scratch.
-struct AnswerSources<'w> {
-    pooled: std::slice::Iter<'w, MeshOutcome>,
-    frontier:
-        std::iter::Zip<std::slice::Iter<'w, CandidatePair>, std::slice::Iter<'w, FrontierAnswer>>,
-    narrow: &'w mut NarrowScratch,
-    manifold: &'w mut Manifold,
-    mesh: &'w mut MeshScratch,
-}
-
-impl AnswerSources<'_> {
-    /// The answer of `pair` (candidate `slot`; bodies `a`, `b` with shapes `sa`, `sb`) by
-    /// `plan`, its contacts appended to `contacts`, and the level it was truncated at when
-    /// the frontier left it unfinished.
-    fn answer(
-        &mut self,
-        query: Query,
-        (slot, pair): (usize, &CandidatePair),
-        ((a, sa), (b, sb)): ((&Body, &Shape), (&Body, &Shape)),
-        plan: &PairPlan<'_>,
-        memory: &mut PairMemories,
-        contacts: &mut Vec<ContactPoint>,
-    ) -> (Answer, Option<u32>) {
-        let narrow = &mut *self.narrow;
-        let answer = match *plan {
-            // Proven apart by a kept separation, which stays as it is (`DISTANCE` frames
-            // never come here). Kept as an answer too, so an unchanged pair is reused.
-            PairPlan::Separated => answer::apart(pair, None),
-            PairPlan::Conservative => {
-                answer::conservative(pair, (a, sa), (b, sb), query, narrow, contacts)
-            }
-            PairPlan::Direct => answer::direct(
-                pair,
-                (a, sa),
-                (b, sb),
-                query,
-                narrow,
-                self.manifold,
-                contacts,
-            ),
-            PairPlan::Frontier(ma, mb) => {
-                narrow.paths.mesh_mesh += 1;
-                let (_, found) = self
-                    .frontier
-                    .find(|(p, _)| *p == pair)
-                    .expect("a frontier answer for every mesh pair not kept");
-                let Completeness::Truncated { level } = found.completeness else {
-                    let cache = &mut memory.entry(pair).mesh_cache;
-                    let mesh = &mut *self.mesh;
-                    return (
-                        answer::mesh_mesh_finished(
-                            pair,
-                            (a, ma),
-                            (b, mb),
-                            query,
-                            found,
-                            cache,
-                            (mesh, &mut narrow.clock),
-                            contacts,
-                        ),
-                        None,
-                    );
-                };
-                let truncated = answer::mesh_mesh_truncated(pair, (a, b), query, found, contacts);
-                return (truncated, Some(level));
-            }
-            PairPlan::Pooled => {
-                narrow.paths.mesh_mesh += 1;
-                let outcome = self.pooled.next().expect("one pool outcome per mesh pair");
-                debug_assert_eq!(outcome.slot as usize, slot);
-                contacts.extend_from_slice(outcome.contacts());
-                memory.entry(pair).mesh_cache = outcome.cache;
-                outcome.answer
-            }
-            PairPlan::MeshMesh(ma, mb) => {
-                narrow.paths.mesh_mesh += 1;
-                let cache = &mut memory.entry(pair).mesh_cache;
-                let mesh = (&mut *self.mesh, &mut narrow.clock);
-                answer::mesh_mesh(pair, (a, ma), (b, mb), query, cache, mesh, contacts)
-            }
-        };
-        (answer, None)
-    }
-}
-
-/// Adds `answer` (its contacts already at `results.contacts[first_contact..]`) to the
-/// frame's records when `query` reports it, linking its contacts; else drops the contacts.
-fn report(
-    query: Query,
-    mut answer: Answer,
-    (a, b): (&Body, &Body),
-    first_contact: usize,
-    results: &mut FrameResults,
-) {
-    if query.reports(&answer, a.margin + b.margin) {
-        let count = results.contacts.len() - first_contact;
-        if count > 0 {
-            answer.result.first_contact = index(first_contact);
-            answer.result.contact_count = index(count);
-            let pair = index(results.pairs.len());
-            for c in &mut results.contacts[first_contact..] {
-                c.pair = pair;
-            }
-        }
-        results.pairs.push(answer.result);
-    } else {
-        results.contacts.truncate(first_contact);
-    }
 }
 
 fn index(n: usize) -> u32 {
