@@ -11,9 +11,11 @@
 //!   ([`FrameCosts::tail_ns`]).
 //!
 //! Each estimate is the typical cost, a running mean moving an eighth of the way to each
-//! sample, a sample counting at most twice the estimate: a frame is refused only when the
-//! scene's usual uninterruptible work cannot fit, never for one frame the OS descheduled
-//! (a frame whose broad phase runs long is late instead, and its stage times say why).
+//! sample, a sample counting at most twice the estimate. The tail per pair also keeps its
+//! mean deviation and is reserved at the mean plus four of them: a deadline is kept by the
+//! slow frames, not the typical one. A frame is refused only when the scene's usual
+//! uninterruptible work cannot fit, never for one frame the OS descheduled (a frame whose
+//! broad phase runs long is late instead, and its stage times say why).
 //! Only broad phases that synced the kept one count (a rebuild, after a new scene or a
 //! frame not started, costs more than the frames that follow). A frame not started lowers
 //! the broad phase and publish estimates by a sixty-fourth, so an estimate grown stale
@@ -115,7 +117,7 @@ impl FrameCosts {
 
     /// The time the tail of a frame takes from here, nanoseconds: `pairs_left` pairs
     /// answered conservatively, then `records` records and theirs published. Per pair, the
-    /// mean cost plus four times its mean deviation ([`Spread::high`]): a deadline is kept
+    /// mean cost plus four times its mean deviation (Jacobson's estimator): a deadline is kept
     /// by the slow frames, not the typical one.
     #[must_use]
     pub fn tail_ns(&self, pairs_left: usize, records: usize) -> u64 {

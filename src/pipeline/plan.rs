@@ -29,7 +29,7 @@ use std::time::{Duration, Instant};
 pub const FRONTIER_RESERVE: Duration = Duration::from_micros(100);
 
 /// Candidate pairs a frame with a deadline answers even when their conservative answers do
-/// not fit the time left ([`FramePlan::cap_to_time`]): 256, a few tens of microseconds of
+/// not fit the time left (the frame's cap to its time): 256, a few tens of microseconds of
 /// conservative answers. A frame whose deadline is already past when its pairs start (its
 /// receipt waited behind another scene's frame, or the OS descheduled it) is late whatever
 /// it does; with this floor a scene of a few hundred pairs still gets every pair answered,
