@@ -121,9 +121,22 @@ impl FrameCosts {
     /// by the slow frames, not the typical one.
     #[must_use]
     pub fn tail_ns(&self, pairs_left: usize, records: usize) -> u64 {
+        self.tail_at(self.tail_ps_per_pair.high(), pairs_left, records)
+    }
+
+    /// [`tail_ns`](Self::tail_ns) at the mean cost per pair: the typical tail, which the
+    /// frontier leaves when it splits the frame with the pair loop (the loop itself keeps
+    /// to [`tail_ns`](Self::tail_ns), so the deadline does not rest on this).
+    #[must_use]
+    pub fn typical_tail_ns(&self, pairs_left: usize, records: usize) -> u64 {
+        self.tail_at(self.tail_ps_per_pair.mean, pairs_left, records)
+    }
+
+    /// The tail at `per_pair` picoseconds a pair (the default before any is measured).
+    fn tail_at(&self, per_pair: u64, pairs_left: usize, records: usize) -> u64 {
         let per_pair = match self.tail_ps_per_pair.mean {
             0 => DEFAULT_TAIL_PS_PER_PAIR,
-            _ => self.tail_ps_per_pair.high(),
+            _ => per_pair,
         };
         let pairs = pairs_left as u64;
         let answers = pairs.saturating_mul(per_pair) / 1000;

@@ -632,7 +632,7 @@ fn mid_phase(
         return (tests, FrontierStats::default());
     }
     let pairs = workspace.candidates.len() + workspace.toi_candidates.len();
-    let tail = Duration::from_nanos(workspace.costs.tail_ns(pairs, 0));
+    let tail = Duration::from_nanos(workspace.costs.typical_tail_ns(pairs, 0));
     let mut reserved = budget
         .deadline()
         .map(|d| frontier_deadline(started, d, tail));
