@@ -27,15 +27,6 @@ pub trait Budget {
     fn is_unlimited(&self) -> bool {
         false
     }
-
-    /// When the [`WorkClock`] of the work polled outside visit counts (the narrow routes,
-    /// the pair loop, time of impact) stops under this budget: at its deadline when it has
-    /// one, else never (a counted budget counts the frontier's visits only, so the narrow
-    /// routes stay exact under it).
-    #[must_use]
-    fn stop(&self) -> Stop {
-        self.deadline().map_or(Stop::Never, Stop::At)
-    }
 }
 
 /// A counted budget: allows work while fewer than `0` visits were made (so `VisitBudget(0)`

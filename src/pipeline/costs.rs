@@ -110,9 +110,8 @@ impl FrameCosts {
         if records <= self.publish_records {
             return self.publish_ns;
         }
-        let scaled = u128::from(self.publish_ns) * u128::from(records + 1)
-            / u128::from(self.publish_records + 1);
-        u64::try_from(scaled).unwrap_or(u64::MAX)
+        // Polled before every pair: u64 arithmetic, saturating far beyond any real frame.
+        self.publish_ns.saturating_mul(records + 1) / (self.publish_records + 1)
     }
 
     /// The time the tail of a frame takes from here, nanoseconds: `pairs_left` pairs
@@ -121,7 +120,11 @@ impl FrameCosts {
     /// by the slow frames, not the typical one.
     #[must_use]
     pub fn tail_ns(&self, pairs_left: usize, records: usize) -> u64 {
-        self.tail_at(self.tail_ps_per_pair.high(), pairs_left, records)
+        let per_pair = self
+            .tail_ps_per_pair
+            .measured()
+            .map_or(DEFAULT_TAIL_PS_PER_PAIR, Spread::high);
+        self.tail_at(per_pair, pairs_left, records)
     }
 
     /// [`tail_ns`](Self::tail_ns) at the mean cost per pair: the typical tail, which the
@@ -129,15 +132,15 @@ impl FrameCosts {
     /// to [`tail_ns`](Self::tail_ns), so the deadline does not rest on this).
     #[must_use]
     pub fn typical_tail_ns(&self, pairs_left: usize, records: usize) -> u64 {
-        self.tail_at(self.tail_ps_per_pair.mean, pairs_left, records)
+        let per_pair = self
+            .tail_ps_per_pair
+            .measured()
+            .map_or(DEFAULT_TAIL_PS_PER_PAIR, |s| s.mean);
+        self.tail_at(per_pair, pairs_left, records)
     }
 
-    /// The tail at `per_pair` picoseconds a pair (the default before any is measured).
+    /// The tail at `per_pair` picoseconds a pair.
     fn tail_at(&self, per_pair: u64, pairs_left: usize, records: usize) -> u64 {
-        let per_pair = match self.tail_ps_per_pair.mean {
-            0 => DEFAULT_TAIL_PS_PER_PAIR,
-            _ => per_pair,
-        };
         let pairs = pairs_left as u64;
         let answers = pairs.saturating_mul(per_pair) / 1000;
         let records = (records as u64).saturating_add(pairs * RECORDS_PER_TAIL_PAIR);
@@ -235,8 +238,13 @@ impl Spread {
         self.mean = typical(self.mean, sample);
     }
 
+    /// `self`, once a sample was taken.
+    fn measured(self) -> Option<Self> {
+        (self.mean != 0).then_some(self)
+    }
+
     /// A cost few samples exceed: the mean plus four deviations.
-    fn high(&self) -> u64 {
+    fn high(self) -> u64 {
         self.mean.saturating_add(self.deviation.saturating_mul(4))
     }
 }

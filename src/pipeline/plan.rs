@@ -102,8 +102,6 @@ pub(super) struct FramePlan {
     pub(super) limited: bool,
     /// The worker pool answered the frame's mesh pairs.
     pub(super) pool: bool,
-    /// When the frame's one [`WorkClock`] stops (see [`clock`](Self::clock)).
-    stop: Stop,
     /// The frame's deadline, when its budget has one.
     deadline: Option<Instant>,
 }
@@ -117,7 +115,6 @@ impl FramePlan {
             limited,
             pool: false,
             // Time of impact keeps to the deadline whatever the frame asks.
-            stop: budget.stop(),
             deadline: budget.deadline(),
         }
     }
@@ -130,7 +127,7 @@ impl FramePlan {
     /// [`NarrowScratch::clock`](crate::narrow::dispatch::NarrowScratch::clock), where the
     /// dispatcher's routes poll it.
     pub(super) fn clock(&self) -> WorkClock {
-        WorkClock::new(self.stop)
+        WorkClock::new(self.deadline.map_or(Stop::Never, Stop::At))
     }
 
     /// Moves `clock`'s stop to the frame's deadline less its tail from here
