@@ -3,7 +3,9 @@
 //! Proxima's wire protocol over iceoryx2 shared memory: the `#[repr(C)]` records, the service
 //! names and the protocol version a client checks on connect. Depends only on iceoryx2 and
 //! std; records use plain arrays (`[f64; 3]`), never glam, so clients in any language that
-//! iceoryx2 binds can speak it.
+//! iceoryx2 binds can speak it. `ipc/PROTOCOL.md` describes the protocol without Rust
+//! (names, settings, type names, byte layouts, codes, sequences); `ipc/tests/protocol_doc.rs`
+//! keeps it equal to this crate.
 //!
 //! The protocol, in the order a client meets it:
 //! - [`wire`]: the records and headers that cross shared memory, their codes and query flags;

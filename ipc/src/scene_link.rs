@@ -61,6 +61,9 @@ pub use crate::result_feed::{ResultFeed, ResultFrame};
 /// allocate a segment of the next power of two (a one-off cost, for the daemon too).
 pub const POSES_INITIAL_MAX_SLICE_LEN: usize = 1024;
 
+/// Pose frames a link's publisher has on loan at once: one frame is written at a time.
+pub const POSES_MAX_LOANED_SAMPLES: usize = 1;
+
 /// One client's link to one scene: its pose publisher, result subscriber and the event
 /// notifier and listener that let either side sleep instead of spin.
 ///
@@ -111,7 +114,7 @@ impl<S: Service> SceneLink<S> {
             .publisher_builder()
             .initial_max_slice_len(POSES_INITIAL_MAX_SLICE_LEN)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
-            .max_loaned_samples(1)
+            .max_loaned_samples(POSES_MAX_LOANED_SAMPLES)
             .create()
             .map_err(|e| open_error("creating the pose publisher", e))?;
         let notifier = poses_ready_service
