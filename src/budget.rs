@@ -14,6 +14,15 @@ pub trait Budget {
     /// ([`FrontierWorkspace::start`](crate::narrow::mesh_mesh::frontier::FrontierWorkspace::start) for the frontier).
     fn allows(&mut self, visits: u64) -> bool;
 
+    /// Whether work may go on after `visits` visits when stopping now would leave `pending`
+    /// entries whose answers the caller then extracts: work that grows with them and that no
+    /// poll interrupts (the frontier's answer pass, and the sort of the round they would
+    /// start). A wall-clock budget that knows their cost reserves it; others ignore them.
+    fn allows_pending(&mut self, visits: u64, pending: u64) -> bool {
+        let _ = pending;
+        self.allows(visits)
+    }
+
     /// The wall-clock instant this budget ends at, when it is one (so a caller can reserve
     /// time for work after the traversal); `None` for counted and unlimited budgets.
     #[must_use]

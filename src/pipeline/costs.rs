@@ -30,6 +30,19 @@ use std::time::Instant;
 /// hundreds of nanoseconds on the 2-core VM, `benches/narrow_phase.rs`'s `proxima-bound`).
 pub const DEFAULT_TAIL_PS_PER_PAIR: u64 = 250_000;
 
+/// The cost of one entry left waiting on the frontier until the scene's own is measured,
+/// picoseconds: its share of the answer pass and of at most one round's sort (tens of
+/// nanoseconds each on the 2-core VM).
+pub const DEFAULT_PENDING_ENTRY_PS: u64 = 100_000;
+
+/// A waiting entry's cost over its share of the answer pass (the part measured): the
+/// answer pass reads it once, and the sort of the round it would start compares it about
+/// `log₂ n` times, about as much again.
+const PENDING_ENTRY_PER_ANSWER: u64 = 2;
+
+/// Fewest entries in an answer pass for its time to be a sample of the per-entry cost.
+const MIN_ANSWER_SAMPLE_ENTRIES: usize = 1024;
+
 /// Fewest pairs in a tail for its time to be a sample of the per-pair cost (fewer are
 /// dominated by the clock's reads and the cache misses of the first).
 const MIN_TAIL_SAMPLE_PAIRS: usize = 16;
@@ -53,6 +66,8 @@ pub struct FrameCosts {
     /// The visit of one candidate before the pair loop (its kept answer and separation
     /// looked up, its hull test when it is a mesh pair), picoseconds (0: not measured).
     visit_ps_per_pair: u64,
+    /// The frontier's answer pass, per entry it read, picoseconds (mean 0: not measured).
+    answer_ps_per_entry: Spread,
     /// Body count of the scene when the estimates were taken (0: none yet).
     bodies: usize,
 }
@@ -85,6 +100,26 @@ impl FrameCosts {
             let sample = ns.saturating_mul(1000) / pairs as u64;
             self.visit_ps_per_pair = typical(self.visit_ps_per_pair, sample);
         }
+    }
+
+    /// Records the frontier's answer pass: `entries` waiting entries read, `ns` in all.
+    pub fn note_answer_pass(&mut self, ns: u64, entries: usize) {
+        if entries >= MIN_ANSWER_SAMPLE_ENTRIES {
+            self.answer_ps_per_entry
+                .note(ns.saturating_mul(1000) / entries as u64);
+        }
+    }
+
+    /// What one entry left waiting on the frontier costs the frame after the frontier
+    /// stops (its answer and its share of a round's sort), picoseconds: the answer pass's
+    /// mean plus four deviations per entry, twice over for the sort.
+    #[must_use]
+    pub fn pending_entry_ps(&self) -> u64 {
+        self.answer_ps_per_entry
+            .measured()
+            .map_or(DEFAULT_PENDING_ENTRY_PS, |s| {
+                s.high().saturating_mul(PENDING_ENTRY_PER_ANSWER)
+            })
     }
 
     /// Records a frame not started for lack of budget: the broad phase and publish
@@ -179,6 +214,7 @@ impl FrameCosts {
                 // What a pair's answer and visit cost does not depend on the scene's size.
                 tail_ps_per_pair: self.tail_ps_per_pair,
                 visit_ps_per_pair: self.visit_ps_per_pair,
+                answer_ps_per_entry: self.answer_ps_per_entry,
                 ..Self::default()
             };
         }
@@ -272,6 +308,28 @@ fn typical(estimate: u64, sample: u64) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_waiting_entry_costs_the_default_until_answer_passes_of_enough_entries_are_timed() {
+        let mut costs = FrameCosts::default();
+        assert_eq!(costs.pending_entry_ps(), DEFAULT_PENDING_ENTRY_PS);
+        costs.note_answer_pass(1_000_000, MIN_ANSWER_SAMPLE_ENTRIES - 1);
+        assert_eq!(
+            costs.pending_entry_ps(),
+            DEFAULT_PENDING_ENTRY_PS,
+            "too few entries"
+        );
+        // 20 ns an entry: the reserve is twice the answer's cost (the sort's share).
+        for _ in 0..200 {
+            costs.note_answer_pass(20_000_000, 1_000_000);
+        }
+        let ps = costs.pending_entry_ps();
+        assert!((40_000..=40_100).contains(&ps), "{ps}");
+        // A scene of another size keeps it: what an entry costs does not depend on it.
+        costs.note_broad(10, 1_000);
+        costs.note_broad(1_000, 1_000);
+        assert_eq!(costs.pending_entry_ps(), ps);
+    }
 
     #[test]
     fn the_estimate_follows_the_typical_cost_and_one_slow_sample_moves_it_little() {

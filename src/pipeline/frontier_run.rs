@@ -3,7 +3,7 @@
 //! frame's run while the bodies rest.
 
 use super::pair_memory::PairMemories;
-use super::{Budget, PipelineWorkspace, Query, body, mesh_pair};
+use super::{Budget, PipelineWorkspace, Query, body, elapsed_ns, mesh_pair};
 use crate::broad::CandidatePair;
 use crate::math::Pose;
 use crate::narrow::MeshShape;
@@ -11,6 +11,7 @@ use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::frontier::FrontierStats;
 use crate::narrow::mesh_mesh::frontier::MeshPairTrees;
 use crate::scene::Scene;
+use std::time::Instant;
 
 /// Answers the frame's mesh–mesh candidates that no kept answer covers through the
 /// frontier, under `budget` (see [`step_within`]): resumes last frame's frontier when it
@@ -34,6 +35,7 @@ pub(super) fn run_frontier(
         frontier_answers,
         frontier_pairs,
         frontier_run,
+        costs,
         ..
     } = workspace;
     // The mesh pairs no kept answer or separation answers, in candidate order.
@@ -78,7 +80,11 @@ pub(super) fn run_frontier(
             spent,
         },
     );
+    // Read every waiting entry, unpolled: the budget reserved its time per entry.
+    let waiting = frontier.waiting();
+    let answers_started = Instant::now();
     frontier.answers(pairs, frontier_answers);
+    costs.note_answer_pass(elapsed_ns(answers_started), waiting);
     // A pair's seed is a proof of closeness (a triangle pair within its threshold), kept
     // while the pair may be close: the next frame tests it first and, while it holds or
     // until the undecided pairs are settled, spends nothing more on the pair.
@@ -182,6 +188,11 @@ struct Resumed<'b> {
 impl Budget for Resumed<'_> {
     fn allows(&mut self, visits: u64) -> bool {
         self.inner.allows(visits - self.base + self.spent)
+    }
+
+    fn allows_pending(&mut self, visits: u64, pending: u64) -> bool {
+        self.inner
+            .allows_pending(visits - self.base + self.spent, pending)
     }
 }
 

@@ -85,7 +85,8 @@ pub use crate::narrow::dispatch::PathCounts;
 pub use costs::FrameCosts;
 use pair_loop::answer_candidates;
 pub use plan::{
-    Deadline, FRONTIER_RESERVE, MIN_ANSWERED_PAIRS, Unlimited, VisitBudget, frontier_deadline,
+    Deadline, FRONTIER_RESERVE, FrontierClock, MIN_ANSWERED_PAIRS, Unlimited, VisitBudget,
+    frontier_deadline,
 };
 use plan::{FramePlan, mandatory_work_fits};
 pub use toi::{PairToi, TOI_TOLERANCE};
@@ -633,9 +634,11 @@ fn mid_phase(
     }
     let pairs = workspace.candidates.len() + workspace.toi_candidates.len();
     let tail = Duration::from_nanos(workspace.costs.typical_tail_ns(pairs, 0));
-    let mut reserved = budget
-        .deadline()
-        .map(|d| frontier_deadline(started, d, tail));
+    let ps_per_pending_entry = workspace.costs.pending_entry_ps();
+    let mut reserved = budget.deadline().map(|d| FrontierClock {
+        deadline: frontier_deadline(started, d, tail),
+        ps_per_pending_entry,
+    });
     let frontier_budget: &mut dyn Budget = match reserved.as_mut() {
         Some(deadline) => deadline,
         None => budget,

@@ -21,8 +21,8 @@ use std::time::{Duration, Instant};
 /// the tail when that is less.
 ///
 /// Why this much: the narrow phase of a few hundred primitive pairs takes about that
-/// (`benches/narrow_phase.rs`), and the frontier overruns its deadline by up to a round's
-/// sort, which is not polled (`examples/time_vs_error`). A small budget keeps three
+/// (`benches/narrow_phase.rs`); the frontier's own unpolled work (a round's sort, its
+/// answer pass) is reserved apart, per waiting entry ([`FrontierClock`]). A small budget keeps three
 /// quarters for the frontier (with the whole reserve, a 100 µs frame left it nothing:
 /// every mesh pair at level 0; the pairs off the frontier keep to the deadline on their
 /// own).
@@ -47,6 +47,36 @@ pub fn frontier_deadline(start: Instant, frame_deadline: Instant, tail: Duration
         .saturating_sub(tail);
     let reserve = tail + FRONTIER_RESERVE.min(left / 4);
     Deadline(frame_deadline.checked_sub(reserve).unwrap_or(start))
+}
+
+/// The frontier's budget in a frame: its deadline ([`frontier_deadline`]), less the time
+/// the entries left waiting will take once it stops (their answers and a round's sort,
+/// [`FrameCosts::pending_entry_ps`] each), so the frontier stops growing while extracting
+/// its answers still fits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FrontierClock {
+    /// When the frontier's work must end, its answers extracted.
+    pub deadline: Deadline,
+    /// What one waiting entry costs after the frontier stops, picoseconds.
+    pub ps_per_pending_entry: u64,
+}
+
+impl Budget for FrontierClock {
+    fn allows(&mut self, visits: u64) -> bool {
+        self.deadline.allows(visits)
+    }
+
+    fn allows_pending(&mut self, _visits: u64, pending: u64) -> bool {
+        let reserve =
+            Duration::from_nanos(pending.saturating_mul(self.ps_per_pending_entry) / 1000);
+        Instant::now()
+            .checked_add(reserve)
+            .is_some_and(|done| done < self.deadline.0)
+    }
+
+    fn deadline(&self) -> Option<Instant> {
+        Some(self.deadline.0)
+    }
 }
 
 /// Whether a frame asking `query` under `budget` can hold its uninterruptible work
@@ -225,6 +255,27 @@ fn pair_work(a: &Shape, b: &Shape) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_frontier_clock_reserves_the_waiting_entries_time_before_its_deadline() {
+        let mut clock = FrontierClock {
+            deadline: Deadline(Instant::now() + Duration::from_millis(50)),
+            ps_per_pending_entry: 1_000_000,
+        };
+        assert!(clock.allows(0) && clock.allows_pending(0, 0));
+        assert!(clock.allows_pending(0, 1_000), "1 ms of entries fits in 50");
+        assert!(
+            !clock.allows_pending(0, 60_000),
+            "60 ms of entries does not"
+        );
+        assert!(!clock.allows_pending(0, u64::MAX), "no overflow");
+        assert_eq!(clock.deadline(), Some(clock.deadline.0));
+        let mut past = FrontierClock {
+            deadline: Deadline(Instant::now()),
+            ps_per_pending_entry: 0,
+        };
+        assert!(!past.allows_pending(0, 0) && !past.allows(0));
+    }
 
     #[test]
     fn the_frontier_deadline_leaves_the_tail_and_the_reserve_or_a_quarter_of_the_rest() {

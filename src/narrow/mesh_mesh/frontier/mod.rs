@@ -49,7 +49,10 @@
 //!
 //! # Cost outside visits
 //! Each round is sorted when it begins (`O(n log n)`, not polled); a set-aside entry is
-//! sorted again in each stage it waits through.
+//! sorted again in each stage it waits through. [`FrontierWorkspace::answers`] reads every
+//! waiting entry. Neither is polled, so each poll tells the budget how many entries wait
+//! ([`Budget::allows_pending`]): a wall-clock budget reserves their sort and answers, and
+//! the frontier stops growing before extracting its answers would overrun the deadline.
 //!
 //! # Allocation
 //! The workspace owns the two entry vectors (swapped every round), the per-pair state and
@@ -421,7 +424,7 @@ impl FrontierWorkspace {
             }
             if self.stats.visits >= self.next_poll {
                 self.stats.polls += 1;
-                if !budget.allows(self.stats.visits) {
+                if !budget.allows_pending(self.stats.visits, self.waiting() as u64) {
                     return false;
                 }
                 self.next_poll = self.stats.visits + self.poll_every;

@@ -494,3 +494,61 @@ fn single_triangle_meshes_are_answered_from_their_root_pair() {
     assert_eq!(out[1].distance_upper, None);
     assert!(2.0 <= out[1].distance_lower + out[1].error_bound);
 }
+
+/// Allows work while at most `cap` entries would be left waiting; records the most seen.
+struct PendingCap {
+    cap: u64,
+    most_seen: u64,
+}
+
+impl Budget for PendingCap {
+    fn allows(&mut self, _visits: u64) -> bool {
+        true
+    }
+
+    fn allows_pending(&mut self, _visits: u64, pending: u64) -> bool {
+        self.most_seen = self.most_seen.max(pending);
+        pending <= self.cap
+    }
+}
+
+#[test]
+fn every_poll_tells_the_budget_the_waiting_entries_so_it_can_stop_the_frontier_growing() {
+    let (a, b, poses) = scene::<Obb>();
+    let pairs = pairs(&a, &b, &poses);
+    let poll_every = 1;
+    let peak = {
+        let mut ws = FrontierWorkspace::with_poll_every(poll_every);
+        let mut budget = PendingCap {
+            cap: u64::MAX,
+            most_seen: 0,
+        };
+        ws.start(&pairs);
+        assert!(ws.run(&pairs, &mut budget));
+        budget.most_seen
+    };
+    // Between two polls one entry is processed, adding at most its 4 children (or a probe
+    // step's): the cap holds to within that growth.
+    let growth = 4;
+    assert!(peak > 8 * growth, "the scene's frontier grows: peak {peak}");
+    for cap in [8, peak / 4, peak / 2] {
+        let mut ws = FrontierWorkspace::with_poll_every(poll_every);
+        let mut budget = PendingCap { cap, most_seen: 0 };
+        ws.start(&pairs);
+        assert!(
+            !ws.run(&pairs, &mut budget),
+            "cap {cap} of peak {peak} stops the run"
+        );
+        assert!(
+            ws.waiting() as u64 > cap && ws.waiting() as u64 <= cap + growth,
+            "cap {cap}: {} waiting",
+            ws.waiting()
+        );
+        let mut answers = Vec::new();
+        ws.answers(&pairs, &mut answers);
+        assert!(
+            answers.iter().any(|a| !a.is_exact()),
+            "cap {cap}: cut short"
+        );
+    }
+}
