@@ -24,6 +24,7 @@
 
 use super::convert::Rejection;
 use super::ingest::{FrameRejection, apply_pose_frame};
+use super::lateness::{LateFrame, Lateness, thread_cpu_ns};
 use super::log::{Cause, Level, Logger, Subject};
 use super::schedule::FrameKey;
 use crate::math::Pose;
@@ -59,8 +60,11 @@ pub struct SceneFrames<S: Service> {
     notifier: Notifier<S>,
     /// Wakes the frame path when a client has published a pose frame.
     poses_ready: Listener<S>,
-    /// The oldest pose frame taken from `poses` and not answered yet, with its receipt.
-    waiting: Option<(PoseSample<S>, FrameKey)>,
+    /// The oldest pose frame taken from `poses` and not answered yet, with its receipt and
+    /// the frame thread's CPU time then ([`thread_cpu_ns`]).
+    waiting: Option<(PoseSample<S>, FrameKey, u64)>,
+    /// Its budgeted frames that were late, and why.
+    lateness: Lateness,
     workspace: PipelineWorkspace,
     output: FrameResults,
     validated: Vec<(BodyId, Pose)>,
@@ -113,6 +117,7 @@ impl<S: Service> SceneFrames<S> {
             notifier,
             poses_ready,
             waiting: None,
+            lateness: Lateness::default(),
             workspace: PipelineWorkspace::with_workers(Arc::clone(workers)),
             output: FrameResults::default(),
             validated: Vec::new(),
@@ -140,14 +145,14 @@ impl<S: Service> SceneFrames<S> {
                 received: Instant::now(),
                 budget_ns: sample.user_header().budget_ns,
             };
-            self.waiting = Some((sample, key));
+            self.waiting = Some((sample, key, thread_cpu_ns()));
         }
         Ok(())
     }
 
     /// The receipt and budget of the frame waiting for its turn.
     pub fn waiting(&self) -> Option<FrameKey> {
-        self.waiting.as_ref().map(|&(_, key)| key)
+        self.waiting.as_ref().map(|&(_, key, _)| key)
     }
 
     /// Answers the waiting frame (see [`take_next`](Self::take_next)) over `scene` (id
@@ -161,7 +166,7 @@ impl<S: Service> SceneFrames<S> {
         scene: &mut Scene,
         log: &mut Logger,
     ) -> Result<bool, String> {
-        let Some((sample, key)) = self.waiting.take() else {
+        let Some((sample, key, cpu_at_receipt)) = self.waiting.take() else {
             return Ok(false);
         };
         let ingest_started = Instant::now();
@@ -216,7 +221,19 @@ impl<S: Service> SceneFrames<S> {
         let publish_ns = self.publish(result, key.received, header.budget_ns)?;
         let records = self.output.record_count() as u64;
         self.workspace.note_publish(publish_ns, records);
+        let (wall_ns, cpu_ns) = (
+            elapsed_ns(key.received),
+            thread_cpu_ns().saturating_sub(cpu_at_receipt),
+        );
+        if let Some(late) = self.lateness.note(header.budget_ns, wall_ns, cpu_ns) {
+            log_late(log, scene_id, header.frame_seq, late);
+        }
         Ok(true)
+    }
+
+    /// Its budgeted frames that were late, and why.
+    pub fn lateness(&self) -> &Lateness {
+        &self.lateness
     }
 
     /// Drops the waiting frame unanswered (its scene is gone).
@@ -273,6 +290,27 @@ impl<S: Service> SceneFrames<S> {
             .map_err(|e| format!("results notify: {e:?}"))?;
         Ok(elapsed_ns(publish_started))
     }
+}
+
+/// Logs a scene's first late frame of each kind (the OS's stall, the daemon's work); later
+/// ones are counted ([`Logger::once`]).
+fn log_late(log: &mut Logger, scene_id: u32, seq: u64, late: LateFrame) {
+    let (level, code, why) = if late.stalled_by_os() {
+        (Level::Debug, 0, "the OS held the frame thread off the CPU")
+    } else {
+        (Level::Info, 1, "late by the daemon's work")
+    };
+    let cause = Cause {
+        what: "late frame",
+        code,
+    };
+    log.once(level, Subject::Scene(scene_id), cause, || {
+        format!(
+            "frame {seq} late by {} µs ({why}: {} µs off the CPU)",
+            late.late_ns / 1_000,
+            late.off_cpu_ns / 1_000
+        )
+    });
 }
 
 fn elapsed_ns(since: Instant) -> u64 {

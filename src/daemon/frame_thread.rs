@@ -104,6 +104,9 @@ impl FrameThread {
             }
             last_work = Instant::now();
         }
+        for live in &self.scenes {
+            log_lateness(&mut self.log, live.id, &live.frames);
+        }
         Ok(())
     }
 
@@ -119,6 +122,7 @@ impl FrameThread {
                         continue;
                     };
                     let LiveScene { scene, frames, .. } = self.scenes.swap_remove(index);
+                    log_lateness(&mut self.log, id, &frames);
                     self.log.release(Subject::Scene(id));
                     // Should the control thread be gone, the scene is let go of here after all.
                     let _ = self.control.retire.try_send(Retired { scene, frames });
@@ -148,5 +152,12 @@ impl FrameThread {
             .answer_waiting(*id, &mut cell.scene, &mut self.log)
             .map_err(DaemonRunError::Ipc)?;
         Ok(true)
+    }
+}
+
+/// Logs how many of a closing scene's frames were late, and why.
+fn log_lateness(log: &mut Logger, id: u32, frames: &SceneFrames<Ipc>) {
+    if let Some(line) = frames.lateness().summary() {
+        log.info(format_args!("{}: {line}", Subject::Scene(id)));
     }
 }

@@ -46,6 +46,7 @@ mod frame_loop;
 mod frame_thread;
 mod gate;
 mod ingest;
+mod lateness;
 pub mod liveness;
 pub mod log;
 mod schedule;
