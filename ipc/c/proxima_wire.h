@@ -75,7 +75,7 @@ extern "C" {
  * Service settings. Open every service with open_or_create and exactly these settings, so
  * whichever side comes first creates it and the other opens it (when opening, iceoryx2
  * treats each as a minimum). Values equal to iceoryx2's defaults are listed too, so that a
- * binding whose defaults differ can set them. See PROTOCOL.md §3.2–3.3.
+ * binding whose defaults differ can set them. See PROTOCOL.md.
  * ------------------------------------------------------------------------------------- */
 
 /** iceoryx2's default max_nodes of publish-subscribe and request-response services,
@@ -265,7 +265,7 @@ typedef enum proxima_RecordKind {
 } proxima_RecordKind;
 
 /* PoseFrameHeader.query_flags: what a frame asks for (at least one; undefined bits are
- * refused). See PROTOCOL.md §5.6 for what each answers. */
+ * refused). See PROTOCOL.md for what each answers. */
 
 /** Pairs that touch or intersect (distance <= 0). */
 #define PROXIMA_QUERY_OVERLAP (UINT32_C(1) << 0)
@@ -378,7 +378,7 @@ typedef struct proxima_ResultFrameHeader {
     uint64_t min_budget_ns;
 } proxima_ResultFrameHeader;
 
-/** A pair, a contact point or a time of impact (see `kind`; PROTOCOL.md §4.6 for each
+/** A pair, a contact point or a time of impact (see `kind`; PROTOCOL.md for each
  *  field per kind). 120 bytes, alignment 8. */
 typedef struct proxima_ResultRecord {
     /** proxima_RecordKind. */
