@@ -127,8 +127,10 @@ extern "C" {
 #define PROXIMA_POSES_MAX_PUBLISHERS 4
 #define PROXIMA_POSES_MAX_SUBSCRIBERS 1
 /** Pose publisher port: initial slice length in records, with the PowerOfTwo allocation
- *  strategy and max_loaned_samples 1. */
+ *  strategy and PROXIMA_POSES_MAX_LOANED_SAMPLES. */
 #define PROXIMA_POSES_INITIAL_MAX_SLICE_LEN 1024
+/** Pose publisher port: frames on loan at once. */
+#define PROXIMA_POSES_MAX_LOANED_SAMPLES 1
 #define PROXIMA_POSES_READY_MAX_NOTIFIERS PROXIMA_POSES_MAX_PUBLISHERS
 #define PROXIMA_POSES_READY_MAX_LISTENERS PROXIMA_DAEMON_EVENT_PORTS
 

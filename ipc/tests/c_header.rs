@@ -301,6 +301,8 @@ fn table() -> Table {
     constant!(t, ipc::DAEMON_EVENT_PORTS => "PROXIMA_DAEMON_EVENT_PORTS");
     constant!(t, scene_link::POSES_INITIAL_MAX_SLICE_LEN
         => "PROXIMA_POSES_INITIAL_MAX_SLICE_LEN");
+    constant!(t, scene_link::POSES_MAX_LOANED_SAMPLES
+        => "PROXIMA_POSES_MAX_LOANED_SAMPLES");
     t.string(
         Some("DEFAULT_ROOT"),
         "PROXIMA_DEFAULT_ROOT",
