@@ -218,14 +218,14 @@ impl<S: Service> SceneFrames<S> {
                 }
             }
         }
-        let publish_ns = self.publish(result, key.received, header.budget_ns)?;
+        let published = self.publish(result, key.received, header.budget_ns)?;
         let records = self.output.record_count() as u64;
-        self.workspace.note_publish(publish_ns, records);
-        let (wall_ns, cpu_ns) = (
-            elapsed_ns(key.received),
-            thread_cpu_ns().saturating_sub(cpu_at_receipt),
-        );
-        if let Some(late) = self.lateness.note(header.budget_ns, wall_ns, cpu_ns) {
+        self.workspace.note_publish(published.publish_ns, records);
+        let cpu_ns = published.cpu_ns.saturating_sub(cpu_at_receipt);
+        if let Some(late) = self
+            .lateness
+            .note(header.budget_ns, published.elapsed_ns, cpu_ns)
+        {
             log_late(log, scene_id, header.frame_seq, late);
         }
         Ok(true)
@@ -256,14 +256,13 @@ impl<S: Service> SceneFrames<S> {
         }
     }
 
-    /// Writes and publishes the result frame and notifies; returns how long that took,
-    /// nanoseconds.
+    /// Writes and publishes the result frame and notifies.
     fn publish(
         &self,
         mut header: ResultFrameHeader,
         received: Instant,
         budget_ns: u64,
-    ) -> Result<u64, String> {
+    ) -> Result<Published, String> {
         let publish_started = Instant::now();
         let FrameResults {
             pairs,
@@ -282,14 +281,29 @@ impl<S: Service> SceneFrames<S> {
             });
         header.stage_ns[wire::stage::PUBLISH] = elapsed_ns(publish_started);
         header.elapsed_ns = elapsed_ns(received);
+        let cpu_ns = thread_cpu_ns();
         header.budget_met = u32::from(budget_ns == 0 || header.elapsed_ns <= budget_ns);
         *sample.user_header_mut() = header;
         sample.send().map_err(|e| format!("results send: {e:?}"))?;
         self.notifier
             .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
             .map_err(|e| format!("results notify: {e:?}"))?;
-        Ok(elapsed_ns(publish_started))
+        Ok(Published {
+            publish_ns: elapsed_ns(publish_started),
+            elapsed_ns: header.elapsed_ns,
+            cpu_ns,
+        })
     }
+}
+
+/// What [`SceneFrames::publish`] measured.
+struct Published {
+    /// Writing, publishing and notifying, nanoseconds.
+    publish_ns: u64,
+    /// The header's `elapsed_ns`: receipt to the result stamped for sending.
+    elapsed_ns: u64,
+    /// The frame thread's CPU time ([`thread_cpu_ns`]) when `elapsed_ns` was taken.
+    cpu_ns: u64,
 }
 
 /// Logs a scene's first late frame of each kind (the OS's stall, the daemon's work); later
@@ -298,7 +312,7 @@ fn log_late(log: &mut Logger, scene_id: u32, seq: u64, late: LateFrame) {
     let (level, code, why) = if late.stalled_by_os() {
         (Level::Debug, 0, "the OS held the frame thread off the CPU")
     } else {
-        (Level::Info, 1, "late by the daemon's work")
+        (Level::Warn, 1, "late by the daemon's work")
     };
     let cause = Cause {
         what: "late frame",

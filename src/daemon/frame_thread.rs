@@ -155,9 +155,10 @@ impl FrameThread {
     }
 }
 
-/// Logs how many of a closing scene's frames were late, and why.
+/// Logs how many of a closing scene's frames were late, and why (a warning: each broke the
+/// promise of an answer by the deadline).
 fn log_lateness(log: &mut Logger, id: u32, frames: &SceneFrames<Ipc>) {
     if let Some(line) = frames.lateness().summary() {
-        log.info(format_args!("{}: {line}", Subject::Scene(id)));
+        log.warn(format_args!("{}: {line}", Subject::Scene(id)));
     }
 }
