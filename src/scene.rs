@@ -182,6 +182,14 @@ pub struct SyncPoint {
     edits: u64,
 }
 
+impl SyncPoint {
+    /// [`Scene::uid`] of the scene it was taken on.
+    #[must_use]
+    pub fn scene_uid(&self) -> u64 {
+        self.uid
+    }
+}
+
 /// Source of [`Scene::uid`]s.
 static NEXT_SCENE_UID: AtomicU64 = AtomicU64::new(1);
 
