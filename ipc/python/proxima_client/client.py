@@ -325,6 +325,7 @@ class Client:
         return client
 
     def _new_port(self) -> Any:
+        """A fresh client port of the control service (PowerOfTwo slices, so meshes of any size fit)."""
         try:
             return (
                 self._service.client_builder()
@@ -502,6 +503,7 @@ class Client:
             else np.ascontiguousarray(payload).view(np.uint8).reshape(-1)
 
         def fill(address: int) -> None:
+            """Writes the payload at ``address``."""
             if data.size:
                 ctypes.memmove(address, data.ctypes.data, data.size)
 
@@ -520,6 +522,7 @@ class Client:
 
     @staticmethod
     def _header(command: Command, scene: int) -> ControlRequest:
+        """A request header for ``command`` on ``scene``, every other field zero."""
         header = ControlRequest()
         header.protocol_version = PROTOCOL_VERSION
         header.command = int(command)
@@ -532,6 +535,7 @@ class Client:
 
     def _register_geometry(self, scene: int, kind: ShapeKindCode, vertices: Any,
                            triangles: Any) -> Registration:
+        """Registers a convex or mesh shape with its geometry payload; the registration."""
         v, t = _geometry(vertices, triangles)
         header = self._header(Command.REGISTER_SHAPE, scene)
         header.shape_kind = int(kind)
@@ -540,6 +544,7 @@ class Client:
         v_bytes, t_bytes = v.nbytes, t.nbytes
 
         def fill(address: int) -> None:
+            """Writes the payload at ``address``."""
             if v_bytes:
                 ctypes.memmove(address, v.ctypes.data, v_bytes)
             if t_bytes:
@@ -549,11 +554,13 @@ class Client:
         return Registration(shape=shape, ready=not flags & reply_flags.SHAPE_BUILDING)
 
     def _wait_registered(self, scene: int, registration: Registration) -> int:
+        """The id of an accepted registration, once its shape is built."""
         if not registration.ready:
             self.wait_shape(scene, registration.shape)
         return registration.shape
 
     def _request(self, header: ControlRequest, length: int, fill: Callable[[int], None]) -> ControlReply:
+        """One request and its reply; raises on timeout, a lost daemon or a foreign reply."""
         answer = self._request_until(header, length, fill, now() + self.reply_timeout)
         if answer is None:
             if not self.daemon_is_alive():
@@ -593,6 +600,7 @@ class Client:
             pass
 
         def poll() -> Optional[tuple[ControlReply, int]]:
+            """The reply (copied) and its server id, if one has arrived."""
             try:
                 response = pending.receive()
             except Exception as e:

@@ -31,6 +31,7 @@ class TransportError(ProximaError):
     """iceoryx2 failed: ``what`` was being done, ``cause`` is the binding's exception."""
 
     def __init__(self, what: str, cause: Optional[BaseException] = None) -> None:
+        """Keeps the failure's details and composes the message."""
         self.what = what
         self.cause = cause
         text = what if cause is None else f"{what}: {type(cause).__name__}: {cause}"
@@ -53,6 +54,7 @@ class BuildTimeout(ProximaError, TimeoutError):
     """A convex or mesh shape was still being built at the build timeout."""
 
     def __init__(self, shape: int) -> None:
+        """Keeps the failure's details and composes the message."""
         self.shape = shape
         super().__init__(f"shape {shape} is still being built")
 
@@ -71,6 +73,7 @@ class DaemonError(ProximaError):
     CODE: Optional[ErrorCode] = None
 
     def __init__(self, code: "ErrorCode | int", reason: str = "", body: Optional[int] = None) -> None:
+        """Keeps the failure's details and composes the message."""
         self.code = code
         self.reason = reason
         self.body = body

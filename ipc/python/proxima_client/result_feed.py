@@ -46,13 +46,14 @@ def records_view(address: int, count: int, owner: Any = None, writeable: bool = 
         return np.empty(0, dtype=RESULT_DTYPE)
     buffer = (ctypes.c_char * (count * _RECORD_BYTES)).from_address(address)
     buffer._owner = owner  # type: ignore[attr-defined]
-    array = np.frombuffer(buffer, RESULT_DTYPE)
+    array = np.frombuffer(buffer, RESULT_DTYPE)  # type: ignore[call-overload]  # ctypes arrays are buffers
     if not writeable:
         array.flags.writeable = False
     return array
 
 
 def _clamp(count: int, length: int) -> int:
+    """``count``, at most ``length``."""
     return count if count < length else length
 
 
@@ -101,6 +102,7 @@ class _Frame:
             raise error_for(status, body=None if body == 0xFFFF_FFFF else body)
 
     def _bounds(self) -> tuple[int, int, int, int]:
+        """Record count and the ends of the pairs, contacts and times of impact, clamped."""
         n = len(self.records)
         h = self.header
         p = _clamp(h.pair_count, n)
@@ -138,6 +140,7 @@ class OwnedResultFrame(_Frame):
     """A result frame copied out of shared memory: it holds no sample and lives on."""
 
     def __init__(self, header: ResultFrameHeader, records: np.ndarray) -> None:
+        """Wraps a received sample (or a copied header and records)."""
         self.header = header
         self.records = records
 
@@ -155,6 +158,7 @@ class ResultFrame(_Frame):
     """
 
     def __init__(self, sample: Any) -> None:
+        """Wraps a received sample (or a copied header and records)."""
         self._sample: Any = sample
         header = ResultFrameHeader()
         ctypes.memmove(ctypes.addressof(header), sample.user_header_ptr, _HEADER_BYTES)

@@ -43,7 +43,8 @@ def poses_view(address: int, count: int) -> np.ndarray:
     """A writeable numpy array of ``count`` :data:`POSE_DTYPE` records at ``address``."""
     if count == 0:
         return np.empty(0, dtype=POSE_DTYPE)
-    return np.frombuffer((ctypes.c_char * (count * _POSE_BYTES)).from_address(address), POSE_DTYPE)
+    buffer = (ctypes.c_char * (count * _POSE_BYTES)).from_address(address)
+    return np.frombuffer(buffer, POSE_DTYPE)  # type: ignore[call-overload]  # ctypes arrays are buffers
 
 
 def pose_array(ids: Any, positions: Any, orientations: Any = None) -> np.ndarray:
@@ -57,6 +58,11 @@ def pose_array(ids: Any, positions: Any, orientations: Any = None) -> np.ndarray
 
 
 def _check_fields(ids: Any, positions: Any, orientations: Any) -> tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
+    """The pose arrays as numpy arrays of the right shapes.
+
+    Raises:
+        ValueError: shapes that do not fit ``(n,)``, ``(n, 3)``, ``(n, 4)``, or non-integer ids.
+    """
     ids = np.asarray(ids)
     positions = np.asarray(positions, dtype=np.float64)
     n = ids.shape[0] if ids.ndim == 1 else -1
@@ -72,6 +78,7 @@ def _check_fields(ids: Any, positions: Any, orientations: Any) -> tuple[np.ndarr
 
 
 def _write_fields(out: np.ndarray, ids: np.ndarray, positions: np.ndarray, orientations: Optional[np.ndarray]) -> None:
+    """Writes the pose fields into ``out`` (a :data:`POSE_DTYPE` array), one numpy copy each."""
     out["body"] = ids
     out["reserved"] = 0
     out["position"] = positions
@@ -87,6 +94,7 @@ class PoseFrame:
     """
 
     def __init__(self, link: "SceneLink", sample: Any, count: int) -> None:
+        """Wraps a loaned sample of ``count`` records (see :meth:`SceneLink.loan_frame`)."""
         self._link = link
         self._sample: Any = sample
         self.poses: np.ndarray = poses_view(sample.payload_ptr, count)
@@ -215,6 +223,7 @@ class SceneLink:
         self._send(sample)
 
     def _loan_sample(self, count: int) -> Any:
+        """A loaned, uninitialised sample of ``count`` pose records."""
         try:
             return self._publisher.loan_slice_uninit(count)
         except Exception as e:
@@ -222,6 +231,7 @@ class SceneLink:
 
     def _loan(self, frame_seq: int, budget_ns: int, query_flags: int, count: int,
               view: bool = True) -> tuple[Any, np.ndarray]:
+        """A loaned sample with the frame header written; with ``view``, a numpy view of its records."""
         if count > U32_MAX:
             raise ValueError(f"{count} poses do not fit a frame")
         header = self._header
@@ -234,6 +244,7 @@ class SceneLink:
         return sample, (poses_view(sample.payload_ptr, count) if view else _EMPTY_POSES)
 
     def _send(self, sample: Any) -> None:
+        """Sends ``sample`` and notifies the poses-ready service (event id 1)."""
         try:
             sample.assume_init().send()
         except Exception as e:

@@ -113,6 +113,7 @@ def make_config(prefix: Optional[str] = None) -> Any:
 
 
 def _service_name(name: str) -> Any:
+    """An iceoryx2 service name, its failure as a :class:`TransportError`."""
     try:
         return iox.ServiceName.new(name)
     except Exception as e:

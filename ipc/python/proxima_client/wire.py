@@ -207,7 +207,8 @@ class _Record(ctypes.Structure):
     def to_dict(self) -> dict[str, Any]:
         """The fields as plain Python values (arrays as lists)."""
         out: dict[str, Any] = {}
-        for name, _ in self._fields_:
+        for field in self._fields_:
+            name = field[0]
             value = getattr(self, name)
             out[name] = list(value) if isinstance(value, ctypes.Array) else value
         return out
@@ -335,6 +336,7 @@ class ControlReply(_Record):
 
 
 def _dtype(fields: list[tuple[str, Any, int]], itemsize: int) -> np.dtype:
+    """A structured dtype with explicit offsets and item size."""
     names, formats, offsets = zip(*fields)
     return np.dtype(
         {"names": list(names), "formats": list(formats), "offsets": list(offsets), "itemsize": itemsize}
@@ -426,7 +428,9 @@ def _check_layouts() -> None:
             continue
         if dtype.itemsize != size:
             raise ImportError(f"{struct.__name__}: numpy itemsize {dtype.itemsize} != {size}")
-        for name, _ in struct._fields_:
+        assert dtype.fields is not None
+        for field in struct._fields_:
+            name = field[0]
             if dtype.fields[name][1] != getattr(struct, name).offset:
                 raise ImportError(f"{struct.__name__}.{name}: numpy and ctypes offsets differ")
     if not np.little_endian:
