@@ -34,7 +34,7 @@ from typing import Any, Optional
 import iceoryx2 as iox
 import numpy as np
 
-from proxima_client import BodySpec, Client, Motion, Sphere, query
+from proxima_client import BodySpec, Client, Motion, Sphere, pose_array, query
 from proxima_client.daemon_process import DaemonProcess, Isolation
 
 RADIUS, SPACING, MARGIN = 0.5, 3.0, 0.1
@@ -56,8 +56,13 @@ def positions_at(points: np.ndarray, offsets: np.ndarray, t: float) -> np.ndarra
     return out
 
 
-def measure_python(client: Client, bodies: int, frames: int, warmup: int, budget_ns: int) -> dict[str, Any]:
-    """The Python client's figures on a fresh scene, in the JSON shape ``frame_dump`` prints."""
+def measure_python(client: Client, bodies: int, frames: int, warmup: int, budget_ns: int,
+                   structured: bool = False) -> dict[str, Any]:
+    """The Python client's figures on a fresh scene, in the JSON shape ``frame_dump`` prints.
+
+    With ``structured``, the poses live in one :data:`POSE_DTYPE` array updated in place
+    and are published with one ``memmove`` (``publish_poses``); else from separate ``ids``
+    and ``positions`` arrays, one numpy copy per field (``publish``)."""
     scene = client.create_scene()
     shape = client.register_primitive(scene, Sphere(RADIUS))
     points, offsets = grid(bodies)
@@ -79,10 +84,16 @@ def measure_python(client: Client, bodies: int, frames: int, warmup: int, budget
         return frame
 
     link.feed.try_receive = timed_try_receive  # type: ignore[method-assign]
+    poses = pose_array(ids, points)
     for seq in range(1, warmup + frames + 1):
         positions = positions_at(points, offsets, seq * 1e-3)
+        if structured:
+            poses["position"] = positions
         t0 = clock()
-        link.publish(seq, budget_ns, query.CLOSE, ids, positions)
+        if structured:
+            link.publish_poses(seq, budget_ns, query.CLOSE, poses)
+        else:
+            link.publish(seq, budget_ns, query.CLOSE, ids, positions)
         t1 = clock()
         frame = link.receive_results_for(seq, 10.0)
         t2 = clock()
@@ -97,7 +108,7 @@ def measure_python(client: Client, bodies: int, frames: int, warmup: int, budget
             rtt[k], side[k], daemon[k] = t2 - t0, (t1 - t0) + last[0] + (t3 - t2), elapsed
     client.drop_scene(scene)
     link.close()
-    return {"client": "python", "bodies": bodies, "frames": frames,
+    return {"client": "python-structured" if structured else "python", "bodies": bodies, "frames": frames,
             "rtt_p50_ns": int(np.percentile(rtt, 50)), "rtt_p99_ns": int(np.percentile(rtt, 99)),
             "rtt_mean_ns": int(rtt.mean()), "daemon_p50_ns": int(np.percentile(daemon, 50)),
             "side_p50_ns": int(np.percentile(side, 50)), "side_p99_ns": int(np.percentile(side, 99))}
@@ -115,7 +126,7 @@ def measure_rust(frame_dump: str, root: str, prefix: str, bodies: int, frames: i
 
 def line(r: dict[str, Any]) -> str:
     us = lambda key: r[key] / 1e3  # noqa: E731
-    text = (f"{r['client']:6}  round trip p50 {us('rtt_p50_ns'):7.1f} p99 {us('rtt_p99_ns'):7.1f} µs  "
+    text = (f"{r['client']:17}  round trip p50 {us('rtt_p50_ns'):7.1f} p99 {us('rtt_p99_ns'):7.1f} µs  "
             f"daemon p50 {us('daemon_p50_ns'):6.1f} µs")
     if "side_p50_ns" in r:
         text += f"  python side p50 {us('side_p50_ns'):5.1f} p99 {us('side_p99_ns'):6.1f} µs"
@@ -133,12 +144,13 @@ def main() -> int:
     parser.add_argument("--root", default="proxima")
     parser.add_argument("--iceoryx-prefix", default=None)
     parser.add_argument("--spawn-daemon", metavar="PATH", help="start this proximad privately")
+    parser.add_argument("--daemon-args", default="", help="extra arguments of the spawned daemon, e.g. '--spin-us 200'")
     args = parser.parse_args()
     iox.set_log_level_from_env_or(iox.LogLevel.Error)
 
     daemon: Optional[DaemonProcess] = None
     if args.spawn_daemon:
-        daemon = DaemonProcess(args.spawn_daemon, Isolation.unique("lat"))
+        daemon = DaemonProcess(args.spawn_daemon, Isolation.unique("lat"), args.daemon_args.split())
     root = daemon.root if daemon else args.root
     prefix = daemon.prefix if daemon else args.iceoryx_prefix
     try:
@@ -156,15 +168,21 @@ def main() -> int:
                 print(f"[{repeat}] {line(rust)}")
             python = measure_python(client, args.bodies, args.frames, args.warmup, args.budget_ns)
             print(f"[{repeat}] {line(python)}")
+            structured = measure_python(client, args.bodies, args.frames, args.warmup, args.budget_ns, True)
+            print(f"[{repeat}] {line(structured)}")
             if rust:
-                print(f"[{repeat}] ratio python/rust round trip p50 {python['rtt_p50_ns'] / rust['rtt_p50_ns']:.2f} "
-                      f"p99 {python['rtt_p99_ns'] / rust['rtt_p99_ns']:.2f}")
+                for p in (python, structured):
+                    print(f"[{repeat}] ratio {p['client']}/rust round trip p50 {p['rtt_p50_ns'] / rust['rtt_p50_ns']:.2f} "
+                          f"p99 {p['rtt_p99_ns'] / rust['rtt_p99_ns']:.2f}")
             results.append((rust, python))
-        side = [p["side_p50_ns"] / 1e3 for _, p in results]
-        print(f"python side p50 per repeat: {', '.join(f'{s:.1f}' for s in side)} µs (target ≤ 40)")
-        ratios = [p["rtt_p50_ns"] / r["rtt_p50_ns"] for r, p in results if r]
-        if ratios:
-            print(f"round trip p50 ratio per repeat: {', '.join(f'{x:.2f}' for x in ratios)} (target ≤ 1.3)")
+            results.append((rust, structured))
+        for name in ("python", "python-structured"):
+            mine = [(r, p) for r, p in results if p["client"] == name]
+            side = ", ".join(f"{p['side_p50_ns'] / 1e3:.1f}" for _, p in mine)
+            print(f"{name}: python side p50 per repeat {side} µs (target ≤ 40)")
+            ratios = ", ".join(f"{p['rtt_p50_ns'] / r['rtt_p50_ns']:.2f}" for r, p in mine if r)
+            if ratios:
+                print(f"{name}: round trip p50 ratio to rust per repeat {ratios} (target ≤ 1.3)")
         client.close()
     finally:
         if daemon is not None:

@@ -34,21 +34,23 @@ from .wire import RESULT_DTYPE, Completeness, ErrorCode, ResultFrameHeader
 
 _RECORD_BYTES = RESULT_DTYPE.itemsize
 _HEADER_BYTES = ctypes.sizeof(ResultFrameHeader)
+#: The records of an empty or released frame (read-only, shared).
+_NO_RECORDS = np.empty(0, dtype=RESULT_DTYPE)
+_NO_RECORDS.flags.writeable = False
 
 
-def records_view(address: int, count: int, owner: Any = None, writeable: bool = False) -> np.ndarray:
-    """A numpy array of ``count`` :data:`RESULT_DTYPE` records at ``address``, no copy.
+def records_view(address: int, count: int, owner: Any = None) -> np.ndarray:
+    """A read-only numpy array of ``count`` :data:`RESULT_DTYPE` records at ``address``, no copy.
 
     The array references ``owner`` (the sample), so the memory stays lent while any view
     of it lives; an explicit release of the owner still ends its validity.
     """
     if count == 0:
-        return np.empty(0, dtype=RESULT_DTYPE)
+        return _NO_RECORDS
     buffer = (ctypes.c_char * (count * _RECORD_BYTES)).from_address(address)
     buffer._owner = owner  # type: ignore[attr-defined]
     array = np.frombuffer(buffer, RESULT_DTYPE)  # type: ignore[call-overload]  # ctypes arrays are buffers
-    if not writeable:
-        array.flags.writeable = False
+    array.flags.writeable = False
     return array
 
 
@@ -181,7 +183,7 @@ class ResultFrame(_Frame):
         """Hands the sample back to the daemon's publisher (idempotent)."""
         sample, self._sample = self._sample, None
         if sample is not None:
-            self.records = np.empty(0, dtype=RESULT_DTYPE)
+            self.records = _NO_RECORDS
             sample.delete()
 
     def __enter__(self) -> "ResultFrame":
