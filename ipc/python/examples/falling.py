@@ -22,7 +22,7 @@ import time
 import iceoryx2 as iox
 import numpy as np
 
-from proxima_client import BodySpec, Capsule, Client, Cuboid, ErrorCode, Motion, Sphere, query
+from proxima_client import BodySpec, Capsule, Client, Cuboid, ErrorCode, Motion, Sphere, frame_flags, query
 from proxima_client.daemon_process import DaemonProcess, Isolation
 
 BIN_HALF = 3.0  # half the bin's inner width, m
@@ -118,7 +118,7 @@ def simulate(client: Client, args: argparse.Namespace) -> int:
           f"{args.rate_hz} Hz")
     dt = 1.0 / args.rate_hz
     frames = int(np.ceil(args.seconds * args.rate_hz))
-    round_trips, truncated, over_budget, lost = [], 0, 0, 0
+    round_trips, truncated, capped, over_budget, lost = [], 0, 0, 0, 0
     start = time.perf_counter()
     for seq in range(1, frames + 1):
         pause = start + seq * dt - time.perf_counter()
@@ -138,19 +138,21 @@ def simulate(client: Client, args: argparse.Namespace) -> int:
                 print(f"frame {seq} refused: {frame.status!r}", file=sys.stderr)
                 return 1
             truncated += not frame.exact
+            capped += bool(frame.header.flags & frame_flags.PAIRS_CAPPED)
             over_budget += not frame.budget_met
             bounced = bounce(frame.pairs, slot, positions, velocities)
             if seq % args.rate_hz == 0:
                 resting = int(np.count_nonzero(np.linalg.norm(velocities, axis=1) < 0.2))
                 print(f"t {seq * dt:5.1f} s  pairs {len(frame.pairs):4}  contacts {len(frame.contacts):4}  "
-                      f"bounced {bounced:4}  resting {resting:4}/{len(ids)}  round trip {round_trips[-1] * 1e6:7.1f} µs  "
+                      f"bounced {bounced:4}  resting {resting:4}/{len(ids)}  round trip {round_trips[-1] * 1e6:7.1f} µs "
+                      f"(daemon {frame.header.elapsed_ns / 1e3:6.1f})  "
                       f"budget {'met' if frame.budget_met else 'MISSED'}")
     rtt = np.array(round_trips) * 1e6
     if len(rtt):
         print(f"round trip: n={len(rtt)} p50 {np.percentile(rtt, 50):.1f} p99 {np.percentile(rtt, 99):.1f} "
               f"max {rtt.max():.1f} µs")
     inside = np.all(np.abs(positions[:, :2]) < BIN_HALF + 0.5, axis=1) & (positions[:, 2] > -0.5)
-    print(f"{frames} frames: {truncated} truncated, {over_budget} over budget, {lost} lost; "
+    print(f"{frames} frames: {truncated} truncated, {capped} with pairs capped, {over_budget} over budget, {lost} lost; "
           f"{int(inside.sum())} of {len(ids)} bodies inside the bin")
     client.drop_scene(scene)
     link.close()
