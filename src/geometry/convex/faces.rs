@@ -95,7 +95,10 @@ fn outline(
             }
         }
     }
-    let start = *next.keys().next()?;
+    // NOTE: the smallest vertex, not the map's first key: a `HashMap`'s iteration order is
+    // random per map, and the outline's first vertex decides how contacts are clipped
+    // against the face (to the last bit), so the same points must give the same outline.
+    let start = *next.keys().min()?;
     let mut loop_ = vec![start];
     let mut cur = next[&start];
     while cur != start {

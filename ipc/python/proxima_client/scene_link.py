@@ -1,0 +1,301 @@
+"""The frame half of the client, mirroring ``ipc/src/scene_link.rs``: a :class:`SceneLink`
+publishes a scene's pose frames, written straight into a loaned shared-memory sample from
+numpy arrays (one numpy copy per field, no per-body Python loop), and receives its result
+frames as numpy views (:class:`~proxima_client.result_feed.ResultFrame`).
+
+.. code-block:: python
+
+    link = client.open_scene(scene)
+    link.publish(1, 0, query.CLOSE, ids, positions, orientations)
+    with link.receive_results_for(1, timeout=0.01) as frame:
+        for pair in frame.pairs:
+            print(pair["body_a"], pair["body_b"], pair["distance"])
+
+After each pose frame the link notifies the scene's poses-ready service (event id 1), so
+a daemon asleep in its WaitSet wakes. A pose frame published before the daemon's
+subscriber exists is lost (no history); the daemon opens a scene's services when the
+scene is created.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from typing import Any, Optional
+
+import iceoryx2 as iox
+import numpy as np
+
+from . import services
+from .errors import TransportError
+from .result_feed import OwnedResultFrame, ResultFeed, ResultFrame
+from .wire import POSE_DTYPE, PROTOCOL_VERSION, U32_MAX, PoseFrameHeader
+
+#: Pose records the publisher's first shared-memory segment holds; a larger frame makes it
+#: allocate a segment of the next power of two (a one-off cost, for the daemon too).
+POSES_INITIAL_MAX_SLICE_LEN: int = 1024
+
+_POSE_BYTES = POSE_DTYPE.itemsize
+_HEADER_BYTES = ctypes.sizeof(PoseFrameHeader)
+_IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+def poses_view(address: int, count: int) -> np.ndarray:
+    """A writeable numpy array of ``count`` :data:`POSE_DTYPE` records at ``address``."""
+    if count == 0:
+        return np.empty(0, dtype=POSE_DTYPE)
+    buffer = (ctypes.c_char * (count * _POSE_BYTES)).from_address(address)
+    return np.frombuffer(buffer, POSE_DTYPE)  # type: ignore[call-overload]  # ctypes arrays are buffers
+
+
+def pose_array(ids: Any, positions: Any, orientations: Any = None) -> np.ndarray:
+    """A :data:`POSE_DTYPE` array from ``ids`` (``(n,)``), ``positions`` (``(n, 3)``) and
+    ``orientations`` (``(n, 4)``, ``[x, y, z, w]``; ``None``: identity). Handy to build a
+    frame once and publish it with :meth:`SceneLink.publish_poses`."""
+    ids, positions, orientations = _check_fields(ids, positions, orientations)
+    out = np.zeros(len(ids), dtype=POSE_DTYPE)
+    _write_fields(out, ids, positions, orientations)
+    return out
+
+
+def _check_fields(ids: Any, positions: Any, orientations: Any) -> tuple[np.ndarray, np.ndarray, Optional[np.ndarray]]:
+    """The pose arrays as numpy arrays of the right shapes.
+
+    Raises:
+        ValueError: shapes that do not fit ``(n,)``, ``(n, 3)``, ``(n, 4)``, or non-integer ids.
+    """
+    ids = np.asarray(ids)
+    positions = np.asarray(positions, dtype=np.float64)
+    n = ids.shape[0] if ids.ndim == 1 else -1
+    if n < 0 or positions.shape != (n, 3):
+        raise ValueError(f"ids must be (n,) and positions (n, 3); got {ids.shape} and {positions.shape}")
+    if ids.dtype.kind not in "ui":
+        raise ValueError(f"body ids must be integers, not {ids.dtype}")
+    if orientations is not None:
+        orientations = np.asarray(orientations, dtype=np.float64)
+        if orientations.shape != (n, 4):
+            raise ValueError(f"orientations must be ({n}, 4), not {orientations.shape}")
+    return ids, positions, orientations
+
+
+def _write_fields(out: np.ndarray, ids: np.ndarray, positions: np.ndarray, orientations: Optional[np.ndarray]) -> None:
+    """Writes the pose fields into ``out`` (a :data:`POSE_DTYPE` array), one numpy copy each."""
+    out["body"] = ids
+    out["reserved"] = 0
+    out["position"] = positions
+    out["orientation"] = _IDENTITY if orientations is None else orientations
+
+
+class PoseFrame:
+    """A loaned pose frame being written in place (see :meth:`SceneLink.loan_frame`).
+
+    :attr:`poses` is a writeable :data:`POSE_DTYPE` view on the sample: fill it (every
+    record: the memory is not initialised), then :meth:`send`. Dropping it unsent hands
+    the memory back.
+    """
+
+    def __init__(self, link: "SceneLink", sample: Any, count: int) -> None:
+        """Wraps a loaned sample of ``count`` records (see :meth:`SceneLink.loan_frame`)."""
+        self._link = link
+        self._sample: Any = sample
+        self.poses: np.ndarray = poses_view(sample.payload_ptr, count)
+
+    def send(self) -> None:
+        """Publishes the frame and notifies the daemon (once; later calls fail)."""
+        sample, self._sample = self._sample, None
+        if sample is None:
+            raise TransportError("the pose frame was sent already")
+        self.poses = np.empty(0, dtype=POSE_DTYPE)
+        self._link._send(sample)
+
+    def __enter__(self) -> "PoseFrame":
+        return self
+
+    def __exit__(self, exc_type: Optional[type], *rest: object) -> None:
+        if exc_type is None and self._sample is not None:
+            self.send()
+        elif self._sample is not None:
+            self._sample.delete()
+            self._sample = None
+
+
+class SceneLink:
+    """One client's link to one scene: pose publisher, poses-ready notifier and the
+    result feed (subscriber and results-ready listener).
+
+    Not thread-safe. A result subscriber lends at most two frames at once: release a
+    :class:`ResultFrame` before receiving the third.
+    """
+
+    def __init__(self, node: Any, root: str, scene: int) -> None:
+        """Opens (or creates, if the daemon has not yet) scene ``scene``'s pose, result and
+        event services under ``root`` on ``node`` and creates this link's ports.
+
+        Raises:
+            TransportError: iceoryx2 failed (incompatible services, too many ports).
+        """
+        self._scene = scene
+        self._poses_service = services.open_service(
+            services.poses_service_builder(node, root, scene), "pose service")
+        self._ready_service = services.open_service(
+            services.poses_ready_service_builder(node, root, scene), "poses-ready event service")
+        try:
+            self._publisher = (
+                self._poses_service.publisher_builder()
+                .initial_max_slice_len(POSES_INITIAL_MAX_SLICE_LEN)
+                .allocation_strategy(iox.AllocationStrategy.PowerOfTwo)
+                .max_loaned_samples(1)
+                .create()
+            )
+            self._notifier = self._ready_service.notifier_builder().create()
+        except Exception as e:
+            raise TransportError("creating the pose publisher or its notifier", e) from e
+        self.feed = ResultFeed(node, root, scene)
+        self._event_id = iox.EventId.new(services.EVENT_POSES_SENT)
+        # The header is written from this buffer with one memmove per frame.
+        self._header = PoseFrameHeader()
+        self._header.protocol_version = PROTOCOL_VERSION
+        self._header.scene = scene
+        self._header_address = ctypes.addressof(self._header)
+
+    @property
+    def scene(self) -> int:
+        """The scene id this link publishes to."""
+        return self._scene
+
+    # -- publishing --------------------------------------------------------------------
+
+    def publish(self, frame_seq: int, budget_ns: int, query_flags: int, ids: Any, positions: Any,
+                orientations: Any = None) -> None:
+        """Publishes pose frame ``frame_seq`` from arrays: body ``ids`` (``(n,)``
+        integers), ``positions`` (``(n, 3)`` metres, world frame) and ``orientations``
+        (``(n, 4)`` unit quaternions ``[x, y, z, w]``; ``None``: identity), each copied once
+        into the loaned sample. ``budget_ns`` 0 = no deadline; ``query_flags`` a set of
+        :class:`~proxima_client.wire.query` bits.
+
+        Raises:
+            ValueError: mismatched shapes; TransportError: iceoryx2 failed.
+        """
+        ids, positions, orientations = _check_fields(ids, positions, orientations)
+        sample, view = self._loan(frame_seq, budget_ns, query_flags, len(ids))
+        _write_fields(view, ids, positions, orientations)
+        self._send(sample)
+
+    def publish_poses(self, frame_seq: int, budget_ns: int, query_flags: int, poses: np.ndarray) -> None:
+        """Publishes pose frame ``frame_seq`` from a structured array. With
+        :data:`POSE_DTYPE` (C-contiguous) it is one ``memmove`` into the sample; any other
+        structured array with fields ``body``, ``position`` and ``orientation`` is copied
+        field by field.
+
+        Raises:
+            ValueError: not a usable structured array; TransportError: iceoryx2 failed.
+        """
+        poses = np.asarray(poses)
+        if poses.ndim != 1:
+            raise ValueError(f"poses must be one-dimensional, not {poses.shape}")
+        n = poses.shape[0]
+        if poses.dtype == POSE_DTYPE and poses.flags.c_contiguous:
+            sample, _ = self._loan(frame_seq, budget_ns, query_flags, n, view=False)
+            if n:
+                ctypes.memmove(sample.payload_ptr, poses.ctypes.data, n * _POSE_BYTES)
+        else:
+            names = poses.dtype.names or ()
+            if not {"body", "position", "orientation"} <= set(names):
+                raise ValueError(f"poses need fields body, position, orientation; got {names}")
+            sample, view = self._loan(frame_seq, budget_ns, query_flags, n)
+            _write_fields(view, poses["body"], poses["position"], poses["orientation"])
+        self._send(sample)
+
+    def loan_frame(self, frame_seq: int, budget_ns: int, query_flags: int, count: int) -> PoseFrame:
+        """Loans pose frame ``frame_seq`` of ``count`` records to be written in place
+        (:attr:`PoseFrame.poses`), then sent with :meth:`PoseFrame.send` or by leaving its
+        ``with`` block; the analogue of the Rust ``publish_poses_with``."""
+        sample, _ = self._loan(frame_seq, budget_ns, query_flags, count, view=False)
+        return PoseFrame(self, sample, count)
+
+    def publish_raw(self, header: PoseFrameHeader, poses: np.ndarray) -> None:
+        """Publishes ``poses`` (:data:`POSE_DTYPE`) under ``header`` exactly as given (its
+        version, scene and count unchecked): for tests of the daemon's frame checks."""
+        poses = np.ascontiguousarray(poses, dtype=POSE_DTYPE)
+        sample = self._loan_sample(len(poses))
+        ctypes.memmove(sample.user_header_ptr, ctypes.addressof(header), _HEADER_BYTES)
+        if len(poses):
+            ctypes.memmove(sample.payload_ptr, poses.ctypes.data, poses.nbytes)
+        self._send(sample)
+
+    def _loan_sample(self, count: int) -> Any:
+        """A loaned, uninitialised sample of ``count`` pose records."""
+        try:
+            return self._publisher.loan_slice_uninit(count)
+        except Exception as e:
+            raise TransportError(f"loaning {count} pose records", e) from e
+
+    def _loan(self, frame_seq: int, budget_ns: int, query_flags: int, count: int,
+              view: bool = True) -> tuple[Any, np.ndarray]:
+        """A loaned sample with the frame header written; with ``view``, a numpy view of its records."""
+        if count > U32_MAX:
+            raise ValueError(f"{count} poses do not fit a frame")
+        header = self._header
+        header.frame_seq = frame_seq
+        header.budget_ns = budget_ns
+        header.query_flags = query_flags
+        header.count = count
+        sample = self._loan_sample(count)
+        ctypes.memmove(sample.user_header_ptr, self._header_address, _HEADER_BYTES)
+        return sample, (poses_view(sample.payload_ptr, count) if view else _EMPTY_POSES)
+
+    def _send(self, sample: Any) -> None:
+        """Sends ``sample`` and notifies the poses-ready service (event id 1)."""
+        try:
+            sample.assume_init().send()
+        except Exception as e:
+            raise TransportError("sending the pose frame", e) from e
+        try:
+            self._notifier.notify_with_custom_event_id(self._event_id)
+        except Exception as e:
+            raise TransportError("notifying the daemon", e) from e
+
+    # -- receiving ---------------------------------------------------------------------
+
+    def set_result_spin(self, seconds: float) -> None:
+        """Sets how long receiving polls before it blocks (see :meth:`ResultFeed.set_spin`)."""
+        self.feed.set_spin(seconds)
+
+    def try_receive_results(self) -> Optional[ResultFrame]:
+        """The next result frame if one has arrived, without waiting."""
+        return self.feed.try_receive()
+
+    def receive_results(self, timeout: float) -> Optional[ResultFrame]:
+        """The next result frame, waiting up to ``timeout`` seconds; ``None`` if none came."""
+        return self.feed.receive(timeout)
+
+    def receive_results_for(self, frame_seq: int, timeout: float) -> Optional[ResultFrame]:
+        """The result frame answering pose frame ``frame_seq``, waiting up to ``timeout``
+        seconds (others received meanwhile are released); ``None`` if it did not come."""
+        return self.feed.receive_for(frame_seq, timeout)
+
+    def receive_copy_for(self, frame_seq: int, timeout: float) -> Optional[OwnedResultFrame]:
+        """Like :meth:`receive_results_for`, but copies the frame out and releases the
+        sample at once: the copying variant."""
+        frame = self.feed.receive_for(frame_seq, timeout)
+        if frame is None:
+            return None
+        with frame:
+            return frame.copy()
+
+    def close(self) -> None:
+        """Releases the link's ports (idempotent)."""
+        self.feed.close()
+        for name in ("_publisher", "_notifier"):
+            port = getattr(self, name, None)
+            if port is not None:
+                port.delete()
+                setattr(self, name, None)
+
+    def __enter__(self) -> "SceneLink":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+_EMPTY_POSES = np.empty(0, dtype=POSE_DTYPE)

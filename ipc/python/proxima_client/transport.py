@@ -1,0 +1,48 @@
+"""How the client waits on iceoryx2, mirroring ``ipc/src/transport.rs``.
+
+Each wait polls for a bounded few tens of µs before it gives up the core: waking a
+blocked process costs 60–120 µs on a VM against a few µs for a polled hand-over, and a
+longer spin would hold a core the daemon may need. Request–response ports cannot join a
+WaitSet, so a control reply is polled: a spin of :data:`CONTROL_REPLY_SPIN_S`, then sleeps
+of :data:`CONTROL_REPLY_SLEEP_S`. A result frame is polled for :data:`RESULTS_SPIN_S`,
+then waited for on the scene's results-ready listener.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Callable, Optional, TypeVar
+
+#: How long a control reply is awaited by spinning before the wait starts sleeping, s.
+CONTROL_REPLY_SPIN_S: float = 20e-6
+#: One sleep of the control reply wait after the spin, s.
+CONTROL_REPLY_SLEEP_S: float = 50e-6
+#: The first pause between two ``ShapeState`` asks while waiting for a build, s; doubles.
+SHAPE_POLL_FIRST_S: float = 200e-6
+#: The longest pause between two ``ShapeState`` asks, s.
+SHAPE_POLL_MAX_S: float = 20e-3
+#: How long a receive polls the result subscriber before it blocks on the listener, s.
+RESULTS_SPIN_S: float = 50e-6
+
+T = TypeVar("T")
+
+#: The clock of every wait: monotonic, nanosecond resolution.
+now = time.perf_counter
+
+
+def poll_until(deadline: float, poll: Callable[[], Optional[T]]) -> Optional[T]:
+    """Calls ``poll`` until it returns a value or :func:`now` passes ``deadline``.
+
+    Spins for :data:`CONTROL_REPLY_SPIN_S`, then sleeps :data:`CONTROL_REPLY_SLEEP_S`
+    between polls. Polls at least once; ``None`` when the deadline passed first.
+    """
+    start = now()
+    while True:
+        value = poll()
+        if value is not None:
+            return value
+        t = now()
+        if t >= deadline:
+            return None
+        if t - start >= CONTROL_REPLY_SPIN_S:
+            time.sleep(min(CONTROL_REPLY_SLEEP_S, deadline - t))
