@@ -40,6 +40,13 @@ pub const DEFAULT_PENDING_ENTRY_PS: u64 = 100_000;
 /// `log₂ n` times, about as much again.
 const PENDING_ENTRY_PER_ANSWER: u64 = 2;
 
+/// The cost of publishing one record until the scene's own is measured, picoseconds: a
+/// 120-byte record written into shared memory (tens of nanoseconds), with room to spare.
+pub const DEFAULT_PUBLISH_PS_PER_RECORD: u64 = 100_000;
+
+/// Fewest records in a published frame for its time to be a sample of the per-record cost.
+const MIN_PUBLISH_SAMPLE_RECORDS: u64 = 64;
+
 /// Fewest entries in an answer pass for its time to be a sample of the per-entry cost.
 const MIN_ANSWER_SAMPLE_ENTRIES: usize = 1024;
 
@@ -61,6 +68,9 @@ pub struct FrameCosts {
     /// Records (pairs, contacts, times of impact) of the frames `publish_ns` was measured
     /// on, a running mean as `publish_ns`.
     publish_records: u64,
+    /// Publishing per record, picoseconds, from frames of many records (their whole time
+    /// over their records: an upper estimate of each further record); 0 until measured.
+    publish_ps_per_record: u64,
     /// A tail pair's answer, picoseconds (mean 0: not measured yet).
     tail_ps_per_pair: Spread,
     /// The visit of one candidate before the pair loop (its kept answer and separation
@@ -84,6 +94,10 @@ impl FrameCosts {
     pub fn note_publish(&mut self, ns: u64, records: u64) {
         self.publish_ns = typical(self.publish_ns, ns);
         self.publish_records = typical(self.publish_records, records);
+        if records >= MIN_PUBLISH_SAMPLE_RECORDS {
+            let sample = ns.saturating_mul(1000) / records;
+            self.publish_ps_per_record = typical(self.publish_ps_per_record, sample);
+        }
     }
 
     /// Records the time of a frame's tail: `pairs` pairs answered after its clock stopped.
@@ -138,15 +152,28 @@ impl FrameCosts {
     }
 
     /// The time publishing `records` records takes, nanoseconds: the typical publish time,
-    /// scaled up in proportion for more records than typical (an upper estimate: the part
-    /// of it that does not grow with the records is scaled too).
+    /// plus, for each record beyond the typical count, the measured cost per record (or
+    /// [`DEFAULT_PUBLISH_PS_PER_RECORD`] until frames of many records were published); 0
+    /// before any publish was told.
+    ///
+    /// Not the typical time scaled in proportion: a scene whose frames published no
+    /// records (bodies still apart) would then price its first frame of a thousand
+    /// contacts at a thousand times its fixed cost, and answer a sample of its pairs under
+    /// any budget.
     #[must_use]
     pub fn publish_estimate_ns(&self, records: u64) -> u64 {
-        if records <= self.publish_records {
-            return self.publish_ns;
+        if self.publish_ns == 0 {
+            // Nothing published yet, or a caller that publishes nothing (a library user).
+            return 0;
         }
+        let per_record = match self.publish_ps_per_record {
+            0 => DEFAULT_PUBLISH_PS_PER_RECORD,
+            measured => measured,
+        };
         // Polled before every pair: u64 arithmetic, saturating far beyond any real frame.
-        self.publish_ns.saturating_mul(records + 1) / (self.publish_records + 1)
+        let more = records.saturating_sub(self.publish_records);
+        self.publish_ns
+            .saturating_add(more.saturating_mul(per_record) / 1000)
     }
 
     /// The time the tail of a frame takes from here, nanoseconds: `pairs_left` pairs
@@ -215,6 +242,7 @@ impl FrameCosts {
                 tail_ps_per_pair: self.tail_ps_per_pair,
                 visit_ps_per_pair: self.visit_ps_per_pair,
                 answer_ps_per_entry: self.answer_ps_per_entry,
+                publish_ps_per_record: self.publish_ps_per_record,
                 ..Self::default()
             };
         }
@@ -400,8 +428,13 @@ mod tests {
             "typical records: the typical publish"
         );
         // 100 ns a pair, its deviation taken as half of it at first: 300 ns counted; 2
-        // records each, 300 in all: 3× the typical 100 records' publish.
-        assert_eq!(costs.tail_ns(100, 100), 30_000 + 2_000 * 301 / 100);
+        // records each, 300 in all: the typical 99 records' publish, and 201 more at the
+        // measured 2 µs over 99 records each.
+        let per_record_ps = 2_000_000 / 99;
+        assert_eq!(
+            costs.tail_ns(100, 100),
+            30_000 + 2_000 + 201 * per_record_ps / 1000
+        );
         costs.note_tail(1_000_000, 4);
         assert_eq!(
             costs.tail_ns(1, 0),
@@ -415,6 +448,35 @@ mod tests {
         assert!(cost(fits) <= left && cost(fits + 1) > left, "{fits}");
         assert_eq!(costs.pairs_that_fit(10, left), 10, "all of few pairs");
         assert_eq!(costs.pairs_that_fit(10, 0), 0);
+    }
+
+    #[test]
+    fn publishing_many_records_after_frames_of_none_costs_their_records_not_a_multiple() {
+        let mut costs = FrameCosts::default();
+        // Bodies apart: 20 µs to publish nothing, frame after frame.
+        for _ in 0..50 {
+            costs.note_publish(20_000, 0);
+        }
+        assert_eq!(costs.publish_estimate_ns(0), 20_000);
+        assert_eq!(
+            costs.publish_estimate_ns(1_000),
+            20_000 + 1_000 * DEFAULT_PUBLISH_PS_PER_RECORD / 1000,
+            "the default per record until frames of many records were timed"
+        );
+        // Then frames of 1,000 records in 60 µs: 60 ns a record, an upper estimate.
+        for _ in 0..100 {
+            costs.note_publish(60_000, 1_000);
+        }
+        let estimate = costs.publish_estimate_ns(3_000);
+        assert!(
+            (179_000..=181_000).contains(&estimate),
+            "the typical 1,000 records' 60 µs and 2,000 more at 60 ns: {estimate}"
+        );
+        costs.note_publish(1_000_000, MIN_PUBLISH_SAMPLE_RECORDS - 1);
+        assert!(
+            costs.publish_estimate_ns(3_000) < 2 * estimate,
+            "a frame of few records is no per-record sample"
+        );
     }
 
     #[test]
