@@ -44,8 +44,12 @@ const PENDING_ENTRY_PER_ANSWER: u64 = 2;
 /// 120-byte record written into shared memory (tens of nanoseconds), with room to spare.
 pub const DEFAULT_PUBLISH_PS_PER_RECORD: u64 = 100_000;
 
-/// Fewest records in a published frame for its time to be a sample of the per-record cost.
-const MIN_PUBLISH_SAMPLE_RECORDS: u64 = 64;
+/// The least a further record is taken to cost, picoseconds, whatever the fit says: writing
+/// 120 bytes to memory another process maps.
+const MIN_PUBLISH_PS_PER_RECORD: u64 = 10_000;
+
+/// Frames a publish fit needs before its slope counts.
+const MIN_FIT_FRAMES: u32 = 8;
 
 /// Fewest entries in an answer pass for its time to be a sample of the per-entry cost.
 const MIN_ANSWER_SAMPLE_ENTRIES: usize = 1024;
@@ -58,7 +62,7 @@ const MIN_TAIL_SAMPLE_PAIRS: usize = 16;
 const RECORDS_PER_TAIL_PAIR: u64 = 2;
 
 /// The scene's measured costs (module docs).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FrameCosts {
     /// Broad phase, nanoseconds.
     broad_ns: u64,
@@ -68,9 +72,8 @@ pub struct FrameCosts {
     /// Records (pairs, contacts, times of impact) of the frames `publish_ns` was measured
     /// on, a running mean as `publish_ns`.
     publish_records: u64,
-    /// Publishing per record, picoseconds, from frames of many records (their whole time
-    /// over their records: an upper estimate of each further record); 0 until measured.
-    publish_ps_per_record: u64,
+    /// Publishing time against records over recent frames: what a further record costs.
+    publish_fit: PublishFit,
     /// A tail pair's answer, picoseconds (mean 0: not measured yet).
     tail_ps_per_pair: Spread,
     /// The visit of one candidate before the pair loop (its kept answer and separation
@@ -94,10 +97,8 @@ impl FrameCosts {
     pub fn note_publish(&mut self, ns: u64, records: u64) {
         self.publish_ns = typical(self.publish_ns, ns);
         self.publish_records = typical(self.publish_records, records);
-        if records >= MIN_PUBLISH_SAMPLE_RECORDS {
-            let sample = ns.saturating_mul(1000) / records;
-            self.publish_ps_per_record = typical(self.publish_ps_per_record, sample);
-        }
+        self.publish_fit
+            .note(records, ns.min(self.publish_ns.saturating_mul(2)));
     }
 
     /// Records the time of a frame's tail: `pairs` pairs answered after its clock stopped.
@@ -152,8 +153,9 @@ impl FrameCosts {
     }
 
     /// The time publishing `records` records takes, nanoseconds: the typical publish time,
-    /// plus, for each record beyond the typical count, the measured cost per record (or
-    /// [`DEFAULT_PUBLISH_PS_PER_RECORD`] until frames of many records were published); 0
+    /// plus, for each record beyond the typical count, the cost of a further record: the
+    /// slope of publishing time against records over recent frames (at least 10 ns), or
+    /// [`DEFAULT_PUBLISH_PS_PER_RECORD`] until frames of different sizes were published; 0
     /// before any publish was told.
     ///
     /// Not the typical time scaled in proportion: a scene whose frames published no
@@ -166,10 +168,12 @@ impl FrameCosts {
             // Nothing published yet, or a caller that publishes nothing (a library user).
             return 0;
         }
-        let per_record = match self.publish_ps_per_record {
-            0 => DEFAULT_PUBLISH_PS_PER_RECORD,
-            measured => measured,
-        };
+        let per_record = self
+            .publish_fit
+            .ps_per_record()
+            .map_or(DEFAULT_PUBLISH_PS_PER_RECORD, |ps| {
+                ps.max(MIN_PUBLISH_PS_PER_RECORD)
+            });
         // Polled before every pair: u64 arithmetic, saturating far beyond any real frame.
         let more = records.saturating_sub(self.publish_records);
         self.publish_ns
@@ -242,7 +246,7 @@ impl FrameCosts {
                 tail_ps_per_pair: self.tail_ps_per_pair,
                 visit_ps_per_pair: self.visit_ps_per_pair,
                 answer_ps_per_entry: self.answer_ps_per_entry,
-                publish_ps_per_record: self.publish_ps_per_record,
+                publish_fit: self.publish_fit,
                 ..Self::default()
             };
         }
@@ -272,6 +276,55 @@ impl TailTimer {
             let ns = u64::try_from(began.elapsed().as_nanos()).unwrap_or(u64::MAX);
             costs.note_tail(ns, pairs);
         }
+    }
+}
+
+/// A straight line through publishing time against records over recent frames: the
+/// running means of records, time, records² and records × time, each moving an eighth of
+/// the way to each frame's (its time counted at most twice the typical, as [`typical`]).
+/// Its slope is what a further record costs; the fixed part of a publish (the notify, the
+/// loan) does not count in it, as it would in the time over the records.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct PublishFit {
+    frames: u32,
+    records: f64,
+    ns: f64,
+    records_sq: f64,
+    records_ns: f64,
+}
+
+impl PublishFit {
+    fn note(&mut self, records: u64, ns: u64) {
+        let (r, t) = (records as f64, ns as f64);
+        if self.frames == 0 {
+            *self = Self {
+                frames: 1,
+                records: r,
+                ns: t,
+                records_sq: r * r,
+                records_ns: r * t,
+            };
+            return;
+        }
+        self.frames = self.frames.saturating_add(1);
+        let step = |mean: &mut f64, x: f64| *mean += (x - *mean) / 8.0;
+        step(&mut self.records, r);
+        step(&mut self.ns, t);
+        step(&mut self.records_sq, r * r);
+        step(&mut self.records_ns, r * t);
+    }
+
+    /// The slope, picoseconds a record, once [`MIN_FIT_FRAMES`] frames whose record counts
+    /// vary by more than a tenth were seen (a fixed count tells no slope).
+    fn ps_per_record(&self) -> Option<u64> {
+        let spread = self.records_sq - self.records * self.records;
+        if self.frames < MIN_FIT_FRAMES || spread <= (0.1 * self.records).powi(2).max(1.0) {
+            return None;
+        }
+        let slope_ns = (self.records_ns - self.records * self.ns) / spread;
+        slope_ns
+            .is_finite()
+            .then(|| (slope_ns.max(0.0) * 1000.0) as u64)
     }
 }
 
@@ -429,11 +482,10 @@ mod tests {
         );
         // 100 ns a pair, its deviation taken as half of it at first: 300 ns counted; 2
         // records each, 300 in all: the typical 99 records' publish, and 201 more at the
-        // measured 2 µs over 99 records each.
-        let per_record_ps = 2_000_000 / 99;
+        // default per record (one frame tells no slope).
         assert_eq!(
             costs.tail_ns(100, 100),
-            30_000 + 2_000 + 201 * per_record_ps / 1000
+            30_000 + 2_000 + 201 * DEFAULT_PUBLISH_PS_PER_RECORD / 1000
         );
         costs.note_tail(1_000_000, 4);
         assert_eq!(
@@ -461,21 +513,39 @@ mod tests {
         assert_eq!(
             costs.publish_estimate_ns(1_000),
             20_000 + 1_000 * DEFAULT_PUBLISH_PS_PER_RECORD / 1000,
-            "the default per record until frames of many records were timed"
+            "the default per record until frames of different sizes were timed"
         );
-        // Then frames of 1,000 records in 60 µs: 60 ns a record, an upper estimate.
-        for _ in 0..100 {
-            costs.note_publish(60_000, 1_000);
+        // Then frames of 500 to 1,500 records at 20 µs plus 30 ns a record.
+        for i in 0..200_u64 {
+            let records = 500 + (i % 11) * 100;
+            costs.note_publish(20_000 + 30 * records, records);
         }
+        let per_record = costs.publish_fit.ps_per_record().expect("a slope");
+        assert!((29_000..=31_000).contains(&per_record), "{per_record}");
         let estimate = costs.publish_estimate_ns(3_000);
+        let truth = 20_000 + 30 * 3_000;
         assert!(
-            (179_000..=181_000).contains(&estimate),
-            "the typical 1,000 records' 60 µs and 2,000 more at 60 ns: {estimate}"
+            (truth..=truth + truth / 10).contains(&estimate),
+            "{estimate} ns for 3,000 records; {truth} true"
         );
-        costs.note_publish(1_000_000, MIN_PUBLISH_SAMPLE_RECORDS - 1);
-        assert!(
-            costs.publish_estimate_ns(3_000) < 2 * estimate,
-            "a frame of few records is no per-record sample"
+    }
+
+    #[test]
+    fn a_fixed_record_count_tells_no_slope_and_a_flat_one_counts_the_least() {
+        let mut fixed = PublishFit::default();
+        for _ in 0..50 {
+            fixed.note(1_000, 50_000);
+        }
+        assert_eq!(fixed.ps_per_record(), None);
+        let mut costs = FrameCosts::default();
+        for i in 0..50_u64 {
+            costs.note_publish(20_000, 100 + (i % 5) * 200);
+        }
+        let records = costs.publish_records;
+        assert_eq!(
+            costs.publish_estimate_ns(records + 1_000),
+            costs.publish_ns + 1_000 * MIN_PUBLISH_PS_PER_RECORD / 1000,
+            "a time that does not grow with the records: the least per record"
         );
     }
 
