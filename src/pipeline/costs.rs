@@ -155,8 +155,8 @@ impl FrameCosts {
     /// The time publishing `records` records takes, nanoseconds: the typical publish time,
     /// plus, for each record beyond the typical count, the cost of a further record: the
     /// slope of publishing time against records over recent frames (at least 10 ns), or
-    /// [`DEFAULT_PUBLISH_PS_PER_RECORD`] until frames of different sizes were published; 0
-    /// before any publish was told.
+    /// 100 ns (`DEFAULT_PUBLISH_PS_PER_RECORD`) until frames of different sizes were
+    /// published; 0 before any publish was told.
     ///
     /// Not the typical time scaled in proportion: a scene whose frames published no
     /// records (bodies still apart) would then price its first frame of a thousand
