@@ -557,9 +557,14 @@ pub fn step_within(
             ..StepReport::default()
         };
     }
+    // A new broad phase is built only when it takes at most half the time left.
+    let room = budget
+        .deadline()
+        .map(|d| d.saturating_duration_since(Instant::now()) / 2);
     let broad = workspace.broad.candidates(
         scene,
         query,
+        room,
         &mut workspace.candidates,
         &mut workspace.toi_candidates,
     );
