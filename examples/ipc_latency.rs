@@ -31,10 +31,11 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use proxima::daemon::{Daemon, DaemonConfig};
-use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion, Primitive};
+use proxima_ipc::client::ClientBuilder;
 use proxima_ipc::scene_link::SceneLink;
 use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation};
 use proxima_ipc::tools::latency::LatencyRecorder;
+use proxima_ipc::tools::latency_scene;
 use proxima_ipc::wire::{
     ErrorCode, PoseFrameHeader, PoseRecord, ResultFrameHeader, ResultRecord, query, stage,
 };
@@ -45,10 +46,6 @@ use std::time::{Duration, Instant};
 const SPIN: Duration = Duration::from_micros(50);
 /// Round trips per block before switching between raw and daemon.
 const BLOCK: usize = 500;
-/// Sphere radius, grid spacing and margin of the bodies, metres.
-const RADIUS: f64 = 0.5;
-const SPACING: f64 = 3.0;
-const MARGIN: f64 = 0.1;
 
 #[derive(Debug, Parser)]
 #[command(about = "proximad round trip against a raw iceoryx2 ping-pong of the same payload")]
@@ -140,7 +137,7 @@ fn measure(args: &Args) -> Result<(), Box<dyn Error>> {
         .reply_timeout(Duration::from_secs(10))
         .connect::<ipc::Service>()?;
     let scene = client.create_scene()?;
-    let mut link = setup_scene(&client, scene, args.bodies)?;
+    let mut link = latency_scene::add_bodies(&client, scene, args.bodies)?;
     let client_spin = Duration::from_micros(args.client_spin_us);
     link.set_result_spin(client_spin);
     if args.rate_hz > 0 {
@@ -174,43 +171,6 @@ fn measure(args: &Args) -> Result<(), Box<dyn Error>> {
     Ok(())
 }
 
-/// Registers the sphere shape and adds `bodies` dynamic spheres on the grid.
-fn setup_scene(
-    client: &Client<ipc::Service>,
-    scene: u32,
-    bodies: usize,
-) -> Result<SceneLink<ipc::Service>, Box<dyn Error>> {
-    let shape = client.register_primitive(scene, Primitive::Sphere { radius: RADIUS })?;
-    for i in 0..bodies {
-        client.add_body(
-            scene,
-            &BodySpec {
-                shape,
-                position: grid_position(i, bodies, 0.0),
-                orientation: [0.0, 0.0, 0.0, 1.0],
-                motion: Motion::Dynamic,
-                group: u32::MAX,
-                mask: u32::MAX,
-                margin: Some(MARGIN),
-            },
-        )?;
-    }
-    Ok(client.open_scene(scene)?)
-}
-
-/// Body `i`'s position at time `t` seconds: its grid point plus a circle of 0.3 m radius
-/// (never closer than 3 − 2·0.3 − 2·0.5 − 2·0.1 = 1.2 m to a neighbour).
-fn grid_position(i: usize, bodies: usize, t: f64) -> [f64; 3] {
-    let side = (bodies as f64).cbrt().ceil() as usize;
-    let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
-    let phase = t * 2.0 + i as f64 * 0.37;
-    [
-        x as f64 * SPACING + 0.3 * phase.cos(),
-        y as f64 * SPACING + 0.3 * phase.sin(),
-        z as f64 * SPACING,
-    ]
-}
-
 /// One daemon round trip: publish every body at time `t`, wait for the answer.
 fn daemon_round_trip(
     link: &SceneLink<ipc::Service>,
@@ -220,12 +180,7 @@ fn daemon_round_trip(
 ) -> Result<(Duration, ResultFrameHeader), Box<dyn Error>> {
     let started = Instant::now();
     link.publish_poses_with(seq, args.budget_ns, query::CLOSE, args.bodies, |i| {
-        PoseRecord {
-            body: i as u32,
-            reserved: 0,
-            position: grid_position(i, args.bodies, t),
-            orientation: [0.0, 0.0, 0.0, 1.0],
-        }
+        latency_scene::pose(i, args.bodies, t)
     })?;
     let frame = link
         .receive_results_for(seq, Duration::from_secs(1))?
@@ -505,12 +460,7 @@ impl RawLink {
         };
         let t = seq as f64 * 1e-3;
         sample
-            .write_from_fn(|i| PoseRecord {
-                body: i as u32,
-                reserved: 0,
-                position: grid_position(i, bodies, t),
-                orientation: [0.0, 0.0, 0.0, 1.0],
-            })
+            .write_from_fn(|i| latency_scene::pose(i, bodies, t))
             .send()
             .map_err(|e| format!("{e:?}"))?;
         self.poses_sent.notify().map_err(|e| format!("{e:?}"))?;

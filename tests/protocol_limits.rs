@@ -9,7 +9,7 @@ use proxima::math::tolerance::MAX_COORDINATE;
 
 #[test]
 fn the_documented_limits_are_the_daemons_defaults() {
-    let limits = protocol_doc::map_under(&protocol_doc::document(), "## 7. Limits", 1);
+    let limits = protocol_doc::map_under(protocol_doc::document(), "## 7. Limits", 1);
     let config = DaemonConfig::default();
     let coded = [
         ("scenes alive at once", f64::from(config.max_scenes)),

@@ -35,8 +35,8 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
 use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion, Primitive};
-use proxima_ipc::scene_link::SceneLink;
 use proxima_ipc::tools::latency::LatencyRecorder;
+use proxima_ipc::tools::latency_scene;
 use proxima_ipc::wire::{BroadPhaseCode, PoseRecord, ResultFrameHeader, ResultRecord, query};
 
 /// How long a result frame is waited for.
@@ -287,12 +287,8 @@ fn frame_json(h: &ResultFrameHeader, records: &[ResultRecord]) -> String {
 }
 
 // ---------------------------------------------------------------------------------------
-// latency: the scene of `examples/ipc_latency.rs`, measured from this client.
-
-/// Sphere radius, grid spacing and margin of the latency scene's bodies, metres.
-const RADIUS: f64 = 0.5;
-const SPACING: f64 = 3.0;
-const MARGIN: f64 = 0.1;
+// latency: the scene of `proxima_ipc::tools::latency_scene` (as `examples/ipc_latency.rs`),
+// measured from this client.
 
 struct LatencyArgs {
     bodies: usize,
@@ -325,48 +321,16 @@ impl LatencyArgs {
     }
 }
 
-/// Body `i`'s position at time `t` seconds: its grid point plus a circle of 0.3 m radius.
-fn grid_position(i: usize, bodies: usize, t: f64) -> [f64; 3] {
-    let side = (bodies as f64).cbrt().ceil() as usize;
-    let (x, y, z) = (i % side, (i / side) % side, i / (side * side));
-    let phase = t * 2.0 + i as f64 * 0.37;
-    [
-        x as f64 * SPACING + 0.3 * phase.cos(),
-        y as f64 * SPACING + 0.3 * phase.sin(),
-        z as f64 * SPACING,
-    ]
-}
-
 fn latency(client: &Client<ipc::Service>, args: &LatencyArgs) -> Result<(), Box<dyn Error>> {
     let scene = client.create_scene()?;
-    let shape = client.register_primitive(scene, Primitive::Sphere { radius: RADIUS })?;
-    for i in 0..args.bodies {
-        client.add_body(
-            scene,
-            &BodySpec {
-                shape,
-                position: grid_position(i, args.bodies, 0.0),
-                orientation: [0.0, 0.0, 0.0, 1.0],
-                motion: Motion::Dynamic,
-                group: u32::MAX,
-                mask: u32::MAX,
-                margin: Some(MARGIN),
-            },
-        )?;
-    }
-    let link: SceneLink<ipc::Service> = client.open_scene(scene)?;
+    let link = latency_scene::add_bodies(client, scene, args.bodies)?;
     let mut round_trips = LatencyRecorder::with_capacity(args.frames);
     let mut engine = LatencyRecorder::with_capacity(args.frames);
     for seq in 1..=(args.warmup + args.frames) as u64 {
         let t = seq as f64 * 1e-3;
         let started = Instant::now();
         link.publish_poses_with(seq, args.budget_ns, query::CLOSE, args.bodies, |i| {
-            PoseRecord {
-                body: i as u32,
-                reserved: 0,
-                position: grid_position(i, args.bodies, t),
-                orientation: [0.0, 0.0, 0.0, 1.0],
-            }
+            latency_scene::pose(i, args.bodies, t)
         })?;
         let frame = link
             .receive_results_for(seq, FRAME_TIMEOUT)?

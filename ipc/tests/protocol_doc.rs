@@ -199,7 +199,7 @@ fn every_record_layout_is_the_codes() {
             heading.contains(&format!("({size} bytes, alignment {align})")),
             "{type_name}: the heading `{heading}` should say {size} bytes, alignment {align}"
         );
-        let rows = table_under(&doc, heading);
+        let rows = table_under(doc, heading);
         let listed: Vec<&str> = rows.iter().map(|r| r[3].as_str()).collect();
         let coded: Vec<&str> = fields.iter().map(|f| f.0).collect();
         assert_eq!(
@@ -456,7 +456,7 @@ fn every_service_name_type_and_setting_is_the_codes() {
     let doc = document();
     let node = IsolatedNode::new();
     let coded = coded_services(&node);
-    let table = table_under(&doc, "## 3. Services");
+    let table = table_under(doc, "## 3. Services");
     assert_eq!(table.len(), coded.len(), "the document's services");
     let mut details = Vec::new();
     for row in &table {
@@ -467,11 +467,11 @@ fn every_service_name_type_and_setting_is_the_codes() {
         assert_eq!(name, service.name, "{}: name", row[0]);
         assert_eq!(row[2], service.pattern, "{}: pattern", row[0]);
         assert_eq!(row[3..6], service.types, "{}: types", row[0]);
-        let settings = map_under(&doc, &format!("#### {}", row[0]), 1);
+        let settings = map_under(doc, &format!("#### {}", row[0]), 1);
         assert_eq!(settings, service.settings, "{}: settings", row[0]);
         details.extend(service.type_details.iter().copied());
     }
-    let names = table_under(&doc, "### 3.1 Type names");
+    let names = table_under(doc, "### 3.1 Type names");
     for detail in details {
         let name = detail.type_name().to_string();
         let row = names
@@ -494,7 +494,7 @@ fn every_service_name_type_and_setting_is_the_codes() {
 #[test]
 fn port_settings_event_ids_and_constants_are_the_codes() {
     let doc = document();
-    let ports: BTreeMap<String, String> = table_under(&doc, "### 3.3 Port settings")
+    let ports: BTreeMap<String, String> = table_under(doc, "### 3.3 Port settings")
         .into_iter()
         .map(|r| (format!("{}/{}", r[0], r[1]), r[2].clone()))
         .collect();
@@ -522,7 +522,7 @@ fn port_settings_event_ids_and_constants_are_the_codes() {
     ]);
     assert_eq!(ports, expected, "port settings");
 
-    let events = map_under(&doc, "### 3.4 Event ids", 1);
+    let events = map_under(doc, "### 3.4 Event ids", 1);
     let expected = BTreeMap::from([
         (
             "EVENT_POSES_SENT".to_owned(),
@@ -539,7 +539,7 @@ fn port_settings_event_ids_and_constants_are_the_codes() {
     ]);
     assert_eq!(events, expected, "event ids");
 
-    let version = map_under(&doc, "## 2. Versioning", 1);
+    let version = map_under(doc, "## 2. Versioning", 1);
     assert_eq!(
         version["PROTOCOL_VERSION"],
         proxima_ipc::PROTOCOL_VERSION.to_string()
@@ -550,7 +550,7 @@ fn port_settings_event_ids_and_constants_are_the_codes() {
         "the title `{title}` names another version"
     );
 
-    let constants = map_under(&doc, "### 5.13 Other constants", 1);
+    let constants = map_under(doc, "### 5.13 Other constants", 1);
     let expected = BTreeMap::from([
         (
             "MAX_CONTACTS_PER_PAIR".to_owned(),
@@ -571,7 +571,7 @@ fn defined<T: std::fmt::Debug>(from_u32: impl Fn(u32) -> Option<T>) -> BTreeMap<
 #[test]
 fn every_code_is_the_codes() {
     let doc = document();
-    let listed = |heading: &str| map_under(&doc, heading, 1);
+    let listed = |heading: &str| map_under(doc, heading, 1);
     assert_eq!(
         listed("### 5.1 ErrorCode"),
         defined(ErrorCode::from_u32),
@@ -632,7 +632,7 @@ fn named(pairs: &[(&str, u32)]) -> BTreeMap<String, u32> {
 fn every_bit_and_stage_is_the_codes() {
     use wire::{frame_flags, query, record_flags, reply_flags, stage};
     let doc = document();
-    let queries = bits(&doc, "### 5.6 query bits");
+    let queries = bits(doc, "### 5.6 query bits");
     assert_eq!(
         queries,
         named(&[
@@ -649,21 +649,21 @@ fn every_bit_and_stage_is_the_codes() {
         "every query bit is listed"
     );
     assert_eq!(
-        bits(&doc, "### 5.8 frame_flags bits"),
+        bits(doc, "### 5.8 frame_flags bits"),
         named(&[
             ("PAIRS_CAPPED", frame_flags::PAIRS_CAPPED),
             ("BUDGET_TOO_SMALL", frame_flags::BUDGET_TOO_SMALL),
         ])
     );
     assert_eq!(
-        bits(&doc, "### 5.9 reply_flags bits"),
+        bits(doc, "### 5.9 reply_flags bits"),
         named(&[("SHAPE_BUILDING", reply_flags::SHAPE_BUILDING)])
     );
     assert_eq!(
-        bits(&doc, "### 5.12 record_flags bits"),
+        bits(doc, "### 5.12 record_flags bits"),
         named(&[("APPROXIMATE", record_flags::APPROXIMATE)])
     );
-    let stages: BTreeMap<String, u32> = table_under(&doc, "### 5.10 stage indices")
+    let stages: BTreeMap<String, u32> = table_under(doc, "### 5.10 stage indices")
         .into_iter()
         .map(|r| (r[1].clone(), number(&r[0]) as u32))
         .collect();

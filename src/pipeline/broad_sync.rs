@@ -232,7 +232,7 @@ impl BroadSync {
             && point.scene_uid() == scene.uid()
         {
             gone.clear();
-            let live = |id: u32| scene.proxy(BodyId(id)).is_some();
+            let live = |id: u32| scene.body(BodyId(id)).is_some();
             gone.extend(
                 kept.proxies()
                     .iter()

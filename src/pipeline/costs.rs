@@ -281,7 +281,8 @@ impl TailTimer {
 
 /// A straight line through publishing time against records over recent frames: the
 /// running means of records, time, records² and records × time, each moving an eighth of
-/// the way to each frame's (its time counted at most twice the typical, as [`typical`]).
+/// the way to each frame's after the first eight (its time counted at most twice the
+/// typical, as [`typical`]).
 /// Its slope is what a further record costs; the fixed part of a publish (the notify, the
 /// loan) does not count in it, as it would in the time over the records.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -296,18 +297,10 @@ struct PublishFit {
 impl PublishFit {
     fn note(&mut self, records: u64, ns: u64) {
         let (r, t) = (records as f64, ns as f64);
-        if self.frames == 0 {
-            *self = Self {
-                frames: 1,
-                records: r,
-                ns: t,
-                records_sq: r * r,
-                records_ns: r * t,
-            };
-            return;
-        }
         self.frames = self.frames.saturating_add(1);
-        let step = |mean: &mut f64, x: f64| *mean += (x - *mean) / 8.0;
+        // The plain mean of the first eight frames (the first taken whole), then an eighth.
+        let weight = 1.0 / f64::from(self.frames.min(8));
+        let step = |mean: &mut f64, x: f64| *mean += (x - *mean) * weight;
         step(&mut self.records, r);
         step(&mut self.ns, t);
         step(&mut self.records_sq, r * r);

@@ -4,11 +4,12 @@ same daemon, in the same run.
     python latency.py --spawn-daemon target/release/proximad \\
         --frame-dump target/release/examples/frame_dump --repeats 3
 
-The scene is ``examples/ipc_latency.rs``'s: ``--bodies`` spheres (radius 0.5 m, margin
-0.1 m) on a 3 m grid, each moving on a 0.3 m circle, so every pose changes every frame;
-frames ask ``CLOSE`` with a 1 ms budget and are sent back to back. Each repeat runs the
-Rust client (``frame_dump latency``, a process of its own) and then this one, each on a
-fresh scene of the one daemon, and prints:
+The scene is ``ipc/src/tools/latency_scene.rs``'s (also ``examples/ipc_latency.rs``'s):
+``--bodies`` spheres (radius 0.5 m, margin 0.1 m) on a 3 m grid, each moving on a 0.3 m
+circle, so every pose changes every frame; frames ask ``CLOSE`` with a 1 ms budget and
+are sent back to back. Each repeat runs the Rust client (``frame_dump latency``, a
+process of its own) and then this one, each on a fresh scene of the one daemon, and
+prints:
 
 - ``round trip``: publish → result frame received (p50, p99);
 - ``python side``: the time this process spends in the client per frame: publishing
@@ -41,7 +42,7 @@ RADIUS, SPACING, MARGIN = 0.5, 3.0, 0.1
 
 
 def grid(bodies: int) -> tuple[np.ndarray, np.ndarray]:
-    """Each body's grid point and phase offset (as ``grid_position`` in ipc_latency.rs)."""
+    """Each body's grid point and phase offset (as ``grid_position`` in ipc/src/tools/latency_scene.rs)."""
     side = int(np.ceil(np.cbrt(bodies)))
     i = np.arange(bodies)
     points = np.stack([(i % side) * SPACING, ((i // side) % side) * SPACING, (i // (side * side)) * SPACING], 1)

@@ -45,7 +45,7 @@ from . import services
 from .errors import BuildTimeout, DaemonLost, NoDaemon, ProtocolMismatchError, ReplyTimeout, TransportError, error_for
 from .result_feed import ResultFeed
 from .scene_link import SceneLink
-from .transport import SHAPE_POLL_FIRST_S, SHAPE_POLL_MAX_S, now, poll_until
+from .transport import SHAPE_POLL_FIRST_S, SHAPE_POLL_MAX_S, now, poll_until, release_ports
 from .wire import (
     PROTOCOL_VERSION,
     U32_MAX,
@@ -350,11 +350,7 @@ class Client:
 
     def close(self) -> None:
         """Releases the client's ports (idempotent). Scene links opened from it stay usable."""
-        for name in ("_port", "_notifier"):
-            port = getattr(self, name, None)
-            if port is not None:
-                port.delete()
-                setattr(self, name, None)
+        release_ports(self, "_port", "_notifier")
 
     def __enter__(self) -> "Client":
         return self

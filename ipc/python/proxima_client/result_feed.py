@@ -29,7 +29,7 @@ import numpy as np
 
 from . import services
 from .errors import TransportError, error_for
-from .transport import RESULTS_SPIN_S, now
+from .transport import RESULTS_SPIN_S, now, release_ports
 from .wire import RESULT_DTYPE, Completeness, ErrorCode, ResultFrameHeader
 
 _RECORD_BYTES = RESULT_DTYPE.itemsize
@@ -273,11 +273,7 @@ class ResultFeed:
 
     def close(self) -> None:
         """Releases the subscriber and listener (idempotent)."""
-        for name in ("_subscriber", "_listener"):
-            port = getattr(self, name, None)
-            if port is not None:
-                port.delete()
-                setattr(self, name, None)
+        release_ports(self, "_subscriber", "_listener")
 
     def __enter__(self) -> "ResultFeed":
         return self

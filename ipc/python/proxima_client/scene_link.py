@@ -28,6 +28,7 @@ import numpy as np
 from . import services
 from .errors import TransportError
 from .result_feed import OwnedResultFrame, ResultFeed, ResultFrame
+from .transport import release_ports
 from .wire import POSE_DTYPE, PROTOCOL_VERSION, U32_MAX, PoseFrameHeader
 
 #: Pose records the publisher's first shared-memory segment holds; a larger frame makes it
@@ -285,11 +286,7 @@ class SceneLink:
     def close(self) -> None:
         """Releases the link's ports (idempotent)."""
         self.feed.close()
-        for name in ("_publisher", "_notifier"):
-            port = getattr(self, name, None)
-            if port is not None:
-                port.delete()
-                setattr(self, name, None)
+        release_ports(self, "_publisher", "_notifier")
 
     def __enter__(self) -> "SceneLink":
         return self

@@ -11,7 +11,7 @@ then waited for on the scene's results-ready listener.
 from __future__ import annotations
 
 import time
-from typing import Callable, Optional, TypeVar
+from typing import Any, Callable, Optional, TypeVar
 
 #: How long a control reply is awaited by spinning before the wait starts sleeping, s.
 CONTROL_REPLY_SPIN_S: float = 20e-6
@@ -46,3 +46,13 @@ def poll_until(deadline: float, poll: Callable[[], Optional[T]]) -> Optional[T]:
             return None
         if t - start >= CONTROL_REPLY_SPIN_S:
             time.sleep(min(CONTROL_REPLY_SLEEP_S, deadline - t))
+
+
+def release_ports(owner: Any, *names: str) -> None:
+    """Deletes ``owner``'s iceoryx2 ports held in the attributes ``names`` and sets each to
+    ``None``, so releasing twice is harmless (the ``close`` of clients, links and feeds)."""
+    for name in names:
+        port = getattr(owner, name, None)
+        if port is not None:
+            port.delete()
+            setattr(owner, name, None)

@@ -332,109 +332,33 @@ class ControlReply(_Record):
 
 
 # ---------------------------------------------------------------------------------------
-# numpy dtypes with pinned offsets: frames are read and written through these.
-
-
-def _dtype(fields: list[tuple[str, Any, int]], itemsize: int) -> np.dtype:
-    """A structured dtype with explicit offsets and item size."""
-    names, formats, offsets = zip(*fields)
-    return np.dtype(
-        {"names": list(names), "formats": list(formats), "offsets": list(offsets), "itemsize": itemsize}
-    )
-
+# numpy dtypes: frames are read and written through these. Each is made from its ctypes
+# structure, so the two cannot disagree on a field or an offset.
 
 #: One :class:`PoseRecord`: ``body`` u32, ``reserved`` u32 (always 0), ``position``
 #: f64[3], ``orientation`` f64[4].
-POSE_DTYPE: np.dtype = _dtype(
-    [
-        ("body", "<u4", 0),
-        ("reserved", "<u4", 4),
-        ("position", ("<f8", (3,)), 8),
-        ("orientation", ("<f8", (4,)), 32),
-    ],
-    64,
-)
-
+POSE_DTYPE: np.dtype = np.dtype(PoseRecord)
 #: One :class:`ResultRecord`.
-RESULT_DTYPE: np.dtype = _dtype(
-    [
-        ("kind", "<u4", 0),
-        ("body_a", "<u4", 4),
-        ("body_b", "<u4", 8),
-        ("index", "<u4", 12),
-        ("count", "<u4", 16),
-        ("flags", "<u4", 20),
-        ("distance", "<f8", 24),
-        ("error_bound", "<f8", 32),
-        ("point_a", ("<f8", (3,)), 40),
-        ("point_b", ("<f8", (3,)), 64),
-        ("normal", ("<f8", (3,)), 88),
-        ("time", "<f8", 112),
-    ],
-    120,
-)
-
+RESULT_DTYPE: np.dtype = np.dtype(ResultRecord)
 #: One :class:`PoseFrameHeader`.
-POSE_FRAME_HEADER_DTYPE: np.dtype = _dtype(
-    [
-        ("protocol_version", "<u4", 0),
-        ("scene", "<u4", 4),
-        ("frame_seq", "<u8", 8),
-        ("budget_ns", "<u8", 16),
-        ("query_flags", "<u4", 24),
-        ("count", "<u4", 28),
-    ],
-    32,
-)
-
+POSE_FRAME_HEADER_DTYPE: np.dtype = np.dtype(PoseFrameHeader)
 #: One :class:`ResultFrameHeader`.
-RESULT_FRAME_HEADER_DTYPE: np.dtype = _dtype(
-    [
-        ("protocol_version", "<u4", 0),
-        ("status", "<u4", 4),
-        ("frame_seq", "<u8", 8),
-        ("error_body", "<u4", 16),
-        ("completeness", "<u4", 20),
-        ("deepest_level", "<u4", 24),
-        ("budget_met", "<u4", 28),
-        ("pair_count", "<u4", 32),
-        ("contact_count", "<u4", 36),
-        ("candidate_count", "<u4", 40),
-        ("toi_count", "<u4", 44),
-        ("elapsed_ns", "<u8", 48),
-        ("stage_ns", ("<u8", (stage.COUNT,)), 56),
-        ("flags", "<u4", 104),
-        ("dropped_candidates", "<u4", 108),
-        ("min_budget_ns", "<u8", 112),
-    ],
-    120,
-)
+RESULT_FRAME_HEADER_DTYPE: np.dtype = np.dtype(ResultFrameHeader)
 
 
 def _check_layouts() -> None:
-    """Every ctypes structure has its Rust size, and its numpy twin the same offsets."""
+    """Every ctypes structure has its Rust record's size and alignment."""
     expected = {
-        PoseFrameHeader: (32, 8, POSE_FRAME_HEADER_DTYPE),
-        PoseRecord: (64, 8, POSE_DTYPE),
-        ResultFrameHeader: (120, 8, RESULT_FRAME_HEADER_DTYPE),
-        ResultRecord: (120, 8, RESULT_DTYPE),
-        ControlRequest: (144, 8, None),
-        ControlReply: (128, 4, None),
+        PoseFrameHeader: (32, 8),
+        PoseRecord: (64, 8),
+        ResultFrameHeader: (120, 8),
+        ResultRecord: (120, 8),
+        ControlRequest: (144, 8),
+        ControlReply: (128, 4),
     }
-    for struct, (size, align, dtype) in expected.items():
+    for struct, (size, align) in expected.items():
         if ctypes.sizeof(struct) != size or ctypes.alignment(struct) != align:
             raise ImportError(f"{struct.__name__}: layout differs from the Rust record")
-        if dtype is None:
-            continue
-        if dtype.itemsize != size:
-            raise ImportError(f"{struct.__name__}: numpy itemsize {dtype.itemsize} != {size}")
-        assert dtype.fields is not None
-        for field in struct._fields_:
-            name = field[0]
-            if dtype.fields[name][1] != getattr(struct, name).offset:
-                raise ImportError(f"{struct.__name__}.{name}: numpy and ctypes offsets differ")
-    if not np.little_endian:
-        raise ImportError("the wire dtypes are little-endian; the daemon writes native order")
 
 
 _check_layouts()

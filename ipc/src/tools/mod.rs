@@ -5,7 +5,9 @@
 //!
 //! - [`daemon_process`]: a daemon (or helper) started as a child process under a service
 //!   root and iceoryx2 prefix of its own, stopped and cleaned up on drop;
-//! - [`latency`]: round-trip recording and the percentile summary every tool prints.
+//! - [`latency`]: round-trip recording and the percentile summary every tool prints;
+//! - [`latency_scene`]: the scene every round-trip measurement uses.
 
 pub mod daemon_process;
 pub mod latency;
+pub mod latency_scene;
