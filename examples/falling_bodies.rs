@@ -110,6 +110,12 @@ fn main() -> Result<(), Box<dyn Error>> {
         2.0 * BIN_HALF,
         args.rate_hz
     );
+    if let Some(access) = client.scene_access(scene_id) {
+        println!(
+            "falling_bodies: watch it with `--example monitor -- --token {}`",
+            access.token
+        );
+    }
     let dt = 1.0 / f64::from(args.rate_hz);
     let period = Duration::from_secs_f64(dt);
     let frames = (args.seconds * f64::from(args.rate_hz)).ceil() as u64;

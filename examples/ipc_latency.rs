@@ -393,7 +393,7 @@ struct RawLink {
 impl RawLink {
     fn open(node: &Node<ipc::Service>, root: &str, spin: Duration) -> Result<Self, Box<dyn Error>> {
         let fail = |what: &str, e: &dyn std::fmt::Debug| format!("raw {what}: {e:?}");
-        let poses_service = proxima_ipc::poses_service_builder(node, root, 0)
+        let poses_service = proxima_ipc::poses_service_builder(node, root, RAW_TOKEN)
             .map_err(|e| fail("name", &e))?
             .open_or_create()
             .map_err(|e| fail("poses service", &e))?;
@@ -403,7 +403,7 @@ impl RawLink {
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
             .create()
             .map_err(|e| fail("poses publisher", &e))?;
-        let results = proxima_ipc::results_service_builder(node, root, 0)
+        let results = proxima_ipc::results_service_builder(node, root, RAW_TOKEN)
             .map_err(|e| fail("name", &e))?
             .open_or_create()
             .map_err(|e| fail("results service", &e))?
@@ -457,6 +457,7 @@ impl RawLink {
             budget_ns: 0,
             query_flags: query::CLOSE,
             count: bodies as u32,
+            frame_key: 0,
         };
         let t = seq as f64 * 1e-3;
         sample
@@ -485,6 +486,9 @@ impl RawLink {
     }
 }
 
+/// The token of the raw baseline's services: any fixed one, as no daemon is involved.
+const RAW_TOKEN: proxima_ipc::SceneToken = proxima_ipc::SceneToken([0, 0]);
+
 /// The echo server: for every pose frame, read every record, publish an empty result frame
 /// with the same `frame_seq`, notify. Waits like the daemon: spin, then block.
 fn run_echo(root: &str, prefix: &str) -> Result<(), Box<dyn Error>> {
@@ -493,14 +497,14 @@ fn run_echo(root: &str, prefix: &str) -> Result<(), Box<dyn Error>> {
         .create::<ipc::Service>()
         .map_err(|e| format!("{e:?}"))?;
     let root = raw_root(root);
-    let poses = proxima_ipc::poses_service_builder(&node, &root, 0)
+    let poses = proxima_ipc::poses_service_builder(&node, &root, RAW_TOKEN)
         .map_err(|e| format!("{e:?}"))?
         .open_or_create()
         .map_err(|e| format!("{e:?}"))?
         .subscriber_builder()
         .create()
         .map_err(|e| format!("{e:?}"))?;
-    let results = proxima_ipc::results_service_builder(&node, &root, 0)
+    let results = proxima_ipc::results_service_builder(&node, &root, RAW_TOKEN)
         .map_err(|e| format!("{e:?}"))?
         .open_or_create()
         .map_err(|e| format!("{e:?}"))?

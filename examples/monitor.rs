@@ -3,9 +3,15 @@
 //!
 //! ```text
 //! cargo run --release                                          # terminal 1: the daemon
-//! cargo run --release --example falling_bodies                 # terminal 2: a simulation (scene 0)
-//! cargo run --release --example monitor -- --scene 0           # terminal 3: one line per second
-//! cargo run --release --example monitor -- --scene 0 --each-frame
+//! cargo run --release --example falling_bodies                 # terminal 2: prints its scene's token
+//! cargo run --release --example monitor -- --token TOKEN       # terminal 3: one line per second
+//! cargo run --release --example monitor -- --token TOKEN --each-frame
+//! ```
+//!
+//! The token (32 hex digits) is the capability to read a scene's results: only its owner
+//! has it, and hands it to the monitors it trusts (DESIGN §10).
+//!
+//! ```text
 //! ```
 //!
 //! Each line aggregates the frames seen since the last: frames per second, frames missed
@@ -25,9 +31,9 @@ use std::time::{Duration, Instant};
 #[derive(Debug, Parser)]
 #[command(about = "Print statistics of a scene's result frames")]
 struct Args {
-    /// Scene id to watch.
-    #[arg(long, default_value_t = 0)]
-    scene: u32,
+    /// The token of the scene to watch (32 hex digits, from its owner).
+    #[arg(long)]
+    token: proxima_ipc::SceneToken,
     /// Service root of the daemon.
     #[arg(long, default_value = proxima_ipc::DEFAULT_ROOT)]
     root: String,
@@ -53,10 +59,10 @@ fn main() -> Result<(), Box<dyn Error>> {
     }
     // A client connection checks the protocol version; the feed needs only its node.
     let client = builder.connect::<ipc::Service>()?;
-    let feed = ResultFeed::open(client.node(), &args.root, args.scene)?;
+    let feed = ResultFeed::open(client.node(), &args.root, args.token)?;
     println!(
-        "monitor: watching scene {} under {:?} (Ctrl-C to stop)",
-        args.scene, args.root
+        "monitor: watching a scene under {:?} (Ctrl-C to stop)",
+        args.root
     );
     let stop_at = args
         .seconds

@@ -11,6 +11,7 @@ use proxima::daemon::log::Level;
 use proxima::daemon::{Daemon, DaemonConfig};
 use std::error::Error;
 use std::path::PathBuf;
+use std::process::ExitCode;
 use std::time::Duration;
 
 /// Large scenes' tables on transparent huge pages ([`proxima::huge_pages`]).
@@ -51,6 +52,10 @@ struct Cli {
     /// Worker threads answering mesh pairs beside the frame thread [default: cores − 1].
     #[arg(long)]
     workers: Option<usize>,
+    /// Write this run's instance id (hex, one line) to FILE, readable by the owner only,
+    /// once the daemon serves: clients that read it connect only to this daemon.
+    #[arg(long, value_name = "FILE")]
+    instance_file: Option<PathBuf>,
 }
 
 /// What to run instead of serving.
@@ -93,14 +98,41 @@ impl Cli {
     }
 }
 
-fn main() -> Result<(), Box<dyn Error>> {
+fn main() -> ExitCode {
     let cli = Cli::parse();
     // iceoryx2's own warnings (e.g. "no config file loaded": we configure it in code) stay
     // quiet unless IOX2_LOG_LEVEL asks for them.
     set_log_level_from_env_or(LogLevel::Error);
-    if let Some(Command::Demo(args)) = &cli.command {
-        return demo::run(args);
+    let outcome = match &cli.command {
+        Some(Command::Demo(args)) => demo::run(args),
+        None => serve(&cli),
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("proximad: {e}");
+            ExitCode::FAILURE
+        }
     }
-    Daemon::new(cli.config()?)?.run()?;
+}
+
+/// Builds the daemon from the command line and serves until a termination signal.
+fn serve(cli: &Cli) -> Result<(), Box<dyn Error>> {
+    let mut daemon = Daemon::new(cli.config()?)?;
+    if let Some(path) = &cli.instance_file {
+        write_instance_file(path, daemon.instance())
+            .map_err(|e| format!("writing the instance file {}: {e}", path.display()))?;
+    }
+    daemon.run()?;
     Ok(())
+}
+
+/// Writes `instance` as hex to `path`, created (or truncated) with mode 0600 on Unix.
+fn write_instance_file(path: &std::path::Path, instance: u64) -> std::io::Result<()> {
+    let mut options = std::fs::OpenOptions::new();
+    options.write(true).create(true).truncate(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::mode(&mut options, 0o600);
+    let mut file = options.open(path)?;
+    std::io::Write::write_all(&mut file, format!("{instance:#018x}\n").as_bytes())
 }

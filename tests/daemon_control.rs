@@ -106,16 +106,21 @@ fn a_client_builds_a_scene_of_every_shape_kind_in_a_real_daemon() {
 fn bad_requests_get_their_codes_and_another_client_keeps_being_served() {
     let daemon = Daemon::start();
     let (bad, good) = (daemon.client(), daemon.client());
-    let scene = good.create_scene().unwrap();
-    let sphere = good
-        .register_primitive(scene, Primitive::Sphere { radius: 1.0 })
+    let good_scene = good.create_scene().unwrap();
+    let good_sphere = good
+        .register_primitive(good_scene, Primitive::Sphere { radius: 1.0 })
         .unwrap();
     let mut next_x = 0.0;
     let mut good_client_still_served = || {
         next_x += 1.0;
-        good.add_body(scene, &body(sphere, next_x))
+        good.add_body(good_scene, &body(good_sphere, next_x))
             .expect("the other client is served");
     };
+    // The bad client's mistakes are made on its own scene: the other's is not its to touch.
+    let scene = bad.create_scene().unwrap();
+    let sphere = bad
+        .register_primitive(scene, Primitive::Sphere { radius: 1.0 })
+        .unwrap();
     let nan_pose = BodySpec {
         position: [f64::NAN, 0.0, 0.0],
         ..body(sphere, 0.0)
@@ -160,6 +165,10 @@ fn bad_requests_get_their_codes_and_another_client_keeps_being_served() {
             rejected(bad.register_mesh(scene, &TETRA, &[])),
         ),
         ("empty convex", rejected(bad.register_convex(scene, &[]))),
+        (
+            "another client's scene",
+            rejected(bad.add_body(good_scene, &body(good_sphere, 9.0))),
+        ),
     ];
     let expected = [
         ErrorCode::InvalidPose,
@@ -172,6 +181,7 @@ fn bad_requests_get_their_codes_and_another_client_keeps_being_served() {
         ErrorCode::MeshIndexOutOfRange,
         ErrorCode::EmptyGeometry,
         ErrorCode::EmptyGeometry,
+        ErrorCode::NotOwner,
     ];
     for ((what, got), want) in cases.iter().zip(expected) {
         assert_eq!(*got, want, "{what}");
@@ -210,8 +220,7 @@ fn bad_requests_get_their_codes_and_another_client_keeps_being_served() {
         Some(ErrorCode::MalformedMessage)
     );
     good_client_still_served();
-    // The scene limit (3) holds, and refusing it harms no one.
-    bad.create_scene().unwrap();
+    // The scene limit (3, two taken) holds, and refusing it harms no one.
     bad.create_scene().unwrap();
     assert_eq!(rejected(bad.create_scene()), ErrorCode::LimitExceeded);
     good_client_still_served();

@@ -377,9 +377,11 @@ fn empty_and_undefined_query_flags_are_refused_and_the_scene_is_untouched() {
     for x in [0.0, 0.9] {
         client.add_body(scene_id, &body(sphere, x)).unwrap();
     }
+    // A second link of the owner's: its own publisher and subscriber on the scene.
+    let access = client.scene_access(scene_id).unwrap();
     let (link, other) = (
         client.open_scene(scene_id).unwrap(),
-        daemon.client().open_scene(scene_id).unwrap(),
+        SceneLink::open(client.node(), client.root(), &access).unwrap(),
     );
     let mut seq = 0;
     for bad in [0, query::TOI | 1 << 5, 1 << 5, query::CLOSE | 1 << 31] {
@@ -423,9 +425,9 @@ fn empty_and_undefined_query_flags_are_refused_and_the_scene_is_untouched() {
 }
 
 #[test]
-fn a_bad_frame_is_answered_with_its_code_and_body_and_another_client_keeps_going() {
+fn a_bad_frame_is_answered_with_its_code_and_body_and_another_link_keeps_going() {
     let daemon = Daemon::start();
-    let (bad_client, good_client) = (daemon.client(), daemon.client());
+    let good_client = daemon.client();
     let scene_id = good_client.create_scene().unwrap();
     let sphere = good_client
         .register_primitive(scene_id, Primitive::Sphere { radius: 0.5 })
@@ -434,8 +436,10 @@ fn a_bad_frame_is_answered_with_its_code_and_body_and_another_client_keeps_going
         let spec = body(sphere, x);
         good_client.add_body(scene_id, &spec).unwrap();
     }
+    // The owner's two links to the scene (another client holds no keys to it).
+    let access = good_client.scene_access(scene_id).unwrap();
     let (bad, good) = (
-        bad_client.open_scene(scene_id).unwrap(),
+        SceneLink::open(good_client.node(), good_client.root(), &access).unwrap(),
         good_client.open_scene(scene_id).unwrap(),
     );
     let nan = PoseRecord {

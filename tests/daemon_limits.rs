@@ -444,13 +444,17 @@ struct Forger {
 
 impl Forger {
     fn new(client: &Client<ipc::Service>, scene: u32) -> Self {
-        let poses = proxima_ipc::poses_service_builder(client.node(), client.root(), scene)
+        let token = client
+            .scene_access(scene)
+            .expect("the client's scene")
+            .token;
+        let poses = proxima_ipc::poses_service_builder(client.node(), client.root(), token)
             .unwrap()
-            .open_or_create()
+            .open()
             .unwrap();
-        let ready = proxima_ipc::poses_ready_service_builder(client.node(), client.root(), scene)
+        let ready = proxima_ipc::poses_ready_service_builder(client.node(), client.root(), token)
             .unwrap()
-            .open_or_create()
+            .open()
             .unwrap();
         let publisher = poses
             .publisher_builder()
@@ -485,6 +489,7 @@ fn forged_headers_and_unusable_poses_are_answered_with_their_code_and_touch_no_s
     let mut good = TwoSpheres::new(&good_client, 0.9);
     let forger = Forger::new(&bad_client, bad.scene);
     let bad_scene = bad.scene;
+    let frame_key = bad_client.scene_access(bad_scene).unwrap().frame_key;
     let header = move |seq: u64, count: u32| PoseFrameHeader {
         protocol_version: PROTOCOL_VERSION,
         scene: bad_scene,
@@ -492,6 +497,7 @@ fn forged_headers_and_unusable_poses_are_answered_with_their_code_and_touch_no_s
         budget_ns: 0,
         query_flags: query::CLOSE,
         count,
+        frame_key,
     };
     // Every bad frame would move body 0 of a scene away from body 1 if it were applied.
     let away = pose_at(0, -5.0);

@@ -34,7 +34,7 @@ extern "C" {
 
 /** Protocol version. A client and a daemon whose versions differ refuse to talk (Hello
  *  answers ProtocolMismatch); every record carries it. */
-#define PROXIMA_PROTOCOL_VERSION UINT32_C(8)
+#define PROXIMA_PROTOCOL_VERSION UINT32_C(9)
 
 /* iceoryx2 matches services by name and by each type's name, size and alignment: declare
  * the types with exactly these names (C: the *_type_details setters; C++: IOX2_TYPE_NAME). */
@@ -55,7 +55,16 @@ extern "C" {
 #define PROXIMA_DEFAULT_ROOT "proxima"
 
 /* Service names, as printf formats: the root (const char *), then for scene services the
- * scene id (uint32_t). Example: snprintf(buf, n, PROXIMA_SERVICE_POSES_FORMAT, root, scene). */
+ * two words of the scene's token (uint64_t, ControlReply.scene_token of its CreateScene),
+ * printed as 32 lowercase hex digits. Example:
+ *   snprintf(buf, n, PROXIMA_SERVICE_POSES_FORMAT, root,
+ *            PROXIMA_SCENE_TOKEN_ARGS(reply.scene_token));
+ * The token is the capability to read the scene's results: keep it out of logs. */
+
+/** The two printf arguments of a scene token (a uint64_t[2]), for the scene formats. */
+#define PROXIMA_SCENE_TOKEN_ARGS(token) (token)[0], (token)[1]
+/** The common prefix of a scene's services: "<root>/scene-<token>". */
+#define PROXIMA_SCENE_SERVICES_FORMAT "%s/scene-%016" PRIx64 "%016" PRIx64
 
 /** Request-response: request user header ControlRequest with a u8 payload slice (geometry),
  *  response ControlReply. */
@@ -63,23 +72,25 @@ extern "C" {
 /** Event: clients notify PROXIMA_EVENT_CONTROL_SENT after each control request. */
 #define PROXIMA_SERVICE_CONTROL_EVENTS_FORMAT "%s/control-events"
 /** Publish-subscribe: PoseRecord slices with a PoseFrameHeader user header. */
-#define PROXIMA_SERVICE_POSES_FORMAT "%s/%" PRIu32 "/poses"
+#define PROXIMA_SERVICE_POSES_FORMAT PROXIMA_SCENE_SERVICES_FORMAT "/poses"
 /** Event: clients notify PROXIMA_EVENT_POSES_SENT after each pose frame. */
-#define PROXIMA_SERVICE_POSES_READY_FORMAT "%s/%" PRIu32 "/poses-ready"
+#define PROXIMA_SERVICE_POSES_READY_FORMAT PROXIMA_SCENE_SERVICES_FORMAT "/poses-ready"
 /** Publish-subscribe: ResultRecord slices with a ResultFrameHeader user header. */
-#define PROXIMA_SERVICE_RESULTS_FORMAT "%s/%" PRIu32 "/results"
+#define PROXIMA_SERVICE_RESULTS_FORMAT PROXIMA_SCENE_SERVICES_FORMAT "/results"
 /** Event: the daemon notifies PROXIMA_EVENT_RESULTS_READY after each result frame. */
-#define PROXIMA_SERVICE_RESULTS_READY_FORMAT "%s/%" PRIu32 "/results-ready"
+#define PROXIMA_SERVICE_RESULTS_READY_FORMAT PROXIMA_SCENE_SERVICES_FORMAT "/results-ready"
 
 /* ---------------------------------------------------------------------------------------
- * Service settings. Open every service with open_or_create and exactly these settings, so
- * whichever side comes first creates it and the other opens it (when opening, iceoryx2
- * treats each as a minimum). Values equal to iceoryx2's defaults are listed too, so that a
- * binding whose defaults differ can set them. See PROTOCOL.md.
+ * Service settings. The daemon creates every service with exactly these settings; a client
+ * only opens them (never creates: a control service that does not exist means the daemon
+ * is not up yet, a scene service that does not exist means no such scene), with the same
+ * settings (when opening, iceoryx2 treats each as a minimum). Values equal to iceoryx2's
+ * defaults are listed too, so that a binding whose defaults differ can set them. See
+ * PROTOCOL.md.
  * ------------------------------------------------------------------------------------- */
 
-/** iceoryx2's default max_nodes of publish-subscribe and request-response services,
- *  used by control, poses and results. */
+/** iceoryx2's default max_nodes of publish-subscribe services, used by poses and results
+ *  (control sets its own). */
 #define PROXIMA_DEFAULT_MAX_NODES 20
 /** iceoryx2's default max_nodes of event services, used by poses ready and results ready
  *  (control events sets its own). */
@@ -87,8 +98,9 @@ extern "C" {
 /** iceoryx2's default event_id_max_value, used by every event service. Event services
  *  set no deadline and no notifier created/dropped/dead events. */
 #define PROXIMA_EVENT_ID_MAX_VALUE 255
-/** Safe overflow (the default) on every publish-subscribe service and on both directions of
- *  control: a full queue drops its oldest entry, the sender never blocks. */
+/** Safe overflow (the default, which the results builder states) on every
+ *  publish-subscribe service and on both directions of control: a full queue drops its
+ *  oldest entry, the sender never blocks. */
 #define PROXIMA_SAFE_OVERFLOW 1
 
 /* control (request-response). */
@@ -101,6 +113,9 @@ extern "C" {
 #define PROXIMA_CONTROL_MAX_RESPONSE_BUFFER_SIZE 4
 #define PROXIMA_CONTROL_MAX_BORROWED_RESPONSES_PER_PENDING_RESPONSE 2
 #define PROXIMA_CONTROL_MAX_LOANED_REQUESTS 2
+/** Nodes that may hold control and control events at once: one per client, plus the
+ *  daemon's ports. */
+#define PROXIMA_CONTROL_MAX_NODES (PROXIMA_CONTROL_MAX_CLIENTS + PROXIMA_DAEMON_EVENT_PORTS)
 /** Client port: initial byte capacity of a request slice, with the PowerOfTwo allocation
  *  strategy so geometry of any size fits. */
 #define PROXIMA_CONTROL_INITIAL_MAX_SLICE_LEN 4096
@@ -108,7 +123,7 @@ extern "C" {
 /* control events (event). */
 #define PROXIMA_CONTROL_EVENTS_MAX_NOTIFIERS PROXIMA_CONTROL_MAX_CLIENTS
 #define PROXIMA_CONTROL_EVENTS_MAX_LISTENERS PROXIMA_DAEMON_EVENT_PORTS
-#define PROXIMA_CONTROL_EVENTS_MAX_NODES (PROXIMA_CONTROL_MAX_CLIENTS + PROXIMA_DAEMON_EVENT_PORTS)
+#define PROXIMA_CONTROL_EVENTS_MAX_NODES PROXIMA_CONTROL_MAX_NODES
 
 /** Daemon ports on a daemon-side event service: the running daemon plus one slot for a
  *  crashed predecessor not yet cleaned up. */
@@ -142,9 +157,10 @@ extern "C" {
 
 /* Event ids. */
 
-/** Sent by a client on <root>/<scene>/poses-ready after publishing a pose frame. */
+/** Sent by a client on <root>/scene-<token>/poses-ready after publishing a pose frame. */
 #define PROXIMA_EVENT_POSES_SENT 1
-/** Sent by the daemon on <root>/<scene>/results-ready after publishing a result frame. */
+/** Sent by the daemon on <root>/scene-<token>/results-ready after publishing a result
+ *  frame. */
 #define PROXIMA_EVENT_RESULTS_READY 2
 /** Sent by a client on <root>/control-events after sending a control request. */
 #define PROXIMA_EVENT_CONTROL_SENT 3
@@ -183,16 +199,25 @@ typedef enum proxima_ErrorCode {
     /** The daemon failed internally (logged); the request may be retried. */
     PROXIMA_ERROR_INTERNAL = 11,
     /** AddBody on a shape still being built; nothing changed: ask ShapeState, retry. */
-    PROXIMA_ERROR_SHAPE_NOT_READY = 12
+    PROXIMA_ERROR_SHAPE_NOT_READY = 12,
+    /** The scene belongs to another client port: only the port that created it may change
+     *  it, drop it, ask ShapeState of it or send it frames. */
+    PROXIMA_ERROR_NOT_OWNER = 13,
+    /** The daemon stopped serving the scene after a fault on its shared-memory services
+     *  (the reason says which); only DropScene is accepted. */
+    PROXIMA_ERROR_SCENE_QUARANTINED = 14
 } proxima_ErrorCode;
 
-/** ControlRequest.command. The reply's id is given where it means something. */
+/** ControlRequest.command. The reply's id is given where it means something. A command
+ *  naming a scene from another client port than its creator's gets
+ *  PROXIMA_ERROR_NOT_OWNER. */
 typedef enum proxima_Command {
     /** Check the protocol version; id = the daemon's version. */
     PROXIMA_COMMAND_HELLO = 0,
-    /** id = the new scene. */
+    /** id = the new scene (random, owned by the requesting client port); the reply also
+     *  carries its frame_key and scene_token. */
     PROXIMA_COMMAND_CREATE_SCENE = 1,
-    /** Drop `scene` with all its bodies. */
+    /** Drop `scene` with all its bodies and services (or a quarantined scene's id). */
     PROXIMA_COMMAND_DROP_SCENE = 2,
     /** shape_kind, dimensions, geometry payload; id = the shape. Convex and mesh shapes are
      *  built after the reply, which then carries PROXIMA_REPLY_FLAG_SHAPE_BUILDING. */
@@ -314,7 +339,7 @@ typedef enum proxima_RecordKind {
  * Records
  * ------------------------------------------------------------------------------------- */
 
-/** User header of a pose frame (a PoseRecord slice). 32 bytes, alignment 8. */
+/** User header of a pose frame (a PoseRecord slice). 40 bytes, alignment 8. */
 typedef struct proxima_PoseFrameHeader {
     /** PROXIMA_PROTOCOL_VERSION of the sender. */
     uint32_t protocol_version;
@@ -329,6 +354,9 @@ typedef struct proxima_PoseFrameHeader {
     uint32_t query_flags;
     /** Number of PoseRecords in the slice (must equal its length). */
     uint32_t count;
+    /** The scene's frame key (ControlReply.frame_key of its CreateScene); a frame with
+     *  another key is not answered. */
+    uint64_t frame_key;
 } proxima_PoseFrameHeader;
 
 /** The new pose of one body; bodies not listed keep their last pose. 64 bytes, alignment 8. */
@@ -344,7 +372,7 @@ typedef struct proxima_PoseRecord {
 } proxima_PoseRecord;
 
 /** User header of a result frame (a ResultRecord slice: pairs, then contacts, then times of
- *  impact). 120 bytes, alignment 8. */
+ *  impact). 128 bytes, alignment 8. */
 typedef struct proxima_ResultFrameHeader {
     /** PROXIMA_PROTOCOL_VERSION of the daemon. */
     uint32_t protocol_version;
@@ -378,6 +406,9 @@ typedef struct proxima_ResultFrameHeader {
     uint32_t dropped_candidates;
     /** With PROXIMA_FRAME_FLAG_BUDGET_TOO_SMALL: the smallest workable budget, ns; else 0. */
     uint64_t min_budget_ns;
+    /** The daemon's instance id (as ControlReply.instance); another than the scene's means
+     *  another daemon. */
+    uint64_t instance;
 } proxima_ResultFrameHeader;
 
 /** A pair, a contact point or a time of impact (see `kind`; PROTOCOL.md for each
@@ -449,7 +480,7 @@ typedef struct proxima_ControlRequest {
     double orientation[4];
 } proxima_ControlRequest;
 
-/** The daemon's answer to one ControlRequest. 128 bytes, alignment 4. */
+/** The daemon's answer to one ControlRequest. 160 bytes, alignment 8. */
 typedef struct proxima_ControlReply {
     /** PROXIMA_PROTOCOL_VERSION of the daemon. */
     uint32_t protocol_version;
@@ -459,6 +490,15 @@ typedef struct proxima_ControlReply {
     uint32_t id;
     /** PROXIMA_REPLY_FLAG_* bits; 0 on error. */
     uint32_t flags;
+    /** The daemon's instance id: random per daemon start, never 0, the same in every reply
+     *  and result header of one run (a change means another daemon). */
+    uint64_t instance;
+    /** CreateScene: the scene's secret frame key, for PoseFrameHeader.frame_key; else 0. */
+    uint64_t frame_key;
+    /** CreateScene: the scene's token, which names its services (see
+     *  PROXIMA_SCENE_SERVICES_FORMAT) and lets whoever holds it read its results; share it
+     *  only with a monitor that may. All zero otherwise. */
+    uint64_t scene_token[2];
     /** Why the request failed: UTF-8, zero-padded, not necessarily zero-terminated. */
     uint8_t reason[PROXIMA_REASON_BYTES];
 } proxima_ControlReply;
@@ -479,17 +519,19 @@ typedef struct proxima_ControlReply {
     typedef char PROXIMA_STATIC_ASSERT_JOIN(proxima_static_assert_, __LINE__)[(cond) ? 1 : -1]
 #endif
 
-PROXIMA_STATIC_ASSERT(sizeof(proxima_PoseFrameHeader) == 32, "PoseFrameHeader is 32 bytes");
+PROXIMA_STATIC_ASSERT(sizeof(proxima_PoseFrameHeader) == 40, "PoseFrameHeader is 40 bytes");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_PoseFrameHeader, frame_seq) == 8, "frame_seq at 8");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_PoseFrameHeader, count) == 28, "count at 28");
+PROXIMA_STATIC_ASSERT(offsetof(proxima_PoseFrameHeader, frame_key) == 32, "frame_key at 32");
 PROXIMA_STATIC_ASSERT(sizeof(proxima_PoseRecord) == 64, "PoseRecord is 64 bytes");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_PoseRecord, position) == 8, "position at 8");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_PoseRecord, orientation) == 32, "orientation at 32");
-PROXIMA_STATIC_ASSERT(sizeof(proxima_ResultFrameHeader) == 120, "ResultFrameHeader is 120 bytes");
+PROXIMA_STATIC_ASSERT(sizeof(proxima_ResultFrameHeader) == 128, "ResultFrameHeader is 128 bytes");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_ResultFrameHeader, elapsed_ns) == 48, "elapsed_ns at 48");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_ResultFrameHeader, stage_ns) == 56, "stage_ns at 56");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_ResultFrameHeader, min_budget_ns) == 112,
                       "min_budget_ns at 112");
+PROXIMA_STATIC_ASSERT(offsetof(proxima_ResultFrameHeader, instance) == 120, "instance at 120");
 PROXIMA_STATIC_ASSERT(sizeof(proxima_ResultRecord) == 120, "ResultRecord is 120 bytes");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_ResultRecord, distance) == 24, "distance at 24");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_ResultRecord, normal) == 88, "normal at 88");
@@ -498,8 +540,11 @@ PROXIMA_STATIC_ASSERT(sizeof(proxima_ControlRequest) == 144, "ControlRequest is 
 PROXIMA_STATIC_ASSERT(offsetof(proxima_ControlRequest, margin) == 48, "margin at 48");
 PROXIMA_STATIC_ASSERT(offsetof(proxima_ControlRequest, orientation) == 112,
                       "orientation at 112");
-PROXIMA_STATIC_ASSERT(sizeof(proxima_ControlReply) == 128, "ControlReply is 128 bytes");
-PROXIMA_STATIC_ASSERT(offsetof(proxima_ControlReply, reason) == 16, "reason at 16");
+PROXIMA_STATIC_ASSERT(sizeof(proxima_ControlReply) == 160, "ControlReply is 160 bytes");
+PROXIMA_STATIC_ASSERT(offsetof(proxima_ControlReply, instance) == 16, "instance at 16");
+PROXIMA_STATIC_ASSERT(offsetof(proxima_ControlReply, frame_key) == 24, "frame_key at 24");
+PROXIMA_STATIC_ASSERT(offsetof(proxima_ControlReply, scene_token) == 32, "scene_token at 32");
+PROXIMA_STATIC_ASSERT(offsetof(proxima_ControlReply, reason) == 48, "reason at 48");
 
 #ifdef __cplusplus
 } /* extern "C" */

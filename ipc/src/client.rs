@@ -56,6 +56,8 @@
 //! once the reply timeout has passed: the daemon's scenes, shapes and bodies are gone with
 //! it, so connect again ([`ClientBuilder::connect`]) and register everything anew.
 
+use std::collections::HashMap;
+use std::sync::{Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 use iceoryx2::config::Config;
@@ -68,11 +70,14 @@ use iceoryx2::prelude::{
     SemanticString as _,
 };
 use iceoryx2::service::Service;
+use iceoryx2::service::builder::event::EventOpenError;
+use iceoryx2::service::builder::request_response::RequestResponseOpenError;
 use iceoryx2::service::port_factory::event::PortFactory as EventPortFactory;
 use iceoryx2::service::port_factory::request_response::PortFactory;
 
+use crate::SceneToken;
 use crate::error::{ClientConnectError, ControlError, SceneOpenError};
-use crate::scene_link::SceneLink;
+use crate::scene_link::{SceneAccess, SceneLink};
 use crate::transport::{CONTROL_REPLY_SLEEP, CONTROL_REPLY_SPIN, SHAPE_POLL_FIRST, SHAPE_POLL_MAX};
 use crate::wire::{
     BroadPhaseCode, Command, ControlReply, ControlRequest, ErrorCode, MotionCode, ShapeKindCode,
@@ -224,6 +229,7 @@ pub struct ClientBuilder {
     prefix: Option<String>,
     reply_timeout: Duration,
     build_timeout: Duration,
+    expected_instance: Option<u64>,
 }
 
 impl Default for ClientBuilder {
@@ -242,7 +248,17 @@ impl ClientBuilder {
             prefix: None,
             reply_timeout: DEFAULT_REPLY_TIMEOUT,
             build_timeout: DEFAULT_BUILD_TIMEOUT,
+            expected_instance: None,
         }
+    }
+
+    /// Connect only to the daemon run with instance id `instance` (as `proximad` logs it at
+    /// start and writes it with `--instance-file`): another process serving the control
+    /// service is refused with [`ClientConnectError::UnexpectedDaemon`].
+    #[must_use]
+    pub fn expect_instance(mut self, instance: u64) -> Self {
+        self.expected_instance = Some(instance);
+        self
     }
 
     /// The root prefix of the daemon's service names (its `--root`).
@@ -293,19 +309,28 @@ impl ClientBuilder {
             .config(&config)
             .create::<S>()
             .map_err(|e| ClientConnectError::Transport(format!("creating the node: {e}")))?;
-        let service = crate::control_service_builder(&node, &self.root)
-            .map_err(|_| ClientConnectError::InvalidRoot(self.root.clone()))?
-            .open_or_create()
-            .map_err(|e| {
-                ClientConnectError::Transport(format!("opening the control service: {e}"))
-            })?;
+        // The daemon creates both services; until it has, there is no daemon to talk to.
+        let invalid_root = |_| ClientConnectError::InvalidRoot(self.root.clone());
+        let control = crate::control_service_builder(&node, &self.root).map_err(invalid_root)?;
+        let service = poll_until(deadline, || match control.clone().open() {
+            Ok(service) => Ok(Some(service)),
+            Err(RequestResponseOpenError::DoesNotExist) => Ok(None),
+            Err(e) => Err(ClientConnectError::Transport(format!(
+                "opening the control service: {e}"
+            ))),
+        })?
+        .ok_or(ClientConnectError::NoDaemon)?;
         let port = control_port(&service)?;
-        let events = crate::control_events_service_builder(&node, &self.root)
-            .map_err(|_| ClientConnectError::InvalidRoot(self.root.clone()))?
-            .open_or_create()
-            .map_err(|e| {
-                ClientConnectError::Transport(format!("opening the control event service: {e}"))
-            })?;
+        let control_events =
+            crate::control_events_service_builder(&node, &self.root).map_err(invalid_root)?;
+        let events = poll_until(deadline, || match control_events.clone().open() {
+            Ok(events) => Ok(Some(events)),
+            Err(EventOpenError::DoesNotExist) => Ok(None),
+            Err(e) => Err(ClientConnectError::Transport(format!(
+                "opening the control event service: {e}"
+            ))),
+        })?
+        .ok_or(ClientConnectError::NoDaemon)?;
         let notifier = events.notifier_builder().create().map_err(|e| {
             ClientConnectError::Transport(format!("creating the control notifier: {e}"))
         })?;
@@ -321,6 +346,8 @@ impl ClientBuilder {
             reply_timeout: self.reply_timeout,
             build_timeout: self.build_timeout,
             daemon: None,
+            instance: 0,
+            scenes: Mutex::default(),
             port,
             notifier,
             service,
@@ -354,6 +381,15 @@ impl ClientBuilder {
             }
         };
         check_hello(&reply)?;
+        if self
+            .expected_instance
+            .is_some_and(|expected| expected != reply.instance)
+        {
+            return Err(ClientConnectError::UnexpectedDaemon {
+                instance: reply.instance,
+            });
+        }
+        client.instance = reply.instance;
         Ok(client)
     }
 }
@@ -397,6 +433,10 @@ pub struct Client<S: Service> {
     build_timeout: Duration,
     /// The server port of the daemon that answered `Hello` (`None` only during connect).
     daemon: Option<UniqueServerId>,
+    /// The instance id of that daemon (0 only during connect).
+    instance: u64,
+    /// The scenes this client created and has not dropped, with their keys.
+    scenes: Mutex<HashMap<u32, SceneAccess>>,
     // Fields drop in order: the ports before their services, all before the node.
     port: ClientPort<S, [u8], ControlRequest, ControlReply, ()>,
     notifier: Notifier<S>,
@@ -440,22 +480,49 @@ impl<S: Service> Client<S> {
         &self.node
     }
 
-    /// Opens the frame link to scene `scene` (its pose, result and event services) on this
-    /// client's node and root. Works whether or not the daemon has opened them yet; whether
-    /// the scene exists is not checked here.
-    ///
-    /// # Errors
-    /// See [`SceneOpenError`].
-    pub fn open_scene(&self, scene: u32) -> Result<SceneLink<S>, SceneOpenError> {
-        SceneLink::open(&self.node, &self.root, scene)
+    /// The instance id of the daemon this client is connected to (random per daemon run).
+    #[must_use]
+    pub fn daemon_instance(&self) -> u64 {
+        self.instance
     }
 
-    /// Creates a scene; returns its id.
+    /// Opens the frame link to scene `scene`, which this client created (its pose, result
+    /// and event services) on this client's node and root.
+    ///
+    /// # Errors
+    /// [`SceneOpenError::NotOwned`] when this client did not create `scene` (or dropped
+    /// it); otherwise see [`SceneOpenError`].
+    pub fn open_scene(&self, scene: u32) -> Result<SceneLink<S>, SceneOpenError> {
+        let access = self
+            .scene_access(scene)
+            .ok_or(SceneOpenError::NotOwned(scene))?;
+        SceneLink::open(&self.node, &self.root, &access)
+    }
+
+    /// The keys of scene `scene`, if this client created it and has not dropped it. Its
+    /// [`token`](SceneAccess::token) is the capability to read its results: give it to a
+    /// monitor that may ([`ResultFeed::open`](crate::result_feed::ResultFeed::open)).
+    #[must_use]
+    pub fn scene_access(&self, scene: u32) -> Option<SceneAccess> {
+        self.owned_scenes().get(&scene).copied()
+    }
+
+    /// Creates a scene owned by this client; returns its id (the client keeps its keys, see
+    /// [`scene_access`](Self::scene_access)).
     ///
     /// # Errors
     /// See [`ControlError`].
     pub fn create_scene(&self) -> Result<u32, ControlError> {
-        self.call(&self.header(Command::CreateScene, 0))
+        let reply = self.request(&self.header(Command::CreateScene, 0), &[])?;
+        let scene = reply_id(&reply)?;
+        let access = SceneAccess {
+            scene,
+            token: SceneToken(reply.scene_token),
+            frame_key: reply.frame_key,
+            instance: reply.instance,
+        };
+        self.owned_scenes().insert(scene, access);
+        Ok(scene)
     }
 
     /// Drops scene `scene` with all its bodies.
@@ -463,7 +530,14 @@ impl<S: Service> Client<S> {
     /// # Errors
     /// See [`ControlError`].
     pub fn drop_scene(&self, scene: u32) -> Result<(), ControlError> {
-        self.call(&self.header(Command::DropScene, scene)).map(drop)
+        self.call(&self.header(Command::DropScene, scene))?;
+        self.owned_scenes().remove(&scene);
+        Ok(())
+    }
+
+    /// The scenes this client owns (a poisoned lock is taken over: the map is always whole).
+    fn owned_scenes(&self) -> std::sync::MutexGuard<'_, HashMap<u32, SceneAccess>> {
+        self.scenes.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
     /// Registers a primitive shape for scene `scene`; returns the shape id.
@@ -784,6 +858,9 @@ impl<S: Service> Client<S> {
         })?;
         match answer {
             Some((_, origin)) if self.daemon.is_some_and(|daemon| daemon != origin) => {
+                Err(ControlError::DaemonLost)
+            }
+            Some((reply, _)) if self.instance != 0 && reply.instance != self.instance => {
                 Err(ControlError::DaemonLost)
             }
             Some(answer) => Ok(answer),

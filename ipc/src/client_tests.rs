@@ -36,6 +36,10 @@ impl Responder {
                 .unwrap()
                 .open_or_create()
                 .unwrap();
+            let _events = crate::control_events_service_builder(&node, &root)
+                .unwrap()
+                .open_or_create()
+                .unwrap();
             let server = service.server_builder().create().unwrap();
             ready_tx.send(()).unwrap();
             while !flag.load(Ordering::Relaxed) {
@@ -745,4 +749,44 @@ fn a_shape_still_building_at_the_build_timeout_is_a_build_timeout() {
             .to_string()
             .contains("shape 4")
     );
+}
+
+/// The instance id the [`instanced`] responder gives in `Hello`'s reply.
+const INSTANCE: u64 = 0x5eed_0001;
+
+/// Answers `Hello` as instance [`INSTANCE`], and every later request as another instance
+/// (a restarted daemon behind the same server port, as far as replies tell).
+fn instanced(header: &ControlRequest, _: &[u8]) -> Option<ControlReply> {
+    let mut reply = ControlReply::ok(PROTOCOL_VERSION);
+    reply.instance = if header.command == Command::Hello as u32 {
+        INSTANCE
+    } else {
+        INSTANCE + 1
+    };
+    Some(reply)
+}
+
+#[test]
+fn a_daemon_of_another_instance_is_refused_and_a_reply_of_another_is_a_lost_daemon() {
+    let root = root("instance");
+    let _responder = Responder::start::<local::Service>(&root, None, instanced);
+    let builder = ClientBuilder::new()
+        .root(&root)
+        .reply_timeout(Duration::from_secs(2));
+    let refused = builder
+        .clone()
+        .expect_instance(INSTANCE + 7)
+        .connect::<local::Service>()
+        .unwrap_err();
+    assert_eq!(
+        refused,
+        ClientConnectError::UnexpectedDaemon { instance: INSTANCE }
+    );
+    let client = builder
+        .expect_instance(INSTANCE)
+        .connect::<local::Service>()
+        .unwrap();
+    assert_eq!(client.daemon_instance(), INSTANCE);
+    assert_eq!(client.create_scene(), Err(ControlError::DaemonLost));
+    assert_eq!(client.scene_access(PROTOCOL_VERSION), None, "nothing kept");
 }

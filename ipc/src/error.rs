@@ -27,6 +27,12 @@ pub enum ClientConnectError {
         /// The daemon's [`PROTOCOL_VERSION`](crate::PROTOCOL_VERSION).
         daemon: u32,
     },
+    /// The daemon that answered is not the one expected
+    /// (`ClientBuilder::expect_instance`): another process serves the control service.
+    UnexpectedDaemon {
+        /// The instance id the answering daemon gave.
+        instance: u64,
+    },
     /// The daemon refused `Hello` for another reason.
     Rejected {
         /// The daemon's error code (`Internal` when the status value is unknown).
@@ -48,6 +54,11 @@ impl std::fmt::Display for ClientConnectError {
                 f,
                 "the daemon speaks protocol version {daemon}, this client {}",
                 crate::PROTOCOL_VERSION
+            ),
+            Self::UnexpectedDaemon { instance } => write!(
+                f,
+                "the process serving the control service (instance {instance:#018x}) is not the \
+                 daemon expected"
             ),
             Self::Rejected { code, reason } => {
                 write!(f, "the daemon refused the connection: {code}: {reason}")
@@ -125,8 +136,14 @@ impl std::error::Error for ControlError {}
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum SceneOpenError {
-    /// The root and scene id do not make valid iceoryx2 service names; carries the root.
+    /// The root does not make valid iceoryx2 service names; carries the root.
     InvalidRoot(String),
+    /// No daemon serves a scene with this token (it was dropped, or never created).
+    NoSuchScene,
+    /// This client did not create the scene (or dropped it): only its creator holds the
+    /// keys to drive it; carries the scene id. A monitor opens a scene's results with the
+    /// token its owner shares (`ResultFeed::open`).
+    NotOwned(u32),
     /// iceoryx2 failed to open or create a scene service or one of its ports (e.g. the
     /// services exist with incompatible settings, or too many ports); carries its error text.
     Transport(String),
@@ -141,6 +158,11 @@ impl std::fmt::Display for SceneOpenError {
                     "service root {root:?} does not make valid scene service names"
                 )
             }
+            Self::NoSuchScene => f.write_str("no daemon serves a scene with this token"),
+            Self::NotOwned(scene) => write!(
+                f,
+                "scene {scene} was not created by this client, which holds no keys to it"
+            ),
             Self::Transport(text) => write!(f, "iceoryx2 failure while opening a scene: {text}"),
         }
     }
@@ -177,6 +199,12 @@ impl std::error::Error for FrameSendError {}
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum FrameReceiveError {
+    /// No daemon serves the scene any more, found when a wait ended without a frame: the
+    /// daemon is gone (its result publisher's process died), or it let go of the scene
+    /// (dropped, released or quarantined; the control reply for the scene says which); or a
+    /// frame came from another daemon instance. Either way the scene is gone: create it
+    /// again (after connecting again when `Client` calls fail with `DaemonLost` too).
+    DaemonLost,
     /// iceoryx2 failed to receive a sample (e.g. the caller holds more result frames than
     /// the subscriber may borrow) or to wait on the event listener; carries its error text.
     Transport(String),
@@ -185,6 +213,9 @@ pub enum FrameReceiveError {
 impl std::fmt::Display for FrameReceiveError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
+            Self::DaemonLost => f.write_str(
+                "the daemon serving the scene is gone (crashed or restarted): reconnect",
+            ),
             Self::Transport(text) => {
                 write!(f, "iceoryx2 failure while receiving a result frame: {text}")
             }

@@ -41,9 +41,9 @@ use iceoryx2::service::service_name::{ServiceName, ServiceNameError};
 
 /// The protocol version. A client and a daemon whose versions differ refuse to talk; bump it
 /// on any change to a wire record's layout or meaning.
-pub const PROTOCOL_VERSION: u32 = 8;
+pub const PROTOCOL_VERSION: u32 = 9;
 
-/// The default root prefix of every service name (`<root>/control`, `<root>/<scene>/poses`…).
+/// The default root prefix of every service name (`<root>/control`, `<root>/scene-<token>/poses`…).
 pub const DEFAULT_ROOT: &str = "proxima";
 
 /// The name of the control service under `root`.
@@ -53,8 +53,9 @@ pub fn control_service_name(root: &str) -> String {
 }
 
 /// The builder of the control service (`<root>/control`), with every setting the daemon and
-/// its clients must agree on. Both sides call this and then `open_or_create()`, so whichever
-/// comes first creates the service with these settings and the other opens it.
+/// its clients must agree on. The daemon creates the service (or, when clients of an
+/// earlier run still hold it, opens it after checking that no one serves it and that its
+/// client, server, request, buffer and node counts are these); clients only `open()`.
 ///
 /// Settings: request `[u8]` (geometry) with a [`wire::ControlRequest`] user header, response
 /// [`wire::ControlReply`]; at most [`CONTROL_MAX_CLIENTS`] clients, [`CONTROL_MAX_SERVERS`]
@@ -77,8 +78,13 @@ pub fn control_service_builder<S: iceoryx2::service::Service>(
         .max_clients(CONTROL_MAX_CLIENTS)
         .max_servers(CONTROL_MAX_SERVERS)
         .max_active_requests_per_client(CONTROL_MAX_ACTIVE_REQUESTS_PER_CLIENT)
-        .max_response_buffer_size(CONTROL_MAX_RESPONSE_BUFFER_SIZE))
+        .max_response_buffer_size(CONTROL_MAX_RESPONSE_BUFFER_SIZE)
+        .max_nodes(CONTROL_MAX_NODES))
 }
+
+/// Nodes that may hold the control service (and the control event service) at once: one
+/// per client, plus the daemon's ports ([`DAEMON_EVENT_PORTS`]).
+pub const CONTROL_MAX_NODES: usize = CONTROL_MAX_CLIENTS + DAEMON_EVENT_PORTS;
 
 /// The iceoryx2 builder type [`control_service_builder`] returns.
 pub type ControlServiceBuilder<S> =
@@ -95,20 +101,62 @@ pub const CONTROL_MAX_RESPONSE_BUFFER_SIZE: usize = 4;
 /// Initial byte capacity of a client's request slice (grows by powers of two).
 pub const CONTROL_INITIAL_MAX_SLICE_LEN: usize = 4096;
 
-/// The builder of scene `scene`'s pose service (`<root>/<scene>/poses`): `[PoseRecord]`
+/// A scene's token: 128 random bits, handed to the scene's owner in the `CreateScene`
+/// reply ([`wire::ControlReply::scene_token`]), that name the scene's services
+/// ([`scene_services_name`]). Whoever holds it can open them, so it is the capability to
+/// read the scene's results; sending it frames needs the frame key as well. `Debug` does not
+/// print it, so it stays out of logs.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct SceneToken(pub [u64; 2]);
+
+impl std::fmt::Display for SceneToken {
+    /// 32 lowercase hex digits: `self.0[0]`, then `self.0[1]`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:016x}{:016x}", self.0[0], self.0[1])
+    }
+}
+
+impl std::str::FromStr for SceneToken {
+    type Err = String;
+
+    /// Parses the 32 hex digits [`Display`](std::fmt::Display) writes.
+    fn from_str(text: &str) -> Result<Self, Self::Err> {
+        let bad = || format!("a scene token is 32 hex digits, not {text:?}");
+        if text.len() != 32 || !text.is_ascii() {
+            return Err(bad());
+        }
+        let half = |digits: &str| u64::from_str_radix(digits, 16).map_err(|_| bad());
+        Ok(Self([half(&text[..16])?, half(&text[16..])?]))
+    }
+}
+
+impl std::fmt::Debug for SceneToken {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("SceneToken(…)")
+    }
+}
+
+/// The common prefix of the services of the scene with token `token` under `root`:
+/// `<root>/scene-<token as 32 hex digits>`.
+#[must_use]
+pub fn scene_services_name(root: &str, token: SceneToken) -> String {
+    format!("{root}/scene-{token}")
+}
+
+/// The builder of a scene's pose service (`<scene services>/poses`): `[PoseRecord]`
 /// slices with a [`wire::PoseFrameHeader`], up to [`POSES_MAX_PUBLISHERS`] client
 /// publishers, the daemon's one subscriber keeping the newest [`FRAME_BUFFER`] frames
-/// (older ones are overwritten: the newest frame wins under a deadline). Both sides call it,
-/// then `open_or_create()`.
+/// (older ones are overwritten: the newest frame wins under a deadline). The daemon creates
+/// it; clients open it.
 ///
 /// # Errors
 /// `root` does not make a valid iceoryx2 service name.
 pub fn poses_service_builder<S: iceoryx2::service::Service>(
     node: &Node<S>,
     root: &str,
-    scene: u32,
+    token: SceneToken,
 ) -> Result<PosesServiceBuilder<S>, ServiceNameError> {
-    let name = ServiceName::new(&poses_service_name(root, scene))?;
+    let name = ServiceName::new(&poses_service_name(root, token))?;
     Ok(node
         .service_builder(&name)
         .publish_subscribe::<[wire::PoseRecord]>()
@@ -119,18 +167,20 @@ pub fn poses_service_builder<S: iceoryx2::service::Service>(
         .history_size(0))
 }
 
-/// The builder of scene `scene`'s result service (`<root>/<scene>/results`): `[ResultRecord]`
+/// The builder of a scene's result service (`<scene services>/results`): `[ResultRecord]`
 /// slices with a [`wire::ResultFrameHeader`], the daemon's one publisher, up to
-/// [`RESULTS_MAX_SUBSCRIBERS`] subscribers (the simulation, monitors).
+/// [`RESULTS_MAX_SUBSCRIBERS`] subscribers (the simulation, monitors). Safe overflow is on
+/// (the default, stated): a subscriber that does not read loses its oldest frames and never
+/// holds the daemon up.
 ///
 /// # Errors
 /// `root` does not make a valid iceoryx2 service name.
 pub fn results_service_builder<S: iceoryx2::service::Service>(
     node: &Node<S>,
     root: &str,
-    scene: u32,
+    token: SceneToken,
 ) -> Result<ResultsServiceBuilder<S>, ServiceNameError> {
-    let name = ServiceName::new(&results_service_name(root, scene))?;
+    let name = ServiceName::new(&results_service_name(root, token))?;
     Ok(node
         .service_builder(&name)
         .publish_subscribe::<[wire::ResultRecord]>()
@@ -138,10 +188,11 @@ pub fn results_service_builder<S: iceoryx2::service::Service>(
         .max_publishers(1)
         .max_subscribers(RESULTS_MAX_SUBSCRIBERS)
         .subscriber_max_buffer_size(FRAME_BUFFER)
-        .history_size(0))
+        .history_size(0)
+        .enable_safe_overflow(true))
 }
 
-/// The builder of scene `scene`'s poses-ready event service (`<root>/<scene>/poses-ready`):
+/// The builder of a scene's poses-ready event service (`<scene services>/poses-ready`):
 /// clients notify [`EVENT_POSES_SENT`] after publishing a pose frame; the daemon's one
 /// listener blocks on it (in its WaitSet) between frames. One service per direction, so
 /// neither side is woken by its own notifications.
@@ -151,9 +202,9 @@ pub fn results_service_builder<S: iceoryx2::service::Service>(
 pub fn poses_ready_service_builder<S: iceoryx2::service::Service>(
     node: &Node<S>,
     root: &str,
-    scene: u32,
+    token: SceneToken,
 ) -> Result<EventBuilder<S>, ServiceNameError> {
-    let name = ServiceName::new(&format!("{root}/{scene}/poses-ready"))?;
+    let name = ServiceName::new(&format!("{}/poses-ready", scene_services_name(root, token)))?;
     Ok(node
         .service_builder(&name)
         .event()
@@ -161,7 +212,7 @@ pub fn poses_ready_service_builder<S: iceoryx2::service::Service>(
         .max_listeners(DAEMON_EVENT_PORTS))
 }
 
-/// The builder of scene `scene`'s results-ready event service (`<root>/<scene>/results-ready`):
+/// The builder of a scene's results-ready event service (`<scene services>/results-ready`):
 /// the daemon notifies [`EVENT_RESULTS_READY`] after publishing a result frame; clients
 /// block on it instead of spinning.
 ///
@@ -170,9 +221,12 @@ pub fn poses_ready_service_builder<S: iceoryx2::service::Service>(
 pub fn results_ready_service_builder<S: iceoryx2::service::Service>(
     node: &Node<S>,
     root: &str,
-    scene: u32,
+    token: SceneToken,
 ) -> Result<EventBuilder<S>, ServiceNameError> {
-    let name = ServiceName::new(&format!("{root}/{scene}/results-ready"))?;
+    let name = ServiceName::new(&format!(
+        "{}/results-ready",
+        scene_services_name(root, token)
+    ))?;
     Ok(node
         .service_builder(&name)
         .event()
@@ -188,9 +242,9 @@ pub fn results_ready_service_builder<S: iceoryx2::service::Service>(
 pub fn events_service_builder<S: iceoryx2::service::Service>(
     node: &Node<S>,
     root: &str,
-    scene: u32,
+    token: SceneToken,
 ) -> Result<EventBuilder<S>, ServiceNameError> {
-    results_ready_service_builder(node, root, scene)
+    results_ready_service_builder(node, root, token)
 }
 
 /// The builder of the control event service (`<root>/control-events`): a client notifies
@@ -210,7 +264,7 @@ pub fn control_events_service_builder<S: iceoryx2::service::Service>(
         .event()
         .max_notifiers(CONTROL_MAX_CLIENTS)
         .max_listeners(DAEMON_EVENT_PORTS)
-        .max_nodes(CONTROL_MAX_CLIENTS + DAEMON_EVENT_PORTS))
+        .max_nodes(CONTROL_MAX_NODES))
 }
 
 /// The iceoryx2 builder type [`poses_service_builder`] returns.
@@ -236,16 +290,16 @@ pub const EVENT_CONTROL_SENT: usize = 3;
 /// crashed predecessor whose node has not been cleaned up yet when a new daemon starts.
 pub const DAEMON_EVENT_PORTS: usize = 2;
 
-/// The name of scene `scene`'s pose service under `root`.
+/// The name of the pose service of the scene with token `token` under `root`.
 #[must_use]
-pub fn poses_service_name(root: &str, scene: u32) -> String {
-    format!("{root}/{scene}/poses")
+pub fn poses_service_name(root: &str, token: SceneToken) -> String {
+    format!("{}/poses", scene_services_name(root, token))
 }
 
-/// The name of scene `scene`'s result service under `root`.
+/// The name of the result service of the scene with token `token` under `root`.
 #[must_use]
-pub fn results_service_name(root: &str, scene: u32) -> String {
-    format!("{root}/{scene}/results")
+pub fn results_service_name(root: &str, token: SceneToken) -> String {
+    format!("{}/results", scene_services_name(root, token))
 }
 
 #[cfg(test)]

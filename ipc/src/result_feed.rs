@@ -8,16 +8,19 @@
 
 use std::time::{Duration, Instant};
 
-use iceoryx2::node::Node;
+use iceoryx2::config::Config;
+use iceoryx2::node::{Node, NodeState, NodeView as _};
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::{CallbackProgression, PortFactory as _};
 use iceoryx2::sample::Sample;
 use iceoryx2::service::Service;
 use iceoryx2::service::port_factory::event::PortFactory as EventPortFactory;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPortFactory;
 
+use crate::SceneToken;
 use crate::error::{FrameReceiveError, SceneOpenError};
-use crate::transport::{RESULTS_SPIN, open_error};
+use crate::transport::{RESULTS_SPIN, event_open_error, open_error, pub_sub_open_error};
 use crate::wire::{ResultFrameHeader, ResultRecord};
 
 /// A subscription to one scene's result frames.
@@ -31,7 +34,11 @@ pub struct ResultFeed<S: Service> {
     listener: Listener<S>,
     /// How long a receive polls before it blocks.
     spin: Duration,
-    _results_service: PubSubPortFactory<S, [ResultRecord], ResultFrameHeader>,
+    /// The daemon instance whose frames this feed accepts (0: any).
+    instance: u64,
+    /// The iceoryx2 configuration of the node that opened the feed (to list nodes).
+    config: Config,
+    results_service: PubSubPortFactory<S, [ResultRecord], ResultFrameHeader>,
     _results_ready_service: EventPortFactory<S>,
 }
 
@@ -42,24 +49,26 @@ impl<S: Service> std::fmt::Debug for ResultFeed<S> {
 }
 
 impl<S: Service> ResultFeed<S> {
-    /// Opens (or creates, if the daemon has not yet) scene `scene`'s result and
-    /// results-ready services under `root` on `node`, and subscribes. Frames published
-    /// before this call are not seen (the service keeps no history).
+    /// Opens the result and results-ready services of the scene with token `token` (the
+    /// capability its owner shares, [`SceneAccess::token`](crate::scene_link::SceneAccess))
+    /// under `root` on `node`, and subscribes. The daemon creates a scene's services with
+    /// the scene; this only opens them. Frames published before this call are not seen (the
+    /// service keeps no history).
     ///
     /// # Errors
-    /// [`SceneOpenError::InvalidRoot`] when `root` and `scene` make no valid service name,
-    /// [`SceneOpenError::Transport`] when iceoryx2 fails (incompatible existing services,
-    /// too many subscribers).
-    pub fn open(node: &Node<S>, root: &str, scene: u32) -> Result<Self, SceneOpenError> {
+    /// [`SceneOpenError::InvalidRoot`] when `root` makes no valid service name,
+    /// [`SceneOpenError::NoSuchScene`] when no daemon serves a scene with this token,
+    /// [`SceneOpenError::Transport`] when iceoryx2 fails (too many subscribers).
+    pub fn open(node: &Node<S>, root: &str, token: SceneToken) -> Result<Self, SceneOpenError> {
         let invalid = |_| SceneOpenError::InvalidRoot(root.to_owned());
-        let results_service = crate::results_service_builder(node, root, scene)
+        let results_service = crate::results_service_builder(node, root, token)
             .map_err(invalid)?
-            .open_or_create()
-            .map_err(|e| open_error("opening the result service", e))?;
-        let results_ready_service = crate::results_ready_service_builder(node, root, scene)
+            .open()
+            .map_err(|e| pub_sub_open_error("opening the result service", e))?;
+        let results_ready_service = crate::results_ready_service_builder(node, root, token)
             .map_err(invalid)?
-            .open_or_create()
-            .map_err(|e| open_error("opening the results-ready event service", e))?;
+            .open()
+            .map_err(|e| event_open_error("opening the results-ready event service", e))?;
         let results = results_service
             .subscriber_builder()
             .create()
@@ -72,20 +81,62 @@ impl<S: Service> ResultFeed<S> {
             results,
             listener,
             spin: RESULTS_SPIN,
-            _results_service: results_service,
+            instance: 0,
+            config: node.config().clone(),
+            results_service,
             _results_ready_service: results_ready_service,
         })
+    }
+
+    /// Accepts only frames of daemon instance `instance` (from the `CreateScene` reply,
+    /// [`SceneAccess::instance`](crate::scene_link::SceneAccess)); a frame of another is
+    /// [`FrameReceiveError::DaemonLost`]. 0 accepts any.
+    pub fn expect_instance(&mut self, instance: u64) {
+        self.instance = instance;
     }
 
     /// The next result frame if one has arrived, without waiting.
     ///
     /// # Errors
+    /// [`FrameReceiveError::DaemonLost`] for a frame of another daemon instance (see
+    /// [`expect_instance`](Self::expect_instance));
     /// [`FrameReceiveError::Transport`] when iceoryx2 fails (e.g. two frames are still held).
     pub fn try_receive(&self) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
-        self.results
+        let frame = self
+            .results
             .receive()
             .map(|sample| sample.map(|sample| ResultFrame { sample }))
-            .map_err(|e| FrameReceiveError::Transport(format!("receiving a result frame: {e}")))
+            .map_err(|e| FrameReceiveError::Transport(format!("receiving a result frame: {e}")))?;
+        match frame {
+            Some(frame) if self.instance != 0 && frame.header().instance != self.instance => {
+                Err(FrameReceiveError::DaemonLost)
+            }
+            frame => Ok(frame),
+        }
+    }
+
+    /// Whether the daemon's result publisher still serves the scene: listed, and its node's
+    /// process alive (a daemon killed without a chance to clean up stays listed).
+    fn daemon_is_alive(&self) -> bool {
+        let mut publishers = Vec::new();
+        self.results_service
+            .dynamic_config()
+            .list_publishers(|publisher| {
+                publishers.push(publisher.node_id);
+                CallbackProgression::Continue
+            });
+        let mut alive = false;
+        let listed = Node::<S>::list(&self.config, |state| {
+            if let NodeState::Alive(view) = &state
+                && publishers.contains(view.id())
+            {
+                alive = true;
+                return CallbackProgression::Stop;
+            }
+            CallbackProgression::Continue
+        });
+        // Nodes that cannot be listed are no proof the daemon is gone.
+        alive || listed.is_err()
     }
 
     /// Sets how long a receive polls before it blocks ([`RESULTS_SPIN`] by default). A
@@ -142,7 +193,11 @@ impl<S: Service> ResultFeed<S> {
             }
             let now = Instant::now();
             if now >= deadline {
-                return Ok(None);
+                return if self.daemon_is_alive() {
+                    Ok(None)
+                } else {
+                    Err(FrameReceiveError::DaemonLost)
+                };
             }
             if now < spin_end {
                 std::hint::spin_loop();

@@ -37,8 +37,9 @@
 //! Pose frames are announced on a separate poses-ready service, so the client's own
 //! notifications never wake its wait.
 //!
-//! A pose frame published before the daemon's subscriber exists is lost (the service keeps
-//! no history); the daemon opens a scene's services when the scene is created.
+//! The daemon creates a scene's services and ports before it answers `CreateScene`, so a
+//! link opened after that reply loses no frame. Only the scene's owner holds its
+//! [`SceneAccess`] (the [`Client`](crate::client::Client) that created it keeps it).
 
 use std::time::Duration;
 
@@ -51,11 +52,34 @@ use iceoryx2::service::port_factory::event::PortFactory as EventPortFactory;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPortFactory;
 
 use crate::error::{FrameReceiveError, FrameSendError, SceneOpenError};
-use crate::transport::open_error;
+use crate::transport::{event_open_error, open_error, pub_sub_open_error};
 use crate::wire::{PoseFrameHeader, PoseRecord};
-use crate::{EVENT_POSES_SENT, PROTOCOL_VERSION};
+use crate::{EVENT_POSES_SENT, PROTOCOL_VERSION, SceneToken};
 
 pub use crate::result_feed::{ResultFeed, ResultFrame};
+
+/// What the owner of a scene holds, from the scene's `CreateScene` reply: everything a
+/// [`SceneLink`] needs. `Debug` prints only the id.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct SceneAccess {
+    /// The scene's id, for control requests and pose frame headers.
+    pub scene: u32,
+    /// The token that names its services; also the capability to read its results
+    /// ([`ResultFeed::open`]), which the owner may share with a monitor.
+    pub token: SceneToken,
+    /// The secret every pose frame carries ([`PoseFrameHeader::frame_key`]).
+    pub frame_key: u64,
+    /// The daemon instance that created the scene; result frames of another are refused.
+    pub instance: u64,
+}
+
+impl std::fmt::Debug for SceneAccess {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneAccess")
+            .field("scene", &self.scene)
+            .finish_non_exhaustive()
+    }
+}
 
 /// Pose records the publisher's first shared-memory segment holds; a larger frame makes it
 /// allocate a segment of the next power of two (a one-off cost, for the daemon too).
@@ -71,7 +95,7 @@ pub const POSES_MAX_LOANED_SAMPLES: usize = 1;
 /// there). A result subscriber lends at most two frames at once: drop a [`ResultFrame`]
 /// before receiving the third.
 pub struct SceneLink<S: Service> {
-    scene: u32,
+    access: SceneAccess,
     // Fields drop in order: the ports before their services.
     poses: Publisher<S, [PoseRecord], PoseFrameHeader>,
     /// Notifies the poses-ready service (the daemon listens).
@@ -85,31 +109,30 @@ pub struct SceneLink<S: Service> {
 impl<S: Service> std::fmt::Debug for SceneLink<S> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("SceneLink")
-            .field("scene", &self.scene)
+            .field("scene", &self.access.scene)
             .finish_non_exhaustive()
     }
 }
 
 impl<S: Service> SceneLink<S> {
-    /// Opens (or creates, if the daemon has not yet) scene `scene`'s pose, result and event
-    /// services under `root` on `node`, with the settings of the shared builders, and
-    /// creates this client's ports on them. The ports keep what they need alive; `node`
-    /// may be dropped first.
+    /// Opens the pose, result and event services of the scene `access` names (the daemon
+    /// created them with the scene) under `root` on `node`, and creates this client's ports
+    /// on them. The ports keep what they need alive; `node` may be dropped first.
     ///
     /// # Errors
-    /// [`SceneOpenError::InvalidRoot`] when `root` and `scene` make no valid service name,
-    /// [`SceneOpenError::Transport`] when iceoryx2 fails (incompatible existing services,
-    /// too many ports).
-    pub fn open(node: &Node<S>, root: &str, scene: u32) -> Result<Self, SceneOpenError> {
+    /// [`SceneOpenError::InvalidRoot`] when `root` makes no valid service name,
+    /// [`SceneOpenError::NoSuchScene`] when no daemon serves the scene,
+    /// [`SceneOpenError::Transport`] when iceoryx2 fails (too many ports).
+    pub fn open(node: &Node<S>, root: &str, access: &SceneAccess) -> Result<Self, SceneOpenError> {
         let invalid = |_| SceneOpenError::InvalidRoot(root.to_owned());
-        let poses_service = crate::poses_service_builder(node, root, scene)
+        let poses_service = crate::poses_service_builder(node, root, access.token)
             .map_err(invalid)?
-            .open_or_create()
-            .map_err(|e| open_error("opening the pose service", e))?;
-        let poses_ready_service = crate::poses_ready_service_builder(node, root, scene)
+            .open()
+            .map_err(|e| pub_sub_open_error("opening the pose service", e))?;
+        let poses_ready_service = crate::poses_ready_service_builder(node, root, access.token)
             .map_err(invalid)?
-            .open_or_create()
-            .map_err(|e| open_error("opening the poses-ready event service", e))?;
+            .open()
+            .map_err(|e| event_open_error("opening the poses-ready event service", e))?;
         let poses = poses_service
             .publisher_builder()
             .initial_max_slice_len(POSES_INITIAL_MAX_SLICE_LEN)
@@ -121,9 +144,10 @@ impl<S: Service> SceneLink<S> {
             .notifier_builder()
             .create()
             .map_err(|e| open_error("creating the event notifier", e))?;
-        let feed = ResultFeed::open(node, root, scene)?;
+        let mut feed = ResultFeed::open(node, root, access.token)?;
+        feed.expect_instance(access.instance);
         Ok(Self {
-            scene,
+            access: *access,
             poses,
             notifier,
             feed,
@@ -135,7 +159,7 @@ impl<S: Service> SceneLink<S> {
     /// The scene id this link publishes to.
     #[must_use]
     pub fn scene(&self) -> u32 {
-        self.scene
+        self.access.scene
     }
 
     /// Publishes pose frame `frame_seq` (budget `budget_ns` nanoseconds, 0 = none; `query_flags`
@@ -234,11 +258,12 @@ impl<S: Service> SceneLink<S> {
     ) -> Result<PoseFrameHeader, FrameSendError> {
         Ok(PoseFrameHeader {
             protocol_version: PROTOCOL_VERSION,
-            scene: self.scene,
+            scene: self.access.scene,
             frame_seq,
             budget_ns,
             query_flags,
             count: u32::try_from(count).map_err(|_| FrameSendError::TooLarge(count))?,
+            frame_key: self.access.frame_key,
         })
     }
 

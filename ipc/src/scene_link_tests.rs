@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::EVENT_RESULTS_READY;
+use crate::SceneToken;
 use crate::wire::{RecordKind, ResultFrameHeader, ResultRecord, query};
 use iceoryx2::node::NodeBuilder;
 use iceoryx2::prelude::local;
@@ -11,6 +12,16 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::thread::JoinHandle;
 use std::time::Instant;
+
+/// The keys of test scene `scene`, as a daemon would hand them out.
+fn access(scene: u32) -> SceneAccess {
+    SceneAccess {
+        scene,
+        token: SceneToken([u64::from(scene) + 1, 0x5eed]),
+        frame_key: 0xfeed_0000 + u64::from(scene),
+        instance: 0,
+    }
+}
 
 /// How the test responder answers one pose frame; `None` leaves it unanswered.
 type Answer = fn(&PoseFrameHeader, &[PoseRecord]) -> Option<(ResultFrameHeader, Vec<ResultRecord>)>;
@@ -33,21 +44,22 @@ impl Responder {
         let (root, flag) = (root.to_owned(), stop.clone());
         let thread = std::thread::spawn(move || {
             let node = NodeBuilder::new().create::<local::Service>().unwrap();
-            let poses = crate::poses_service_builder(&node, &root, scene)
+            let token = access(scene).token;
+            let poses = crate::poses_service_builder(&node, &root, token)
                 .unwrap()
-                .open_or_create()
+                .create()
                 .unwrap();
-            let results = crate::results_service_builder(&node, &root, scene)
+            let results = crate::results_service_builder(&node, &root, token)
                 .unwrap()
-                .open_or_create()
+                .create()
                 .unwrap();
-            let poses_ready = crate::poses_ready_service_builder(&node, &root, scene)
+            let poses_ready = crate::poses_ready_service_builder(&node, &root, token)
                 .unwrap()
-                .open_or_create()
+                .create()
                 .unwrap();
-            let results_ready = crate::results_ready_service_builder(&node, &root, scene)
+            let results_ready = crate::results_ready_service_builder(&node, &root, token)
                 .unwrap()
-                .open_or_create()
+                .create()
                 .unwrap();
             let subscriber = poses.subscriber_builder().create().unwrap();
             let publisher = results
@@ -140,6 +152,7 @@ fn echo(
             deepest_level: header.query_flags,
             pair_count: records.len() as u32,
             stage_ns,
+            min_budget_ns: header.frame_key,
             ..ResultFrameHeader::default()
         },
         records,
@@ -210,7 +223,7 @@ const WAIT: Duration = Duration::from_secs(5);
 fn a_frame_of_three_poses_round_trips_with_its_header() {
     let root = root("three");
     let responder = Responder::start(&root, 4, echo);
-    let link = SceneLink::open(&node(), &root, 4).unwrap();
+    let link = SceneLink::open(&node(), &root, &access(4)).unwrap();
     assert_eq!(link.scene(), 4);
     let poses: Vec<_> = (0..3).map(|i| pose(1, i)).collect();
     link.publish_poses(17, 250_000, query::CLOSE | query::CONTACTS, &poses)
@@ -219,6 +232,11 @@ fn a_frame_of_three_poses_round_trips_with_its_header() {
     assert_echo(&frame, 17, &poses);
     let header = frame.header();
     assert_eq!(header.error_body, 4, "the pose header carries the scene");
+    assert_eq!(
+        header.min_budget_ns,
+        access(4).frame_key,
+        "and its frame key"
+    );
     assert_eq!(header.deepest_level, query::CLOSE | query::CONTACTS);
     assert_eq!(header.stage_ns[1], 250_000);
     assert_eq!(responder.next(), 17);
@@ -227,10 +245,12 @@ fn a_frame_of_three_poses_round_trips_with_its_header() {
 }
 
 #[test]
-fn the_client_may_come_first_and_empty_frames_round_trip() {
+fn a_scene_nobody_serves_is_refused_and_empty_frames_round_trip() {
     let root = root("first");
-    let link = SceneLink::open(&node(), &root, 0).unwrap();
+    let refused = SceneLink::open(&node(), &root, &access(0)).unwrap_err();
+    assert_eq!(refused, SceneOpenError::NoSuchScene);
     let responder = Responder::start(&root, 0, echo);
+    let link = SceneLink::open(&node(), &root, &access(0)).unwrap();
     link.publish_poses(1, 0, 0, &[]).unwrap();
     let frame = link.receive_results(WAIT).unwrap().expect("a result frame");
     assert_echo(&frame, 1, &[]);
@@ -241,7 +261,7 @@ fn the_client_may_come_first_and_empty_frames_round_trip() {
 fn frames_beyond_the_initial_slice_grow_both_directions() {
     let root = root("large");
     let _responder = Responder::start(&root, 2, echo);
-    let link = SceneLink::open(&node(), &root, 2).unwrap();
+    let link = SceneLink::open(&node(), &root, &access(2)).unwrap();
     for (seq, count) in [
         (1u64, 10usize),
         (2, 1024),
@@ -264,7 +284,7 @@ fn frames_beyond_the_initial_slice_grow_both_directions() {
 fn publish_with_writes_exactly_what_fill_returns_in_index_order() {
     let root = root("fill");
     let _responder = Responder::start(&root, 3, echo);
-    let link = SceneLink::open(&node(), &root, 3).unwrap();
+    let link = SceneLink::open(&node(), &root, &access(3)).unwrap();
     for (seq, count) in [(10u64, 1usize), (11, 3), (12, 2_000)] {
         let mut calls = Vec::new();
         link.publish_poses_with(seq, 5, query::OVERLAP, count, |i| {
@@ -284,7 +304,8 @@ fn publish_with_writes_exactly_what_fill_returns_in_index_order() {
 #[test]
 fn receive_times_out_with_none_when_nobody_answers() {
     let root = root("silent");
-    let link = SceneLink::open(&node(), &root, 1).unwrap();
+    let _responder = Responder::start(&root, 1, |_, _| None);
+    let link = SceneLink::open(&node(), &root, &access(1)).unwrap();
     // Nobody answers: the wait must last its whole timeout and then give up.
     link.publish_poses(1, 0, 0, &[pose(1, 0)]).unwrap();
     for timeout in [
@@ -321,7 +342,7 @@ fn a_late_answer_is_caught_by_the_blocking_wait() {
     }
     let root = root("slow");
     let _responder = Responder::start(&root, 6, slow);
-    let link = SceneLink::open(&node(), &root, 6).unwrap();
+    let link = SceneLink::open(&node(), &root, &access(6)).unwrap();
     let poses = [pose(9, 0), pose(9, 1)];
     let start = Instant::now();
     link.publish_poses(9, 0, 0, &poses).unwrap();
@@ -334,7 +355,7 @@ fn a_late_answer_is_caught_by_the_blocking_wait() {
 fn receive_for_skips_a_stale_frame() {
     let root = root("stale");
     let responder = Responder::start(&root, 5, echo);
-    let link = SceneLink::open(&node(), &root, 5).unwrap();
+    let link = SceneLink::open(&node(), &root, &access(5)).unwrap();
     let (old, new) = ([pose(1, 0)], [pose(2, 0), pose(2, 1)]);
     link.publish_poses(1, 0, 0, &old).unwrap();
     assert_eq!(responder.next(), 1);
@@ -375,7 +396,7 @@ fn receive_for_skips_a_stale_frame() {
 fn pairs_and_contacts_clamp_to_the_payload_when_the_header_lies() {
     let root = root("liar");
     let _responder = Responder::start(&root, 7, liar);
-    let link = SceneLink::open(&node(), &root, 7).unwrap();
+    let link = SceneLink::open(&node(), &root, &access(7)).unwrap();
     let poses: Vec<_> = (0..3).map(|i| pose(7, i)).collect();
     // (pair_count, contact_count) → (pairs, contacts) over 3 records.
     let cases = [
@@ -404,14 +425,16 @@ fn pairs_and_contacts_clamp_to_the_payload_when_the_header_lies() {
 #[test]
 fn a_root_that_makes_no_service_name_is_refused() {
     let too_long = "r".repeat(300);
-    let error = SceneLink::open(&node(), &too_long, 0).unwrap_err();
+    let error = SceneLink::open(&node(), &too_long, &access(0)).unwrap_err();
     assert_eq!(error, SceneOpenError::InvalidRoot(too_long));
     assert!(error.to_string().contains("does not make valid"));
 }
 
 #[test]
 fn too_many_poses_for_the_wire_count_are_refused_before_loaning() {
-    let link = SceneLink::open(&node(), &root("count"), 0).unwrap();
+    let root = root("count");
+    let _responder = Responder::start(&root, 0, echo);
+    let link = SceneLink::open(&node(), &root, &access(0)).unwrap();
     let count = u32::MAX as usize + 1;
     let error = link
         .publish_poses_with(1, 0, 0, count, |_| unreachable!("nothing is loaned"))
@@ -426,18 +449,29 @@ fn a_connected_client_opens_the_scene_under_its_root() {
     let stop = Arc::new(AtomicBool::new(false));
     let (ready_tx, ready_rx) = mpsc::channel();
     let (control_root, flag) = (root.clone(), stop.clone());
-    // A control server that only answers Hello, so the client connects.
+    // A control server that answers Hello, and CreateScene with scene 8's keys.
     let control = std::thread::spawn(move || {
         let node = node();
         let service = crate::control_service_builder(&node, &control_root)
             .unwrap()
-            .open_or_create()
+            .create()
+            .unwrap();
+        let _events = crate::control_events_service_builder(&node, &control_root)
+            .unwrap()
+            .create()
             .unwrap();
         let server = service.server_builder().create().unwrap();
         ready_tx.send(()).unwrap();
         while !flag.load(Ordering::Relaxed) {
             while let Some(active) = server.receive().unwrap() {
-                let reply = crate::wire::ControlReply::ok(PROTOCOL_VERSION);
+                let command = active.user_header().command;
+                let mut reply = crate::wire::ControlReply::ok(PROTOCOL_VERSION);
+                if command == crate::wire::Command::CreateScene as u32 {
+                    let keys = access(8);
+                    reply.id = keys.scene;
+                    reply.scene_token = keys.token.0;
+                    reply.frame_key = keys.frame_key;
+                }
                 active.send_copy(reply).unwrap();
             }
             std::thread::sleep(Duration::from_micros(50));
@@ -449,6 +483,12 @@ fn a_connected_client_opens_the_scene_under_its_root() {
         .root(&root)
         .connect::<local::Service>()
         .unwrap();
+    assert_eq!(
+        client.open_scene(8).unwrap_err(),
+        SceneOpenError::NotOwned(8)
+    );
+    assert_eq!(client.create_scene().unwrap(), 8);
+    assert_eq!(client.scene_access(8), Some(access(8)));
     let link = client.open_scene(8).unwrap();
     drop(client); // the link's ports keep what they need alive
     assert_eq!(link.scene(), 8);

@@ -60,9 +60,31 @@ fn a_control_request_with_geometry_gets_its_reply_over_a_real_service() {
 }
 
 #[test]
-fn scene_services_live_under_the_root_and_scene() {
-    assert_eq!(poses_service_name("proxima", 3), "proxima/3/poses");
-    assert_eq!(results_service_name("t-1", 0), "t-1/0/results");
+fn scene_services_live_under_the_root_and_the_scene_token() {
+    let token = SceneToken([0x0123_4567_89ab_cdef, 0xfe]);
+    assert_eq!(
+        poses_service_name("proxima", token),
+        "proxima/scene-0123456789abcdef00000000000000fe/poses"
+    );
+    assert_eq!(
+        results_service_name("t-1", token),
+        "t-1/scene-0123456789abcdef00000000000000fe/results"
+    );
+    assert_eq!(
+        format!("{token:?}"),
+        "SceneToken(…)",
+        "tokens stay out of logs"
+    );
+    assert_eq!(token.to_string().parse::<SceneToken>(), Ok(token));
+    for bad in [
+        "",
+        "0123",
+        &"g".repeat(32),
+        &"0".repeat(33),
+        &"é".repeat(16),
+    ] {
+        assert!(bad.parse::<SceneToken>().is_err(), "{bad:?} parsed");
+    }
 }
 
 #[test]
@@ -75,7 +97,7 @@ fn every_error_code_survives_the_wire_and_unknown_values_are_refused() {
             known += 1;
         }
     }
-    assert_eq!(known, 13);
+    assert_eq!(known, 15);
     assert_eq!(ErrorCode::from_u32(u32::MAX), None);
 }
 
@@ -107,7 +129,12 @@ fn a_pose_frame_and_a_result_frame_cross_a_real_service_unchanged() {
     let node = NodeBuilder::new().create::<local::Service>().unwrap();
     let root = format!("wire-test-{}", std::process::id());
     let poses = node
-        .service_builder(&poses_service_name(&root, 1).as_str().try_into().unwrap())
+        .service_builder(
+            &poses_service_name(&root, SceneToken([1, 2]))
+                .as_str()
+                .try_into()
+                .unwrap(),
+        )
         .publish_subscribe::<[PoseRecord]>()
         .user_header::<PoseFrameHeader>()
         .open_or_create()
@@ -131,6 +158,7 @@ fn a_pose_frame_and_a_result_frame_cross_a_real_service_unchanged() {
         budget_ns: 1_000_000,
         query_flags: query::CLOSE | query::CONTACTS,
         count: 3,
+        frame_key: 0,
     };
     let mut sample = publisher.loan_slice_uninit(3).unwrap();
     *sample.user_header_mut() = header;
@@ -140,7 +168,12 @@ fn a_pose_frame_and_a_result_frame_cross_a_real_service_unchanged() {
     assert_eq!(received.payload(), &[record(0), record(1), record(2)]);
 
     let results = node
-        .service_builder(&results_service_name(&root, 1).as_str().try_into().unwrap())
+        .service_builder(
+            &results_service_name(&root, SceneToken([1, 2]))
+                .as_str()
+                .try_into()
+                .unwrap(),
+        )
         .publish_subscribe::<[ResultRecord]>()
         .user_header::<ResultFrameHeader>()
         .open_or_create()
@@ -186,11 +219,11 @@ fn a_pose_frame_and_a_result_frame_cross_a_real_service_unchanged() {
 fn each_direction_of_scene_events_has_its_own_service_so_no_side_hears_itself() {
     let node = NodeBuilder::new().create::<local::Service>().unwrap();
     let root = format!("events-test-{}", std::process::id());
-    let poses_ready = poses_ready_service_builder(&node, &root, 4)
+    let poses_ready = poses_ready_service_builder(&node, &root, SceneToken([4, 4]))
         .unwrap()
         .open_or_create()
         .unwrap();
-    let results_ready = results_ready_service_builder(&node, &root, 4)
+    let results_ready = results_ready_service_builder(&node, &root, SceneToken([4, 4]))
         .unwrap()
         .open_or_create()
         .unwrap();
@@ -210,7 +243,7 @@ fn each_direction_of_scene_events_has_its_own_service_so_no_side_hears_itself() 
     assert_eq!(ids(&client_listener), Vec::<usize>::new());
     assert_eq!(ids(&daemon_listener), [EVENT_POSES_SENT]);
     // The daemon's frame path opens the result events under their older name.
-    events_service_builder(&node, &root, 4)
+    events_service_builder(&node, &root, SceneToken([4, 4]))
         .unwrap()
         .open_or_create()
         .unwrap()

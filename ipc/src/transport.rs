@@ -10,6 +10,8 @@
 use std::time::Duration;
 
 use crate::error::SceneOpenError;
+use iceoryx2::service::builder::event::EventOpenError;
+use iceoryx2::service::builder::publish_subscribe::PublishSubscribeOpenError;
 
 /// How long a control request's reply is awaited by spinning before the wait starts
 /// sleeping: request–response ports cannot join a WaitSet, so the reply is polled.
@@ -29,4 +31,20 @@ pub const RESULTS_SPIN: Duration = Duration::from_micros(50);
 /// A scene's services or ports could not be opened: `what` failed with iceoryx2's error `e`.
 pub(crate) fn open_error(what: &str, e: impl std::fmt::Display) -> SceneOpenError {
     SceneOpenError::Transport(format!("{what}: {e}"))
+}
+
+/// A scene's publish–subscribe service could not be opened: no such scene, or `what` failed.
+pub(crate) fn pub_sub_open_error(what: &str, e: PublishSubscribeOpenError) -> SceneOpenError {
+    match e {
+        PublishSubscribeOpenError::DoesNotExist => SceneOpenError::NoSuchScene,
+        e => open_error(what, e),
+    }
+}
+
+/// A scene's event service could not be opened: no such scene, or `what` failed.
+pub(crate) fn event_open_error(what: &str, e: EventOpenError) -> SceneOpenError {
+    match e {
+        EventOpenError::DoesNotExist => SceneOpenError::NoSuchScene,
+        e => open_error(what, e),
+    }
 }

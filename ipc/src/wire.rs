@@ -19,6 +19,11 @@
 //! `AddBody`, `RemoveBody`, `UpdateBody`, `SetSceneParams` (the scene's broad phase,
 //! [`BroadPhaseCode`]), `ShapeState`.
 //!
+//! Every command that names a scene is answered only for the client port that created it
+//! (others get [`ErrorCode::NotOwner`]); its pose frames must carry the scene's frame key;
+//! its services are named by its token, the capability to read its results (since protocol
+//! version 9).
+//!
 //! Shapes are built apart from the frames: a convex or mesh shape's `RegisterShape` is
 //! answered as soon as its header is checked, with its id and
 //! [`reply_flags::SHAPE_BUILDING`]; the shape becomes usable once built, which `ShapeState`
@@ -124,6 +129,10 @@ pub struct PoseFrameHeader {
     pub query_flags: u32,
     /// Number of [`PoseRecord`]s in the payload (must equal the slice length).
     pub count: u32,
+    /// The scene's frame key, from its `CreateScene` reply ([`ControlReply::frame_key`]):
+    /// only the scene's owner knows it. A frame with another key is not answered (since
+    /// protocol version 9).
+    pub frame_key: u64,
 }
 
 /// The new pose of one body. Bodies not listed in a frame keep their last pose.
@@ -178,6 +187,13 @@ pub enum ErrorCode {
     /// [`Command::ShapeState`] says it is built, then send the request again (since
     /// protocol version 8).
     ShapeNotReady = 12,
+    /// The scene belongs to another client: only the client that created a scene may change
+    /// it, drop it, ask about it or send it frames (since protocol version 9).
+    NotOwner = 13,
+    /// The daemon stopped serving the scene after a fault on its shared-memory services
+    /// (the reason says which); its state is gone. Only `DropScene` is accepted, to let go
+    /// of the id (since protocol version 9).
+    SceneQuarantined = 14,
 }
 
 impl ErrorCode {
@@ -198,6 +214,8 @@ impl ErrorCode {
             10 => Self::MalformedMessage,
             11 => Self::Internal,
             12 => Self::ShapeNotReady,
+            13 => Self::NotOwner,
+            14 => Self::SceneQuarantined,
             _ => return None,
         })
     }
@@ -219,6 +237,8 @@ impl std::fmt::Display for ErrorCode {
             Self::MalformedMessage => "malformed message",
             Self::Internal => "internal error",
             Self::ShapeNotReady => "shape not built yet",
+            Self::NotOwner => "the scene belongs to another client",
+            Self::SceneQuarantined => "the scene was quarantined after a shared-memory fault",
         };
         f.write_str(text)
     }
@@ -302,6 +322,9 @@ pub struct ResultFrameHeader {
     /// this scene's frames, nanoseconds (its ingest plus the typical time of the stages no
     /// deadline can interrupt: the broad phase and publishing). 0 otherwise.
     pub min_budget_ns: u64,
+    /// The daemon's instance id ([`ControlReply::instance`]); a frame from another instance
+    /// is not an answer to this client (since protocol version 9).
+    pub instance: u64,
 }
 
 /// Bits of [`ResultFrameHeader::flags`].
@@ -406,7 +429,9 @@ pub struct ResultRecord {
 pub enum Command {
     /// Check the protocol version; the reply's `id` is the daemon's version.
     Hello = 0,
-    /// Create a scene; the reply's `id` is the new scene id.
+    /// Create a scene owned by the requesting client port; the reply's `id` is the new scene
+    /// id (random, never `u32::MAX`), with the scene's secret
+    /// [`frame_key`](ControlReply::frame_key) and [`scene_token`](ControlReply::scene_token).
     CreateScene = 1,
     /// Drop scene `scene` with all its bodies.
     DropScene = 2,
@@ -635,6 +660,16 @@ pub struct ControlReply {
     pub id: u32,
     /// [`reply_flags`] bits; 0 on error (since protocol version 8; before, reserved and 0).
     pub flags: u32,
+    /// The daemon's instance id: random, never 0, the same in every reply and result
+    /// header of one daemon run and different after a restart (since protocol version 9).
+    pub instance: u64,
+    /// `CreateScene`: the scene's frame key, for [`PoseFrameHeader::frame_key`]; 0 otherwise.
+    /// Secret: whoever knows it may send the scene frames.
+    pub frame_key: u64,
+    /// `CreateScene`: the scene's token, which names its services
+    /// ([`scene_services_name`](crate::scene_services_name)); all zero otherwise. It is the
+    /// capability to read the scene's results: share it only with a monitor that may.
+    pub scene_token: [u64; 2],
     /// Why the request failed: UTF-8, padded with zero bytes (empty on success).
     pub reason: [u8; REASON_BYTES],
 }
@@ -648,6 +683,9 @@ impl ControlReply {
             status: ErrorCode::Ok as u32,
             id,
             flags: 0,
+            instance: 0,
+            frame_key: 0,
+            scene_token: [0; 2],
             reason: [0; REASON_BYTES],
         }
     }
@@ -691,8 +729,8 @@ impl ControlReply {
 }
 
 const _: () = assert!(size_of::<ControlRequest>() == 144);
-const _: () = assert!(size_of::<ControlReply>() == 128);
-const _: () = assert!(size_of::<PoseFrameHeader>() == 32);
+const _: () = assert!(size_of::<ControlReply>() == 160);
+const _: () = assert!(size_of::<PoseFrameHeader>() == 40);
 const _: () = assert!(size_of::<PoseRecord>() == 64);
-const _: () = assert!(size_of::<ResultFrameHeader>() == 120);
+const _: () = assert!(size_of::<ResultFrameHeader>() == 128);
 const _: () = assert!(size_of::<ResultRecord>() == 120);

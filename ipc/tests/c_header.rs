@@ -22,8 +22,9 @@ use iceoryx2::prelude::*;
 use iceoryx2::service::static_config::message_type_details::TypeDetail;
 use proxima_ipc::{self as ipc, scene_link, wire};
 
-/// The scene id the generated program formats service names with.
-const SCENE: u32 = 42;
+/// The scene token the generated program formats service names with (its C array is
+/// `TOKEN`, declared before `main`).
+const TOKEN: ipc::SceneToken = ipc::SceneToken([0x0123_4567_89ab_cdef, 0xfe]);
 
 /// One checked line: the program prints `key\tvalue`, the table expects `expected`.
 struct Entry {
@@ -85,7 +86,7 @@ impl Table {
         let args = if c_name.starts_with("PROXIMA_SERVICE_CONTROL") {
             format!("\"{root}\"")
         } else {
-            format!("\"{root}\", (uint32_t){SCENE}")
+            format!("\"{root}\", PROXIMA_SCENE_TOKEN_ARGS(TOKEN)")
         };
         self.push(
             None,
@@ -227,7 +228,7 @@ fn table() -> Table {
 
     t.record(record!(PoseFrameHeader = wire::PoseFrameHeader::default(),
         "PROXIMA_TYPE_NAME_POSE_FRAME_HEADER";
-        protocol_version, scene, frame_seq, budget_ns, query_flags, count));
+        protocol_version, scene, frame_seq, budget_ns, query_flags, count, frame_key));
     t.record(record!(PoseRecord = wire::PoseRecord::default(),
         "PROXIMA_TYPE_NAME_POSE_RECORD";
         body, reserved, position, orientation));
@@ -236,7 +237,7 @@ fn table() -> Table {
         "PROXIMA_TYPE_NAME_RESULT_FRAME_HEADER";
         protocol_version, status, frame_seq, error_body, completeness, deepest_level,
         budget_met, pair_count, contact_count, candidate_count, toi_count, elapsed_ns,
-        stage_ns, flags, dropped_candidates, min_budget_ns),
+        stage_ns, flags, dropped_candidates, min_budget_ns, instance),
     );
     t.record(record!(ResultRecord = wire::ResultRecord::default(),
         "PROXIMA_TYPE_NAME_RESULT_RECORD";
@@ -249,11 +250,11 @@ fn table() -> Table {
         orientation));
     t.record(record!(ControlReply = wire::ControlReply::ok(0),
         "PROXIMA_TYPE_NAME_CONTROL_REPLY";
-        protocol_version, status, id, flags, reason));
+        protocol_version, status, id, flags, instance, frame_key, scene_token, reason));
 
     codes!(t, ErrorCode, "PROXIMA_ERROR_": Ok, ProtocolMismatch, UnknownScene, UnknownBody,
         UnknownShape, InvalidPose, InvalidShape, MeshIndexOutOfRange, EmptyGeometry,
-        LimitExceeded, MalformedMessage, Internal, ShapeNotReady);
+        LimitExceeded, MalformedMessage, Internal, ShapeNotReady, NotOwner, SceneQuarantined);
     codes!(t, Command, "PROXIMA_COMMAND_": Hello, CreateScene, DropScene, RegisterShape,
         AddBody, RemoveBody, UpdateBody, SetSceneParams, ShapeState);
     codes!(t, ShapeKindCode, "PROXIMA_SHAPE_KIND_": Sphere, Capsule, Cuboid, Cylinder, Cone,
@@ -292,6 +293,7 @@ fn table() -> Table {
     constant!(t, ipc::CONTROL_MAX_RESPONSE_BUFFER_SIZE
         => "PROXIMA_CONTROL_MAX_RESPONSE_BUFFER_SIZE");
     constant!(t, ipc::CONTROL_INITIAL_MAX_SLICE_LEN => "PROXIMA_CONTROL_INITIAL_MAX_SLICE_LEN");
+    constant!(t, ipc::CONTROL_MAX_NODES => "PROXIMA_CONTROL_MAX_NODES");
     constant!(t, ipc::POSES_MAX_PUBLISHERS => "PROXIMA_POSES_MAX_PUBLISHERS");
     constant!(t, ipc::RESULTS_MAX_SUBSCRIBERS => "PROXIMA_RESULTS_MAX_SUBSCRIBERS");
     constant!(t, ipc::FRAME_BUFFER => "PROXIMA_FRAME_BUFFER");
@@ -344,7 +346,7 @@ fn services(t: &mut Table) {
     for (c_name, value) in [
         ("PROXIMA_CONTROL_MAX_CLIENTS", config.max_clients()),
         ("PROXIMA_CONTROL_MAX_SERVERS", config.max_servers()),
-        ("PROXIMA_DEFAULT_MAX_NODES", config.max_nodes()),
+        ("PROXIMA_CONTROL_MAX_NODES", config.max_nodes()),
         (
             "PROXIMA_CONTROL_MAX_ACTIVE_REQUESTS_PER_CLIENT",
             config.max_active_requests_per_client(),
@@ -385,7 +387,7 @@ fn services(t: &mut Table) {
     );
     assert_eq!(
         type_detail(&response.payload),
-        (wire_name::<wire::ControlReply>(), 128, 4),
+        (wire_name::<wire::ControlReply>(), 160, 8),
         "the control response"
     );
     let (payload_name, payload_size, payload_align) = type_detail(&request.payload);
@@ -403,11 +405,16 @@ fn services(t: &mut Table) {
     );
     t.string(None, "PROXIMA_TYPE_NAME_NO_HEADER", &no_header_name);
 
-    let poses = ipc::poses_service_builder(&node, &root, SCENE)
+    t.service_name(
+        "PROXIMA_SCENE_SERVICES_FORMAT",
+        &root,
+        &ipc::scene_services_name(&root, TOKEN),
+    );
+    let poses = ipc::poses_service_builder(&node, &root, TOKEN)
         .unwrap()
         .create()
         .unwrap();
-    let results = ipc::results_service_builder(&node, &root, SCENE)
+    let results = ipc::results_service_builder(&node, &root, TOKEN)
         .unwrap()
         .create()
         .unwrap();
@@ -426,7 +433,7 @@ fn services(t: &mut Table) {
     );
     assert_eq!(
         type_detail(&config.message_type_details().user_header),
-        (wire_name::<wire::PoseFrameHeader>(), 32, 8)
+        (wire_name::<wire::PoseFrameHeader>(), 40, 8)
     );
     assert_eq!(
         type_detail(&config.message_type_details().payload),
@@ -441,7 +448,7 @@ fn services(t: &mut Table) {
     );
     assert_eq!(
         type_detail(&config.message_type_details().user_header),
-        (wire_name::<wire::ResultFrameHeader>(), 120, 8)
+        (wire_name::<wire::ResultFrameHeader>(), 128, 8)
     );
     assert_eq!(
         type_detail(&config.message_type_details().payload),
@@ -458,14 +465,14 @@ fn services(t: &mut Table) {
         ),
         (
             "POSES_READY",
-            ipc::poses_ready_service_builder(&node, &root, SCENE)
+            ipc::poses_ready_service_builder(&node, &root, TOKEN)
                 .unwrap()
                 .create()
                 .unwrap(),
         ),
         (
             "RESULTS_READY",
-            ipc::results_ready_service_builder(&node, &root, SCENE)
+            ipc::results_ready_service_builder(&node, &root, TOKEN)
                 .unwrap()
                 .create()
                 .unwrap(),
@@ -594,12 +601,15 @@ inline const char *ty(double) { return "f64"; }
 #define STR(N) printf("str " #N "\t%s\n", N)
 #define NAME(F, ...) do { char b[256]; snprintf(b, sizeof b, F, __VA_ARGS__); \
     printf("name " #F "\t%s\n", b); } while (0)
-
-int main(void) {
 "#;
 
 fn program(table: &Table) -> String {
     let mut source = PROGRAM_PRELUDE.to_owned();
+    let [high, low] = TOKEN.0;
+    source.push_str(&format!(
+        "\nstatic const uint64_t TOKEN[2] = {{UINT64_C({high:#x}), UINT64_C({low:#x})}};\n\n\
+         int main(void) {{\n"
+    ));
     for entry in &table.entries {
         source.push_str("    ");
         source.push_str(&entry.c_stmt);
@@ -775,8 +785,8 @@ fn the_header_compiles_cleanly_as_c99_and_as_cxx98_to_cxx20() {
              proxima_PoseFrameHeader h;\n\
              h.protocol_version = PROXIMA_PROTOCOL_VERSION;\n\
              h.query_flags = PROXIMA_QUERY_CLOSE | PROXIMA_QUERY_CONTACTS;\n\
-             return (h.protocol_version == 8 && h.query_flags == 10\n\
-                     && PROXIMA_ERROR_SHAPE_NOT_READY == 12) ? 0 : 1;\n\
+             return (h.protocol_version == 9 && h.query_flags == 10\n\
+                     && PROXIMA_ERROR_SCENE_QUARANTINED == 14) ? 0 : 1;\n\
          }\n",
     )
     .unwrap();

@@ -64,6 +64,21 @@ fn records() -> Vec<(&'static str, usize, usize, Vec<Field>)> {
                 size_of_val(&zero.flags),
             ),
             (
+                "instance",
+                offset_of!(ControlReply, instance),
+                size_of_val(&zero.instance),
+            ),
+            (
+                "frame_key",
+                offset_of!(ControlReply, frame_key),
+                size_of_val(&zero.frame_key),
+            ),
+            (
+                "scene_token",
+                offset_of!(ControlReply, scene_token),
+                size_of_val(&zero.scene_token),
+            ),
+            (
                 "reason",
                 offset_of!(ControlReply, reason),
                 size_of_val(&zero.reason),
@@ -110,7 +125,8 @@ fn records() -> Vec<(&'static str, usize, usize, Vec<Field>)> {
                 frame_seq,
                 budget_ns,
                 query_flags,
-                count
+                count,
+                frame_key
             }),
         ),
         (
@@ -145,6 +161,7 @@ fn records() -> Vec<(&'static str, usize, usize, Vec<Field>)> {
                 flags,
                 dropped_candidates,
                 min_budget_ns,
+                instance,
             }),
         ),
         (
@@ -367,8 +384,11 @@ struct CodedService {
     type_details: Vec<TypeDetail>,
 }
 
-/// Creates every service with the shared builders (scene 0) and reads back what iceoryx2
-/// stored: the settings and types a peer must match.
+/// The token the scene services of [`coded_services`] are named by.
+const TOKEN: proxima_ipc::SceneToken = proxima_ipc::SceneToken([0, 0]);
+
+/// Creates every service with the shared builders (scene token [`TOKEN`]) and reads back
+/// what iceoryx2 stored: the settings and types a peer must match.
 fn coded_services(n: &IsolatedNode) -> BTreeMap<&'static str, CodedService> {
     let (node, root) = (&n.node, n.root.as_str());
     let control = proxima_ipc::control_service_builder(node, root)
@@ -380,19 +400,19 @@ fn coded_services(n: &IsolatedNode) -> BTreeMap<&'static str, CodedService> {
         .unwrap()
         .open_or_create()
         .unwrap();
-    let poses = proxima_ipc::poses_service_builder(node, root, 0)
+    let poses = proxima_ipc::poses_service_builder(node, root, TOKEN)
         .unwrap()
         .open_or_create()
         .unwrap();
-    let results = proxima_ipc::results_service_builder(node, root, 0)
+    let results = proxima_ipc::results_service_builder(node, root, TOKEN)
         .unwrap()
         .open_or_create()
         .unwrap();
-    let poses_ready = proxima_ipc::poses_ready_service_builder(node, root, 0)
+    let poses_ready = proxima_ipc::poses_ready_service_builder(node, root, TOKEN)
         .unwrap()
         .open_or_create()
         .unwrap();
-    let results_ready = proxima_ipc::results_ready_service_builder(node, root, 0)
+    let results_ready = proxima_ipc::results_ready_service_builder(node, root, TOKEN)
         .unwrap()
         .open_or_create()
         .unwrap();
@@ -463,7 +483,9 @@ fn every_service_name_type_and_setting_is_the_codes() {
         let service = coded
             .get(row[0].as_str())
             .unwrap_or_else(|| panic!("unknown service `{}`", row[0]));
-        let name = row[1].replace("<root>", &node.root).replace("<scene>", "0");
+        let name = row[1]
+            .replace("<root>", &node.root)
+            .replace("<token>", &TOKEN.to_string());
         assert_eq!(name, service.name, "{}: name", row[0]);
         assert_eq!(row[2], service.pattern, "{}: pattern", row[0]);
         assert_eq!(row[3..6], service.types, "{}: types", row[0]);

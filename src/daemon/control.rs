@@ -1,8 +1,17 @@
 //! The control service's logic: one request in, one reply out, against the daemon's scenes.
 //!
 //! State handling, no IPC: the control thread receives a request, calls
-//! [`ControlState::handle`] and sends the reply. A refused request changes nothing and gets
-//! the error code and reason; it is logged once by the caller.
+//! [`ControlState::handle`] with the client port it came from and sends the reply. A refused
+//! request changes nothing and gets the error code and reason; it is logged once by the
+//! caller.
+//!
+//! # Trust
+//! A scene belongs to the client port that created it: every command naming it from
+//! another port is refused with `NotOwner` (DESIGN §10). Scene ids are random, so a client
+//! cannot name the next scene before it exists; each scene also gets a secret frame key
+//! (its pose frames must carry it) and a secret token that names its services. A scene
+//! whose services failed is [quarantined](ControlState::quarantine): its state is freed, and
+//! its owner is told why until it drops the id.
 //!
 //! Every request is O(1) or a copy: scene edits take the scene's lock
 //! ([`shared_scene`]) for one edit; a convex or mesh registration is
@@ -12,24 +21,42 @@
 use super::builder::{BuildJob, BuildQueue};
 use super::config::DaemonConfig;
 use super::convert::{self, Rejection, ShapeRequest};
+use super::liveness::OwnerId;
+use super::secrets;
 use super::shape_table::ShapeState;
 use super::shared_scene::{self, SharedScene, lock};
 use crate::broad::{BroadPhaseChoice, BroadPhaseKind};
 use crate::scene::{BodyDesc, BodyId, Scene};
-use proxima_ipc::PROTOCOL_VERSION;
 use proxima_ipc::wire::{
     BroadPhaseCode, Command, ControlReply, ControlRequest, ErrorCode, reply_flags,
 };
+use proxima_ipc::{PROTOCOL_VERSION, SceneToken};
+use std::collections::HashMap;
 use std::sync::Arc;
 
-/// The scenes a daemon serves, by id (ids are not reused while the daemon runs), and the
-/// queue of shapes to build.
+/// The scenes a daemon serves, by id, and the queue of shapes to build.
 #[derive(Debug)]
 pub struct ControlState {
     config: DaemonConfig,
-    scenes: Vec<Option<SharedScene>>,
-    live_scenes: u32,
+    /// This daemon run's instance id, in every reply.
+    instance: u64,
+    /// Live and quarantined scenes (a quarantined one counts against `max_scenes` until its
+    /// owner drops it or is gone).
+    scenes: HashMap<u32, SceneEntry>,
     builds: BuildQueue,
+}
+
+/// A scene as the control service knows it.
+#[derive(Debug)]
+pub struct SceneEntry {
+    /// The client port that created it, the only one it answers.
+    pub owner: OwnerId,
+    /// The secret that names its services.
+    pub token: SceneToken,
+    /// The secret its pose frames carry.
+    pub frame_key: u64,
+    /// Its state, or why it was quarantined.
+    pub state: Result<SharedScene, String>,
 }
 
 /// A successful request's reply: the id and the [`reply_flags`].
@@ -46,33 +73,68 @@ impl From<u32> for Answer {
 }
 
 impl ControlState {
-    /// No scenes yet; convex and mesh shapes go to `builds`.
+    /// No scenes yet; convex and mesh shapes go to `builds`; every reply carries
+    /// `instance`.
     #[must_use]
-    pub fn new(config: DaemonConfig, builds: BuildQueue) -> Self {
+    pub fn new(config: DaemonConfig, builds: BuildQueue, instance: u64) -> Self {
         Self {
             config,
-            scenes: Vec::new(),
-            live_scenes: 0,
+            instance,
+            scenes: HashMap::new(),
             builds,
         }
     }
 
-    /// Scene `id`, if it lives.
+    /// Scene `id`, live or quarantined.
     #[must_use]
-    pub fn scene(&self, id: u32) -> Option<&SharedScene> {
-        self.scenes.get(id as usize).and_then(Option::as_ref)
+    pub fn entry(&self, id: u32) -> Option<&SceneEntry> {
+        self.scenes.get(&id)
     }
 
-    /// Answers one request; the state changes only when the reply is a success.
-    pub fn handle(&mut self, request: &ControlRequest, payload: &[u8]) -> ControlReply {
-        match self.try_handle(request, payload) {
+    /// Scene `id`, if it lives (not quarantined).
+    #[must_use]
+    pub fn scene(&self, id: u32) -> Option<&SharedScene> {
+        self.scenes.get(&id)?.state.as_ref().ok()
+    }
+
+    /// Answers one request from client port `origin`; the state changes only when the
+    /// reply is a success. A `CreateScene` reply carries the new scene's keys.
+    pub fn handle(
+        &mut self,
+        origin: OwnerId,
+        request: &ControlRequest,
+        payload: &[u8],
+    ) -> ControlReply {
+        let mut reply = match self.try_handle(origin, request, payload) {
             Ok(Answer { id, flags }) => ControlReply::ok_with(id, flags),
             Err(r) => ControlReply::error(r.code, &r.reason),
+        };
+        reply.instance = self.instance;
+        if request.command == Command::CreateScene as u32
+            && let Some(entry) = self.scenes.get(&reply.id)
+        {
+            reply.frame_key = entry.frame_key;
+            reply.scene_token = entry.token.0;
         }
+        reply
+    }
+
+    /// Stops serving scene `id` after a fault on its services: frees its state and answers
+    /// its owner's requests with `SceneQuarantined` and `reason` until it drops the id.
+    /// Returns whether the scene was live.
+    pub fn quarantine(&mut self, id: u32, reason: String) -> bool {
+        let Some(entry) = self.scenes.get_mut(&id).filter(|e| e.state.is_ok()) else {
+            return false;
+        };
+        if let Ok(shared) = std::mem::replace(&mut entry.state, Err(reason)) {
+            lock(&shared).dropped = true;
+        }
+        true
     }
 
     fn try_handle(
         &mut self,
+        origin: OwnerId,
         request: &ControlRequest,
         payload: &[u8],
     ) -> Result<Answer, Rejection> {
@@ -99,13 +161,15 @@ impl ControlState {
         }
         match command {
             Command::Hello => Ok(PROTOCOL_VERSION.into()),
-            Command::CreateScene => self.create_scene().map(Answer::from),
-            Command::DropScene => self
-                .drop_scene(request.scene)
-                .map(|()| request.scene.into()),
-            Command::RegisterShape => self.register_shape(request, payload),
+            Command::CreateScene => self.create_scene(origin).map(Answer::from),
+            Command::DropScene => {
+                self.owned_entry(origin, request.scene)?;
+                self.drop_scene(request.scene)
+                    .map(|()| request.scene.into())
+            }
+            Command::RegisterShape => self.register_shape(origin, request, payload),
             Command::ShapeState => {
-                let building = match lock(self.live_scene(request.scene)?)
+                let building = match lock(self.owned_scene(origin, request.scene)?)
                     .shapes
                     .state(request.target)?
                 {
@@ -117,17 +181,17 @@ impl ControlState {
                     flags: building,
                 })
             }
-            Command::AddBody => self.add_body(request).map(Answer::from),
+            Command::AddBody => self.add_body(origin, request).map(Answer::from),
             Command::RemoveBody => {
                 let body = BodyId(request.target);
-                let mut cell = lock(self.live_scene(request.scene)?);
+                let mut cell = lock(self.owned_scene(origin, request.scene)?);
                 cell.scene.remove_body(body).map_err(scene_rejection)?;
                 Ok(request.target.into())
             }
             Command::UpdateBody => {
                 let motion = convert::motion(request.motion)?;
                 let (filter, margin) = (convert::filter(request), convert::margin(request.margin));
-                let mut cell = lock(self.live_scene(request.scene)?);
+                let mut cell = lock(self.owned_scene(origin, request.scene)?);
                 cell.scene
                     .update_body(BodyId(request.target), motion, filter, margin)
                     .map_err(scene_rejection)?;
@@ -135,7 +199,7 @@ impl ControlState {
             }
             Command::SetSceneParams => {
                 let choice = broad_phase(request.broad_phase)?;
-                lock(self.live_scene(request.scene)?)
+                lock(self.owned_scene(origin, request.scene)?)
                     .scene
                     .set_broad_phase(choice);
                 Ok(request.scene.into())
@@ -144,10 +208,10 @@ impl ControlState {
     }
 
     /// Adds a body of a built shape: the request is checked before the scene is locked.
-    fn add_body(&self, request: &ControlRequest) -> Result<u32, Rejection> {
+    fn add_body(&self, origin: OwnerId, request: &ControlRequest) -> Result<u32, Rejection> {
         let pose = convert::pose(request.position, request.orientation)?;
         let motion = convert::motion(request.motion)?;
-        let mut cell = lock(self.live_scene(request.scene)?);
+        let mut cell = lock(self.owned_scene(origin, request.scene)?);
         let desc = BodyDesc {
             shape: cell.shapes.usable(request.target)?,
             pose,
@@ -162,6 +226,7 @@ impl ControlState {
     /// the builder with a copy of its payload (the reply says it is being built).
     fn register_shape(
         &self,
+        origin: OwnerId,
         request: &ControlRequest,
         payload: &[u8],
     ) -> Result<Answer, Rejection> {
@@ -173,7 +238,7 @@ impl ControlState {
             &config.mesh_limits,
             config.max_convex_points,
         )?;
-        let shared = self.live_scene(request.scene)?;
+        let shared = self.owned_scene(origin, request.scene)?;
         let geometry = match shape {
             ShapeRequest::Primitive(shape) => {
                 let mut cell = lock(shared);
@@ -208,19 +273,20 @@ impl ControlState {
     }
 
     /// Drops scene `id` with all its shapes and bodies (a frame or build still holding it
-    /// leaves it alone, see [`shared_scene`]).
+    /// leaves it alone, see [`shared_scene`]), or lets go of a quarantined id.
     ///
     /// # Errors
     /// [`ErrorCode::UnknownScene`] when no such scene lives.
     pub fn drop_scene(&mut self, id: u32) -> Result<(), Rejection> {
-        lock(self.live_scene(id)?).dropped = true;
-        self.scenes[id as usize] = None;
-        self.live_scenes -= 1;
+        let entry = self.scenes.remove(&id).ok_or_else(|| unknown(id))?;
+        if let Ok(shared) = entry.state {
+            lock(&shared).dropped = true;
+        }
         Ok(())
     }
 
-    fn create_scene(&mut self) -> Result<u32, Rejection> {
-        if self.live_scenes >= self.config.max_scenes {
+    fn create_scene(&mut self, owner: OwnerId) -> Result<u32, Rejection> {
+        if self.scenes.len() >= self.config.max_scenes as usize {
             return Err(Rejection::new(
                 ErrorCode::LimitExceeded,
                 format!(
@@ -231,15 +297,57 @@ impl ControlState {
         }
         let scene = Scene::try_new(self.config.default_margin, self.config.scene_limits)
             .map_err(scene_rejection)?;
-        self.scenes.push(Some(shared_scene::share(scene)));
-        self.live_scenes += 1;
-        Ok(self.scenes.len() as u32 - 1)
+        let secret = |what| {
+            secrets::random_u64().map_err(|e| {
+                Rejection::new(
+                    ErrorCode::Internal,
+                    format!("no randomness for {what}: {e}"),
+                )
+            })
+        };
+        // Random ids: a client cannot name (or set up services for) a scene before it exists.
+        let id = loop {
+            let id = secret("a scene id")? as u32;
+            if id != u32::MAX && !self.scenes.contains_key(&id) {
+                break id;
+            }
+        };
+        let entry = SceneEntry {
+            owner,
+            token: SceneToken([secret("a scene token")?, secret("a scene token")?]),
+            frame_key: secret("a frame key")?,
+            state: Ok(shared_scene::share(scene)),
+        };
+        self.scenes.insert(id, entry);
+        Ok(id)
     }
 
-    fn live_scene(&self, id: u32) -> Result<&SharedScene, Rejection> {
-        self.scene(id)
-            .ok_or_else(|| Rejection::new(ErrorCode::UnknownScene, format!("no scene {id}")))
+    /// Scene `id`, if it exists and belongs to client port `origin`.
+    fn owned_entry(&self, origin: OwnerId, id: u32) -> Result<&SceneEntry, Rejection> {
+        let entry = self.scenes.get(&id).ok_or_else(|| unknown(id))?;
+        if entry.owner != origin {
+            return Err(Rejection::new(
+                ErrorCode::NotOwner,
+                format!("scene {id} belongs to another client"),
+            ));
+        }
+        Ok(entry)
     }
+
+    /// Scene `id`'s state, if it belongs to client port `origin` and is not quarantined.
+    fn owned_scene(&self, origin: OwnerId, id: u32) -> Result<&SharedScene, Rejection> {
+        self.owned_entry(origin, id)?
+            .state
+            .as_ref()
+            .map_err(|reason| {
+                Rejection::new(ErrorCode::SceneQuarantined, format!("scene {id}: {reason}"))
+            })
+    }
+}
+
+/// The refusal of a request naming scene `id`, which does not exist.
+fn unknown(id: u32) -> Rejection {
+    Rejection::new(ErrorCode::UnknownScene, format!("no scene {id}"))
 }
 
 /// The broad-phase choice of a wire code.

@@ -1,13 +1,19 @@
 use super::super::builder::{self, BuildJob};
+use super::super::liveness::OwnerId;
 use super::super::log::{Level, Logger};
 use super::*;
 use crossbeam::channel::Receiver;
 use proxima_ipc::wire::{MotionCode, ShapeKindCode};
 
+/// The client port every test request comes from, unless a test says otherwise.
+const OWNER: OwnerId = 0x0A;
+/// The daemon instance id of the tests' states.
+const INSTANCE: u64 = 0x1234_5678;
+
 /// A control state whose builds wait in a queue of `queued` for [`build_all`].
 fn state_with(config: DaemonConfig, queued: usize) -> (ControlState, Receiver<BuildJob>) {
     let (builds, jobs) = BuildQueue::bounded(queued);
-    (ControlState::new(config, builds), jobs)
+    (ControlState::new(config, builds, INSTANCE), jobs)
 }
 
 /// Builds every queued shape as the builder thread does; returns how many.
@@ -25,7 +31,7 @@ fn shape_state(state: &mut ControlState, scene: u32, shape: u32) -> ControlReply
         target: shape,
         ..request(Command::ShapeState)
     };
-    state.handle(&ask, &[])
+    state.handle(OWNER, &ask, &[])
 }
 
 fn request(command: Command) -> ControlRequest {
@@ -87,13 +93,14 @@ const TETRA_INDICES: [u32; 12] = [0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3];
 fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
     let (mut state, jobs) = state_with(DaemonConfig::default(), 4);
     assert_eq!(
-        state.handle(&request(Command::Hello), &[]).id,
+        state.handle(OWNER, &request(Command::Hello), &[]).id,
         PROTOCOL_VERSION
     );
-    let scene = state.handle(&request(Command::CreateScene), &[]).id;
-    let sphere = state.handle(&sphere_request(scene), &[]);
+    let scene = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    let sphere = state.handle(OWNER, &sphere_request(scene), &[]);
     assert_eq!(code(&sphere), ErrorCode::Ok, "{}", sphere.reason());
     let mesh = state.handle(
+        OWNER,
         &mesh_request(scene, 4, 12),
         &mesh_payload(&TETRA, &TETRA_INDICES),
     );
@@ -101,6 +108,7 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
     assert_eq!(build_all(&jobs), 1);
     let add = |state: &mut ControlState, shape: u32, x: f64| {
         state.handle(
+            OWNER,
             &ControlRequest {
                 scene,
                 target: shape,
@@ -125,7 +133,7 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
         margin: 0.25,
         ..request(Command::UpdateBody)
     };
-    assert_eq!(code(&state.handle(&update, &[])), ErrorCode::Ok);
+    assert_eq!(code(&state.handle(OWNER, &update, &[])), ErrorCode::Ok);
     assert_eq!(
         lock(state.scene(scene).unwrap())
             .scene
@@ -139,8 +147,11 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
         target: a.id,
         ..request(Command::RemoveBody)
     };
-    assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::Ok);
-    assert_eq!(code(&state.handle(&remove, &[])), ErrorCode::UnknownBody);
+    assert_eq!(code(&state.handle(OWNER, &remove, &[])), ErrorCode::Ok);
+    assert_eq!(
+        code(&state.handle(OWNER, &remove, &[])),
+        ErrorCode::UnknownBody
+    );
     for (wire_code, choice) in [
         (5, BroadPhaseChoice::Fixed(BroadPhaseKind::SkinGrid)),
         (4, BroadPhaseChoice::Fixed(BroadPhaseKind::ColumnGrid)),
@@ -154,7 +165,7 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
             broad_phase: wire_code,
             ..request(Command::SetSceneParams)
         };
-        let reply = state.handle(&params, &[]);
+        let reply = state.handle(OWNER, &params, &[]);
         assert_eq!((code(&reply), reply.id), (ErrorCode::Ok, scene));
         assert_eq!(
             lock(state.scene(scene).unwrap()).scene.broad_phase(),
@@ -165,9 +176,12 @@ fn a_scene_takes_shapes_and_bodies_and_lets_them_go() {
         scene,
         ..request(Command::DropScene)
     };
-    assert_eq!(code(&state.handle(&drop, &[])), ErrorCode::Ok);
+    assert_eq!(code(&state.handle(OWNER, &drop, &[])), ErrorCode::Ok);
     assert!(state.scene(scene).is_none());
-    assert_eq!(code(&state.handle(&drop, &[])), ErrorCode::UnknownScene);
+    assert_eq!(
+        code(&state.handle(OWNER, &drop, &[])),
+        ErrorCode::UnknownScene
+    );
 }
 
 #[test]
@@ -181,16 +195,17 @@ fn every_bad_request_gets_its_code_and_changes_nothing() {
         ..DaemonConfig::default()
     };
     let (mut state, _jobs) = state_with(config, 4);
-    let scene = state.handle(&request(Command::CreateScene), &[]).id;
+    let scene = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
     let sphere = ControlRequest {
         scene,
         shape_kind: ShapeKindCode::Sphere as u32,
         dimensions: [1.0; 4],
         ..request(Command::RegisterShape)
     };
-    let shape = state.handle(&sphere, &[]).id;
+    let shape = state.handle(OWNER, &sphere, &[]).id;
     let body = state
         .handle(
+            OWNER,
             &ControlRequest {
                 scene,
                 target: shape,
@@ -360,7 +375,7 @@ fn every_bad_request_gets_its_code_and_changes_nothing() {
         ),
     ];
     for (i, (req, payload, expected)) in cases.iter().enumerate() {
-        let reply = state.handle(req, payload);
+        let reply = state.handle(OWNER, req, payload);
         assert_eq!(code(&reply), *expected, "case {i}: {}", reply.reason());
         assert_eq!(reply.id, u32::MAX, "case {i}");
         assert!(!reply.reason().is_empty(), "case {i}");
@@ -372,14 +387,15 @@ fn every_bad_request_gets_its_code_and_changes_nothing() {
     }
     // The scene limit, and the scene still serves after all of it.
     assert_eq!(
-        code(&state.handle(&request(Command::CreateScene), &[])),
+        code(&state.handle(OWNER, &request(Command::CreateScene), &[])),
         ErrorCode::Ok
     );
     assert_eq!(
-        code(&state.handle(&request(Command::CreateScene), &[])),
+        code(&state.handle(OWNER, &request(Command::CreateScene), &[])),
         ErrorCode::LimitExceeded
     );
     let again = state.handle(
+        OWNER,
         &ControlRequest {
             scene,
             target: shape,
@@ -393,7 +409,7 @@ fn every_bad_request_gets_its_code_and_changes_nothing() {
 #[test]
 fn geometry_refused_while_building_is_the_shapes_answer_and_adds_nothing() {
     let (mut state, jobs) = state_with(DaemonConfig::default(), 8);
-    let scene = state.handle(&request(Command::CreateScene), &[]).id;
+    let scene = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
     let infinite = [[0.0, f64::INFINITY, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     let no_points = ControlRequest {
         scene,
@@ -416,7 +432,7 @@ fn geometry_refused_while_building_is_the_shapes_answer_and_adds_nothing() {
     ];
     let mut ids = Vec::new();
     for (registration, payload, _) in &cases {
-        let accepted = state.handle(registration, payload);
+        let accepted = state.handle(OWNER, registration, payload);
         assert_eq!(code(&accepted), ErrorCode::Ok, "{}", accepted.reason());
         assert_eq!(accepted.flags, reply_flags::SHAPE_BUILDING);
         ids.push(accepted.id);
@@ -430,6 +446,7 @@ fn geometry_refused_while_building_is_the_shapes_answer_and_adds_nothing() {
             assert_eq!(code(&answer), *expected, "shape {id}: {}", answer.reason());
         }
         let body = state.handle(
+            OWNER,
             &ControlRequest {
                 scene,
                 target: id,
@@ -452,14 +469,14 @@ fn geometry_refused_while_building_is_the_shapes_answer_and_adds_nothing() {
 #[test]
 fn a_full_build_queue_refuses_a_registration_and_a_dropped_scenes_builds_change_nothing() {
     let (mut state, jobs) = state_with(DaemonConfig::default(), 1);
-    let scene = state.handle(&request(Command::CreateScene), &[]).id;
+    let scene = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
     let (tetra, payload) = (
         mesh_request(scene, 4, 12),
         mesh_payload(&TETRA, &TETRA_INDICES),
     );
-    let first = state.handle(&tetra, &payload);
+    let first = state.handle(OWNER, &tetra, &payload);
     assert_eq!((code(&first), first.id), (ErrorCode::Ok, 0));
-    let refused = state.handle(&tetra, &payload);
+    let refused = state.handle(OWNER, &tetra, &payload);
     assert_eq!(
         code(&refused),
         ErrorCode::LimitExceeded,
@@ -473,7 +490,7 @@ fn a_full_build_queue_refuses_a_registration_and_a_dropped_scenes_builds_change_
     );
     // Once the builder has taken a job, there is room again.
     let taken = jobs.try_recv().unwrap();
-    let second = state.handle(&tetra, &payload);
+    let second = state.handle(OWNER, &tetra, &payload);
     assert_eq!((code(&second), second.id), (ErrorCode::Ok, 1));
 
     let cell = Arc::clone(state.scene(scene).unwrap());
@@ -481,7 +498,7 @@ fn a_full_build_queue_refuses_a_registration_and_a_dropped_scenes_builds_change_
         scene,
         ..request(Command::DropScene)
     };
-    assert_eq!(code(&state.handle(&dropping, &[])), ErrorCode::Ok);
+    assert_eq!(code(&state.handle(OWNER, &dropping, &[])), ErrorCode::Ok);
     let mut log = Logger::in_memory(Level::Debug);
     builder::build(taken, &DaemonConfig::default().mesh_limits, &mut log);
     assert_eq!(build_all(&jobs), 1);
@@ -492,8 +509,8 @@ fn a_full_build_queue_refuses_a_registration_and_a_dropped_scenes_builds_change_
 
     // With the builder gone (the daemon stopping), a registration fails inside.
     drop(jobs);
-    let other = state.handle(&request(Command::CreateScene), &[]).id;
-    let stranded = state.handle(&mesh_request(other, 4, 12), &payload);
+    let other = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    let stranded = state.handle(OWNER, &mesh_request(other, 4, 12), &payload);
     assert_eq!(
         code(&stranded),
         ErrorCode::Internal,
@@ -505,9 +522,10 @@ fn a_full_build_queue_refuses_a_registration_and_a_dropped_scenes_builds_change_
 #[test]
 fn a_mesh_refuses_bodies_until_it_is_built_and_a_primitive_is_ready_at_once() {
     let (mut state, jobs) = state_with(DaemonConfig::default(), 4);
-    let scene = state.handle(&request(Command::CreateScene), &[]).id;
-    let sphere = state.handle(&sphere_request(scene), &[]);
+    let scene = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    let sphere = state.handle(OWNER, &sphere_request(scene), &[]);
     let mesh = state.handle(
+        OWNER,
         &mesh_request(scene, 4, 12),
         &mesh_payload(&TETRA, &TETRA_INDICES),
     );
@@ -527,7 +545,7 @@ fn a_mesh_refuses_bodies_until_it_is_built_and_a_primitive_is_ready_at_once() {
             target: mesh.id,
             ..request(Command::AddBody)
         };
-        state.handle(&body, &[])
+        state.handle(OWNER, &body, &[])
     };
     let early = add(&mut state);
     assert_eq!(code(&early), ErrorCode::ShapeNotReady, "{}", early.reason());
@@ -544,4 +562,132 @@ fn a_mesh_refuses_bodies_until_it_is_built_and_a_primitive_is_ready_at_once() {
         code(&shape_state(&mut state, scene, 7)),
         ErrorCode::UnknownShape
     );
+}
+
+/// Every command that names a scene, as a request on `scene` (shape or body 0).
+fn scene_commands(scene: u32) -> Vec<ControlRequest> {
+    [
+        Command::DropScene,
+        Command::RegisterShape,
+        Command::AddBody,
+        Command::RemoveBody,
+        Command::UpdateBody,
+        Command::SetSceneParams,
+        Command::ShapeState,
+    ]
+    .into_iter()
+    .map(|command| match command {
+        Command::RegisterShape => sphere_request(scene),
+        command => ControlRequest {
+            scene,
+            ..request(command)
+        },
+    })
+    .collect()
+}
+
+#[test]
+fn only_the_creating_client_port_may_use_a_scene_and_the_reply_hands_it_the_keys() {
+    let (mut state, _jobs) = state_with(DaemonConfig::default(), 4);
+    let created = state.handle(OWNER, &request(Command::CreateScene), &[]);
+    assert_eq!(code(&created), ErrorCode::Ok);
+    assert_eq!(created.instance, INSTANCE);
+    assert_ne!(created.frame_key, 0);
+    assert_ne!(created.scene_token, [0, 0]);
+    let scene = created.id;
+    let shape = state.handle(OWNER, &sphere_request(scene), &[]).id;
+    let add = ControlRequest {
+        scene,
+        target: shape,
+        ..request(Command::AddBody)
+    };
+    assert_eq!(state.handle(OWNER, &add, &[]).id, 0);
+    let intruder: OwnerId = OWNER + 1;
+    for command in scene_commands(scene) {
+        let reply = state.handle(intruder, &command, &[]);
+        assert_eq!(code(&reply), ErrorCode::NotOwner, "{command:?}");
+        assert_eq!(reply.instance, INSTANCE);
+        assert_eq!((reply.frame_key, reply.scene_token), (0, [0, 0]));
+    }
+    // Nothing changed: the owner's body and shape are there, the scene lives.
+    let cell = lock(state.scene(scene).unwrap());
+    assert_eq!(cell.scene.body_count(), 1);
+    drop(cell);
+    // An id never handed out is unknown, whoever asks.
+    for command in scene_commands(scene.wrapping_add(1)) {
+        let reply = state.handle(intruder, &command, &[]);
+        assert_eq!(code(&reply), ErrorCode::UnknownScene, "{command:?}");
+    }
+    let drop = ControlRequest {
+        scene,
+        ..request(Command::DropScene)
+    };
+    assert_eq!(code(&state.handle(OWNER, &drop, &[])), ErrorCode::Ok);
+}
+
+#[test]
+fn scene_ids_and_keys_are_random_and_never_repeat_among_live_scenes() {
+    let config = DaemonConfig {
+        max_scenes: 200,
+        ..DaemonConfig::default()
+    };
+    let (mut state, _jobs) = state_with(config, 4);
+    let replies: Vec<ControlReply> = (0..200)
+        .map(|_| state.handle(OWNER, &request(Command::CreateScene), &[]))
+        .collect();
+    let ids: std::collections::HashSet<u32> = replies.iter().map(|r| r.id).collect();
+    let keys: std::collections::HashSet<u64> = replies.iter().map(|r| r.frame_key).collect();
+    let tokens: std::collections::HashSet<[u64; 2]> =
+        replies.iter().map(|r| r.scene_token).collect();
+    assert_eq!((ids.len(), keys.len(), tokens.len()), (200, 200, 200));
+    assert!(!ids.contains(&u32::MAX));
+    // Not sequential: 200 consecutive ids from random draws would be a 2^-6000 event.
+    let (low, high) = (ids.iter().min().unwrap(), ids.iter().max().unwrap());
+    assert!(high - low > 200, "ids {low}..{high} look sequential");
+}
+
+#[test]
+fn a_quarantined_scene_tells_its_owner_why_until_dropped_and_frees_its_slot() {
+    let config = DaemonConfig {
+        max_scenes: 1,
+        ..DaemonConfig::default()
+    };
+    let (mut state, _jobs) = state_with(config, 4);
+    let scene = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    let shared = Arc::clone(state.scene(scene).unwrap());
+    assert!(state.quarantine(scene, "results send: ConnectionBroken".to_owned()));
+    assert!(!state.quarantine(scene, "again".to_owned()), "once only");
+    assert!(
+        lock(&shared).dropped,
+        "a frame still holding it leaves it alone"
+    );
+    assert!(state.scene(scene).is_none());
+    for command in scene_commands(scene) {
+        if command.command == Command::DropScene as u32 {
+            continue;
+        }
+        let reply = state.handle(OWNER, &command, &[]);
+        assert_eq!(code(&reply), ErrorCode::SceneQuarantined, "{command:?}");
+        assert!(
+            reply.reason().contains("ConnectionBroken"),
+            "{}",
+            reply.reason()
+        );
+        let other = state.handle(OWNER + 1, &command, &[]);
+        assert_eq!(code(&other), ErrorCode::NotOwner, "{command:?}");
+    }
+    // It still counts against the limit until its owner lets go of the id.
+    let refused = state.handle(OWNER, &request(Command::CreateScene), &[]);
+    assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+    let drop = ControlRequest {
+        scene,
+        ..request(Command::DropScene)
+    };
+    assert_eq!(code(&state.handle(OWNER, &drop, &[])), ErrorCode::Ok);
+    assert_eq!(
+        code(&state.handle(OWNER, &drop, &[])),
+        ErrorCode::UnknownScene
+    );
+    let again = state.handle(OWNER, &request(Command::CreateScene), &[]);
+    assert_eq!(code(&again), ErrorCode::Ok);
 }

@@ -21,10 +21,11 @@
 //! are orphaned and, after [`DaemonConfig::dead_client_grace`], dropped ([`Liveness`]).
 
 use super::Ipc;
+use super::claim::{self, ControlFactory, EventSettings};
 use super::config::DaemonConfig;
 use super::control::ControlState;
 use super::error::{DaemonRunError, DaemonStartError};
-use super::frame_loop::SceneFrames;
+use super::frame_loop::{SceneFrames, SceneKeys};
 use super::gate::Gate;
 use super::liveness::{Liveness, OwnerId};
 use super::log::{Cause, Level, Logger, Subject};
@@ -37,7 +38,6 @@ use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
-use iceoryx2::service::port_factory::request_response::PortFactory as RequestResponseFactory;
 use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -61,18 +61,14 @@ pub enum FrameCommand {
 /// so that closing the ports (unmapping shared memory) and freeing the scene (its bodies and
 /// shapes, when no one else holds it) happen on the control thread, not between frames.
 pub struct Retired {
+    /// The scene's id.
+    pub id: u32,
     /// The scene.
     pub scene: SharedScene,
     /// Its frame ports.
     pub frames: Box<SceneFrames<Ipc>>,
-}
-
-impl Retired {
-    /// Closes the ports, then lets go of the scene (freed if no build still holds it).
-    fn let_go(self) {
-        drop(self.frames);
-        drop(self.scene);
-    }
+    /// The fault on its ports that made the frame thread give it up, if that was why.
+    pub fault: Option<String>,
 }
 
 /// The control thread's ends of its links to the frame thread.
@@ -91,7 +87,9 @@ pub struct ControlThread {
     server: Server<Ipc, [u8], ControlRequest, ControlReply, ()>,
     requests_sent: Listener<Ipc>,
     frames: FrameLinks,
-    control_service: RequestResponseFactory<Ipc, [u8], ControlRequest, ControlReply, ()>,
+    control_service: ControlFactory,
+    /// This daemon run's instance id.
+    instance: u64,
     node: Node<Ipc>,
     state: ControlState,
     liveness: Liveness,
@@ -107,39 +105,50 @@ pub struct ControlThread {
 }
 
 impl ControlThread {
-    /// Creates the control service, its server and the control event listener on `node`.
+    /// Claims the control service ([`claim`]), creates its server and the control event
+    /// listener on `node`; scenes' result headers will carry `instance`.
     ///
     /// # Errors
-    /// [`DaemonStartError`] when the root is invalid or iceoryx2 fails.
+    /// [`DaemonStartError`] when the root is invalid, another process holds the control
+    /// service, or iceoryx2 fails.
     pub fn new(
         node: Node<Ipc>,
         config: &DaemonConfig,
         state: ControlState,
         frames: FrameLinks,
         workers: Arc<WorkerPool>,
+        instance: u64,
     ) -> Result<Self, DaemonStartError> {
         let bad_root =
             |e| DaemonStartError::Config(format!("service root {:?}: {e:?}", config.root));
-        let control_service = proxima_ipc::control_service_builder(&node, &config.root)
-            .map_err(bad_root)?
-            .open_or_create()
-            .map_err(DaemonStartError::ipc("control service"))?;
+        let root = &config.root;
+        let control_service = claim::control_service(
+            proxima_ipc::control_service_builder(&node, root).map_err(bad_root)?,
+            &proxima_ipc::control_service_name(root),
+        )?;
         let server = control_service
             .server_builder()
             .create()
             .map_err(DaemonStartError::ipc("control server"))?;
-        let requests_sent = proxima_ipc::control_events_service_builder(&node, &config.root)
-            .map_err(bad_root)?
-            .open_or_create()
-            .map_err(DaemonStartError::ipc("control event service"))?
-            .listener_builder()
-            .create()
-            .map_err(DaemonStartError::ipc("control event listener"))?;
+        let events = EventSettings {
+            notifiers: proxima_ipc::CONTROL_MAX_CLIENTS,
+            listeners: proxima_ipc::DAEMON_EVENT_PORTS,
+            nodes: Some(proxima_ipc::CONTROL_MAX_NODES),
+        };
+        let requests_sent = claim::event_service(
+            proxima_ipc::control_events_service_builder(&node, root).map_err(bad_root)?,
+            &format!("{root}/control-events"),
+            events,
+        )?
+        .listener_builder()
+        .create()
+        .map_err(DaemonStartError::ipc("control event listener"))?;
         Ok(Self {
             server,
             requests_sent,
             frames,
             control_service,
+            instance,
             node,
             state,
             liveness: Liveness::new(config.dead_client_grace),
@@ -183,9 +192,11 @@ impl ControlThread {
         let start = Instant::now();
         let (mut next_sweep, mut last_work) = (start + self.sweep_interval, start);
         loop {
-            let served = self.serve_requests()?;
+            let served = self.serve_requests();
             // Closing ports and freeing scenes: done here, not between frames.
-            self.frames.retired.try_iter().for_each(Retired::let_go);
+            while let Ok(retired) = self.frames.retired.try_recv() {
+                self.let_go(retired);
+            }
             let now = Instant::now();
             if served > 0 {
                 last_work = now;
@@ -215,29 +226,42 @@ impl ControlThread {
     }
 
     /// Answers every waiting control request; returns how many.
-    fn serve_requests(&mut self) -> Result<usize, DaemonRunError> {
+    /// A failure to receive (a client's segment that cannot be mapped, say) is logged and
+    /// ends this round; it never ends the daemon.
+    fn serve_requests(&mut self) -> usize {
         let mut served = 0;
-        while let Some(active) = self
-            .server
-            .receive()
-            .map_err(|e| DaemonRunError::Ipc(format!("control receive: {e:?}")))?
-        {
+        loop {
+            let active = match self.server.receive() {
+                Ok(Some(active)) => active,
+                Ok(None) => break,
+                Err(e) => {
+                    let cause = Cause {
+                        what: "control receive failure",
+                        code: 0,
+                    };
+                    self.log.once(Level::Error, Subject::Daemon, cause, || {
+                        format!("receiving a control request failed: {e:?}")
+                    });
+                    break;
+                }
+            };
             if let Some(gate) = &self.gate {
                 gate.pass();
             }
             let request = *active.user_header();
             let origin = active.origin().value();
-            let mut reply = self.state.handle(&request, active.payload());
+            let mut reply = self.state.handle(origin, &request, active.payload());
             if reply.status == ErrorCode::Ok as u32 {
                 reply = self.follow_scene_changes(&request, reply, origin);
             } else {
                 self.log_refusal(&request, &reply, origin);
             }
             // A client that went away no longer wants the reply: not an error of the daemon.
+            reply.instance = self.instance;
             let _ = active.send_copy(reply);
             served += 1;
         }
-        Ok(served)
+        served
     }
 
     /// Logs a refused request once per client and cause.
@@ -278,7 +302,7 @@ impl ControlThread {
         let outcome = self.liveness.sweep(now, |owner| connected.contains(&owner));
         self.log.release_if(|subject| match subject {
             Subject::Client(id) => !connected.contains(&id),
-            Subject::Scene(_) => false,
+            Subject::Scene(_) | Subject::Daemon => false,
         });
         for &id in &outcome.orphaned {
             self.log.warn(format_args!(
@@ -292,6 +316,27 @@ impl ControlThread {
             self.log.info(format_args!(
                 "scene {id} released: its client has been gone for {:?}",
                 self.liveness.grace()
+            ));
+        }
+    }
+
+    /// Closes a retired scene's ports, then lets go of it (freed if no build still holds
+    /// it); a scene given up for a fault stays quarantined, so its owner learns why.
+    fn let_go(&mut self, retired: Retired) {
+        let Retired {
+            id,
+            scene,
+            frames,
+            fault,
+        } = retired;
+        drop(frames);
+        drop(scene);
+        if let Some(why) = fault
+            && self.state.quarantine(id, why)
+        {
+            self.log.warn(format_args!(
+                "{}: quarantined; its owner is told until it drops the scene",
+                Subject::Scene(id)
             ));
         }
     }
@@ -332,7 +377,15 @@ impl ControlThread {
             return reply;
         }
         let id = reply.id;
-        let opened = SceneFrames::open(&self.node, &self.root, id, &self.workers);
+        let Some(entry) = self.state.entry(id) else {
+            return ControlReply::error(ErrorCode::Internal, "the new scene is gone");
+        };
+        let keys = SceneKeys {
+            token: entry.token,
+            frame_key: entry.frame_key,
+            instance: self.instance,
+        };
+        let opened = SceneFrames::open(&self.node, &self.root, keys, &self.workers);
         match (opened, self.state.scene(id)) {
             (Ok(frames), Some(scene)) => {
                 let scene = Arc::clone(scene);

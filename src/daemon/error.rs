@@ -11,6 +11,9 @@ pub enum DaemonStartError {
     Config(String),
     /// iceoryx2 could not create the node or a service or port.
     Ipc(String),
+    /// A service the daemon serves is already served, or was set up with other settings,
+    /// by another process: the daemon refuses to serve beside it.
+    Occupied(String),
 }
 
 impl DaemonStartError {
@@ -25,6 +28,7 @@ impl fmt::Display for DaemonStartError {
         match self {
             Self::Config(why) => write!(f, "invalid configuration: {why}"),
             Self::Ipc(why) => write!(f, "shared-memory setup failed: {why}"),
+            Self::Occupied(why) => write!(f, "refusing to start: {why}"),
         }
     }
 }

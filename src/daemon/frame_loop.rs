@@ -43,7 +43,7 @@ use proxima_ipc::wire::{
     self, ErrorCode, PoseFrameHeader, PoseRecord, RecordKind, ResultFrameHeader, ResultRecord,
     record_flags,
 };
-use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION};
+use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION, SceneToken};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -53,8 +53,21 @@ const INITIAL_RESULT_RECORDS: usize = 1024;
 /// A received pose frame, still in shared memory.
 type PoseSample<S> = Sample<S, [PoseRecord], PoseFrameHeader>;
 
+/// Who a scene's frames are for: the secrets its services and frames carry, and the daemon
+/// run answering them.
+#[derive(Clone, Copy)]
+pub struct SceneKeys {
+    /// Names the scene's services.
+    pub token: SceneToken,
+    /// Every pose frame of the scene's owner carries it; other frames are not answered.
+    pub frame_key: u64,
+    /// This daemon run's instance id, in every result header.
+    pub instance: u64,
+}
+
 /// A scene's ports, the frame waiting for its turn and per-frame scratch space.
 pub struct SceneFrames<S: Service> {
+    keys: SceneKeys,
     poses: Subscriber<S, [PoseRecord], PoseFrameHeader>,
     results: Publisher<S, [ResultRecord], ResultFrameHeader>,
     notifier: Notifier<S>,
@@ -71,47 +84,54 @@ pub struct SceneFrames<S: Service> {
 }
 
 impl<S: Service> SceneFrames<S> {
-    /// Opens (or creates) scene `scene`'s services under `root`.
+    /// Creates the services of the scene `keys` names under `root`, with every setting of
+    /// the shared builders, and the daemon's ports on them. Services that already exist were
+    /// set up by someone else (the token is secret and fresh): refused, not opened.
     ///
     /// # Errors
     /// The iceoryx2 failure, as text.
     pub fn open(
         node: &Node<S>,
         root: &str,
-        scene: u32,
+        keys: SceneKeys,
         workers: &Arc<WorkerPool>,
     ) -> Result<Self, String> {
-        let poses = proxima_ipc::poses_service_builder(node, root, scene)
+        let token = keys.token;
+        let poses = proxima_ipc::poses_service_builder(node, root, token)
             .map_err(|e| format!("{e:?}"))?
-            .open_or_create()
-            .map_err(|e| format!("poses service: {e:?}"))?
+            .create()
+            .map_err(|e| format!("creating the poses service: {e:?}"))?
             .subscriber_builder()
             .create()
             .map_err(|e| format!("poses subscriber: {e:?}"))?;
-        let results = proxima_ipc::results_service_builder(node, root, scene)
+        // Never held up by a subscriber that does not read: with safe overflow (set by the
+        // builder) its oldest frame is overwritten, and were it off, the frame is dropped.
+        let results = proxima_ipc::results_service_builder(node, root, token)
             .map_err(|e| format!("{e:?}"))?
-            .open_or_create()
-            .map_err(|e| format!("results service: {e:?}"))?
+            .create()
+            .map_err(|e| format!("creating the results service: {e:?}"))?
             .publisher_builder()
             .initial_max_slice_len(INITIAL_RESULT_RECORDS)
             .allocation_strategy(AllocationStrategy::PowerOfTwo)
+            .backpressure_strategy(BackpressureStrategy::DiscardData)
             .create()
             .map_err(|e| format!("results publisher: {e:?}"))?;
-        let notifier = proxima_ipc::events_service_builder(node, root, scene)
+        let notifier = proxima_ipc::events_service_builder(node, root, token)
             .map_err(|e| format!("{e:?}"))?
-            .open_or_create()
-            .map_err(|e| format!("events service: {e:?}"))?
+            .create()
+            .map_err(|e| format!("creating the results-ready service: {e:?}"))?
             .notifier_builder()
             .create()
             .map_err(|e| format!("events notifier: {e:?}"))?;
-        let poses_ready = proxima_ipc::poses_ready_service_builder(node, root, scene)
+        let poses_ready = proxima_ipc::poses_ready_service_builder(node, root, token)
             .map_err(|e| format!("{e:?}"))?
-            .open_or_create()
-            .map_err(|e| format!("poses-ready service: {e:?}"))?
+            .create()
+            .map_err(|e| format!("creating the poses-ready service: {e:?}"))?
             .listener_builder()
             .create()
             .map_err(|e| format!("poses-ready listener: {e:?}"))?;
         Ok(Self {
+            keys,
             poses,
             results,
             notifier,
@@ -156,7 +176,8 @@ impl<S: Service> SceneFrames<S> {
     }
 
     /// Answers the waiting frame (see [`take_next`](Self::take_next)) over `scene` (id
-    /// `scene_id`); returns whether there was one.
+    /// `scene_id`); returns whether it answered one (a frame without the scene's frame key
+    /// is dropped unanswered).
     ///
     /// # Errors
     /// The iceoryx2 failure, as text (client mistakes are answered in the result header).
@@ -169,8 +190,20 @@ impl<S: Service> SceneFrames<S> {
         let Some((sample, key, cpu_at_receipt)) = self.waiting.take() else {
             return Ok(false);
         };
-        let ingest_started = Instant::now();
         let header = *sample.user_header();
+        if header.frame_key != self.keys.frame_key {
+            // Not the owner's: not answered, so the owner's results are untouched.
+            drop(sample);
+            let cause = Cause {
+                what: "foreign pose frame",
+                code: ErrorCode::NotOwner as u32,
+            };
+            log.once(Level::Warn, Subject::Scene(scene_id), cause, || {
+                "pose frame without the scene's frame key ignored (not its owner's)".to_owned()
+            });
+            return Ok(false);
+        }
+        let ingest_started = Instant::now();
         let outcome = apply_pose_frame(
             scene_id,
             scene,
@@ -183,6 +216,7 @@ impl<S: Service> SceneFrames<S> {
             protocol_version: PROTOCOL_VERSION,
             frame_seq: header.frame_seq,
             error_body: u32::MAX,
+            instance: self.keys.instance,
             ..ResultFrameHeader::default()
         };
         let ingest_ns = elapsed_ns(ingest_started);
@@ -412,5 +446,61 @@ fn toi_record(r: &PairToi) -> ResultRecord {
         point_b: r.point_b.to_array(),
         normal: r.normal.to_array(),
         time: r.time,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use iceoryx2::prelude::local;
+
+    #[test]
+    fn a_scene_whose_services_someone_else_set_up_first_is_refused_not_served() {
+        let node = NodeBuilder::new().create::<local::Service>().unwrap();
+        let root = format!("frame-loop-test-{}", std::process::id());
+        let workers = Arc::new(WorkerPool::new(0));
+        let keys = |n| SceneKeys {
+            token: SceneToken([n, 7]),
+            frame_key: 1,
+            instance: 1,
+        };
+        // Each of the four services, set up ahead with hostile settings (one event id, a
+        // deadline, safe overflow off): the scene is refused, whichever it is.
+        let _results_ready =
+            proxima_ipc::results_ready_service_builder(&node, &root, keys(1).token)
+                .unwrap()
+                .event_id_max_value(1)
+                .create()
+                .unwrap();
+        let _poses_ready = proxima_ipc::poses_ready_service_builder(&node, &root, keys(2).token)
+            .unwrap()
+            .deadline(std::time::Duration::from_millis(1))
+            .create()
+            .unwrap();
+        let _results = proxima_ipc::results_service_builder(&node, &root, keys(3).token)
+            .unwrap()
+            .enable_safe_overflow(false)
+            .create()
+            .unwrap();
+        let _poses = proxima_ipc::poses_service_builder(&node, &root, keys(4).token)
+            .unwrap()
+            .create()
+            .unwrap();
+        for (n, service) in [
+            (1, "results-ready"),
+            (2, "poses-ready"),
+            (3, "results"),
+            (4, "poses"),
+        ] {
+            let refused = SceneFrames::open(&node, &root, keys(n), &workers).err();
+            let why = refused.unwrap_or_else(|| panic!("{service}: served"));
+            assert!(
+                why.contains(&format!("creating the {service} service"))
+                    && why.contains("AlreadyExists"),
+                "{service}: {why}"
+            );
+        }
+        // A fresh token's services are created and served.
+        assert!(SceneFrames::open(&node, &root, keys(5), &workers).is_ok());
     }
 }

@@ -8,6 +8,12 @@
 //! arrive opened, and a closed scene goes back whole ([`Retired`]) to be let go of on the
 //! control thread. A frame of a scene dropped since it was taken is dropped unanswered.
 //!
+//! # Faults
+//! An iceoryx2 failure on one scene's ports (receive, loan, send, notify) quarantines that
+//! scene: the frame thread stops serving it and hands it back with the reason, and the
+//! control thread frees it and tells its owner (DESIGN §10). Every other scene goes on; the
+//! daemon never stops for it.
+//!
 //! # Waiting (hybrid)
 //! After the last frame the thread keeps polling for [`DaemonConfig::spin`], then blocks in
 //! its WaitSet on every scene's poses-ready listener and its own wake-up listener (the
@@ -87,7 +93,7 @@ impl FrameThread {
         let mut last_work = Instant::now();
         while !stop.is_stopped() {
             self.follow_commands();
-            if self.serve_next()? {
+            if self.serve_next() {
                 last_work = Instant::now();
                 continue;
             }
@@ -118,40 +124,63 @@ impl FrameThread {
                     self.scenes.push(LiveScene { id, scene, frames });
                 }
                 FrameCommand::Close(id) => {
-                    let Some(index) = self.scenes.iter().position(|s| s.id == id) else {
-                        continue;
-                    };
-                    let LiveScene { scene, frames, .. } = self.scenes.swap_remove(index);
-                    log_lateness(&mut self.log, id, &frames);
-                    self.log.release(Subject::Scene(id));
-                    // Should the control thread be gone, the scene is let go of here after all.
-                    let _ = self.control.retire.try_send(Retired { scene, frames });
+                    if let Some(index) = self.scenes.iter().position(|s| s.id == id) {
+                        self.retire(index, None);
+                    }
                 }
             }
         }
     }
 
+    /// Stops serving the scene at `index` and hands it back to the control thread, with the
+    /// fault that ended it, if any.
+    fn retire(&mut self, index: usize, fault: Option<String>) {
+        let LiveScene { id, scene, frames } = self.scenes.swap_remove(index);
+        log_lateness(&mut self.log, id, &frames);
+        if let Some(why) = &fault {
+            self.log.error(format_args!(
+                "{}: quarantined after a fault on its services: {why}",
+                Subject::Scene(id)
+            ));
+        }
+        self.log.release(Subject::Scene(id));
+        // Should the control thread be gone, the scene is let go of here after all.
+        let retired = Retired {
+            id,
+            scene,
+            frames,
+            fault,
+        };
+        let _ = self.control.retire.try_send(retired);
+    }
+
     /// Takes each scene's next frame, answers the most urgent of those waiting; returns
-    /// whether there was one.
-    fn serve_next(&mut self) -> Result<bool, DaemonRunError> {
-        for live in &mut self.scenes {
-            live.frames.take_next().map_err(DaemonRunError::Ipc)?;
+    /// whether there was one. A scene whose ports fail is quarantined.
+    fn serve_next(&mut self) -> bool {
+        let mut index = 0;
+        while index < self.scenes.len() {
+            match self.scenes[index].frames.take_next() {
+                Ok(()) => index += 1,
+                Err(fault) => self.retire(index, Some(fault)),
+            }
         }
         let waiting = self.scenes.iter().enumerate();
         let waiting = waiting.filter_map(|(i, live)| Some((i, live.frames.waiting()?)));
         let Some(index) = most_urgent(waiting) else {
-            return Ok(false);
+            return false;
         };
         let LiveScene { id, scene, frames } = &mut self.scenes[index];
         let mut cell = lock(scene);
         if cell.dropped {
             frames.discard_waiting();
-            return Ok(true);
+            return true;
         }
-        frames
-            .answer_waiting(*id, &mut cell.scene, &mut self.log)
-            .map_err(DaemonRunError::Ipc)?;
-        Ok(true)
+        let answered = frames.answer_waiting(*id, &mut cell.scene, &mut self.log);
+        drop(cell);
+        if let Err(fault) = answered {
+            self.retire(index, Some(fault));
+        }
+        true
     }
 }
 

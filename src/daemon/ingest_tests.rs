@@ -30,6 +30,7 @@ fn header(count: usize) -> PoseFrameHeader {
         budget_ns: 0,
         query_flags: query::CLOSE,
         count: count as u32,
+        frame_key: 0,
     }
 }
 

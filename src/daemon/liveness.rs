@@ -7,6 +7,7 @@
 //! hands it back to be dropped. Owners are opaque ids (the daemon uses iceoryx2's
 //! `UniqueClientId` values); time is injected, so tests need neither iceoryx2 nor a clock.
 
+use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 /// An owner's id: the value of the control client port that created the scene.
@@ -16,8 +17,8 @@ pub type OwnerId = u128;
 #[derive(Debug, Clone)]
 pub struct Liveness {
     grace: Duration,
-    /// Indexed by scene id; `None` for scenes not tracked (dropped, or never created).
-    scenes: Vec<Option<Ownership>>,
+    /// The scenes tracked (not dropped), by id.
+    scenes: HashMap<u32, Ownership>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,7 +43,7 @@ impl Liveness {
     pub fn new(grace: Duration) -> Self {
         Self {
             grace,
-            scenes: Vec::new(),
+            scenes: HashMap::new(),
         }
     }
 
@@ -54,65 +55,56 @@ impl Liveness {
 
     /// Records that `owner` created scene `scene` (replacing any earlier record of that id).
     pub fn adopt(&mut self, scene: u32, owner: OwnerId) {
-        let index = scene as usize;
-        if self.scenes.len() <= index {
-            self.scenes.resize(index + 1, None);
-        }
-        self.scenes[index] = Some(Ownership {
+        let ownership = Ownership {
             owner,
             orphaned_since: None,
-        });
+        };
+        self.scenes.insert(scene, ownership);
     }
 
     /// Stops tracking scene `scene` (it was dropped by request).
     pub fn forget(&mut self, scene: u32) {
-        if let Some(slot) = self.scenes.get_mut(scene as usize) {
-            *slot = None;
-        }
+        self.scenes.remove(&scene);
     }
 
     /// The owner of scene `scene`, if tracked.
     #[must_use]
     pub fn owner(&self, scene: u32) -> Option<OwnerId> {
-        self.scenes.get(scene as usize)?.map(|o| o.owner)
+        self.scenes.get(&scene).map(|o| o.owner)
     }
 
     /// Whether scene `scene` is tracked and its owner was gone at the last sweep.
     #[must_use]
     pub fn is_orphaned(&self, scene: u32) -> bool {
         self.scenes
-            .get(scene as usize)
-            .and_then(|o| o.as_ref())
+            .get(&scene)
             .is_some_and(|o| o.orphaned_since.is_some())
     }
 
     /// Checks every tracked scene's owner against `is_connected` at time `now`: an owner
     /// that is back clears the orphan mark, a newly missing one sets it to `now`, and a scene
-    /// orphaned since at least `now − grace` expires (and is forgotten).
+    /// orphaned since at least `now − grace` expires (and is forgotten). The outcome's
+    /// lists are in id order.
     pub fn sweep(&mut self, now: Instant, is_connected: impl Fn(OwnerId) -> bool) -> SweepOutcome {
         let mut outcome = SweepOutcome::default();
-        for (id, slot) in self.scenes.iter_mut().enumerate() {
-            let Some(ownership) = slot else { continue };
+        for (&id, ownership) in &mut self.scenes {
             if is_connected(ownership.owner) {
                 ownership.orphaned_since = None;
                 continue;
             }
-            match ownership.orphaned_since {
-                None => {
-                    ownership.orphaned_since = Some(now);
-                    outcome.orphaned.push(id as u32);
-                    if self.grace.is_zero() {
-                        outcome.expired.push(id as u32);
-                        *slot = None;
-                    }
-                }
-                Some(since) if now.saturating_duration_since(since) >= self.grace => {
-                    outcome.expired.push(id as u32);
-                    *slot = None;
-                }
-                Some(_) => {}
+            let since = *ownership.orphaned_since.get_or_insert_with(|| {
+                outcome.orphaned.push(id);
+                now
+            });
+            if now.saturating_duration_since(since) >= self.grace {
+                outcome.expired.push(id);
             }
         }
+        for id in &outcome.expired {
+            self.scenes.remove(id);
+        }
+        outcome.orphaned.sort_unstable();
+        outcome.expired.sort_unstable();
         outcome
     }
 }

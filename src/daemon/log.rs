@@ -65,6 +65,8 @@ pub enum Subject {
     Scene(u32),
     /// A control client, by its iceoryx2 port id value.
     Client(u128),
+    /// The daemon as a whole (its own services).
+    Daemon,
 }
 
 impl fmt::Display for Subject {
@@ -72,6 +74,7 @@ impl fmt::Display for Subject {
         match self {
             Self::Scene(id) => write!(f, "scene {id}"),
             Self::Client(id) => write!(f, "client {id:x}"),
+            Self::Daemon => f.write_str("daemon"),
         }
     }
 }
@@ -246,6 +249,7 @@ fn subject_key(subject: Subject) -> (u8, u128) {
     match subject {
         Subject::Scene(id) => (0, u128::from(id)),
         Subject::Client(id) => (1, id),
+        Subject::Daemon => (2, 0),
     }
 }
 

@@ -36,6 +36,7 @@
 //! - `error`: start-up and run failures (client mistakes are wire error codes instead).
 
 mod builder;
+mod claim;
 pub mod config;
 pub mod config_file;
 mod control;
@@ -50,6 +51,7 @@ mod lateness;
 pub mod liveness;
 pub mod log;
 mod schedule;
+mod secrets;
 mod service_loop;
 mod shape_table;
 mod shared_scene;

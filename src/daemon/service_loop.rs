@@ -13,6 +13,7 @@
 
 use super::Ipc;
 use super::builder::{self, BuildJob, BuildQueue};
+use super::claim::{self, EventSettings};
 use super::config::DaemonConfig;
 use super::control::ControlState;
 use super::control_thread::{ControlThread, FrameLinks};
@@ -20,6 +21,7 @@ use super::error::{DaemonRunError, DaemonStartError};
 use super::frame_thread::{ControlLinks, FrameThread};
 use super::gate::Gate;
 use super::log::{Level, Logger};
+use super::secrets;
 use super::stop::{StopHandle, StopOnDrop};
 use crate::geometry::MeshLimits;
 use crate::pipeline::WorkerPool;
@@ -34,6 +36,8 @@ const FRAME_COMMANDS: usize = 64;
 /// A `proximad` ready to serve: its threads' state, the build queue and the settings the
 /// threads start with (see the module docs).
 pub struct Daemon {
+    /// This run's instance id: random, in every reply and result header.
+    instance: u64,
     control: ControlThread,
     frames: FrameThread,
     /// The builder thread's end of the build queue, until `run` starts it.
@@ -54,6 +58,9 @@ impl Daemon {
     /// # Errors
     /// [`DaemonStartError`] when the configuration is invalid or iceoryx2 fails.
     pub fn new(config: DaemonConfig) -> Result<Self, DaemonStartError> {
+        let instance = secrets::random_u64().map_err(|e| {
+            DaemonStartError::Ipc(format!("no randomness for the instance id: {e}"))
+        })?;
         let node = create_node(&config)?;
         let (wake, wake_listener) = frame_wake(&node, &config.root)?;
         let (commands, incoming) = channel::bounded(FRAME_COMMANDS);
@@ -73,13 +80,14 @@ impl Daemon {
             wake,
             retired,
         };
-        let state = ControlState::new(config.clone(), builds);
-        let control = ControlThread::new(node, &config, state, links, workers)?;
+        let state = ControlState::new(config.clone(), builds, instance);
+        let control = ControlThread::new(node, &config, state, links, workers, instance)?;
         let config_line = format!(
             "spin {:?}, sweep every {:?}, dead-client grace {:?}",
             config.spin, config.sweep_interval, config.dead_client_grace
         );
         Ok(Self {
+            instance,
             control,
             frames,
             build_jobs: Some(build_jobs),
@@ -104,7 +112,10 @@ impl Daemon {
             return Ok(());
         }
         let mut log = Logger::new(self.log_level);
-        log.info(format_args!("root {:?}, {}", self.root, self.config_line));
+        log.info(format_args!(
+            "root {:?}, instance {:#018x}, {}",
+            self.root, self.instance, self.config_line
+        ));
         if let Some(jobs) = self.build_jobs.take() {
             builder::spawn(
                 jobs,
@@ -141,6 +152,14 @@ impl Daemon {
         });
         log.info(format_args!("stopping"));
         result
+    }
+
+    /// This run's instance id (random per start, never 0): every control reply and result
+    /// header carries it, so clients can tell this daemon from another
+    /// (`ClientBuilder::expect_instance`).
+    #[must_use]
+    pub fn instance(&self) -> u64 {
+        self.instance
     }
 
     /// A handle that stops [`run`](Self::run) from another thread, as SIGTERM does, within
@@ -189,15 +208,21 @@ fn frame_wake(
     ),
     DaemonStartError,
 > {
-    let name = ServiceName::new(&format!("{root}/frame-wake"))
+    let text = format!("{root}/frame-wake");
+    let name = ServiceName::new(&text)
         .map_err(|e| DaemonStartError::Config(format!("service root {root:?}: {e:?}")))?;
-    let service = node
+    let ports = proxima_ipc::DAEMON_EVENT_PORTS;
+    let builder = node
         .service_builder(&name)
         .event()
-        .max_notifiers(proxima_ipc::DAEMON_EVENT_PORTS)
-        .max_listeners(proxima_ipc::DAEMON_EVENT_PORTS)
-        .open_or_create()
-        .map_err(DaemonStartError::ipc("frame wake-up service"))?;
+        .max_notifiers(ports)
+        .max_listeners(ports);
+    let expected = EventSettings {
+        notifiers: ports,
+        listeners: ports,
+        nodes: None,
+    };
+    let service = claim::event_service(builder, &text, expected)?;
     let notifier = service
         .notifier_builder()
         .create()

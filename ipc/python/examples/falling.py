@@ -3,6 +3,7 @@
 
     python falling.py --spawn-daemon target/debug/proximad --bodies 200 --seconds 5
     python falling.py --root proxima                      # a daemon already running
+    python falling.py --root proxima --token-file /tmp/falling.token   # let monitor.py watch
 
 A static bin (floor and four walls, cuboids) and a mix of spheres, boxes, capsules and
 convex hulls dropped above it. Each frame integrates gravity (semi-implicit Euler, numpy,
@@ -11,11 +12,16 @@ no per-body loop), publishes every moving body's pose straight into shared memor
 its normal (restitution 0.4, bodies as unit point masses: no spin response), pushing
 them apart by the depth. Once a second it prints the frame's pairs, contacts, round trip
 and whether it met its budget; then a summary.
+
+The scene is this client's alone. With ``--token-file`` it writes the scene's token (the
+capability to read its results, nothing more) to a file only its user can read, for
+``monitor.py`` to follow the frames.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 
@@ -82,6 +88,13 @@ def bounce(pairs: np.ndarray, slot: np.ndarray, positions: np.ndarray, velocitie
     return int(np.count_nonzero(impulse > 0.0))
 
 
+def write_token(path: str, token: str) -> None:
+    """Writes ``token`` to ``path``, readable and writable by this user only."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(fd, "w") as f:
+        f.write(token + "\n")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bodies", type=int, default=200)
@@ -91,6 +104,7 @@ def main() -> int:
     parser.add_argument("--root", default="proxima", help="service root of a running daemon")
     parser.add_argument("--iceoryx-prefix", default=None, help="iceoryx2 prefix of a running daemon")
     parser.add_argument("--spawn-daemon", metavar="PATH", help="start this proximad privately instead")
+    parser.add_argument("--token-file", metavar="FILE", help="write the scene's token here for monitor.py")
     args = parser.parse_args()
     iox.set_log_level_from_env_or(iox.LogLevel.Error)
 
@@ -114,6 +128,8 @@ def simulate(client: Client, args: argparse.Namespace) -> int:
     slot[ids] = np.arange(len(ids))
     velocities = np.zeros_like(positions)
     link = client.open_scene(scene)
+    if args.token_file:
+        write_token(args.token_file, str(link.access.token))
     print(f"falling.py: scene {scene}, {len(ids)} bodies into a {2 * BIN_HALF:.0f} m bin ({len(statics)} static pieces), "
           f"{args.rate_hz} Hz")
     dt = 1.0 / args.rate_hz

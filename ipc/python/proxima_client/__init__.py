@@ -5,9 +5,11 @@ Pure Python over the ``iceoryx2`` 0.10.0 bindings and numpy; it mirrors the Rust
 
 - :mod:`~proxima_client.wire`: the ``#[repr(C)]`` records as ctypes structures and numpy
   dtypes with pinned offsets, the codes and bit sets, :data:`PROTOCOL_VERSION`;
-- :mod:`~proxima_client.services`: service names, settings and builders;
+- :mod:`~proxima_client.services`: service names (by :class:`SceneToken`), settings and
+  builders;
 - :mod:`~proxima_client.client`: :class:`Client` (connect, scenes, shapes, bodies);
-- :mod:`~proxima_client.scene_link`: :class:`SceneLink`, pose frames out from numpy arrays;
+- :mod:`~proxima_client.scene_link`: :class:`SceneLink`, pose frames out from numpy arrays,
+  with the :class:`SceneAccess` the scene's owner holds;
 - :mod:`~proxima_client.result_feed`: result frames in as numpy views
   (:class:`ResultFrame`) or copies (:class:`OwnedResultFrame`);
 - :mod:`~proxima_client.errors`: typed exceptions carrying the daemon's :class:`ErrorCode`;
@@ -42,11 +44,16 @@ from .errors import (
     MalformedMessageError,
     MeshIndexOutOfRangeError,
     NoDaemon,
+    NoSuchScene,
+    NotOwned,
+    NotOwnerError,
     ProtocolMismatchError,
     ProximaError,
     ReplyTimeout,
+    SceneQuarantinedError,
     ShapeNotReadyError,
     TransportError,
+    UnexpectedDaemon,
     UnknownBodyError,
     UnknownSceneError,
     UnknownShapeError,
@@ -55,8 +62,8 @@ from .errors import (
     error_for,
 )
 from .result_feed import OwnedResultFrame, ResultFeed, ResultFrame
-from .scene_link import PoseFrame, SceneLink, pose_array
-from .services import DEFAULT_ROOT
+from .scene_link import PoseFrame, SceneAccess, SceneLink, pose_array
+from .services import DEFAULT_ROOT, SceneToken
 from .wire import (
     POSE_DTYPE,
     PROTOCOL_VERSION,

@@ -24,10 +24,19 @@ their registration is answered. :meth:`Client.register_convex` and
 variants return at once, and :meth:`Client.add_body` on a shape not built yet raises
 :class:`~proxima_client.errors.ShapeNotReadyError`.
 
+**Scenes are private.** A scene belongs to the client port that created it: other
+clients' requests naming it raise :class:`~proxima_client.errors.NotOwnerError`. The
+client keeps each scene's keys from its ``CreateScene`` reply (:meth:`Client.scene_access`:
+the frame key its frames carry, the token that names its services), so only it can
+:meth:`~Client.open_scene`; it may share the token with a monitor, which opens the
+results alone (:meth:`Client.open_result_feed`).
+
 **When the daemon goes away.** A client is bound to the daemon that answered its
-``Hello``. Once that daemon is gone (crashed, or replaced by a restart), requests raise
+``Hello``, and to its instance id, which every reply carries. Once that daemon is gone
+(crashed, or replaced by a restart), requests raise
 :class:`~proxima_client.errors.DaemonLost`: at once if no daemon serves the control
-service, when the reply comes from another daemon, or at the reply timeout.
+service, when the reply comes from another daemon (another server port or instance id),
+or at the reply timeout.
 """
 
 from __future__ import annotations
@@ -42,9 +51,20 @@ import iceoryx2 as iox
 import numpy as np
 
 from . import services
-from .errors import BuildTimeout, DaemonLost, NoDaemon, ProtocolMismatchError, ReplyTimeout, TransportError, error_for
+from .errors import (
+    BuildTimeout,
+    DaemonLost,
+    NoDaemon,
+    NotOwned,
+    ProtocolMismatchError,
+    ReplyTimeout,
+    TransportError,
+    UnexpectedDaemon,
+    error_for,
+)
 from .result_feed import ResultFeed
-from .scene_link import SceneLink
+from .scene_link import SceneAccess, SceneLink
+from .services import SceneToken
 from .transport import SHAPE_POLL_FIRST_S, SHAPE_POLL_MAX_S, now, poll_until, release_ports
 from .wire import (
     PROTOCOL_VERSION,
@@ -235,6 +255,8 @@ class Client:
         self._notifier = notifier
         self._port: Any = None
         self._daemon: Optional[int] = None
+        self._instance = 0
+        self._scenes: dict[int, SceneAccess] = {}
         self.reply_timeout = reply_timeout
         self.build_timeout = build_timeout
         self._event_id = iox.EventId.new(services.EVENT_CONTROL_SENT)
@@ -249,9 +271,11 @@ class Client:
         reply_timeout: float = DEFAULT_REPLY_TIMEOUT,
         build_timeout: float = DEFAULT_BUILD_TIMEOUT,
         node_name: str = "proxima-py-client",
+        expect_instance: Optional[int] = None,
     ) -> "Client":
         """Creates the node, opens the control services and checks the daemon's protocol
-        version with ``Hello``, waiting up to ``reply_timeout`` seconds for a daemon.
+        version with ``Hello``, waiting up to ``reply_timeout`` seconds for a daemon: the
+        daemon creates the services, so until it has, there is no daemon to talk to.
 
         Args:
             root: the daemon's ``--root``.
@@ -260,10 +284,14 @@ class Client:
             reply_timeout: seconds each request waits for its reply.
             build_timeout: seconds the waiting registrations wait for a shape's build.
             node_name: the iceoryx2 node name (shows in iceoryx2's tools).
+            expect_instance: connect only to the daemon run with this instance id (as
+                ``proximad`` logs it at start and writes it with ``--instance-file``).
 
         Raises:
             NoDaemon: no daemon answered in time.
             ProtocolMismatchError: the daemon speaks another protocol version.
+            UnexpectedDaemon: the daemon that answered has another instance id than
+                ``expect_instance``.
             TransportError: bad root or prefix, or iceoryx2 failed.
         """
         deadline = now() + reply_timeout
@@ -278,10 +306,15 @@ class Client:
             )
         except Exception as e:
             raise TransportError("creating the node", e) from e
-        service = services.open_service(services.control_service_builder(node, root), "control service")
-        events = services.open_service(
-            services.control_events_service_builder(node, root), "control event service"
-        )
+        nobody = f"no proxima daemon serves {services.control_service_name(root)!r}"
+        service = poll_until(deadline, lambda: services.try_open_service(
+            services.control_service_builder(node, root), "control service"))
+        if service is None:
+            raise NoDaemon(nobody)
+        events = poll_until(deadline, lambda: services.try_open_service(
+            services.control_events_service_builder(node, root), "control event service"))
+        if events is None:
+            raise NoDaemon(nobody)
         try:
             notifier = events.notifier_builder().create()
         except Exception as e:
@@ -293,7 +326,7 @@ class Client:
         served = poll_until(deadline, lambda: True if service.dynamic_config.number_of_servers > 0 else None)
         if served is None:
             client.close()
-            raise NoDaemon(f"no proxima daemon serves {services.control_service_name(root)!r}")
+            raise NoDaemon(nobody)
         hello = client._header(Command.HELLO, 0)
         wait = FIRST_HELLO_WAIT
         while True:
@@ -321,7 +354,11 @@ class Client:
                 ErrorCode.PROTOCOL_MISMATCH,
                 f"the daemon speaks protocol {reply.id}, this client {PROTOCOL_VERSION}",
             )
+        if expect_instance is not None and reply.instance != expect_instance:
+            client.close()
+            raise UnexpectedDaemon(reply.instance)
         client._daemon = daemon
+        client._instance = reply.instance
         return client
 
     def _new_port(self) -> Any:
@@ -348,6 +385,12 @@ class Client:
         """The iceoryx2 node every port of this client lives on."""
         return self._node
 
+    @property
+    def daemon_instance(self) -> int:
+        """The instance id of the daemon this client is connected to (random per daemon
+        run, never 0)."""
+        return self._instance
+
     def close(self) -> None:
         """Releases the client's ports (idempotent). Scene links opened from it stay usable."""
         release_ports(self, "_port", "_notifier")
@@ -361,20 +404,51 @@ class Client:
     # -- scenes ------------------------------------------------------------------------
 
     def open_scene(self, scene: int) -> SceneLink:
-        """Opens scene ``scene``'s frame path: pose publisher and result subscriber."""
-        return SceneLink(self._node, self._root, scene)
+        """Opens the frame path (pose publisher and result subscriber) of scene ``scene``,
+        which this client created.
 
-    def open_result_feed(self, scene: int) -> ResultFeed:
-        """Subscribes to scene ``scene``'s result frames only (a monitor)."""
-        return ResultFeed(self._node, self._root, scene)
+        Raises:
+            NotOwned: this client did not create ``scene`` (or dropped it).
+            NoSuchScene: the daemon no longer serves it.
+            TransportError: iceoryx2 failed.
+        """
+        access = self.scene_access(scene)
+        if access is None:
+            raise NotOwned(scene)
+        return SceneLink(self._node, self._root, access)
+
+    def open_result_feed(self, token: SceneToken) -> ResultFeed:
+        """Subscribes to the result frames of the scene with token ``token`` (a monitor:
+        the token is what the scene's owner shares), accepting only frames of this
+        client's daemon.
+
+        Raises:
+            NoSuchScene: the daemon serves no scene with this token.
+            TransportError: iceoryx2 failed.
+        """
+        feed = ResultFeed(self._node, self._root, token)
+        feed.expect_instance(self._instance)
+        return feed
+
+    def scene_access(self, scene: int) -> Optional[SceneAccess]:
+        """The keys of scene ``scene``, if this client created it and has not dropped it.
+        Its ``token`` is the capability to read the scene's results: give it only to a
+        monitor that may."""
+        return self._scenes.get(scene)
 
     def create_scene(self) -> int:
-        """Creates a scene; returns its id."""
-        return self._call(self._header(Command.CREATE_SCENE, 0))
+        """Creates a scene owned by this client; returns its id (the client keeps its keys,
+        see :meth:`scene_access`)."""
+        reply = self.request(self._header(Command.CREATE_SCENE, 0))
+        scene, _ = check_reply(reply)
+        self._scenes[scene] = SceneAccess(scene=scene, token=SceneToken(tuple(reply.scene_token)),
+                                          frame_key=reply.frame_key, instance=reply.instance)
+        return scene
 
     def drop_scene(self, scene: int) -> None:
-        """Drops scene ``scene`` with all its bodies."""
+        """Drops scene ``scene`` with all its bodies (also a quarantined scene's id)."""
         self._call(self._header(Command.DROP_SCENE, scene))
+        self._scenes.pop(scene, None)
 
     def set_broad_phase(self, scene: int, broad_phase: BroadPhaseCode) -> None:
         """Sets which broad phase scene ``scene``'s frames run from its next frame on
@@ -565,6 +639,8 @@ class Client:
         reply, origin = answer
         if self._daemon is not None and origin != self._daemon:
             raise DaemonLost("the reply came from another daemon (a restart)")
+        if self._instance and reply.instance != self._instance:
+            raise DaemonLost("the reply came from another daemon instance (a restart)")
         return reply
 
     def _request_until(self, header: ControlRequest, length: int,

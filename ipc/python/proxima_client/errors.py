@@ -10,8 +10,12 @@ Everything raised derives from :class:`ProximaError`:
 - :class:`ReplyTimeout`, :class:`BuildTimeout`: nothing came back in time (both are also
   :class:`TimeoutError`).
 - :class:`DaemonLost`: the daemon this client said ``Hello`` to is gone (crashed, or a
-  restart now serves the root); connect again and register everything anew.
-- :class:`NoDaemon`: connecting found no daemon answering in time.
+  restart now serves the root), told by a control reply or a result frame; connect again
+  and register everything anew.
+- :class:`NoDaemon`: connecting found no daemon answering in time;
+  :class:`UnexpectedDaemon`: another daemon than the one expected answered.
+- :class:`NotOwned`: this client did not create the scene it asked to open;
+  :class:`NoSuchScene`: no daemon serves a scene with the token given.
 - :class:`TransportError`: iceoryx2 failed (opening services, loaning, sending); carries the
   binding's error text.
 """
@@ -43,7 +47,45 @@ class NoDaemon(ProximaError):
 
 
 class DaemonLost(ProximaError):
-    """The daemon this client connected to is gone; its scenes, shapes and bodies too."""
+    """The daemon this client connected to is gone; its scenes, shapes and bodies too.
+
+    Raised for a control reply of another daemon (another server port or instance id), a
+    result frame of another daemon instance, or a wait that ended while no live daemon
+    serves (the control service, or the scene's results)."""
+
+
+class UnexpectedDaemon(ProximaError):
+    """The daemon that answered ``Hello`` is not the one expected
+    (``Client.connect(expect_instance=...)``): another process serves the control service.
+
+    Attributes:
+        instance: the instance id the answering daemon gave.
+    """
+
+    def __init__(self, instance: int) -> None:
+        """Keeps the instance id and composes the message."""
+        self.instance = instance
+        super().__init__(f"the process serving the control service (instance {instance:#018x}) "
+                         "is not the daemon expected")
+
+
+class NotOwned(ProximaError):
+    """This client did not create the scene (or dropped it), so it holds no keys to it; a
+    monitor opens a scene's results with the token its owner shares
+    (``Client.open_result_feed``).
+
+    Attributes:
+        scene: the scene id.
+    """
+
+    def __init__(self, scene: int) -> None:
+        """Keeps the scene id and composes the message."""
+        self.scene = scene
+        super().__init__(f"scene {scene} was not created by this client, which holds no keys to it")
+
+
+class NoSuchScene(ProximaError):
+    """No daemon serves a scene with this token (it was dropped, or never created)."""
 
 
 class ReplyTimeout(ProximaError, TimeoutError):
@@ -156,6 +198,20 @@ class ShapeNotReadyError(DaemonError):
     CODE = ErrorCode.SHAPE_NOT_READY
 
 
+class NotOwnerError(DaemonError):
+    """The scene belongs to another client port: only the one that created it may change it,
+    drop it, ask about it or send it frames."""
+
+    CODE = ErrorCode.NOT_OWNER
+
+
+class SceneQuarantinedError(DaemonError):
+    """The daemon stopped serving the scene after a fault on its shared-memory services (the
+    reason says which); only dropping it is accepted."""
+
+    CODE = ErrorCode.SCENE_QUARANTINED
+
+
 class UnknownStatusError(DaemonError):
     """The status is a value this protocol version does not define."""
 
@@ -175,6 +231,8 @@ _BY_CODE: dict[ErrorCode, type[DaemonError]] = {
         MalformedMessageError,
         InternalError,
         ShapeNotReadyError,
+        NotOwnerError,
+        SceneQuarantinedError,
     )
     if cls.CODE is not None
 }

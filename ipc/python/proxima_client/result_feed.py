@@ -11,6 +11,12 @@ not be read. :meth:`ResultFrame.copy` gives an :class:`OwnedResultFrame` that li
 A subscriber lends at most two frames at once (iceoryx2's default borrow limit): release
 a frame before receiving the third.
 
+A feed is opened by the scene's token (:class:`~proxima_client.services.SceneToken`), the
+capability its owner shares with monitors. A frame of another daemon instance than the one
+expected (:meth:`ResultFeed.expect_instance`), or a wait that times out while no live
+process publishes the scene's results, raises
+:class:`~proxima_client.errors.DaemonLost`.
+
 **iceoryx2 0.10.0 binding bug.** On slice services the Python bindings' ``payload()``
 reports the slice length in *bytes* instead of elements, so reading it runs past the
 sample. This module never calls it: the record count comes from the sample's iceoryx2
@@ -28,7 +34,8 @@ import iceoryx2 as iox
 import numpy as np
 
 from . import services
-from .errors import TransportError, error_for
+from .errors import DaemonLost, NoSuchScene, TransportError, error_for
+from .services import SceneToken
 from .transport import RESULTS_SPIN_S, now, release_ports
 from .wire import RESULT_DTYPE, Completeness, ErrorCode, ResultFrameHeader
 
@@ -196,27 +203,49 @@ class ResultFrame(_Frame):
         return f"ResultFrame(frame_seq={self.frame_seq}, status={self.status!r}, records={len(self.records)}, held={self.held})"
 
 
+def open_scene_service(builder: Any, what: str) -> Any:
+    """Opens one of a scene's services (the daemon created them with the scene).
+
+    Raises:
+        NoSuchScene: the service does not exist; TransportError: iceoryx2 failed.
+    """
+    service = services.try_open_service(builder, what)
+    if service is None:
+        raise NoSuchScene(f"no daemon serves a scene with this token (its {what} does not exist)")
+    return service
+
+
 class ResultFeed:
     """A subscription to one scene's result frames, with the scene's results-ready
     listener to sleep on. Frames published before it was opened are not seen."""
 
-    def __init__(self, node: Any, root: str, scene: int) -> None:
-        """Opens (or creates, if the daemon has not yet) scene ``scene``'s result and
-        results-ready services under ``root`` on ``node``, and subscribes.
+    def __init__(self, node: Any, root: str, token: SceneToken) -> None:
+        """Opens the result and results-ready services of the scene with token ``token``
+        (the capability its owner shares) under ``root`` on ``node``, and subscribes. The
+        daemon creates a scene's services with the scene; this only opens them. Frames of
+        any daemon instance are accepted until :meth:`expect_instance`.
 
         Raises:
-            TransportError: iceoryx2 failed (incompatible services, too many subscribers).
+            NoSuchScene: no daemon serves a scene with this token.
+            TransportError: iceoryx2 failed (e.g. too many subscribers).
         """
-        self._results_service = services.open_service(
-            services.results_service_builder(node, root, scene), "result service")
-        self._ready_service = services.open_service(
-            services.results_ready_service_builder(node, root, scene), "results-ready event service")
+        self._results_service = open_scene_service(
+            services.results_service_builder(node, root, token), "result service")
+        self._ready_service = open_scene_service(
+            services.results_ready_service_builder(node, root, token), "results-ready event service")
         try:
             self._subscriber = self._results_service.subscriber_builder().create()
             self._listener = self._ready_service.listener_builder().create()
         except Exception as e:
             raise TransportError("creating the result subscriber or its listener", e) from e
         self.spin = RESULTS_SPIN_S
+        self._instance = 0
+
+    def expect_instance(self, instance: int) -> None:
+        """Accepts only frames of daemon instance ``instance`` (from the scene's
+        ``CreateScene`` reply, or the monitoring client's ``daemon_instance``); a frame of
+        another raises :class:`~proxima_client.errors.DaemonLost`. 0 accepts any."""
+        self._instance = instance
 
     def set_spin(self, seconds: float) -> None:
         """Sets how long a receive polls before it blocks (:data:`RESULTS_SPIN_S` by
@@ -228,22 +257,44 @@ class ResultFeed:
         """The next result frame if one has arrived, without waiting.
 
         Raises:
+            DaemonLost: the frame comes from another daemon instance than the one expected.
             TransportError: iceoryx2 failed (e.g. two frames are still held).
         """
         try:
             sample = self._subscriber.receive()
         except Exception as e:
             raise TransportError("receiving a result frame", e) from e
-        return None if sample is None else ResultFrame(sample)
+        if sample is None:
+            return None
+        frame = ResultFrame(sample)
+        if self._instance and frame.header.instance != self._instance:
+            frame.release()
+            raise DaemonLost("a result frame came from another daemon instance (a restart)")
+        return frame
+
+    def daemon_is_alive(self) -> bool:
+        """Whether a live process (the daemon) still publishes the scene's results, after
+        removing the ports of crashed processes from the service (so a daemon killed
+        without cleaning up counts as gone). A dropped scene has no publisher either."""
+        try:
+            self._results_service.try_cleanup_dead_nodes()
+        except Exception:  # cleanup is best effort; the count below decides
+            pass
+        return self._results_service.dynamic_config.number_of_publishers > 0
 
     def receive(self, timeout: float) -> Optional[ResultFrame]:
-        """The next result frame, waiting up to ``timeout`` seconds; ``None`` if none came."""
+        """The next result frame, waiting up to ``timeout`` seconds; ``None`` if none came.
+
+        Raises:
+            DaemonLost: a frame of another daemon instance, or none came and no live
+                process publishes the scene's results.
+        """
         return self._receive_until(now() + timeout, lambda header: True)
 
     def receive_for(self, frame_seq: int, timeout: float) -> Optional[ResultFrame]:
         """The result frame answering pose frame ``frame_seq``, waiting up to ``timeout``
         seconds; frames received meanwhile for other sequence numbers are released.
-        ``None`` when it did not arrive in time."""
+        ``None`` when it did not arrive in time; raises like :meth:`receive`."""
         return self._receive_until(now() + timeout, lambda header: header.frame_seq == frame_seq)
 
     def _receive_until(self, deadline: float, accept: Callable[[ResultFrameHeader], bool]) -> Optional[ResultFrame]:
@@ -251,7 +302,8 @@ class ResultFeed:
 
         A notification that arrives between a poll and the blocking wait stays pending in
         the listener, so the wait returns at once and the loop polls again. The listener
-        may also wake with nothing new, so the deadline is always judged by the clock.
+        may also wake with nothing new, so the deadline is always judged by the clock. At
+        the deadline, a scene no live process publishes raises :class:`DaemonLost`.
         """
         spin_end = now() + self.spin
         while True:
@@ -263,6 +315,8 @@ class ResultFeed:
                 frame = self.try_receive()
             t = now()
             if t >= deadline:
+                if not self.daemon_is_alive():
+                    raise DaemonLost("no live daemon publishes the scene's results")
                 return None
             if t < spin_end:
                 continue

@@ -12,14 +12,17 @@ frames as numpy views (:class:`~proxima_client.result_feed.ResultFrame`).
             print(pair["body_a"], pair["body_b"], pair["distance"])
 
 After each pose frame the link notifies the scene's poses-ready service (event id 1), so
-a daemon asleep in its WaitSet wakes. A pose frame published before the daemon's
-subscriber exists is lost (no history); the daemon opens a scene's services when the
-scene is created.
+a daemon asleep in its WaitSet wakes. The daemon creates a scene's services and ports
+before it answers ``CreateScene``, so a link opened after that reply loses no frame. Only
+the scene's owner holds its :class:`SceneAccess` (the
+:class:`~proxima_client.client.Client` that created it keeps it): every frame carries the
+scene's frame key, and a frame with another key is not answered.
 """
 
 from __future__ import annotations
 
 import ctypes
+from dataclasses import dataclass, field
 from typing import Any, Optional
 
 import iceoryx2 as iox
@@ -27,13 +30,37 @@ import numpy as np
 
 from . import services
 from .errors import TransportError
-from .result_feed import OwnedResultFrame, ResultFeed, ResultFrame
+from .result_feed import OwnedResultFrame, ResultFeed, ResultFrame, open_scene_service
+from .services import SceneToken
 from .transport import release_ports
 from .wire import POSE_DTYPE, PROTOCOL_VERSION, U32_MAX, PoseFrameHeader
 
 #: Pose records the publisher's first shared-memory segment holds; a larger frame makes it
 #: allocate a segment of the next power of two (a one-off cost, for the daemon too).
 POSES_INITIAL_MAX_SLICE_LEN: int = 1024
+
+
+
+@dataclass(frozen=True)
+class SceneAccess:
+    """What the owner of a scene holds, from the scene's ``CreateScene`` reply: everything
+    a :class:`SceneLink` needs. ``repr()`` shows only the id (the rest is secret).
+
+    Attributes:
+        scene: the scene's id, for control requests and pose frame headers.
+        token: the token that names its services; also the capability to read its results
+            (:class:`~proxima_client.result_feed.ResultFeed`), which the owner may share
+            with a monitor.
+        frame_key: the secret every pose frame carries.
+        instance: the daemon instance that created the scene; result frames of another
+            raise :class:`~proxima_client.errors.DaemonLost`.
+    """
+
+    scene: int
+    token: SceneToken = field(repr=False)
+    frame_key: int = field(repr=False)
+    instance: int = field(repr=False)
+
 
 _POSE_BYTES = POSE_DTYPE.itemsize
 _HEADER_BYTES = ctypes.sizeof(PoseFrameHeader)
@@ -127,18 +154,20 @@ class SceneLink:
     :class:`ResultFrame` before receiving the third.
     """
 
-    def __init__(self, node: Any, root: str, scene: int) -> None:
-        """Opens (or creates, if the daemon has not yet) scene ``scene``'s pose, result and
-        event services under ``root`` on ``node`` and creates this link's ports.
+    def __init__(self, node: Any, root: str, access: SceneAccess) -> None:
+        """Opens the pose, result and event services of the scene ``access`` names (the
+        daemon created them with the scene) under ``root`` on ``node`` and creates this
+        link's ports; its result feed accepts only frames of ``access.instance``.
 
         Raises:
-            TransportError: iceoryx2 failed (incompatible services, too many ports).
+            NoSuchScene: no daemon serves the scene.
+            TransportError: iceoryx2 failed (e.g. too many ports).
         """
-        self._scene = scene
-        self._poses_service = services.open_service(
-            services.poses_service_builder(node, root, scene), "pose service")
-        self._ready_service = services.open_service(
-            services.poses_ready_service_builder(node, root, scene), "poses-ready event service")
+        self._access = access
+        self._poses_service = open_scene_service(
+            services.poses_service_builder(node, root, access.token), "pose service")
+        self._ready_service = open_scene_service(
+            services.poses_ready_service_builder(node, root, access.token), "poses-ready event service")
         try:
             self._publisher = (
                 self._poses_service.publisher_builder()
@@ -150,18 +179,25 @@ class SceneLink:
             self._notifier = self._ready_service.notifier_builder().create()
         except Exception as e:
             raise TransportError("creating the pose publisher or its notifier", e) from e
-        self.feed = ResultFeed(node, root, scene)
+        self.feed = ResultFeed(node, root, access.token)
+        self.feed.expect_instance(access.instance)
         self._event_id = iox.EventId.new(services.EVENT_POSES_SENT)
         # The header is written from this buffer with one memmove per frame.
         self._header = PoseFrameHeader()
         self._header.protocol_version = PROTOCOL_VERSION
-        self._header.scene = scene
+        self._header.scene = access.scene
+        self._header.frame_key = access.frame_key
         self._header_address = ctypes.addressof(self._header)
 
     @property
     def scene(self) -> int:
         """The scene id this link publishes to."""
-        return self._scene
+        return self._access.scene
+
+    @property
+    def access(self) -> SceneAccess:
+        """The scene's keys this link publishes with."""
+        return self._access
 
     # -- publishing --------------------------------------------------------------------
 
@@ -215,7 +251,8 @@ class SceneLink:
 
     def publish_raw(self, header: PoseFrameHeader, poses: np.ndarray) -> None:
         """Publishes ``poses`` (:data:`POSE_DTYPE`) under ``header`` exactly as given (its
-        version, scene and count unchecked): for tests of the daemon's frame checks."""
+        version, scene, count and frame key unchecked): for tests of the daemon's frame
+        checks."""
         poses = np.ascontiguousarray(poses, dtype=POSE_DTYPE)
         sample = self._loan_sample(len(poses))
         ctypes.memmove(sample.user_header_ptr, ctypes.addressof(header), _HEADER_BYTES)

@@ -1,29 +1,37 @@
 """Service names, settings and builders, mirroring ``ipc/src/lib.rs``.
 
-The daemon and its clients open every service with one set of settings; whichever comes
-first creates the service with them, the other opens it, where they are minimum
-requirements. These builders ask for exactly what the Rust builders set, and nothing
-else (the rest comes from iceoryx2's config defaults on both sides).
+The daemon creates every service with one set of settings: the control services when it
+starts, a scene's four when it creates the scene. Clients only open them (never create),
+where the settings they state are minimum requirements: a control service that does not
+exist means no daemon yet, a scene service that does not exist means no such scene. These
+builders ask for exactly what the Rust builders set, and nothing else (the rest comes
+from iceoryx2's config defaults on both sides).
 
-=========================================  ===========================================
-service                                    settings
-=========================================  ===========================================
-``<root>/control``                         request–response ``[u8]`` + ControlRequest
-                                           header → ControlReply; 64 clients, 1 server,
-                                           4 requests in flight, 4 buffered responses
-``<root>/control-events``                  event; 64 notifiers, 2 listeners, 66 nodes
-``<root>/<scene>/poses``                   ``[PoseRecord]`` + PoseFrameHeader; 4
-                                           publishers, 1 subscriber, buffer 2, history 0
-``<root>/<scene>/results``                 ``[ResultRecord]`` + ResultFrameHeader; 1
-                                           publisher, 8 subscribers, buffer 2, history 0
-``<root>/<scene>/poses-ready``              event; 4 notifiers, 2 listeners
-``<root>/<scene>/results-ready``            event; 2 notifiers, 8 listeners
-=========================================  ===========================================
+A scene's services are named by its :class:`SceneToken` (from its ``CreateScene`` reply),
+not by its id: ``<root>/scene-<token as 32 hex digits>/...``. Whoever holds the token can
+open them, so it is the capability to read the scene's results.
+
+======================================  =================================================
+service                                 settings
+======================================  =================================================
+``<root>/control``                      request–response ``[u8]`` + ControlRequest header
+                                        → ControlReply; 64 clients, 1 server, 66 nodes, 4
+                                        requests in flight, 4 buffered responses
+``<root>/control-events``               event; 64 notifiers, 2 listeners, 66 nodes
+``<root>/scene-<token>/poses``          ``[PoseRecord]`` + PoseFrameHeader; 4 publishers,
+                                        1 subscriber, buffer 2, history 0
+``<root>/scene-<token>/results``        ``[ResultRecord]`` + ResultFrameHeader; 1
+                                        publisher, 8 subscribers, buffer 2, history 0,
+                                        safe overflow
+``<root>/scene-<token>/poses-ready``    event; 4 notifiers, 2 listeners
+``<root>/scene-<token>/results-ready``  event; 2 notifiers, 8 listeners
+======================================  =================================================
 """
 
 from __future__ import annotations
 
 import ctypes
+from dataclasses import dataclass
 from typing import Any, Optional
 
 import iceoryx2 as iox
@@ -62,6 +70,49 @@ EVENT_RESULTS_READY: int = 2
 EVENT_CONTROL_SENT: int = 3
 #: Daemon ports on a daemon-side event service (the daemon plus a crashed predecessor).
 DAEMON_EVENT_PORTS: int = 2
+#: Nodes that may hold the control service (and the control event service) at once: one
+#: per client, plus the daemon's ports.
+CONTROL_MAX_NODES: int = CONTROL_MAX_CLIENTS + DAEMON_EVENT_PORTS
+
+_U64_MAX = (1 << 64) - 1
+
+
+@dataclass(frozen=True, repr=False)
+class SceneToken:
+    """A scene's token: 128 random bits, two u64 words from the scene's ``CreateScene``
+    reply (``ControlReply.scene_token``), that name the scene's services. Whoever holds it
+    can open them, so it is the capability to read the scene's results (sending frames
+    needs the frame key as well). ``str()`` gives its 32 hex digits; ``repr()`` does not,
+    so it stays out of logs.
+    """
+
+    words: tuple[int, int]
+
+    def __post_init__(self) -> None:
+        """Checks that there are two words, each a u64."""
+        words = tuple(int(w) for w in self.words)
+        if len(words) != 2 or not all(0 <= w <= _U64_MAX for w in words):
+            raise ValueError("a scene token is two u64 words")
+        object.__setattr__(self, "words", words)
+
+    @classmethod
+    def from_hex(cls, text: str) -> "SceneToken":
+        """The token whose :func:`str` is ``text`` (32 hex digits).
+
+        Raises:
+            ValueError: not 32 hex digits.
+        """
+        text = text.strip()
+        if len(text) != 32:
+            raise ValueError(f"a scene token is 32 hex digits, not {len(text)} characters")
+        return cls((int(text[:16], 16), int(text[16:], 16)))
+
+    def __str__(self) -> str:
+        """32 lowercase hex digits: ``words[0]``, then ``words[1]``."""
+        return f"{self.words[0]:016x}{self.words[1]:016x}"
+
+    def __repr__(self) -> str:
+        return "SceneToken(…)"
 
 
 def control_service_name(root: str) -> str:
@@ -74,24 +125,30 @@ def control_events_service_name(root: str) -> str:
     return f"{root}/control-events"
 
 
-def poses_service_name(root: str, scene: int) -> str:
-    """``<root>/<scene>/poses``."""
-    return f"{root}/{scene}/poses"
+def scene_services_name(root: str, token: SceneToken) -> str:
+    """The common prefix of the services of the scene with token ``token``:
+    ``<root>/scene-<token>``."""
+    return f"{root}/scene-{token}"
 
 
-def results_service_name(root: str, scene: int) -> str:
-    """``<root>/<scene>/results``."""
-    return f"{root}/{scene}/results"
+def poses_service_name(root: str, token: SceneToken) -> str:
+    """``<root>/scene-<token>/poses``."""
+    return f"{scene_services_name(root, token)}/poses"
 
 
-def poses_ready_service_name(root: str, scene: int) -> str:
-    """``<root>/<scene>/poses-ready``."""
-    return f"{root}/{scene}/poses-ready"
+def results_service_name(root: str, token: SceneToken) -> str:
+    """``<root>/scene-<token>/results``."""
+    return f"{scene_services_name(root, token)}/results"
 
 
-def results_ready_service_name(root: str, scene: int) -> str:
-    """``<root>/<scene>/results-ready``."""
-    return f"{root}/{scene}/results-ready"
+def poses_ready_service_name(root: str, token: SceneToken) -> str:
+    """``<root>/scene-<token>/poses-ready``."""
+    return f"{scene_services_name(root, token)}/poses-ready"
+
+
+def results_ready_service_name(root: str, token: SceneToken) -> str:
+    """``<root>/scene-<token>/results-ready``."""
+    return f"{scene_services_name(root, token)}/results-ready"
 
 
 def make_config(prefix: Optional[str] = None) -> Any:
@@ -121,7 +178,8 @@ def _service_name(name: str) -> Any:
 
 
 def control_service_builder(node: Any, root: str) -> Any:
-    """The builder of ``<root>/control`` with the daemon's settings; call ``open_or_create()``."""
+    """The builder of ``<root>/control`` with the daemon's settings (open it with
+    :func:`try_open_service`)."""
     return (
         node.service_builder(_service_name(control_service_name(root)))
         .request_response(iox.Slice[ctypes.c_uint8], ControlReply)
@@ -130,6 +188,7 @@ def control_service_builder(node: Any, root: str) -> Any:
         .max_servers(CONTROL_MAX_SERVERS)
         .max_active_requests_per_client(CONTROL_MAX_ACTIVE_REQUESTS_PER_CLIENT)
         .max_response_buffer_size(CONTROL_MAX_RESPONSE_BUFFER_SIZE)
+        .max_nodes(CONTROL_MAX_NODES)
     )
 
 
@@ -140,14 +199,14 @@ def control_events_service_builder(node: Any, root: str) -> Any:
         .event()
         .max_notifiers(CONTROL_MAX_CLIENTS)
         .max_listeners(DAEMON_EVENT_PORTS)
-        .max_nodes(CONTROL_MAX_CLIENTS + DAEMON_EVENT_PORTS)
+        .max_nodes(CONTROL_MAX_NODES)
     )
 
 
-def poses_service_builder(node: Any, root: str, scene: int) -> Any:
-    """The builder of ``<root>/<scene>/poses``."""
+def poses_service_builder(node: Any, root: str, token: SceneToken) -> Any:
+    """The builder of ``<root>/scene-<token>/poses``."""
     return (
-        node.service_builder(_service_name(poses_service_name(root, scene)))
+        node.service_builder(_service_name(poses_service_name(root, token)))
         .publish_subscribe(iox.Slice[PoseRecord])
         .user_header(PoseFrameHeader)
         .max_publishers(POSES_MAX_PUBLISHERS)
@@ -157,43 +216,55 @@ def poses_service_builder(node: Any, root: str, scene: int) -> Any:
     )
 
 
-def results_service_builder(node: Any, root: str, scene: int) -> Any:
-    """The builder of ``<root>/<scene>/results``."""
+def results_service_builder(node: Any, root: str, token: SceneToken) -> Any:
+    """The builder of ``<root>/scene-<token>/results``. Safe overflow is on (iceoryx2's
+    default, stated): a subscriber that does not read loses its oldest frames and never
+    holds the daemon up."""
     return (
-        node.service_builder(_service_name(results_service_name(root, scene)))
+        node.service_builder(_service_name(results_service_name(root, token)))
         .publish_subscribe(iox.Slice[ResultRecord])
         .user_header(ResultFrameHeader)
         .max_publishers(1)
         .max_subscribers(RESULTS_MAX_SUBSCRIBERS)
         .subscriber_max_buffer_size(FRAME_BUFFER)
         .history_size(0)
+        .enable_safe_overflow(True)
     )
 
 
-def poses_ready_service_builder(node: Any, root: str, scene: int) -> Any:
-    """The builder of ``<root>/<scene>/poses-ready``; clients notify :data:`EVENT_POSES_SENT`."""
+def poses_ready_service_builder(node: Any, root: str, token: SceneToken) -> Any:
+    """The builder of ``<root>/scene-<token>/poses-ready``; clients notify
+    :data:`EVENT_POSES_SENT`."""
     return (
-        node.service_builder(_service_name(poses_ready_service_name(root, scene)))
+        node.service_builder(_service_name(poses_ready_service_name(root, token)))
         .event()
         .max_notifiers(POSES_MAX_PUBLISHERS)
         .max_listeners(DAEMON_EVENT_PORTS)
     )
 
 
-def results_ready_service_builder(node: Any, root: str, scene: int) -> Any:
-    """The builder of ``<root>/<scene>/results-ready``; the daemon notifies
+def results_ready_service_builder(node: Any, root: str, token: SceneToken) -> Any:
+    """The builder of ``<root>/scene-<token>/results-ready``; the daemon notifies
     :data:`EVENT_RESULTS_READY`."""
     return (
-        node.service_builder(_service_name(results_ready_service_name(root, scene)))
+        node.service_builder(_service_name(results_ready_service_name(root, token)))
         .event()
         .max_notifiers(DAEMON_EVENT_PORTS)
         .max_listeners(RESULTS_MAX_SUBSCRIBERS)
     )
 
 
-def open_service(builder: Any, what: str) -> Any:
-    """``builder.open_or_create()``, its failure as a :class:`TransportError`."""
+def try_open_service(builder: Any, what: str) -> Optional[Any]:
+    """``builder.open()``: the service, or ``None`` when it does not exist (the daemon has
+    not created it, or has removed it). Clients never create a service.
+
+    Raises:
+        TransportError: any other failure (e.g. incompatible settings, too many nodes).
+    """
     try:
-        return builder.open_or_create()
+        return builder.open()
     except Exception as e:
+        # The bindings raise <Pattern>OpenError('DoesNotExist').
+        if type(e).__name__.endswith("OpenError") and e.args[:1] == ("DoesNotExist",):
+            return None
         raise TransportError(f"opening the {what}", e) from e

@@ -10,14 +10,18 @@ Units are SI (metres; times in integer nanoseconds, named ``_ns``); positions an
 orientations are in the world frame of the scene; quaternions are ``[x, y, z, w]``.
 Changing any layout or meaning requires bumping :data:`PROTOCOL_VERSION`, on both sides.
 
-=============================================  =====================  ===================
-service                                        payload                user header
-=============================================  =====================  ===================
-``<root>/<scene>/poses`` (publish–subscribe)   ``[PoseRecord]``       PoseFrameHeader
-``<root>/<scene>/results`` (publish–subscribe) ``[ResultRecord]``     ResultFrameHeader
-``<root>/control`` (request–response)          request ``[u8]``,      request:
-                                               response ControlReply  ControlRequest
-=============================================  =====================  ===================
+=====================================================  =====================  =================
+service                                                payload                user header
+=====================================================  =====================  =================
+``<root>/scene-<token>/poses`` (publish–subscribe)     ``[PoseRecord]``       PoseFrameHeader
+``<root>/scene-<token>/results`` (publish–subscribe)   ``[ResultRecord]``     ResultFrameHeader
+``<root>/control`` (request–response)                  request ``[u8]``,      request:
+                                                       response ControlReply  ControlRequest
+=====================================================  =====================  =================
+
+A scene belongs to the client port that created it: its ``CreateScene`` reply carries the
+scene's ``frame_key`` (every pose frame carries it) and ``scene_token`` (names its
+services); every reply and result header carries the daemon's ``instance`` id.
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ from typing import Any
 import numpy as np
 
 #: The protocol version; a client and a daemon whose versions differ refuse to talk.
-PROTOCOL_VERSION: int = 8
+PROTOCOL_VERSION: int = 9
 
 #: Most contact records per pair (one manifold).
 MAX_CONTACTS_PER_PAIR: int = 4
@@ -116,6 +120,11 @@ class ErrorCode(enum.IntEnum):
     MALFORMED_MESSAGE = 10
     INTERNAL = 11
     SHAPE_NOT_READY = 12
+    #: The scene belongs to another client port (only its creator may use it).
+    NOT_OWNER = 13
+    #: The daemon stopped serving the scene after a shared-memory fault; only
+    #: ``DropScene`` is accepted.
+    SCENE_QUARANTINED = 14
 
 
 class Command(enum.IntEnum):
@@ -215,7 +224,10 @@ class _Record(ctypes.Structure):
 
 
 class PoseFrameHeader(_Record):
-    """The user header of one pose frame (a ``[PoseRecord]`` sample), 32 bytes."""
+    """The user header of one pose frame (a ``[PoseRecord]`` sample), 40 bytes.
+
+    ``frame_key`` is the scene's, from its ``CreateScene`` reply: a frame with another key
+    is not answered."""
 
     _TYPE_NAME = "proxima::PoseFrameHeader"
     _fields_ = [
@@ -225,6 +237,7 @@ class PoseFrameHeader(_Record):
         ("budget_ns", _u64),
         ("query_flags", _u32),
         ("count", _u32),
+        ("frame_key", _u64),
     ]
 
 
@@ -241,7 +254,8 @@ class PoseRecord(_Record):
 
 
 class ResultFrameHeader(_Record):
-    """The user header of one result frame (a ``[ResultRecord]`` sample), 120 bytes."""
+    """The user header of one result frame (a ``[ResultRecord]`` sample), 128 bytes;
+    ``instance`` is the daemon's instance id, as in its control replies."""
 
     _TYPE_NAME = "proxima::ResultFrameHeader"
     _fields_ = [
@@ -261,6 +275,7 @@ class ResultFrameHeader(_Record):
         ("flags", _u32),
         ("dropped_candidates", _u32),
         ("min_budget_ns", _u64),
+        ("instance", _u64),
     ]
 
 
@@ -313,7 +328,12 @@ class ControlRequest(_Record):
 
 
 class ControlReply(_Record):
-    """The daemon's answer to one :class:`ControlRequest`, 128 bytes."""
+    """The daemon's answer to one :class:`ControlRequest`, 160 bytes.
+
+    ``instance`` is the daemon's instance id (random per start, never 0, in every reply);
+    a ``CreateScene`` reply also carries the new scene's secret ``frame_key`` and its
+    ``scene_token`` (two u64 words that name its services), both zero otherwise.
+    """
 
     _TYPE_NAME = "proxima::ControlReply"
     _fields_ = [
@@ -321,6 +341,9 @@ class ControlReply(_Record):
         ("status", _u32),
         ("id", _u32),
         ("flags", _u32),
+        ("instance", _u64),
+        ("frame_key", _u64),
+        ("scene_token", _u64 * 2),
         ("reason", ctypes.c_uint8 * REASON_BYTES),
     ]
 
@@ -349,12 +372,12 @@ RESULT_FRAME_HEADER_DTYPE: np.dtype = np.dtype(ResultFrameHeader)
 def _check_layouts() -> None:
     """Every ctypes structure has its Rust record's size and alignment."""
     expected = {
-        PoseFrameHeader: (32, 8),
+        PoseFrameHeader: (40, 8),
         PoseRecord: (64, 8),
-        ResultFrameHeader: (120, 8),
+        ResultFrameHeader: (128, 8),
         ResultRecord: (120, 8),
         ControlRequest: (144, 8),
-        ControlReply: (128, 4),
+        ControlReply: (160, 8),
     }
     for struct, (size, align) in expected.items():
         if ctypes.sizeof(struct) != size or ctypes.alignment(struct) != align:

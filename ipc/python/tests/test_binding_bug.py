@@ -35,9 +35,9 @@ def node() -> Iterator[object]:
 
 
 def _send_results(node: object, count: int) -> tuple[object, object]:
-    """A results service of scene 0 (the daemon's settings), a frame of ``count`` records
+    """A results service (the daemon's settings, token 0), a frame of ``count`` records
     published to it; returns (publisher, subscriber) with the frame waiting."""
-    service = services.results_service_builder(node, "bug", 0).open_or_create()
+    service = services.results_service_builder(node, "bug", services.SceneToken((0, 0))).open_or_create()
     publisher = service.publisher_builder().initial_max_slice_len(16).allocation_strategy(
         iox.AllocationStrategy.PowerOfTwo).create()
     subscriber = service.subscriber_builder().create()
@@ -69,7 +69,7 @@ def test_bindings_still_report_slice_length_in_bytes(node: object) -> None:
 
 
 def test_bindings_report_bytes_on_the_publisher_side_too(node: object) -> None:
-    service = services.poses_service_builder(node, "bug", 1).open_or_create()
+    service = services.poses_service_builder(node, "bug", services.SceneToken((0, 1))).open_or_create()
     publisher = service.publisher_builder().initial_max_slice_len(16).allocation_strategy(
         iox.AllocationStrategy.PowerOfTwo).create()
     sample = publisher.loan_slice_uninit(3)

@@ -1,10 +1,12 @@
-"""Every control command against a real daemon, and every error code a control request can
-get back, checked by exception type and code."""
+"""Every control command against a real daemon, every error code a control request can get
+back (checked by exception type and code), scene ownership between clients, and the
+daemon's instance id."""
 
 from __future__ import annotations
 
 import os
 import signal
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -30,14 +32,18 @@ from proxima_client import (
     MeshIndexOutOfRangeError,
     Motion,
     NoDaemon,
+    NotOwned,
+    NotOwnerError,
     ProtocolMismatchError,
     ReplyTimeout,
     ShapeNotReadyError,
     ShapeState,
     Sphere,
+    UnexpectedDaemon,
     UnknownBodyError,
     UnknownSceneError,
     UnknownShapeError,
+    query,
 )
 from proxima_client.client import check_reply
 from proxima_client.daemon_process import DaemonProcess
@@ -89,8 +95,9 @@ def test_a_request_in_another_protocol_version_gets_protocol_mismatch(client: Cl
         check_reply(reply)
     assert caught.value.code is ErrorCode.PROTOCOL_MISMATCH
     # The same version mismatch on a real command changes nothing.
-    assert client.request(raw(Command.CREATE_SCENE, version=PROTOCOL_VERSION + 1)).status == 1
-    assert client.create_scene() == 0
+    refused = client.request(raw(Command.CREATE_SCENE, version=PROTOCOL_VERSION + 1))
+    assert refused.status == 1 and refused.frame_key == 0 and list(refused.scene_token) == [0, 0]
+    assert client.scene_access(client.create_scene()) is not None
 
 
 # -- scenes -----------------------------------------------------------------------------
@@ -98,7 +105,7 @@ def test_a_request_in_another_protocol_version_gets_protocol_mismatch(client: Cl
 
 def test_scenes_are_created_and_dropped_and_a_dropped_scene_is_unknown(client: Client) -> None:
     a, b = client.create_scene(), client.create_scene()
-    assert a != b
+    assert a != b and U32_MAX not in (a, b)
     client.drop_scene(a)
     with pytest.raises(UnknownSceneError) as caught:
         client.drop_scene(a)
@@ -276,6 +283,95 @@ def test_a_body_with_a_nan_initial_pose_is_refused(client: Client) -> None:
     with pytest.raises(DaemonError) as caught:
         client.add_body(scene, BodySpec(shape=shape, position=(float("nan"), 0.0, 0.0)))
     assert caught.value.code is ErrorCode.INVALID_POSE
+
+
+# -- ownership --------------------------------------------------------------------------
+
+
+def test_a_second_client_gets_not_owner_on_the_first_clients_scene(daemon: DaemonProcess, client: Client) -> None:
+    scene = client.create_scene()
+    shape = client.register_primitive(scene, Sphere(0.5))
+    body = client.add_body(scene, BodySpec(shape=shape))
+    with connect(daemon) as other:
+        for command in (
+            lambda: other.register_primitive(scene, Sphere(1.0)),
+            lambda: other.shape_state(scene, shape),
+            lambda: other.add_body(scene, BodySpec(shape=shape)),
+            lambda: other.update_body(scene, body, Motion.STATIC, 1, 1, None),
+            lambda: other.remove_body(scene, body),
+            lambda: other.set_broad_phase(scene, BroadPhaseCode.AUTO),
+            lambda: other.drop_scene(scene),
+        ):
+            with pytest.raises(NotOwnerError) as caught:
+                command()
+            assert caught.value.code is ErrorCode.NOT_OWNER and str(scene) in caught.value.reason
+        # Its own scenes are its own; an id that names no scene is unknown, not foreign.
+        mine = other.create_scene()
+        other.register_primitive(mine, Sphere(1.0))
+        with pytest.raises(NotOwnerError):
+            client.drop_scene(mine)
+        with pytest.raises(UnknownSceneError):
+            other.drop_scene(next(i for i in range(3) if i not in (scene, mine)))
+    # Nothing the other client tried changed the owner's scene.
+    client.update_body(scene, body, Motion.KINEMATIC, 1, 1, None)
+    client.remove_body(scene, body)
+
+
+def test_only_the_creator_opens_a_scene_and_forgets_it_once_dropped(daemon: DaemonProcess, client: Client) -> None:
+    scene = client.create_scene()
+    access = client.scene_access(scene)
+    assert access is not None and access.scene == scene
+    assert access.frame_key != 0 and access.token.words != (0, 0)
+    assert str(access.token) not in repr(access), "the keys stay out of logs"
+    with connect(daemon) as other:
+        with pytest.raises(NotOwned) as caught:
+            other.open_scene(scene)
+        assert caught.value.scene == scene and other.scene_access(scene) is None
+    client.open_scene(scene).close()
+    client.drop_scene(scene)
+    assert client.scene_access(scene) is None
+    with pytest.raises(NotOwned):
+        client.open_scene(scene)
+
+
+# -- the daemon's instance id -----------------------------------------------------------
+
+
+def test_the_instance_id_is_the_same_in_every_reply_and_result_header(start_daemon) -> None:  # type: ignore[no-untyped-def]
+    first, second = start_daemon(), start_daemon()
+    with connect(first) as client, connect(second) as other:
+        instance = client.daemon_instance
+        assert instance != 0 and other.daemon_instance not in (0, instance)
+        assert client.request(raw(Command.HELLO)).instance == instance
+        refused = client.request(raw(Command.SHAPE_STATE, scene=7))
+        assert refused.status == ErrorCode.UNKNOWN_SCENE and refused.instance == instance
+        scene = client.create_scene()
+        access = client.scene_access(scene)
+        assert access is not None and access.instance == instance
+        shape = client.register_primitive(scene, Sphere(0.5))
+        body = client.add_body(scene, BodySpec(shape=shape))
+        with client.open_scene(scene) as link:
+            link.publish(1, 0, query.CLOSE, [body], [(0.0, 0.0, 0.0)])
+            frame = link.receive_results_for(1, REPLY_TIMEOUT)
+            assert frame is not None
+            with frame:
+                frame.raise_for_status()
+                assert frame.header.instance == instance
+
+
+def test_expect_instance_connects_only_to_that_daemon(start_daemon, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    path = tmp_path / "instance"
+    daemon = start_daemon(["--instance-file", str(path)])
+    with connect(daemon) as client:
+        # Written before the daemon serves, so before Hello is answered.
+        instance = int(path.read_text().strip(), 16)
+        assert instance == client.daemon_instance
+    assert path.stat().st_mode & 0o777 == 0o600
+    with connect(daemon, expect_instance=instance) as same:
+        assert same.daemon_instance == instance
+    with pytest.raises(UnexpectedDaemon) as caught:
+        connect(daemon, expect_instance=instance ^ 1)
+    assert caught.value.instance == instance
 
 
 # -- the daemon going away --------------------------------------------------------------

@@ -1,5 +1,6 @@
 """Pose frames published from numpy, result frames read as structured arrays, checked
-against analytic answers; every error a frame's status can carry."""
+against analytic answers; every error a frame's status can carry; frames without the
+scene's frame key, and monitors reading a scene's results by its token."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
-from support import FRAME_TIMEOUT
+from support import FRAME_TIMEOUT, connect
 
 from proxima_client import (
     POSE_DTYPE,
@@ -20,11 +21,16 @@ from proxima_client import (
     InvalidPoseError,
     MalformedMessageError,
     Motion,
+    NoSuchScene,
+    NotOwned,
+    NotOwnerError,
     PoseFrameHeader,
     ProtocolMismatchError,
     RecordKind,
     ResultFrame,
+    SceneAccess,
     SceneLink,
+    SceneToken,
     Sphere,
     TransportError,
     UnknownBodyError,
@@ -32,7 +38,12 @@ from proxima_client import (
     pose_array,
     query,
 )
+from proxima_client.daemon_process import DaemonProcess
+from proxima_client.transport import now
 from proxima_client.wire import PROTOCOL_VERSION, U32_MAX
+
+#: How long a test waits to be sure a frame is not answered, s.
+UNANSWERED_WAIT = 0.5
 
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
@@ -301,7 +312,8 @@ def test_raw_frames_with_a_bad_count_version_or_scene_are_refused(client: Client
 
     def header(seq: int, **fields: int) -> PoseFrameHeader:
         h = PoseFrameHeader(protocol_version=PROTOCOL_VERSION, scene=s.scene, frame_seq=seq,
-                            budget_ns=0, query_flags=query.CLOSE, count=1)
+                            budget_ns=0, query_flags=query.CLOSE, count=1,
+                            frame_key=s.link.access.frame_key)
         for name, value in fields.items():
             setattr(h, name, value)
         return h
@@ -312,7 +324,7 @@ def test_raw_frames_with_a_bad_count_version_or_scene_are_refused(client: Client
     with _raw_answer(s, header(2, protocol_version=PROTOCOL_VERSION + 1), poses) as frame:
         with pytest.raises(ProtocolMismatchError):
             frame.raise_for_status()
-    with _raw_answer(s, header(3, scene=s.scene + 5), poses) as frame:
+    with _raw_answer(s, header(3, scene=(s.scene + 5) & U32_MAX), poses) as frame:
         with pytest.raises(UnknownSceneError):
             frame.raise_for_status()
     with _raw_answer(s, header(4), poses) as frame:
@@ -338,3 +350,69 @@ def test_static_bodies_never_pair_with_each_other(client: Client) -> None:
     link = client.open_scene(scene)
     with answer(link, 1, query.OVERLAP, [c], [(0.0, 0.5, 0.0)]) as frame:
         assert sorted((int(p["body_a"]), int(p["body_b"])) for p in frame.pairs) == [(a, c), (b, c)]
+
+
+# -- frame keys and tokens --------------------------------------------------------------
+
+
+def test_a_frame_without_the_scenes_frame_key_is_not_answered_and_changes_nothing(
+    daemon: DaemonProcess, client: Client
+) -> None:
+    s = spheres(client, [0.5, 0.5], [(0.0, 0.0, 0.0), (5.0, 0.0, 0.0)], margin=0.0)
+    access = s.link.access
+    # Another client that learned the token, not the frame key, publishes to the scene.
+    forged = SceneAccess(scene=s.scene, token=access.token, frame_key=access.frame_key ^ 1,
+                         instance=access.instance)
+    with connect(daemon) as intruder, SceneLink(intruder.node, intruder.root, forged) as link:
+        link.publish(1, 0, query.CLOSE, s.bodies[1:], [(0.9, 0.0, 0.0)])  # would touch body 0
+        assert link.receive_results_for(1, UNANSWERED_WAIT) is None
+    assert s.link.receive_results_for(1, UNANSWERED_WAIT) is None
+    # The owner's next frame is answered, and body 1 is still where the owner put it.
+    with answer(s.link, 2, query.CLOSE, s.bodies[:1], [(0.0, 0.0, 0.0)]) as frame:
+        frame.raise_for_status()
+        assert len(frame.pairs) == 0
+    # The same with the owner's own link and a raw header carrying another key.
+    header = PoseFrameHeader(protocol_version=PROTOCOL_VERSION, scene=s.scene, frame_seq=3, budget_ns=0,
+                             query_flags=query.CLOSE, count=1, frame_key=access.frame_key + 1)
+    s.link.publish_raw(header, pose_array(s.bodies[1:], [(0.9, 0.0, 0.0)]))
+    assert s.link.receive_results_for(3, UNANSWERED_WAIT) is None
+    with answer(s.link, 4, query.CLOSE, s.bodies[:1], [(0.0, 0.0, 0.0)]) as frame:
+        assert frame.ok and len(frame.pairs) == 0
+
+
+def test_a_monitor_opens_the_results_with_the_owners_token_and_sees_the_owners_frames(
+    daemon: DaemonProcess, client: Client
+) -> None:
+    s = spheres(client, [0.5, 0.5], [(0.0, 0.0, 0.0), (0.9, 0.0, 0.0)], margin=0.0)
+    token = s.link.access.token
+    with connect(daemon) as monitor, monitor.open_result_feed(token) as feed:
+        with answer(s.link, 1, query.CLOSE | query.CONTACTS, s.bodies, [(0.0, 0.0, 0.0), (0.9, 0.0, 0.0)]) as frame:
+            owners = frame.copy()
+        seen = feed.receive_for(1, FRAME_TIMEOUT)
+        assert seen is not None
+        with seen:
+            assert seen.header.instance == monitor.daemon_instance == client.daemon_instance
+            assert (seen.header.pair_count, seen.header.contact_count) == (1, 1)
+            assert seen.records.tobytes() == owners.records.tobytes()
+        # Reading is all the token allows.
+        with pytest.raises(NotOwned):
+            monitor.open_scene(s.scene)
+        with pytest.raises(NotOwnerError):
+            monitor.drop_scene(s.scene)
+
+
+def test_a_token_no_scene_has_opens_nothing(client: Client) -> None:
+    with pytest.raises(NoSuchScene):
+        client.open_result_feed(SceneToken((1, 2)))
+    scene = client.create_scene()
+    token = client.scene_access(scene).token  # type: ignore[union-attr]
+    client.open_result_feed(token).close()
+    client.drop_scene(scene)
+    # The daemon lets go of the scene's services after the reply: wait for them to go.
+    deadline = now() + FRAME_TIMEOUT
+    while True:
+        try:
+            client.open_result_feed(token).close()
+        except NoSuchScene:
+            break
+        assert now() < deadline, "the dropped scene's services outlived it"

@@ -1,5 +1,6 @@
 """A Python client killed without a chance to clean up loses its scenes after the daemon's
-grace period, while a live client's scenes stay."""
+grace period, while a live client's scenes stay; a killed daemon is told by a scene's
+result wait."""
 
 from __future__ import annotations
 
@@ -11,7 +12,8 @@ import time
 import pytest
 from support import connect
 
-from proxima_client import Sphere, UnknownSceneError
+from proxima_client import BodySpec, DaemonLost, NotOwnerError, Sphere, UnknownSceneError, query
+from proxima_client.daemon_process import DaemonProcess
 from proxima_client.transport import now
 
 GRACE_MS = 200
@@ -44,8 +46,9 @@ def test_a_killed_clients_scene_is_dropped_after_the_grace_and_a_live_ones_is_ke
     try:
         orphan = int(_read_line(child, 30.0))
         assert orphan != kept
-        # Alive and served while its creator lives.
-        survivor.register_primitive(orphan, Sphere(1.0))
+        # Alive while its creator lives: another client is refused as not its owner.
+        with pytest.raises(NotOwnerError):
+            survivor.register_primitive(orphan, Sphere(1.0))
         child.kill()
         child.wait()
         started = now()
@@ -53,6 +56,8 @@ def test_a_killed_clients_scene_is_dropped_after_the_grace_and_a_live_ones_is_ke
         while True:
             try:
                 survivor.register_primitive(orphan, Sphere(1.0))
+            except NotOwnerError:
+                pass
             except UnknownSceneError as e:
                 assert str(orphan) in e.reason
                 break
@@ -69,3 +74,20 @@ def test_a_killed_clients_scene_is_dropped_after_the_grace_and_a_live_ones_is_ke
     survivor.register_primitive(kept, Sphere(1.0))
     survivor.close()
 
+
+
+def test_a_result_wait_on_a_killed_daemons_scene_raises_daemon_lost(daemon: DaemonProcess) -> None:
+    client = connect(daemon)
+    scene = client.create_scene()
+    body = client.add_body(scene, BodySpec(shape=client.register_primitive(scene, Sphere(0.5))))
+    link = client.open_scene(scene)
+    link.publish(1, 0, query.CLOSE, [body], [(0.0, 0.0, 0.0)])
+    frame = link.receive_results_for(1, 10.0)
+    assert frame is not None
+    frame.release()
+    assert link.receive_results(0.05) is None  # alive: no frame is no error
+    daemon.kill()
+    with pytest.raises(DaemonLost):
+        link.receive_results(0.05)
+    link.close()
+    client.close()

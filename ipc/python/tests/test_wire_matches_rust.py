@@ -87,6 +87,27 @@ def test_constants_match() -> None:
                  "EVENT_CONTROL_SENT", "DAEMON_EVENT_PORTS"):
         assert getattr(services, name) == _rust_const(LIB_RS, name), name
     assert f'"{services.DEFAULT_ROOT}"' in re.search(r"pub const DEFAULT_ROOT: &str = (.*);", LIB_RS).group(1)
+    # Not a literal in lib.rs: one node per client plus the daemon's ports.
+    assert "pub const CONTROL_MAX_NODES: usize = CONTROL_MAX_CLIENTS + DAEMON_EVENT_PORTS;" in LIB_RS
+    assert services.CONTROL_MAX_NODES == services.CONTROL_MAX_CLIENTS + services.DAEMON_EVENT_PORTS
+
+
+def test_scene_services_are_named_by_the_token_as_in_rust() -> None:
+    # The same token and names as `scene_services_live_under_the_root_and_the_scene_token`
+    # in ipc/src/tests.rs.
+    token = services.SceneToken((0x0123_4567_89AB_CDEF, 0xFE))
+    assert services.poses_service_name("proxima", token) == "proxima/scene-0123456789abcdef00000000000000fe/poses"
+    assert services.results_service_name("t-1", token) == "t-1/scene-0123456789abcdef00000000000000fe/results"
+    assert services.poses_ready_service_name("r", token).endswith("/poses-ready")
+    assert services.results_ready_service_name("r", token).endswith("/results-ready")
+    assert 'format!("{root}/scene-{token}")' in LIB_RS
+    assert 'write!(f, "{:016x}{:016x}", self.0[0], self.0[1])' in LIB_RS
+    assert services.SceneToken.from_hex(str(token)) == token
+    assert "0123" not in repr(token), "tokens stay out of logs"
+    with pytest.raises(ValueError):
+        services.SceneToken((1 << 64, 0))
+    with pytest.raises(ValueError):
+        services.SceneToken.from_hex("abc")
 
 
 RECORDS = [wire.PoseFrameHeader, wire.PoseRecord, wire.ResultFrameHeader, wire.ResultRecord,

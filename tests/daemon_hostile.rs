@@ -1,0 +1,394 @@
+//! A hostile client against the real `proximad`, over real shared memory (issue #31's
+//! attacks): each test asserts that the daemon stays up, the victim keeps being served,
+//! the attacker gets its code, and nothing of the victim's changes.
+//!
+//! The attacker runs as another process where the attack is a client's: this test binary
+//! re-executed with [`ATTACKER_ROLE`] set runs only `attacker_role`, which attacks the scene
+//! named in the variable and prints one line per step (`CODE <step> <error code>`,
+//! `SENT <step>`), then `DONE`.
+//!
+//! Same-user limits (README "Who can use the daemon"): iceoryx2 0.10 lets any process of
+//! the daemon's user list services, so the attacker here learns the victim's scene token
+//! that way, as a real one could. What it cannot learn is the frame key, and ownership does
+//! not depend on either.
+
+#[path = "support/daemon.rs"]
+mod daemon_harness;
+
+use daemon_harness::{Daemon, body, pose_at};
+use iceoryx2::prelude::*;
+use proxima_ipc::client::{Client, ClientBuilder, Motion, Primitive};
+use proxima_ipc::error::{ControlError, FrameReceiveError};
+use proxima_ipc::scene_link::SceneLink;
+use proxima_ipc::wire::{
+    BroadPhaseCode, ErrorCode, PoseFrameHeader, ResultFrameHeader, ResultRecord, query,
+};
+use proxima_ipc::{EVENT_POSES_SENT, PROTOCOL_VERSION, SceneToken};
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+const TIMEOUT: Duration = Duration::from_secs(10);
+/// Environment variable that turns this binary into the attacker (its value: the daemon's
+/// root and prefix and the victim's scene id, separated by spaces).
+const ATTACKER_ROLE: &str = "PROXIMA_HOSTILE_ATTACKER";
+
+/// The victim: a scene of two unit spheres (bodies 0 and 1) overlapping by 0.1 m, and its
+/// frame link.
+struct Victim {
+    client: Client<ipc::Service>,
+    scene: u32,
+    link: SceneLink<ipc::Service>,
+    seq: u64,
+}
+
+impl Victim {
+    fn new(daemon: &Daemon) -> Self {
+        let client = daemon.client();
+        let scene = client.create_scene().unwrap();
+        let sphere = client
+            .register_primitive(scene, Primitive::Sphere { radius: 0.5 })
+            .unwrap();
+        for x in [0.0, 0.9] {
+            client.add_body(scene, &body(sphere, x)).unwrap();
+        }
+        let link = client.open_scene(scene).unwrap();
+        Self {
+            client,
+            scene,
+            link,
+            seq: 0,
+        }
+    }
+
+    /// One frame (body 1 left where it is): answered Ok, with the one pair at −0.1 m, so
+    /// neither its bodies, poses nor masks were changed.
+    fn assert_untouched(&mut self) {
+        self.seq += 1;
+        let seq = self.seq;
+        self.link
+            .publish_poses(seq, 2_000_000, query::CLOSE, &[pose_at(1, 0.9)])
+            .unwrap();
+        let frame = self
+            .link
+            .receive_results_for(seq, TIMEOUT)
+            .unwrap()
+            .unwrap_or_else(|| panic!("victim frame {seq} answered"));
+        let header = frame.header();
+        assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
+        assert_eq!(header.instance, self.client.daemon_instance());
+        let pairs = frame.pairs();
+        assert_eq!(pairs.len(), 1, "frame {seq}: the victim's pair");
+        assert_eq!((pairs[0].body_a, pairs[0].body_b), (0, 1));
+        assert!(
+            (pairs[0].distance + 0.1).abs() < 1e-12,
+            "{}",
+            pairs[0].distance
+        );
+    }
+}
+
+/// The token of the only scene served under `root`, found the way any process of the
+/// daemon's user can: by listing iceoryx2's services.
+fn listed_token(root: &str, prefix: &str) -> SceneToken {
+    let config = config_with_prefix(prefix);
+    let head = format!("{root}/scene-");
+    let mut found = None;
+    ipc::Service::list(&config, |service| {
+        let name = service.static_details.name().to_string();
+        if let Some(rest) = name.strip_prefix(&head)
+            && let Some((token, _)) = rest.split_once('/')
+        {
+            found = token.parse().ok();
+        }
+        CallbackProgression::Continue
+    })
+    .unwrap();
+    found.expect("the victim's services are listed")
+}
+
+fn config_with_prefix(prefix: &str) -> iceoryx2::config::Config {
+    let mut config = iceoryx2::config::Config::global_config().clone();
+    config.global.prefix = FileName::new(prefix.as_bytes()).unwrap();
+    config
+}
+
+/// The attacker (only when spawned with [`ATTACKER_ROLE`]; otherwise it returns at once):
+/// every command on the victim's scene, then a forged pose frame on its pose service.
+#[test]
+fn attacker_role() {
+    let Ok(spec) = std::env::var(ATTACKER_ROLE) else {
+        return;
+    };
+    let mut words = spec.split(' ');
+    let (root, prefix) = (words.next().unwrap(), words.next().unwrap());
+    let scene: u32 = words.next().unwrap().parse().unwrap();
+    let client = ClientBuilder::new()
+        .root(root)
+        .iceoryx_prefix(prefix)
+        .reply_timeout(TIMEOUT)
+        .connect::<ipc::Service>()
+        .expect("the attacker connects");
+    let mut out = std::io::stdout().lock();
+    let mut report = |step: &str, result: Result<(), ControlError>| {
+        let code = match result {
+            Ok(()) => "Ok".to_owned(),
+            Err(ControlError::Rejected { code, .. }) => format!("{code:?}"),
+            Err(e) => format!("{e:?}"),
+        };
+        writeln!(out, "CODE {step} {code}").unwrap();
+    };
+    let sphere = Primitive::Sphere { radius: 9.0 };
+    report(
+        "register",
+        client.register_primitive(scene, sphere).map(drop),
+    );
+    report("add", client.add_body(scene, &body(0, 5.0)).map(drop));
+    report(
+        "update",
+        client.update_body(scene, 1, Motion::Static, 0, 0, None),
+    );
+    report("remove", client.remove_body(scene, 1));
+    let grid = BroadPhaseCode::HashGrid;
+    report("params", client.set_broad_phase(scene, grid));
+    report("state", client.shape_state(scene, 0).map(drop));
+    report("drop", client.drop_scene(scene));
+    let open = client
+        .open_scene(scene)
+        .map(drop)
+        .map_err(|e| format!("{e:?}"));
+    writeln!(out, "OPEN {open:?}").unwrap();
+    // A forged frame on the victim's own pose service, found by listing: it would move body 1
+    // away and, with every flag, cost the daemon work.
+    forge_frame(client.node(), root, listed_token(root, prefix), scene);
+    writeln!(out, "SENT forged\nDONE").unwrap();
+    out.flush().unwrap();
+}
+
+/// Publishes a pose frame on the scene with token `token` without its frame key.
+fn forge_frame(node: &Node<ipc::Service>, root: &str, token: SceneToken, scene: u32) {
+    let poses = proxima_ipc::poses_service_builder(node, root, token)
+        .unwrap()
+        .open()
+        .unwrap();
+    let publisher = poses.publisher_builder().create().unwrap();
+    let ready = proxima_ipc::poses_ready_service_builder(node, root, token)
+        .unwrap()
+        .open()
+        .unwrap();
+    let notifier = ready.notifier_builder().create().unwrap();
+    for guess in [0, 1, u64::MAX] {
+        let mut sample = publisher.loan_slice_uninit(1).unwrap();
+        *sample.user_header_mut() = PoseFrameHeader {
+            protocol_version: PROTOCOL_VERSION,
+            scene,
+            frame_seq: 1_000_000 + guess % 7,
+            budget_ns: 0,
+            query_flags: query::ALL,
+            count: 1,
+            frame_key: guess,
+        };
+        sample.write_from_fn(|_| pose_at(1, 50.0)).send().unwrap();
+        notifier
+            .notify_with_custom_event_id(EventId::new(EVENT_POSES_SENT))
+            .unwrap();
+    }
+}
+
+/// Runs the attacker process against `victim`'s scene; returns its output lines.
+fn run_attacker(daemon: &Daemon, scene: u32) -> Vec<String> {
+    let child = Command::new(std::env::current_exe().unwrap())
+        .args([
+            "attacker_role",
+            "--exact",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env(
+            ATTACKER_ROLE,
+            format!("{} {} {scene}", daemon.root(), daemon.prefix()),
+        )
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the attacker starts");
+    let output = child.wait_with_output().expect("the attacker ends");
+    assert!(output.status.success(), "the attacker failed");
+    BufReader::new(output.stdout.as_slice())
+        .lines()
+        .map_while(Result::ok)
+        .map(|line| match line.find("CODE ").or(line.find("OPEN ")) {
+            // libtest may have printed `test attacker_role ... ` on the same line.
+            Some(start) => line[start..].to_owned(),
+            None => line,
+        })
+        .collect()
+}
+
+#[test]
+fn another_clients_commands_and_frames_are_refused_and_change_nothing() {
+    let daemon = Daemon::start();
+    let mut victim = Victim::new(&daemon);
+    victim.assert_untouched();
+    let lines = run_attacker(&daemon, victim.scene);
+    for step in [
+        "register", "add", "update", "remove", "params", "state", "drop",
+    ] {
+        let expected = format!("CODE {step} NotOwner");
+        assert!(lines.contains(&expected), "{expected} not in {lines:?}");
+    }
+    let open = format!("OPEN Err({:?})", format!("NotOwned({})", victim.scene));
+    assert!(lines.contains(&open), "{open} not in {lines:?}");
+    assert!(lines.iter().any(|l| l.ends_with("DONE")), "{lines:?}");
+    // The forged frames were not answered to the victim and moved nothing; its scene,
+    // bodies, shapes and masks are as they were.
+    victim.assert_untouched();
+    if let Some(frame) = victim.link.try_receive_results().unwrap() {
+        panic!("an unasked frame reached the victim: {:?}", frame.header());
+    }
+    let shape = victim
+        .client
+        .register_primitive(victim.scene, Primitive::Sphere { radius: 0.1 })
+        .unwrap();
+    assert_eq!(shape, 1, "the attacker registered no shape");
+    assert_eq!(
+        victim.client.add_body(victim.scene, &body(shape, 40.0)),
+        Ok(2),
+        "the attacker added no body"
+    );
+    victim.assert_untouched();
+}
+
+#[test]
+fn a_subscriber_that_never_reads_never_holds_the_daemon_up() {
+    let daemon = Daemon::start();
+    let mut victim = Victim::new(&daemon);
+    // Another process of the same user finds the results service and subscribes, with the
+    // largest buffer it may, then never reads.
+    let config = config_with_prefix(daemon.prefix());
+    let node = NodeBuilder::new()
+        .config(&config)
+        .create::<ipc::Service>()
+        .unwrap();
+    let token = listed_token(daemon.root(), daemon.prefix());
+    let results = node
+        .service_builder(
+            &proxima_ipc::results_service_name(daemon.root(), token)
+                .as_str()
+                .try_into()
+                .unwrap(),
+        )
+        .publish_subscribe::<[ResultRecord]>()
+        .user_header::<ResultFrameHeader>()
+        .open()
+        .unwrap();
+    assert!(results.static_config().has_safe_overflow());
+    let _idle = results
+        .subscriber_builder()
+        .buffer_size(proxima_ipc::FRAME_BUFFER)
+        .create()
+        .unwrap();
+    // Many more frames than any buffer holds: each is answered (a blocked publisher would
+    // answer none past the buffer).
+    for _ in 0..200 {
+        victim.assert_untouched();
+    }
+}
+
+#[test]
+fn a_control_service_served_or_set_up_by_another_process_stops_the_daemon_at_start() {
+    let daemon = Daemon::start();
+    // Serving: a client is answered.
+    let mut victim = Victim::new(&daemon);
+    let config = config_with_prefix(daemon.prefix());
+    let impostor = NodeBuilder::new()
+        .config(&config)
+        .create::<ipc::Service>()
+        .unwrap();
+    // The real daemon serves `root`; a second one on the same root must refuse, not join.
+    let second = Command::new(env!("CARGO_BIN_EXE_proximad"))
+        .args(["--root", daemon.root(), "--iceoryx-prefix", daemon.prefix()])
+        .output()
+        .expect("proximad runs");
+    assert!(!second.status.success());
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert!(stderr.contains("already serve"), "{stderr}");
+    // A root whose control service someone else created with room for a second server.
+    let root = format!("{}-squatted", daemon.root());
+    let _squatter = proxima_ipc::control_service_builder(&impostor, &root)
+        .unwrap()
+        .max_servers(2)
+        .create()
+        .unwrap();
+    let refused = Command::new(env!("CARGO_BIN_EXE_proximad"))
+        .args(["--root", &root, "--iceoryx-prefix", daemon.prefix()])
+        .output()
+        .expect("proximad runs");
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(stderr.contains("max_servers 2"), "{stderr}");
+    // The running daemon was not disturbed by either.
+    victim.assert_untouched();
+    Victim::new(&daemon).assert_untouched();
+}
+
+#[test]
+fn nodes_held_on_the_control_service_do_not_lock_new_clients_out() {
+    let daemon = Daemon::start();
+    let mut first = Victim::new(&daemon);
+    let config = config_with_prefix(daemon.prefix());
+    let name = proxima_ipc::control_service_name(daemon.root());
+    // Thirty nodes each holding the control service and its event service (iceoryx2's
+    // default limit was 20 nodes per service).
+    let held: Vec<_> = (0..30)
+        .map(|_| {
+            let node = NodeBuilder::new()
+                .config(&config)
+                .create::<ipc::Service>()
+                .unwrap();
+            let control = proxima_ipc::control_service_builder(&node, daemon.root())
+                .unwrap()
+                .open()
+                .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+            let events = proxima_ipc::control_events_service_builder(&node, daemon.root())
+                .unwrap()
+                .open()
+                .unwrap();
+            (control, events, node)
+        })
+        .collect();
+    let mut victim = Victim::new(&daemon);
+    victim.assert_untouched();
+    first.assert_untouched();
+    drop(held);
+}
+
+#[test]
+fn a_restarted_daemon_answers_no_old_frame_and_old_clients_learn_it_is_lost() {
+    let mut daemon = Daemon::start();
+    let mut old = Victim::new(&daemon);
+    old.assert_untouched();
+    let old_token = old.client.scene_access(old.scene).unwrap().token;
+    daemon.kill();
+    daemon.restart();
+    let mut new = Victim::new(&daemon);
+    new.assert_untouched();
+    assert_ne!(new.client.daemon_instance(), old.client.daemon_instance());
+    // The old client's frame goes to services no daemon serves: never answered, and the
+    // wait ends with a lost daemon, not an answer from the new one.
+    old.link
+        .publish_poses(99, 0, query::CLOSE, &[pose_at(1, 50.0)])
+        .unwrap();
+    assert_eq!(
+        old.link
+            .receive_results_for(99, Duration::from_millis(300))
+            .err(),
+        Some(FrameReceiveError::DaemonLost)
+    );
+    assert_eq!(
+        old.client.add_body(old.scene, &body(0, 1.0)),
+        Err(ControlError::DaemonLost)
+    );
+    // The new scene has other services and kept its bodies where they were.
+    assert_ne!(new.client.scene_access(new.scene).unwrap().token, old_token);
+    new.assert_untouched();
+}
