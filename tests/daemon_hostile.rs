@@ -392,3 +392,65 @@ fn a_restarted_daemon_answers_no_old_frame_and_old_clients_learn_it_is_lost() {
     assert_ne!(new.client.scene_access(new.scene).unwrap().token, old_token);
     new.assert_untouched();
 }
+
+#[test]
+fn reserved_fields_bad_coordinates_and_oversized_headers_get_their_codes_before_any_work() {
+    use proxima_ipc::wire::{Command, ControlRequest, ShapeKindCode};
+    let daemon = Daemon::start();
+    let mut victim = Victim::new(&daemon);
+    let attacker = daemon.client();
+    let scene = attacker.create_scene().unwrap();
+    let code = |reply: proxima_ipc::wire::ControlReply| ErrorCode::from_u32(reply.status);
+    // A reserved field set: refused, whatever the command.
+    let reserved = ControlRequest {
+        protocol_version: PROTOCOL_VERSION,
+        command: Command::Hello as u32,
+        reserved: 1,
+        ..ControlRequest::default()
+    };
+    let reply = attacker.request(&reserved, &[]).unwrap();
+    assert_eq!(code(reply), Some(ErrorCode::MalformedMessage));
+    // A mesh header far over the limits (10^7 triangles) with a tiny payload: refused for
+    // the limit from the header alone, before its payload is even measured.
+    let oversized = ControlRequest {
+        protocol_version: PROTOCOL_VERSION,
+        command: Command::RegisterShape as u32,
+        scene,
+        shape_kind: ShapeKindCode::Mesh as u32,
+        vertex_count: 3,
+        index_count: 30_000_000,
+        ..ControlRequest::default()
+    };
+    let reply = attacker.request(&oversized, &[0; 64]).unwrap();
+    assert_eq!(code(reply), Some(ErrorCode::LimitExceeded));
+    // A convex point beyond the coordinate limit is a bad shape, not a size limit.
+    let far = attacker.register_convex(scene, &[[0.0; 3], [1e300, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    assert!(
+        matches!(
+            far,
+            Err(ControlError::Rejected {
+                code: ErrorCode::InvalidShape,
+                ..
+            })
+        ),
+        "{far:?}"
+    );
+    // A pose record whose reserved field is set: the frame is refused, naming the body.
+    let link = attacker.open_scene(scene).unwrap();
+    let sphere = attacker
+        .register_primitive(scene, Primitive::Sphere { radius: 0.5 })
+        .unwrap();
+    let body_id = attacker.add_body(scene, &body(sphere, 0.0)).unwrap();
+    let record = proxima_ipc::wire::PoseRecord {
+        reserved: 7,
+        ..pose_at(body_id, 3.0)
+    };
+    link.publish_poses(1, 0, query::CLOSE, &[record]).unwrap();
+    let frame = link.receive_results_for(1, TIMEOUT).unwrap().unwrap();
+    assert_eq!(
+        ErrorCode::from_u32(frame.header().status),
+        Some(ErrorCode::MalformedMessage)
+    );
+    assert_eq!(frame.header().error_body, body_id);
+    victim.assert_untouched();
+}

@@ -170,7 +170,8 @@ pub enum ErrorCode {
     /// A pose has a NaN or infinite coordinate, a coordinate beyond the limit, or a
     /// quaternion that is not unit length.
     InvalidPose = 5,
-    /// A primitive shape's dimensions are NaN, infinite, negative or out of range.
+    /// A primitive shape's dimensions are NaN, infinite, negative or out of range, or a
+    /// convex or mesh point has a NaN, infinite or out-of-range coordinate.
     InvalidShape = 6,
     /// A mesh index points past the vertex list.
     MeshIndexOutOfRange = 7,
@@ -178,7 +179,8 @@ pub enum ErrorCode {
     EmptyGeometry = 8,
     /// Geometry, bodies or scenes beyond the daemon's configured limits.
     LimitExceeded = 9,
-    /// A header's counts disagree with its payload, or a field has an undefined value.
+    /// A header's counts disagree with its payload, a field has an undefined value, or a
+    /// `reserved` field is not 0 (checked since protocol version 9).
     MalformedMessage = 10,
     /// The daemon failed internally (logged); the request may be retried.
     Internal = 11,

@@ -147,6 +147,12 @@ impl ControlState {
                 ),
             ));
         }
+        if request.reserved != 0 {
+            return Err(Rejection::new(
+                ErrorCode::MalformedMessage,
+                "the reserved field is not 0",
+            ));
+        }
         let Some(command) = Command::from_u32(request.command) else {
             return Err(Rejection::new(
                 ErrorCode::MalformedMessage,

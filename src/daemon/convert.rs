@@ -186,13 +186,7 @@ fn mesh_request(
     payload_len: usize,
     limits: &MeshLimits,
 ) -> Result<ShapeRequest, Rejection> {
-    check_payload_len(request.vertex_count, request.index_count, payload_len)?;
-    if !request.index_count.is_multiple_of(3) {
-        return Err(Rejection::new(
-            ErrorCode::MalformedMessage,
-            "mesh indices are not a multiple of 3",
-        ));
-    }
+    // The limits first, from the header alone: nothing sized by the client is touched.
     let (vertices, triangles) = (
         request.vertex_count as usize,
         request.index_count as usize / 3,
@@ -204,6 +198,13 @@ fn mesh_request(
                 "{vertices} vertices and {triangles} triangles, the limits are {} and {}",
                 limits.max_vertices, limits.max_triangles
             ),
+        ));
+    }
+    check_payload_len(request.vertex_count, request.index_count, payload_len)?;
+    if !request.index_count.is_multiple_of(3) {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            "mesh indices are not a multiple of 3",
         ));
     }
     Ok(ShapeRequest::Geometry(GeometryRequest {
@@ -255,10 +256,13 @@ fn convex(points: &[DVec3]) -> Result<Shape, Rejection> {
     ConvexPolyhedron::try_from_points(points)
         .map(|hull| Shape::Convex(Arc::new(hull)))
         .map_err(|e| {
+            // A coordinate beyond the limit is a bad shape, not a size limit (the number of
+            // points was checked against the limit before decoding).
             let code = match e {
                 ConvexHullError::Empty => ErrorCode::EmptyGeometry,
-                ConvexHullError::TooLarge { .. } => ErrorCode::LimitExceeded,
-                _ => ErrorCode::InvalidShape,
+                ConvexHullError::NonFinite { .. } | ConvexHullError::TooLarge { .. } => {
+                    ErrorCode::InvalidShape
+                }
             };
             Rejection::new(code, e.to_string())
         })

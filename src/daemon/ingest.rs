@@ -79,6 +79,13 @@ pub fn apply_pose_frame(
     validated.clear();
     for record in records {
         let id = BodyId(record.body);
+        if record.reserved != 0 {
+            return refuse(
+                ErrorCode::MalformedMessage,
+                format!("pose of body {}: reserved field is not 0", record.body),
+                Some(record.body),
+            );
+        }
         if scene.body(id).is_none() {
             return refuse(
                 ErrorCode::UnknownBody,
