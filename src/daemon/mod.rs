@@ -58,6 +58,10 @@ mod shared_scene;
 mod stop;
 mod wait;
 
+#[cfg(test)]
+#[path = "fuzz_tests.rs"]
+mod fuzz_tests;
+
 pub use config::DaemonConfig;
 pub use convert::Rejection;
 pub use error::{DaemonRunError, DaemonStartError};
