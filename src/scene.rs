@@ -6,8 +6,11 @@
 //! per scene and the pipeline reads each frame; it does no collision work itself beyond
 //! keeping each body's world-space bounding box current for the broad phase.
 //!
-//! Ids are scoped to their scene and never reused while the scene lives (DESIGN §9: no
-//! assumption that would block splitting scenes across daemons).
+//! Ids are scoped to their scene (DESIGN §9: no assumption that would block splitting
+//! scenes across daemons). Shape ids are never reused; a removed body's id is, by the next
+//! body added, so a scene's tables stay as large as its most bodies alive at once, however
+//! many come and go. Readers that keep answers per body tell a new body in an old slot by
+//! its [`Body::version`], which never repeats within a scene.
 //!
 //! # Frames and motion
 //! A scene counts the frames answered over it ([`Scene::end_frame`], called once a frame's
@@ -29,7 +32,8 @@
 //! # Invariants
 //! Checked by [`Scene::validate`]: every live body names a registered shape; its world box
 //! is its shape's local box moved by its pose; no body's frame stamps are ahead of the
-//! scene's frame count; the count of live bodies matches.
+//! scene's frame count; the count of live bodies matches; the free slots are exactly the
+//! empty ones.
 
 use crate::bounding::{Aabb, BoundingVolume};
 pub use crate::broad::CollisionFilter;
@@ -203,9 +207,12 @@ pub struct Scene {
     shapes: Vec<Shape>,
     /// `shape_boxes[i]` is shape `i`'s local box, computed once at registration.
     shape_boxes: Vec<LocalBox>,
-    /// Slot `i` holds body `i` while it lives; removed bodies leave `None` (ids are not
-    /// reused).
+    /// Slot `i` holds body `i` while it lives; removed bodies leave `None` until a new body
+    /// takes the slot.
     bodies: Vec<Option<Body>>,
+    /// The empty slots, most recently freed last, each with the frame it was last put in
+    /// the change log (so an id removed and reused within one frame is logged once).
+    free: Vec<(u32, u64)>,
     live: u32,
     /// Frames answered so far ([`Scene::end_frame`]): the current frame's number.
     frame: u64,
@@ -230,6 +237,7 @@ impl Clone for Scene {
             shapes: self.shapes.clone(),
             shape_boxes: self.shape_boxes.clone(),
             bodies: self.bodies.clone(),
+            free: self.free.clone(),
             live: self.live,
             frame: self.frame,
             default_margin: self.default_margin,
@@ -254,6 +262,7 @@ impl Scene {
             shapes: Vec::new(),
             shape_boxes: Vec::new(),
             bodies: Vec::new(),
+            free: Vec::new(),
             live: 0,
             frame: 0,
             default_margin,
@@ -316,7 +325,7 @@ impl Scene {
             return Err(SceneError::TooManyBodies(self.limits.max_bodies));
         }
         let world_bounds = local.world(&desc.pose);
-        self.bodies.push(Some(Body {
+        let body = Body {
             shape: desc.shape,
             pose: desc.pose,
             motion: desc.motion,
@@ -328,15 +337,28 @@ impl Scene {
             added_in: self.frame,
             logged_in: self.frame,
             version: self.edits + 1,
-        }));
+        };
+        let id = match self.free.pop() {
+            Some((id, logged_in)) => {
+                self.bodies[id as usize] = Some(body);
+                if logged_in != self.frame {
+                    self.changes.push(id);
+                }
+                id
+            }
+            None => {
+                self.bodies.push(Some(body));
+                let id = self.bodies.len() as u32 - 1;
+                self.changes.push(id);
+                id
+            }
+        };
         self.live += 1;
-        let id = self.bodies.len() as u32 - 1;
-        self.changes.push(id);
         self.edits += 1;
         Ok(BodyId(id))
     }
 
-    /// Removes a body; its id is not reused.
+    /// Removes a body; the next body added takes its id.
     ///
     /// # Errors
     /// [`SceneError::UnknownBody`] when no such body lives.
@@ -350,6 +372,7 @@ impl Scene {
         if body.logged_in != self.frame {
             self.changes.push(id.0);
         }
+        self.free.push((id.0, self.frame));
         self.edits += 1;
         Ok(body)
     }
@@ -609,6 +632,15 @@ impl Scene {
         if live != self.live {
             return Err(format!("{live} live bodies, {} counted", self.live));
         }
+        let mut free: Vec<u32> = self.free.iter().map(|&(id, _)| id).collect();
+        free.sort_unstable();
+        free.dedup();
+        let all_empty = free
+            .iter()
+            .all(|&id| self.bodies.get(id as usize).is_some_and(Option::is_none));
+        if !all_empty || free.len() + live as usize != self.bodies.len() {
+            return Err("the free slots are not exactly the empty ones".into());
+        }
         let mut ids = self.changes.clone();
         ids.sort_unstable();
         if ids.windows(2).any(|w| w[0] == w[1])
@@ -819,17 +851,19 @@ mod tests {
             Err(SceneError::UnknownBody(BodyId(7)))
         );
         assert_eq!(format!("{s:?}"), before);
-        // Limits, and ids never reused after removal.
+        // Limits, and a removed body's id taken by the next body, with a new version.
         let b = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
-        let c = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
+        s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
         assert_eq!(
             s.add_body(&desc(sphere, Pose::IDENTITY)),
             Err(SceneError::TooManyBodies(3))
         );
+        let old_version = s.body(b).unwrap().version();
         s.remove_body(b).unwrap();
         assert_eq!(s.remove_body(b), Err(SceneError::UnknownBody(b)));
         let d = s.add_body(&desc(sphere, Pose::IDENTITY)).unwrap();
-        assert!(d > c && d != b);
+        assert_eq!(d, b);
+        assert!(s.body(d).unwrap().version() > old_version);
         for _ in 0..3 {
             s.register_shape(Shape::Sphere(Sphere::new(1.0))).unwrap();
         }

@@ -454,3 +454,21 @@ fn reserved_fields_bad_coordinates_and_oversized_headers_get_their_codes_before_
     assert_eq!(frame.header().error_body, body_id);
     victim.assert_untouched();
 }
+
+#[test]
+fn endless_add_remove_cycles_reuse_body_slots_so_the_scene_stays_its_size() {
+    let daemon = Daemon::start();
+    let mut victim = Victim::new(&daemon);
+    let client = daemon.client();
+    let scene = client.create_scene().unwrap();
+    let sphere = client
+        .register_primitive(scene, Primitive::Sphere { radius: 0.1 })
+        .unwrap();
+    let keep = client.add_body(scene, &body(sphere, 0.0)).unwrap();
+    for cycle in 0..10_000 {
+        let id = client.add_body(scene, &body(sphere, 1.0)).unwrap();
+        assert_eq!(id, keep + 1, "cycle {cycle}: the freed slot is taken again");
+        client.remove_body(scene, id).unwrap();
+    }
+    victim.assert_untouched();
+}

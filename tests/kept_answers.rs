@@ -33,7 +33,7 @@ fn unchanged_pairs_reuse_their_answers_and_frames_equal_fresh_ones() {
         )
         .unwrap(),
     );
-    let mut bodies: Vec<BodyId> = Vec::new();
+    let (mut bodies, mut shapes): (Vec<BodyId>, Vec<_>) = (Vec::new(), Vec::new());
     for i in 0..30 {
         let shape = match i % 6 {
             0 => Shape::Sphere(Sphere::new(0.3)),
@@ -44,6 +44,7 @@ fn unchanged_pairs_reuse_their_answers_and_frames_equal_fresh_ones() {
             _ => Shape::Mesh(Arc::clone(&torus)),
         };
         let shape = scene.register_shape(shape).unwrap();
+        shapes.push(shape);
         let id = scene
             .add_body(&BodyDesc {
                 shape,
@@ -69,7 +70,7 @@ fn unchanged_pairs_reuse_their_answers_and_frames_equal_fresh_ones() {
     let (mut got, mut want) = (FrameResults::default(), FrameResults::default());
     let (mut reused_total, mut fresh_total, mut quiet_frames) = (0, 0, 0);
     let mut last_query = queries[0];
-    let (mut last_pairs, mut exact_checks) = (BTreeSet::new(), 0);
+    let (mut last_pairs, mut exact_checks, mut replaced) = (BTreeSet::new(), 0, 0);
     for frame in 0..FRAMES {
         // A few bodies change each frame (none on some frames); the query changes now and
         // then, which must stop all reuse for that frame.
@@ -81,9 +82,23 @@ fn unchanged_pairs_reuse_their_answers_and_frames_equal_fresh_ones() {
         };
         for _ in 0..movers {
             let id = bodies[rng.random_range(0..bodies.len())];
-            if rng.random_bool(0.9) {
+            let action = rng.random_range(0.0..1.0);
+            if action < 0.8 {
                 let pose = Pose::new(point_in_cube(&mut rng, HALF), rotation(&mut rng));
                 scene.set_pose(id, pose).unwrap();
+            } else if action < 0.9 {
+                // Replaced in place: another shape, same pose, and the removed body's id.
+                // Its old answers must not be kept (the slot's body has a new version).
+                let old = scene.remove_body(id).unwrap();
+                let desc = BodyDesc {
+                    shape: shapes[rng.random_range(0..shapes.len())],
+                    pose: old.pose,
+                    motion: old.motion,
+                    filter: old.filter,
+                    margin: None,
+                };
+                assert_eq!(scene.add_body(&desc).unwrap(), id, "the slot is reused");
+                replaced += 1;
             } else {
                 let body = *scene.body(id).unwrap();
                 scene
@@ -144,6 +159,7 @@ fn unchanged_pairs_reuse_their_answers_and_frames_equal_fresh_ones() {
     }
     assert!(exact_checks > 50, "{exact_checks}");
     assert!(quiet_frames > 20, "{quiet_frames}");
+    assert!(replaced > 20, "{replaced} bodies replaced in place");
     assert!(
         reused_total > 1_000 && fresh_total > 1_000,
         "{reused_total} {fresh_total}"

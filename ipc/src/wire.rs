@@ -451,7 +451,9 @@ pub enum Command {
     /// [`ErrorCode::ShapeNotReady`] while the shape is being built, with
     /// [`ErrorCode::UnknownShape`] when its build failed.
     AddBody = 4,
-    /// Remove body `target` from scene `scene`.
+    /// Remove body `target` from scene `scene`. The next body added to the scene gets its
+    /// id (since protocol version 9: a scene's tables stay as large as its most bodies
+    /// alive at once); pose records still naming it then move the new body.
     RemoveBody = 5,
     /// Change body `target`'s motion, group, mask and margin.
     UpdateBody = 6,

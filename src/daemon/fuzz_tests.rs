@@ -17,13 +17,13 @@ use super::ingest::apply_pose_frame;
 use super::liveness::OwnerId;
 use super::log::{Level, Logger};
 use crate::geometry::MeshLimits;
-use crate::scene::{BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits};
 use crate::math::{DQuat, DVec3, Pose};
+use crate::scene::{BodyDesc, BodyId, CollisionFilter, Motion, Scene, SceneLimits};
 use crossbeam::channel::Receiver;
 use proxima_ipc::PROTOCOL_VERSION;
 use proxima_ipc::wire::{
-    Command, ControlReply, ControlRequest, ErrorCode, PoseFrameHeader, PoseRecord,
-    ShapeKindCode, query,
+    Command, ControlReply, ControlRequest, ErrorCode, PoseFrameHeader, PoseRecord, ShapeKindCode,
+    query,
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -130,7 +130,9 @@ fn mutate(rng: &mut Pcg64Mcg, request: &mut ControlRequest, payload: &mut Vec<u8
             14 => payload.truncate(rng.random_range(0..=payload.len())),
             _ if payload.is_empty() => payload.extend(edge_f64(rng).to_ne_bytes()),
             _ => {
-                let at = rng.random_range(0..payload.len() / 8 * 8 + 1).min(payload.len() - 1);
+                let at = rng
+                    .random_range(0..payload.len() / 8 * 8 + 1)
+                    .min(payload.len() - 1);
                 let value = edge_f64(rng).to_ne_bytes();
                 let end = (at + 8).min(payload.len());
                 payload[at..end].copy_from_slice(&value[..end - at]);
@@ -266,7 +268,9 @@ fn four_spheres() -> Scene {
 
 /// Every body's pose in `scene`'s four.
 fn poses(scene: &Scene) -> Vec<Pose> {
-    (0..4).map(|i| scene.body(BodyId(i)).unwrap().pose).collect()
+    (0..4)
+        .map(|i| scene.body(BodyId(i)).unwrap().pose)
+        .collect()
 }
 
 #[test]
