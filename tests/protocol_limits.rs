@@ -29,6 +29,10 @@ fn the_documented_limits_are_the_daemons_defaults() {
             config.max_queued_builds as f64,
         ),
         (
+            "shape memory, MiB (all scenes)",
+            (config.max_geometry_bytes >> 20) as f64,
+        ),
+        (
             "candidate pairs answered per frame",
             f64::from(config.scene_limits.max_pairs_per_frame),
         ),

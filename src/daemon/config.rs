@@ -25,6 +25,11 @@ pub struct DaemonConfig {
     /// clients together); a registration beyond is refused with `LimitExceeded`. Each holds
     /// a copy of its geometry payload.
     pub max_queued_builds: usize,
+    /// Memory all convex and mesh shapes of all scenes may take, bytes, as estimated from
+    /// each registration's header before anything is copied or built
+    /// ([`geometry_estimate`](super::budget_memory::geometry_estimate)); a registration
+    /// beyond is refused with `LimitExceeded`. A dropped scene gives its share back.
+    pub max_geometry_bytes: u64,
     /// Close-pair margin of bodies that do not set one, metres.
     pub default_margin: f64,
     /// How long the frame thread (after its last frame) and the control thread (after its
@@ -60,6 +65,7 @@ impl Default for DaemonConfig {
             },
             max_convex_points: 1 << 16,
             max_queued_builds: 4,
+            max_geometry_bytes: 8 << 30,
             default_margin: 0.0,
             spin: Duration::from_micros(50),
             sweep_interval: Duration::from_millis(100),

@@ -18,6 +18,7 @@
 //! max_mesh_triangles = 4194304
 //! max_convex_points = 65536
 //! max_queued_builds = 4           # convex and mesh shapes waiting for the builder
+//! max_geometry_mib = 8192         # memory of all convex and mesh shapes, estimated up front
 //!
 //! [scene]
 //! default_margin_m = 0.0          # close-pair margin of bodies that set none, metres
@@ -90,6 +91,8 @@ pub struct LimitsSection {
     pub max_convex_points: Option<u32>,
     /// Most convex and mesh shapes waiting to be built.
     pub max_queued_builds: Option<usize>,
+    /// Memory of all convex and mesh shapes, MiB.
+    pub max_geometry_mib: Option<u64>,
 }
 
 /// `[scene]`: defaults of every scene.
@@ -221,6 +224,13 @@ impl ConfigFile {
             l.max_queued_builds,
             "limits.max_queued_builds",
         )?;
+        let mut geometry_mib = out.max_geometry_bytes >> 20;
+        set_positive(
+            &mut geometry_mib,
+            l.max_geometry_mib,
+            "limits.max_geometry_mib",
+        )?;
+        out.max_geometry_bytes = geometry_mib.saturating_mul(1 << 20);
         if let Some(margin) = self.scene.default_margin_m {
             if !(margin.is_finite() && margin >= 0.0) {
                 return Err(ConfigFileError::Invalid {
@@ -291,6 +301,7 @@ mod tests {
             max_mesh_triangles = 40
             max_convex_points = 50
             max_queued_builds = 60
+            max_geometry_mib = 70
             [scene]
             default_margin_m = 0.25
             [service_loop]
@@ -315,6 +326,7 @@ mod tests {
         );
         assert_eq!((c.max_convex_points, c.default_margin), (50, 0.25));
         assert_eq!(c.max_queued_builds, 60);
+        assert_eq!(c.max_geometry_bytes, 70 << 20);
         assert_eq!(
             (c.log_level, c.workers),
             (super::super::log::Level::Debug, 13)
@@ -354,6 +366,10 @@ mod tests {
             (
                 "[limits]\nmax_queued_builds = 0",
                 "limits.max_queued_builds",
+            ),
+            (
+                "[limits]\nmax_geometry_mib = 0",
+                "limits.max_geometry_mib",
             ),
             ("[scene]\ndefault_margin_m = -0.1", "scene.default_margin_m"),
             ("[scene]\ndefault_margin_m = nan", "scene.default_margin_m"),

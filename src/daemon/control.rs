@@ -18,6 +18,7 @@
 //! checked ([`convert::shape_request`]), gets its shape id, and its payload is copied into a
 //! [`BuildJob`] for the builder thread; the reply says the shape is being built.
 
+use super::budget_memory;
 use super::builder::{BuildJob, BuildQueue};
 use super::config::DaemonConfig;
 use super::convert::{self, Rejection, ShapeRequest};
@@ -44,6 +45,9 @@ pub struct ControlState {
     /// owner drops it or is gone).
     scenes: HashMap<u32, SceneEntry>,
     builds: BuildQueue,
+    /// Bytes charged to convex and mesh shapes of every scene alive
+    /// ([`budget_memory`](super::budget_memory)), at most `config.max_geometry_bytes`.
+    geometry_bytes: u64,
 }
 
 /// A scene as the control service knows it.
@@ -57,6 +61,8 @@ pub struct SceneEntry {
     pub frame_key: u64,
     /// Its state, or why it was quarantined.
     pub state: Result<SharedScene, String>,
+    /// Bytes charged to its convex and mesh shapes.
+    pub geometry_bytes: u64,
 }
 
 /// A successful request's reply: the id and the [`reply_flags`].
@@ -82,6 +88,7 @@ impl ControlState {
             instance,
             scenes: HashMap::new(),
             builds,
+            geometry_bytes: 0,
         }
     }
 
@@ -129,6 +136,7 @@ impl ControlState {
         if let Ok(shared) = std::mem::replace(&mut entry.state, Err(reason)) {
             lock(&shared).dropped = true;
         }
+        self.geometry_bytes -= std::mem::take(&mut entry.geometry_bytes);
         true
     }
 
@@ -231,7 +239,7 @@ impl ControlState {
     /// A primitive is registered at once; a convex or mesh shape gets its id and goes to
     /// the builder with a copy of its payload (the reply says it is being built).
     fn register_shape(
-        &self,
+        &mut self,
         origin: OwnerId,
         request: &ControlRequest,
         payload: &[u8],
@@ -260,6 +268,19 @@ impl ControlState {
         // Before an id is handed out for nothing: only this thread queues, so the room
         // found here is still there below.
         self.builds.check_room()?;
+        let charge = budget_memory::geometry_estimate(&geometry);
+        let (in_use, budget) = (self.geometry_bytes, config.max_geometry_bytes);
+        if in_use.saturating_add(charge) > budget {
+            return Err(Rejection::new(
+                ErrorCode::LimitExceeded,
+                format!(
+                    "the shape needs about {} MiB; the daemon's {} MiB for shapes has {} MiB left",
+                    charge.div_ceil(1 << 20),
+                    budget >> 20,
+                    budget.saturating_sub(in_use) >> 20
+                ),
+            ));
+        }
         let shape = lock(shared).shapes.reserve(max_shapes)?;
         let job = BuildJob {
             scene_id: request.scene,
@@ -271,6 +292,10 @@ impl ControlState {
         if let Err(refused) = self.builds.submit(job) {
             lock(shared).shapes.finish(shape, Err(refused.clone()));
             return Err(refused);
+        }
+        self.geometry_bytes += charge;
+        if let Some(entry) = self.scenes.get_mut(&request.scene) {
+            entry.geometry_bytes += charge;
         }
         Ok(Answer {
             id: shape,
@@ -288,6 +313,7 @@ impl ControlState {
         if let Ok(shared) = entry.state {
             lock(&shared).dropped = true;
         }
+        self.geometry_bytes -= entry.geometry_bytes;
         Ok(())
     }
 
@@ -323,6 +349,7 @@ impl ControlState {
             token: SceneToken([secret("a scene token")?, secret("a scene token")?]),
             frame_key: secret("a frame key")?,
             state: Ok(shared_scene::share(scene)),
+            geometry_bytes: 0,
         };
         self.scenes.insert(id, entry);
         Ok(id)

@@ -691,3 +691,48 @@ fn a_quarantined_scene_tells_its_owner_why_until_dropped_and_frees_its_slot() {
     let again = state.handle(OWNER, &request(Command::CreateScene), &[]);
     assert_eq!(code(&again), ErrorCode::Ok);
 }
+
+#[test]
+fn shapes_are_charged_against_the_memory_budget_before_anything_is_copied_and_scenes_give_it_back()
+{
+    use super::super::budget_memory::MESH_BYTES_PER_TRIANGLE;
+    // Room for one 4-triangle tetrahedron mesh, not two.
+    let one_mesh = 4 * MESH_BYTES_PER_TRIANGLE + 4 * 64;
+    let config = DaemonConfig {
+        max_geometry_bytes: one_mesh + one_mesh / 2,
+        ..DaemonConfig::default()
+    };
+    let (mut state, jobs) = state_with(config, 4);
+    let payload = mesh_payload(&TETRA, &TETRA_INDICES);
+    let first = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    let second = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    assert_eq!(
+        code(&state.handle(OWNER, &mesh_request(first, 4, 12), &payload)),
+        ErrorCode::Ok
+    );
+    let refused = state.handle(OWNER, &mesh_request(second, 4, 12), &payload);
+    assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+    assert!(refused.reason().contains("MiB"), "{}", refused.reason());
+    assert_eq!(build_all(&jobs), 1, "the refused one was never queued");
+    // Primitives cost nothing against it.
+    assert_eq!(
+        code(&state.handle(OWNER, &sphere_request(second), &[])),
+        ErrorCode::Ok
+    );
+    // Dropping the first scene gives its charge back; quarantining does too.
+    let drop = ControlRequest {
+        scene: first,
+        ..request(Command::DropScene)
+    };
+    assert_eq!(code(&state.handle(OWNER, &drop, &[])), ErrorCode::Ok);
+    assert_eq!(
+        code(&state.handle(OWNER, &mesh_request(second, 4, 12), &payload)),
+        ErrorCode::Ok
+    );
+    assert!(state.quarantine(second, "test fault".to_owned()));
+    let third = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    assert_eq!(
+        code(&state.handle(OWNER, &mesh_request(third, 4, 12), &payload)),
+        ErrorCode::Ok
+    );
+}

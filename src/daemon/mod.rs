@@ -35,6 +35,7 @@
 //! - `gate`: [`Gate`], a test hook that holds builds or control requests;
 //! - `error`: start-up and run failures (client mistakes are wire error codes instead).
 
+mod budget_memory;
 mod builder;
 mod claim;
 pub mod config;
