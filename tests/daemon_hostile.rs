@@ -5,7 +5,21 @@
 //! The attacker runs as another process where the attack is a client's: this test binary
 //! re-executed with [`ATTACKER_ROLE`] set runs only `attacker_role`, which attacks the scene
 //! named in the variable and prints one line per step (`CODE <step> <error code>`,
-//! `SENT <step>`), then `DONE`.
+//! `SENT <step>`), then `DONE`; with [`DOOMED_ROLE`] set it runs only `doomed_client_role`,
+//! a client that is killed mid-frame.
+//!
+//! | attack (issue #31's table) | test |
+//! |---|---|
+//! | 1 services set up ahead of a scene | unit test in `src/daemon/frame_loop.rs` (ids are random, names secret) |
+//! | 2 a subscriber that never reads | `a_subscriber_that_never_reads_never_holds_the_daemon_up` |
+//! | 3 commands and frames on another's scene | `another_clients_commands_and_frames_are_refused_and_change_nothing` |
+//! | 4 an impostor on the control service | `a_control_service_served_or_set_up_by_another_process_stops_the_daemon_at_start` |
+//! | 5 nodes held on the control service | `nodes_held_on_the_control_service_do_not_lock_new_clients_out` |
+//! | 6 a restarted daemon | `a_restarted_daemon_answers_no_old_frame_and_old_clients_learn_it_is_lost` |
+//! | 7, 11 oversized headers, reserved fields, far coordinates | `reserved_fields_bad_coordinates_and_oversized_headers_get_their_codes_before_any_work` |
+//! | 8 endless add/remove | `endless_add_remove_cycles_reuse_body_slots_so_the_scene_stays_its_size` |
+//! | 9 a client killed mid-frame | `a_killed_clients_scene_release_is_seen_by_a_monitor_holding_its_token` (its frame is not yet abandoned mid-way) |
+//! | 10 another OS user's `global_mgmt` | not tested (needs a second OS user); README "Who can use the daemon" |
 //!
 //! Same-user limits (README "Who can use the daemon"): iceoryx2 0.10 lets any process of
 //! the daemon's user list services, so the attacker here learns the victim's scene token
@@ -19,6 +33,7 @@ use daemon_harness::{Daemon, body, pose_at};
 use iceoryx2::prelude::*;
 use proxima_ipc::client::{Client, ClientBuilder, Motion, Primitive};
 use proxima_ipc::error::{ControlError, FrameReceiveError};
+use proxima_ipc::result_feed::ResultFeed;
 use proxima_ipc::scene_link::SceneLink;
 use proxima_ipc::wire::{
     BroadPhaseCode, ErrorCode, PoseFrameHeader, ResultFrameHeader, ResultRecord, query,
@@ -32,6 +47,9 @@ const TIMEOUT: Duration = Duration::from_secs(10);
 /// Environment variable that turns this binary into the attacker (its value: the daemon's
 /// root and prefix and the victim's scene id, separated by spaces).
 const ATTACKER_ROLE: &str = "PROXIMA_HOSTILE_ATTACKER";
+/// Environment variable that turns this binary into a client that is killed mid-frame (its
+/// value: the daemon's root and prefix).
+const DOOMED_ROLE: &str = "PROXIMA_HOSTILE_DOOMED";
 
 /// The victim: a scene of two unit spheres (bodies 0 and 1) overlapping by 0.1 m, and its
 /// frame link.
@@ -163,6 +181,88 @@ fn attacker_role() {
     forge_frame(client.node(), root, listed_token(root, prefix), scene);
     writeln!(out, "SENT forged\nDONE").unwrap();
     out.flush().unwrap();
+}
+
+/// The doomed client (only when spawned with [`DOOMED_ROLE`]; otherwise it returns at
+/// once): a scene, a frame whose answer it never reads, its token on stdout (as an owner
+/// hands it to a monitor), then it waits to be killed.
+#[test]
+fn doomed_client_role() {
+    let Ok(spec) = std::env::var(DOOMED_ROLE) else {
+        return;
+    };
+    let (root, prefix) = spec.split_once(' ').expect("root and prefix");
+    let client = ClientBuilder::new()
+        .root(root)
+        .iceoryx_prefix(prefix)
+        .reply_timeout(TIMEOUT)
+        .connect::<ipc::Service>()
+        .expect("the doomed client connects");
+    let scene = client.create_scene().unwrap();
+    let sphere = client
+        .register_primitive(scene, Primitive::Sphere { radius: 0.5 })
+        .unwrap();
+    client.add_body(scene, &body(sphere, 0.0)).unwrap();
+    let link = client.open_scene(scene).unwrap();
+    let token = client.scene_access(scene).unwrap().token;
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "TOKEN {token}").unwrap();
+    out.flush().unwrap();
+    link.publish_poses(1, 0, query::CLOSE, &[pose_at(0, 0.5)])
+        .unwrap();
+    std::thread::sleep(Duration::from_secs(60));
+    panic!("the doomed client was not killed");
+}
+
+#[test]
+fn a_killed_clients_scene_release_is_seen_by_a_monitor_holding_its_token() {
+    let daemon = Daemon::start_with(&["--grace-ms", "300"]);
+    let mut victim = Victim::new(&daemon);
+    let mut doomed = Command::new(std::env::current_exe().unwrap())
+        .args([
+            "doomed_client_role",
+            "--exact",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env(
+            DOOMED_ROLE,
+            format!("{} {}", daemon.root(), daemon.prefix()),
+        )
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the doomed client starts");
+    let stdout = doomed.stdout.take().unwrap();
+    let token: SceneToken = BufReader::new(stdout)
+        .lines()
+        .map_while(Result::ok)
+        .find_map(|line| Some(line.split_once("TOKEN ")?.1.trim().parse().unwrap()))
+        .expect("the doomed client reports its token");
+    // The monitor the owner trusted: a client of its own, reading by token.
+    let monitor = daemon.client();
+    let feed = ResultFeed::open(monitor.node(), daemon.root(), token).unwrap();
+    assert!(
+        feed.receive(Duration::from_millis(50)).is_ok(),
+        "while its owner lives, the scene is served"
+    );
+    doomed.kill().unwrap();
+    doomed.wait().unwrap();
+    // Within the grace period plus a few sweeps the daemon lets the scene go, and the
+    // monitor's wait ends with the scene gone instead of waiting forever.
+    let mut released = false;
+    for _ in 0..100 {
+        victim.assert_untouched();
+        match feed.receive(Duration::from_millis(50)) {
+            Err(FrameReceiveError::DaemonLost) => {
+                released = true;
+                break;
+            }
+            Ok(_) => {}
+            Err(e) => panic!("monitor: {e}"),
+        }
+    }
+    assert!(released, "the monitor never saw the scene go");
+    victim.assert_untouched();
 }
 
 /// Publishes a pose frame on the scene with token `token` without its frame key.

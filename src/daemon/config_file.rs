@@ -367,10 +367,7 @@ mod tests {
                 "[limits]\nmax_queued_builds = 0",
                 "limits.max_queued_builds",
             ),
-            (
-                "[limits]\nmax_geometry_mib = 0",
-                "limits.max_geometry_mib",
-            ),
+            ("[limits]\nmax_geometry_mib = 0", "limits.max_geometry_mib"),
             ("[scene]\ndefault_margin_m = -0.1", "scene.default_margin_m"),
             ("[scene]\ndefault_margin_m = nan", "scene.default_margin_m"),
             ("[scene]\ndefault_margin_m = inf", "scene.default_margin_m"),
