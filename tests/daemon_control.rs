@@ -93,8 +93,8 @@ fn a_client_builds_a_scene_of_every_shape_kind_in_a_real_daemon() {
         rejected(client.remove_body(scene, bodies[1])),
         ErrorCode::UnknownBody
     );
-    // Ids are not reused.
-    assert_eq!(client.add_body(scene, &body(shapes[0], 9.0)).unwrap(), 7);
+    // The removed body's id goes to the next body added.
+    assert_eq!(client.add_body(scene, &body(shapes[0], 9.0)).unwrap(), 1);
     client.drop_scene(scene).unwrap();
     assert_eq!(
         rejected(client.add_body(scene, &body(0, 0.0))),

@@ -14,6 +14,10 @@ fn the_documented_limits_are_the_daemons_defaults() {
     let coded = [
         ("scenes alive at once", f64::from(config.max_scenes)),
         (
+            "scenes alive at once per control client port",
+            f64::from(config.max_scenes_per_client),
+        ),
+        (
             "shapes per scene",
             f64::from(config.scene_limits.max_shapes),
         ),

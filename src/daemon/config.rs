@@ -15,6 +15,9 @@ pub struct DaemonConfig {
     pub iceoryx_prefix: Option<String>,
     /// Most scenes alive at once.
     pub max_scenes: u32,
+    /// Most scenes alive at once created by one control client port (so one client cannot
+    /// take every scene).
+    pub max_scenes_per_client: u32,
     /// Limits of each scene.
     pub scene_limits: SceneLimits,
     /// Limits of each registered mesh.
@@ -58,6 +61,7 @@ impl Default for DaemonConfig {
             root: proxima_ipc::DEFAULT_ROOT.to_string(),
             iceoryx_prefix: None,
             max_scenes: 64,
+            max_scenes_per_client: 16,
             scene_limits: SceneLimits::STANDARD,
             mesh_limits: MeshLimits {
                 max_vertices: 1 << 22,

@@ -11,6 +11,7 @@
 //!
 //! [limits]
 //! max_scenes = 64
+//! max_scenes_per_client = 16      # scenes one control client port may hold
 //! max_shapes_per_scene = 4096
 //! max_bodies_per_scene = 100000
 //! max_pairs_per_frame = 16384     # candidate pairs a frame answers; more are dropped and counted
@@ -77,6 +78,8 @@ pub struct ServiceLoopSection {
 pub struct LimitsSection {
     /// Most scenes alive at once.
     pub max_scenes: Option<u32>,
+    /// Most scenes one control client port may hold.
+    pub max_scenes_per_client: Option<u32>,
     /// Most shapes registered in one scene.
     pub max_shapes_per_scene: Option<u32>,
     /// Most live bodies in one scene.
@@ -190,6 +193,11 @@ impl ConfigFile {
         let l = &self.limits;
         set_positive(&mut out.max_scenes, l.max_scenes, "limits.max_scenes")?;
         set_positive(
+            &mut out.max_scenes_per_client,
+            l.max_scenes_per_client,
+            "limits.max_scenes_per_client",
+        )?;
+        set_positive(
             &mut out.scene_limits.max_shapes,
             l.max_shapes_per_scene,
             "limits.max_shapes_per_scene",
@@ -302,6 +310,7 @@ mod tests {
             max_convex_points = 50
             max_queued_builds = 60
             max_geometry_mib = 70
+            max_scenes_per_client = 80
             [scene]
             default_margin_m = 0.25
             [service_loop]
@@ -327,6 +336,7 @@ mod tests {
         assert_eq!((c.max_convex_points, c.default_margin), (50, 0.25));
         assert_eq!(c.max_queued_builds, 60);
         assert_eq!(c.max_geometry_bytes, 70 << 20);
+        assert_eq!(c.max_scenes_per_client, 80);
         assert_eq!(
             (c.log_level, c.workers),
             (super::super::log::Level::Debug, 13)

@@ -327,6 +327,13 @@ impl ControlState {
                 ),
             ));
         }
+        let quota = self.config.max_scenes_per_client;
+        if self.scenes.values().filter(|e| e.owner == owner).count() >= quota as usize {
+            return Err(Rejection::new(
+                ErrorCode::LimitExceeded,
+                format!("this client holds its limit of {quota} scenes"),
+            ));
+        }
         let scene = Scene::try_new(self.config.default_margin, self.config.scene_limits)
             .map_err(scene_rejection)?;
         let secret = |what| {

@@ -629,6 +629,7 @@ fn only_the_creating_client_port_may_use_a_scene_and_the_reply_hands_it_the_keys
 fn scene_ids_and_keys_are_random_and_never_repeat_among_live_scenes() {
     let config = DaemonConfig {
         max_scenes: 200,
+        max_scenes_per_client: 200,
         ..DaemonConfig::default()
     };
     let (mut state, _jobs) = state_with(config, 4);
@@ -735,4 +736,40 @@ fn shapes_are_charged_against_the_memory_budget_before_anything_is_copied_and_sc
         code(&state.handle(OWNER, &mesh_request(third, 4, 12), &payload)),
         ErrorCode::Ok
     );
+}
+
+#[test]
+fn one_client_port_holds_at_most_its_quota_of_scenes_and_others_still_get_theirs() {
+    let config = DaemonConfig {
+        max_scenes: 5,
+        max_scenes_per_client: 2,
+        ..DaemonConfig::default()
+    };
+    let (mut state, _jobs) = state_with(config, 4);
+    let create = request(Command::CreateScene);
+    let mine: Vec<u32> = (0..2)
+        .map(|_| state.handle(OWNER, &create, &[]).id)
+        .collect();
+    let refused = state.handle(OWNER, &create, &[]);
+    assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+    assert!(
+        refused.reason().contains("this client"),
+        "{}",
+        refused.reason()
+    );
+    for other in [OWNER + 1, OWNER + 2] {
+        assert_eq!(code(&state.handle(other, &create, &[])), ErrorCode::Ok);
+    }
+    // The daemon-wide limit (5) still holds, and a dropped scene frees the quota.
+    assert_eq!(code(&state.handle(OWNER + 3, &create, &[])), ErrorCode::Ok);
+    assert_eq!(
+        code(&state.handle(OWNER + 4, &create, &[])),
+        ErrorCode::LimitExceeded
+    );
+    let drop = ControlRequest {
+        scene: mine[0],
+        ..request(Command::DropScene)
+    };
+    assert_eq!(code(&state.handle(OWNER, &drop, &[])), ErrorCode::Ok);
+    assert_eq!(code(&state.handle(OWNER, &create, &[])), ErrorCode::Ok);
 }
