@@ -713,8 +713,8 @@ fn frames_with_a_fixed_incremental_sap_or_hash_grid_match_the_in_process_pipelin
                 margin: Some(MARGIN),
             };
             assert_eq!(oracle.add_body(&desc).unwrap(), BodyId(id));
-            assert_eq!(id as usize, poses.len());
-            poses.push(Some(desc.pose));
+            assert_eq!(id as usize, gone, "the removed body's slot is taken again");
+            poses[gone] = Some(desc.pose);
         }
         let q = queries[frame as usize % queries.len()];
         let mut records = Vec::new();
