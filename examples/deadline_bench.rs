@@ -132,19 +132,8 @@ impl Session {
     /// Starts `exe` under a root and prefix of its own and connects.
     fn start(exe: &Path) -> Result<Self, Box<dyn Error>> {
         let isolation = Isolation::unique("dlb");
+        let daemon = ChildProcess::spawn_quiet_daemon(exe, &isolation)?;
         let Isolation { root, prefix } = &isolation;
-        let daemon = ChildProcess::spawn(
-            exe,
-            [
-                "--root",
-                root,
-                "--iceoryx-prefix",
-                prefix,
-                "--log-level",
-                "warn",
-            ],
-            prefix,
-        )?;
         let client = ClientBuilder::new()
             .root(root)
             .iceoryx_prefix(prefix)

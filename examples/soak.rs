@@ -106,20 +106,9 @@ struct Tally {
 }
 
 fn soak(args: &Args) -> Result<(), Box<dyn Error>> {
-    let Isolation { root, prefix } = Isolation::unique("soak");
-    let daemon_path = sibling_daemon()?;
-    let mut daemon = ChildProcess::spawn(
-        &daemon_path,
-        [
-            "--root",
-            &root,
-            "--iceoryx-prefix",
-            &prefix,
-            "--log-level",
-            "warn",
-        ],
-        &prefix,
-    )?;
+    let isolation = Isolation::unique("soak");
+    let mut daemon = ChildProcess::spawn_quiet_daemon(sibling_daemon()?, &isolation)?;
+    let Isolation { root, prefix } = isolation;
     let pid = daemon.id().ok_or("the daemon did not start")?;
     // Idle and serving: the descriptors and files that must be all that is left at the end.
     std::thread::sleep(Duration::from_secs(1));

@@ -48,20 +48,10 @@ pub struct DemoArgs {
 /// # Errors
 /// The daemon could not be started or reached, or refused the scene.
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn Error>> {
-    let Isolation { root, prefix } = Isolation::unique("demo");
+    let isolation = Isolation::unique("demo");
     let exe = std::env::current_exe()?;
-    let mut daemon = ChildProcess::spawn(
-        &exe,
-        [
-            "--root",
-            &root,
-            "--iceoryx-prefix",
-            &prefix,
-            "--log-level",
-            "warn",
-        ],
-        &prefix,
-    )?;
+    let mut daemon = ChildProcess::spawn_quiet_daemon(&exe, &isolation)?;
+    let Isolation { root, prefix } = isolation;
     let client = ClientBuilder::new()
         .root(&root)
         .iceoryx_prefix(&prefix)

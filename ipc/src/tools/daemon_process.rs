@@ -69,6 +69,27 @@ impl ChildProcess {
         })
     }
 
+    /// Starts the daemon `program` under `isolation`'s root and prefix, logging warnings
+    /// and errors only (tools that print their own results).
+    ///
+    /// # Errors
+    /// The program could not be started.
+    pub fn spawn_quiet_daemon(
+        program: impl AsRef<OsStr>,
+        isolation: &Isolation,
+    ) -> std::io::Result<Self> {
+        let Isolation { root, prefix } = isolation;
+        let args = [
+            "--root",
+            root,
+            "--iceoryx-prefix",
+            prefix,
+            "--log-level",
+            "warn",
+        ];
+        Self::spawn(program, args, prefix)
+    }
+
     /// The child's process id.
     #[must_use]
     pub fn id(&self) -> Option<u32> {
