@@ -312,25 +312,21 @@ impl ClientBuilder {
         // The daemon creates both services; until it has, there is no daemon to talk to.
         let invalid_root = |_| ClientConnectError::InvalidRoot(self.root.clone());
         let control = crate::control_service_builder(&node, &self.root).map_err(invalid_root)?;
-        let service = poll_until(deadline, || match control.clone().open() {
-            Ok(service) => Ok(Some(service)),
-            Err(RequestResponseOpenError::DoesNotExist) => Ok(None),
-            Err(e) => Err(ClientConnectError::Transport(format!(
-                "opening the control service: {e}"
-            ))),
-        })?
-        .ok_or(ClientConnectError::NoDaemon)?;
+        let service = open_when_created(
+            deadline,
+            "control service",
+            || control.clone().open(),
+            |e| matches!(e, RequestResponseOpenError::DoesNotExist),
+        )?;
         let port = control_port(&service)?;
         let control_events =
             crate::control_events_service_builder(&node, &self.root).map_err(invalid_root)?;
-        let events = poll_until(deadline, || match control_events.clone().open() {
-            Ok(events) => Ok(Some(events)),
-            Err(EventOpenError::DoesNotExist) => Ok(None),
-            Err(e) => Err(ClientConnectError::Transport(format!(
-                "opening the control event service: {e}"
-            ))),
-        })?
-        .ok_or(ClientConnectError::NoDaemon)?;
+        let events = open_when_created(
+            deadline,
+            "control event service",
+            || control_events.clone().open(),
+            |e| matches!(e, EventOpenError::DoesNotExist),
+        )?;
         let notifier = events.notifier_builder().create().map_err(|e| {
             ClientConnectError::Transport(format!("creating the control notifier: {e}"))
         })?;
@@ -392,6 +388,25 @@ impl ClientBuilder {
         client.instance = reply.instance;
         Ok(client)
     }
+}
+
+/// Opens a service the daemon creates (`what`, for the error text), polling until it
+/// exists (`is_missing` tells the open error that says it does not yet) or `deadline`
+/// passes ([`ClientConnectError::NoDaemon`]).
+fn open_when_created<T, E: std::fmt::Display>(
+    deadline: Instant,
+    what: &str,
+    mut open: impl FnMut() -> Result<T, E>,
+    is_missing: impl Fn(&E) -> bool,
+) -> Result<T, ClientConnectError> {
+    poll_until(deadline, || match open() {
+        Ok(service) => Ok(Some(service)),
+        Err(e) if is_missing(&e) => Ok(None),
+        Err(e) => Err(ClientConnectError::Transport(format!(
+            "opening the {what}: {e}"
+        ))),
+    })?
+    .ok_or(ClientConnectError::NoDaemon)
 }
 
 /// How long connect waits for the first `Hello`'s reply before it sends `Hello` again from

@@ -92,6 +92,22 @@ impl ControlState {
         }
     }
 
+    /// This daemon run's instance id, which every reply carries.
+    #[must_use]
+    pub fn instance(&self) -> u64 {
+        self.instance
+    }
+
+    /// A failure reply, carrying the instance id like every other (for refusals made
+    /// outside [`handle`](Self::handle)).
+    #[must_use]
+    pub fn refusal(&self, code: ErrorCode, reason: &str) -> ControlReply {
+        ControlReply {
+            instance: self.instance,
+            ..ControlReply::error(code, reason)
+        }
+    }
+
     /// Scene `id`, live or quarantined.
     #[must_use]
     pub fn entry(&self, id: u32) -> Option<&SceneEntry> {
@@ -113,10 +129,12 @@ impl ControlState {
         payload: &[u8],
     ) -> ControlReply {
         let mut reply = match self.try_handle(origin, request, payload) {
-            Ok(Answer { id, flags }) => ControlReply::ok_with(id, flags),
-            Err(r) => ControlReply::error(r.code, &r.reason),
+            Ok(Answer { id, flags }) => ControlReply {
+                instance: self.instance,
+                ..ControlReply::ok_with(id, flags)
+            },
+            Err(r) => self.refusal(r.code, &r.reason),
         };
-        reply.instance = self.instance;
         if request.command == Command::CreateScene as u32
             && let Some(entry) = self.scenes.get(&reply.id)
         {

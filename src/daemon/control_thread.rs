@@ -88,8 +88,6 @@ pub struct ControlThread {
     requests_sent: Listener<Ipc>,
     frames: FrameLinks,
     control_service: ControlFactory,
-    /// This daemon run's instance id.
-    instance: u64,
     node: Node<Ipc>,
     state: ControlState,
     liveness: Liveness,
@@ -106,7 +104,7 @@ pub struct ControlThread {
 
 impl ControlThread {
     /// Claims the control service ([`claim`]), creates its server and the control event
-    /// listener on `node`; scenes' result headers will carry `instance`.
+    /// listener on `node`; replies and scenes' result headers carry `state`'s instance id.
     ///
     /// # Errors
     /// [`DaemonStartError`] when the root is invalid, another process holds the control
@@ -117,7 +115,6 @@ impl ControlThread {
         state: ControlState,
         frames: FrameLinks,
         workers: Arc<WorkerPool>,
-        instance: u64,
     ) -> Result<Self, DaemonStartError> {
         let bad_root =
             |e| DaemonStartError::Config(format!("service root {:?}: {e:?}", config.root));
@@ -148,7 +145,6 @@ impl ControlThread {
             requests_sent,
             frames,
             control_service,
-            instance,
             node,
             state,
             liveness: Liveness::new(config.dead_client_grace),
@@ -257,7 +253,6 @@ impl ControlThread {
                 self.log_refusal(&request, &reply, origin);
             }
             // A client that went away no longer wants the reply: not an error of the daemon.
-            reply.instance = self.instance;
             let _ = active.send_copy(reply);
             served += 1;
         }
@@ -378,12 +373,14 @@ impl ControlThread {
         }
         let id = reply.id;
         let Some(entry) = self.state.entry(id) else {
-            return ControlReply::error(ErrorCode::Internal, "the new scene is gone");
+            return self
+                .state
+                .refusal(ErrorCode::Internal, "the new scene is gone");
         };
         let keys = SceneKeys {
             token: entry.token,
             frame_key: entry.frame_key,
-            instance: self.instance,
+            instance: self.state.instance(),
         };
         let opened = SceneFrames::open(&self.node, &self.root, keys, &self.workers);
         match (opened, self.state.scene(id)) {
@@ -405,7 +402,8 @@ impl ControlThread {
                 self.log.error(format_args!(
                     "scene {id}: opening its services failed: {why}"
                 ));
-                ControlReply::error(ErrorCode::Internal, &format!("scene services: {why}"))
+                self.state
+                    .refusal(ErrorCode::Internal, &format!("scene services: {why}"))
             }
         }
     }

@@ -81,7 +81,7 @@ impl Daemon {
             retired,
         };
         let state = ControlState::new(config.clone(), builds, instance);
-        let control = ControlThread::new(node, &config, state, links, workers, instance)?;
+        let control = ControlThread::new(node, &config, state, links, workers)?;
         let config_line = format!(
             "spin {:?}, sweep every {:?}, dead-client grace {:?}",
             config.spin, config.sweep_interval, config.dead_client_grace
