@@ -9,10 +9,8 @@
 //! ```
 //!
 //! The token (32 hex digits) is the capability to read a scene's results: only its owner
-//! has it, and hands it to the monitors it trusts (DESIGN §10).
-//!
-//! ```text
-//! ```
+//! has it, and hands it to the monitors it trusts (DESIGN §10). The monitor stops when the
+//! daemon releases the scene (its owner dropped it or is gone), saying which.
 //!
 //! Each line aggregates the frames seen since the last: frames per second, frames missed
 //! (gaps in `frame_seq`: the monitor fell behind, or frames the daemon never answered),
@@ -22,6 +20,7 @@
 use clap::Parser;
 use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
 use proxima_ipc::client::ClientBuilder;
+use proxima_ipc::error::FrameReceiveError;
 use proxima_ipc::result_feed::ResultFeed;
 use proxima_ipc::tools::latency::LatencyRecorder;
 use proxima_ipc::wire::{Completeness, ErrorCode, ResultFrameHeader, stage};
@@ -71,7 +70,14 @@ fn main() -> Result<(), Box<dyn Error>> {
     let mut last_seq: Option<u64> = None;
     let mut last_print = Instant::now();
     while stop_at.is_none_or(|t| Instant::now() < t) {
-        if let Some(frame) = feed.receive(Duration::from_millis(100))? {
+        let received = match feed.receive(Duration::from_millis(100)) {
+            Err(released @ FrameReceiveError::SceneReleased { .. }) => {
+                println!("monitor: {released}");
+                break;
+            }
+            received => received?,
+        };
+        if let Some(frame) = received {
             let header = *frame.header();
             drop(frame);
             if let Some(last) = last_seq {

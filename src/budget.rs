@@ -5,6 +5,8 @@
 //! A budget is polled between batches, never inside a primitive test (DESIGN §5), so work
 //! may end up to one batch past it; the caller reserves time for what follows.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// How much work may still be done, polled between bounded batches of visits.
@@ -108,6 +110,37 @@ impl Completeness {
     }
 }
 
+/// A flag another thread raises to abandon a frame's work: the daemon raises a scene's once
+/// its owner is gone (DESIGN §10). Every [`WorkClock`] and frontier budget holding it stops
+/// at its next poll, as if its deadline had come, so the frame ends with conservative
+/// answers marked `Truncated` (and an unlimited frame is no longer exact). Clones share the
+/// flag; the default one can never be raised. Once raised it stays raised.
+#[derive(Debug, Clone, Default)]
+pub struct Abandon(Option<Arc<AtomicBool>>);
+
+impl Abandon {
+    /// A flag not raised yet.
+    #[must_use]
+    pub fn new() -> Self {
+        Self(Some(Arc::new(AtomicBool::new(false))))
+    }
+
+    /// Raises the flag: the work polling it stops at its next poll.
+    pub fn raise(&self) {
+        if let Some(flag) = &self.0 {
+            // Relaxed: the flag guards no data; a poll that misses it sees it at the next.
+            flag.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Whether the flag was raised.
+    #[inline]
+    #[must_use]
+    pub fn is_raised(&self) -> bool {
+        self.0.as_ref().is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+}
+
 /// When a [`WorkClock`] stops the work it is polled for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Stop {
@@ -125,14 +158,17 @@ pub enum Stop {
 /// whether more may be done. Reading the wall clock costs about 25 ns, so an
 /// [`Stop::At`] clock reads it only once [`WORK_PER_CLOCK_READ`] units have passed since
 /// the last read; a unit is about the cost of a closed-form pair (tens of ns), and a step
-/// that costs more counts more. Once stopped, it stays stopped.
-#[derive(Debug, Clone, Copy, Default)]
+/// that costs more counts more. Whatever its [`Stop`], a clock made
+/// [`abandonable`](Self::abandonable) also looks at its [`Abandon`] flag at those reads.
+/// Once stopped, it stays stopped.
+#[derive(Debug, Clone, Default)]
 pub struct WorkClock {
     stop: Stop,
     work: u64,
-    /// `work` at which an [`Stop::At`] clock next reads the time.
+    /// `work` at which the clock next reads the time and the abandon flag.
     next_read: u64,
     stopped: bool,
+    abandon: Abandon,
 }
 
 /// Units of work between two reads of the wall clock by a [`WorkClock`].
@@ -147,7 +183,15 @@ impl WorkClock {
             work: 0,
             next_read: 0,
             stopped: false,
+            abandon: Abandon::default(),
         }
+    }
+
+    /// This clock, also stopped once `abandon` is raised.
+    #[must_use]
+    pub fn abandonable(mut self, abandon: Abandon) -> Self {
+        self.abandon = abandon;
+        self
     }
 
     /// Counts `units` more units of work about to be done; whether they may be. The first
@@ -158,16 +202,24 @@ impl WorkClock {
         }
         let before = self.work;
         self.work = before.saturating_add(units);
+        let reads = before >= self.next_read;
+        if reads {
+            self.next_read = before.saturating_add(WORK_PER_CLOCK_READ);
+        }
+        let abandoned = || reads && self.abandon.is_raised();
         self.stopped = match self.stop {
-            Stop::Never => false,
-            Stop::AfterWork(limit) => before >= limit,
-            Stop::At(instant) if before >= self.next_read => {
-                self.next_read = before + WORK_PER_CLOCK_READ;
-                Instant::now() >= instant
-            }
-            Stop::At(_) => false,
+            Stop::Never => abandoned(),
+            Stop::AfterWork(limit) => before >= limit || abandoned(),
+            Stop::At(instant) => reads && (Instant::now() >= instant || abandoned()),
         };
         !self.stopped
+    }
+
+    /// Whether this clock's [`Abandon`] flag was raised (read now, whether or not the clock
+    /// has stopped yet).
+    #[must_use]
+    pub fn is_abandoned(&self) -> bool {
+        self.abandon.is_raised()
     }
 
     /// Whether the clock has stopped the work.
@@ -216,6 +268,37 @@ mod tests {
         assert!((0..1000).all(|_| counted.allows(3)) && !counted.allows(3));
         let mut never = WorkClock::default();
         assert!((0..1000).all(|_| never.allows(u64::MAX / 2)));
+    }
+
+    #[test]
+    fn an_abandoned_clock_stops_at_its_next_read_whatever_its_stop() {
+        let far = Instant::now() + Duration::from_secs(3600);
+        for stop in [Stop::Never, Stop::At(far), Stop::AfterWork(u64::MAX)] {
+            let abandon = Abandon::new();
+            let mut clock = WorkClock::new(stop).abandonable(abandon.clone());
+            assert!(
+                (0..100).all(|_| clock.allows(1)),
+                "{stop:?} before the flag"
+            );
+            abandon.raise();
+            let allowed = (0..2 * WORK_PER_CLOCK_READ)
+                .take_while(|_| clock.allows(1))
+                .count() as u64;
+            assert!(
+                allowed < WORK_PER_CLOCK_READ,
+                "{stop:?}: {allowed} units after"
+            );
+            assert!(
+                clock.stopped() && !clock.allows(0),
+                "{stop:?} stays stopped"
+            );
+        }
+        // A clock without the flag, or with one never raised, is not stopped by it.
+        let mut plain = WorkClock::default();
+        Abandon::new().raise();
+        assert!((0..1000).all(|_| plain.allows(1)));
+        assert!(!Abandon::default().is_raised());
+        Abandon::default().raise();
     }
 
     #[test]

@@ -34,7 +34,7 @@ extern "C" {
 
 /** Protocol version. A client and a daemon whose versions differ refuse to talk (Hello
  *  answers ProtocolMismatch); every record carries it. */
-#define PROXIMA_PROTOCOL_VERSION UINT32_C(9)
+#define PROXIMA_PROTOCOL_VERSION UINT32_C(10)
 
 /* iceoryx2 matches services by name and by each type's name, size and alignment: declare
  * the types with exactly these names (C: the *_type_details setters; C++: IOX2_TYPE_NAME). */
@@ -205,7 +205,10 @@ typedef enum proxima_ErrorCode {
     PROXIMA_ERROR_NOT_OWNER = 13,
     /** The daemon stopped serving the scene after a fault on its shared-memory services
      *  (the reason says which); only DropScene is accepted. */
-    PROXIMA_ERROR_SCENE_QUARANTINED = 14
+    PROXIMA_ERROR_SCENE_QUARANTINED = 14,
+    /** In a result frame only: the daemon let go of the scene; its last frame, no
+     *  records. */
+    PROXIMA_ERROR_SCENE_RELEASED = 15
 } proxima_ErrorCode;
 
 /** ControlRequest.command. The reply's id is given where it means something. A command
@@ -317,6 +320,9 @@ typedef enum proxima_RecordKind {
 /** The budget cannot hold the uninterruptible work: nothing answered, min_budget_ns says
  *  what would do. */
 #define PROXIMA_FRAME_FLAG_BUDGET_TOO_SMALL (UINT32_C(1) << 1)
+/** The scene's owner is gone: the frame's work was abandoned (Truncated answers), and the
+ *  scene is released after the daemon's grace period. */
+#define PROXIMA_FRAME_FLAG_OWNER_GONE (UINT32_C(1) << 2)
 
 /** ResultRecord.flags: the answer is conservative (distance a lower bound within
  *  error_bound), not exact. */

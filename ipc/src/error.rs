@@ -205,6 +205,13 @@ pub enum FrameReceiveError {
     /// frame came from another daemon instance. Either way the scene is gone: create it
     /// again (after connecting again when `Client` calls fail with `DaemonLost` too).
     DaemonLost,
+    /// The daemon let go of the scene and said so in the scene's last result frame: its
+    /// owner dropped it, or (`owner_gone`) its owner had been gone for the daemon's grace
+    /// period. A monitor holding the scene's token learns here that it is over.
+    SceneReleased {
+        /// The owner's absence was why (its control client closed or its process died).
+        owner_gone: bool,
+    },
     /// iceoryx2 failed to receive a sample (e.g. the caller holds more result frames than
     /// the subscriber may borrow) or to wait on the event listener; carries its error text.
     Transport(String),
@@ -216,6 +223,12 @@ impl std::fmt::Display for FrameReceiveError {
             Self::DaemonLost => f.write_str(
                 "the daemon serving the scene is gone (crashed or restarted): reconnect",
             ),
+            Self::SceneReleased { owner_gone: true } => {
+                f.write_str("the daemon released the scene: its owner is gone")
+            }
+            Self::SceneReleased { owner_gone: false } => {
+                f.write_str("the daemon released the scene: its owner dropped it")
+            }
             Self::Transport(text) => {
                 write!(f, "iceoryx2 failure while receiving a result frame: {text}")
             }

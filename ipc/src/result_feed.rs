@@ -21,7 +21,7 @@ use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubPor
 use crate::SceneToken;
 use crate::error::{FrameReceiveError, SceneOpenError};
 use crate::transport::{RESULTS_SPIN, event_open_error, open_error, pub_sub_open_error};
-use crate::wire::{ResultFrameHeader, ResultRecord};
+use crate::wire::{ErrorCode, ResultFrameHeader, ResultRecord, frame_flags};
 
 /// A subscription to one scene's result frames.
 ///
@@ -100,6 +100,8 @@ impl<S: Service> ResultFeed<S> {
     /// # Errors
     /// [`FrameReceiveError::DaemonLost`] for a frame of another daemon instance (see
     /// [`expect_instance`](Self::expect_instance));
+    /// [`FrameReceiveError::SceneReleased`] for the scene's last frame, once the daemon let
+    /// go of it;
     /// [`FrameReceiveError::Transport`] when iceoryx2 fails (e.g. two frames are still held).
     pub fn try_receive(&self) -> Result<Option<ResultFrame<S>>, FrameReceiveError> {
         let frame = self
@@ -110,6 +112,10 @@ impl<S: Service> ResultFeed<S> {
         match frame {
             Some(frame) if self.instance != 0 && frame.header().instance != self.instance => {
                 Err(FrameReceiveError::DaemonLost)
+            }
+            Some(frame) if frame.header().status == ErrorCode::SceneReleased as u32 => {
+                let owner_gone = frame.header().flags & frame_flags::OWNER_GONE != 0;
+                Err(FrameReceiveError::SceneReleased { owner_gone })
             }
             frame => Ok(frame),
         }

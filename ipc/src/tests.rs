@@ -97,7 +97,7 @@ fn every_error_code_survives_the_wire_and_unknown_values_are_refused() {
             known += 1;
         }
     }
-    assert_eq!(known, 15);
+    assert_eq!(known, 16);
     assert_eq!(ErrorCode::from_u32(u32::MAX), None);
 }
 

@@ -196,6 +196,10 @@ pub enum ErrorCode {
     /// (the reason says which); its state is gone. Only `DropScene` is accepted, to let go
     /// of the id (since protocol version 9).
     SceneQuarantined = 14,
+    /// In a result frame only: the daemon let go of the scene (dropped by its owner, or
+    /// released after its owner was gone for the grace period, `OWNER_GONE` then set), and
+    /// this is the scene's last frame. No records (since protocol version 10).
+    SceneReleased = 15,
 }
 
 impl ErrorCode {
@@ -218,6 +222,7 @@ impl ErrorCode {
             12 => Self::ShapeNotReady,
             13 => Self::NotOwner,
             14 => Self::SceneQuarantined,
+            15 => Self::SceneReleased,
             _ => return None,
         })
     }
@@ -241,6 +246,7 @@ impl std::fmt::Display for ErrorCode {
             Self::ShapeNotReady => "shape not built yet",
             Self::NotOwner => "the scene belongs to another client",
             Self::SceneQuarantined => "the scene was quarantined after a shared-memory fault",
+            Self::SceneReleased => "the daemon let go of the scene",
         };
         f.write_str(text)
     }
@@ -342,6 +348,11 @@ pub mod frame_flags {
     /// `Truncated`, no records), on time, with the budget it would need in
     /// `min_budget_ns`. The scene's state is unchanged but for the frame's poses.
     pub const BUDGET_TOO_SMALL: u32 = 1 << 1;
+    /// The scene's owner is gone (its control client closed, or its process died): the
+    /// daemon abandoned the frame's work at its next poll, so its answers are conservative
+    /// (`Truncated`) even without a budget, and it releases the scene after its grace period
+    /// (since protocol version 10).
+    pub const OWNER_GONE: u32 = 1 << 2;
 }
 
 /// Bits of [`ResultRecord::flags`]; undefined bits are 0.

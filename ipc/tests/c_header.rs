@@ -254,7 +254,8 @@ fn table() -> Table {
 
     codes!(t, ErrorCode, "PROXIMA_ERROR_": Ok, ProtocolMismatch, UnknownScene, UnknownBody,
         UnknownShape, InvalidPose, InvalidShape, MeshIndexOutOfRange, EmptyGeometry,
-        LimitExceeded, MalformedMessage, Internal, ShapeNotReady, NotOwner, SceneQuarantined);
+        LimitExceeded, MalformedMessage, Internal, ShapeNotReady, NotOwner, SceneQuarantined,
+        SceneReleased);
     codes!(t, Command, "PROXIMA_COMMAND_": Hello, CreateScene, DropScene, RegisterShape,
         AddBody, RemoveBody, UpdateBody, SetSceneParams, ShapeState);
     codes!(t, ShapeKindCode, "PROXIMA_SHAPE_KIND_": Sphere, Capsule, Cuboid, Cylinder, Cone,
@@ -273,6 +274,7 @@ fn table() -> Table {
     constant!(t, wire::query::ALL => "PROXIMA_QUERY_ALL");
     constant!(t, wire::frame_flags::PAIRS_CAPPED => "PROXIMA_FRAME_FLAG_PAIRS_CAPPED");
     constant!(t, wire::frame_flags::BUDGET_TOO_SMALL => "PROXIMA_FRAME_FLAG_BUDGET_TOO_SMALL");
+    constant!(t, wire::frame_flags::OWNER_GONE => "PROXIMA_FRAME_FLAG_OWNER_GONE");
     constant!(t, wire::record_flags::APPROXIMATE => "PROXIMA_RECORD_FLAG_APPROXIMATE");
     constant!(t, wire::reply_flags::SHAPE_BUILDING => "PROXIMA_REPLY_FLAG_SHAPE_BUILDING");
     constant!(t, wire::stage::INGEST => "PROXIMA_STAGE_INGEST");
@@ -785,8 +787,8 @@ fn the_header_compiles_cleanly_as_c99_and_as_cxx98_to_cxx20() {
              proxima_PoseFrameHeader h;\n\
              h.protocol_version = PROXIMA_PROTOCOL_VERSION;\n\
              h.query_flags = PROXIMA_QUERY_CLOSE | PROXIMA_QUERY_CONTACTS;\n\
-             return (h.protocol_version == 9 && h.query_flags == 10\n\
-                     && PROXIMA_ERROR_SCENE_QUARANTINED == 14) ? 0 : 1;\n\
+             return (h.protocol_version == 10 && h.query_flags == 10\n\
+                     && PROXIMA_ERROR_SCENE_RELEASED == 15) ? 0 : 1;\n\
          }\n",
     )
     .unwrap();

@@ -675,6 +675,7 @@ fn every_bit_and_stage_is_the_codes() {
         named(&[
             ("PAIRS_CAPPED", frame_flags::PAIRS_CAPPED),
             ("BUDGET_TOO_SMALL", frame_flags::BUDGET_TOO_SMALL),
+            ("OWNER_GONE", frame_flags::OWNER_GONE),
         ])
     );
     assert_eq!(

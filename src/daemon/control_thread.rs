@@ -25,7 +25,7 @@ use super::claim::{self, ControlFactory, EventSettings};
 use super::config::DaemonConfig;
 use super::control::ControlState;
 use super::error::{DaemonRunError, DaemonStartError};
-use super::frame_loop::{SceneFrames, SceneKeys};
+use super::frame_loop::{SceneFrames, SceneKeys, SceneSignals};
 use super::gate::Gate;
 use super::liveness::{Liveness, OwnerId};
 use super::log::{Cause, Level, Logger, Subject};
@@ -39,6 +39,7 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
 use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
+use std::collections::HashMap;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -100,6 +101,8 @@ pub struct ControlThread {
     sweep_interval: Duration,
     /// Scratch list of the connected control clients, refilled at each sweep.
     connected: Vec<OwnerId>,
+    /// Each served scene's signals to its frames (owner gone, being released).
+    signals: HashMap<u32, SceneSignals>,
 }
 
 impl ControlThread {
@@ -155,6 +158,7 @@ impl ControlThread {
             spin: config.spin,
             sweep_interval: config.sweep_interval,
             connected: Vec::new(),
+            signals: HashMap::new(),
         })
     }
 
@@ -246,6 +250,7 @@ impl ControlThread {
             }
             let request = *active.user_header();
             let origin = active.origin().value();
+            self.stop_frame_before_drop(&request, origin);
             let mut reply = self.state.handle(origin, &request, active.payload());
             if reply.status == ErrorCode::Ok as u32 {
                 reply = self.follow_scene_changes(&request, reply, origin);
@@ -257,6 +262,20 @@ impl ControlThread {
             served += 1;
         }
         served
+    }
+
+    /// Before its owner's DropScene is handled (which takes the scene's lock), stops the
+    /// scene's frame in progress at its next poll, so the drop waits for a poll step, not
+    /// for the frame's end. Anyone else's DropScene changes nothing, here as in the reply.
+    fn stop_frame_before_drop(&self, request: &ControlRequest, origin: OwnerId) {
+        let owners_drop = request.command == Command::DropScene as u32
+            && self
+                .state
+                .entry(request.scene)
+                .is_some_and(|entry| entry.owner == origin);
+        if owners_drop && let Some(signals) = self.signals.get(&request.scene) {
+            signals.releasing();
+        }
     }
 
     /// Logs a refused request once per client and cause.
@@ -300,9 +319,12 @@ impl ControlThread {
             Subject::Scene(_) | Subject::Daemon => false,
         });
         for &id in &outcome.orphaned {
+            if let Some(signals) = self.signals.get(&id) {
+                signals.owner_gone();
+            }
             self.log.warn(format_args!(
-                "scene {id}: the client that created it is gone; the scene is dropped after a \
-                 grace period of {:?}",
+                "scene {id}: the client that created it is gone; its frames are abandoned at \
+                 their next poll, and the scene is released after a grace period of {:?}",
                 self.liveness.grace()
             ));
         }
@@ -338,6 +360,10 @@ impl ControlThread {
 
     /// Drops scene `id`'s state (if it still lives) and takes its ports off the frame thread.
     fn release_scene(&mut self, id: u32) {
+        // A frame in progress stops at its next poll, so the lock comes free soon.
+        if let Some(signals) = self.signals.remove(&id) {
+            signals.releasing();
+        }
         // A scene already dropped by request has nothing left to release.
         let _ = self.state.drop_scene(id);
         self.tell_frames(FrameCommand::Close(id));
@@ -377,10 +403,12 @@ impl ControlThread {
                 .state
                 .refusal(ErrorCode::Internal, "the new scene is gone");
         };
+        let signals = SceneSignals::new();
         let keys = SceneKeys {
             token: entry.token,
             frame_key: entry.frame_key,
             instance: self.state.instance(),
+            signals: signals.clone(),
         };
         let opened = SceneFrames::open(&self.node, &self.root, keys, &self.workers);
         match (opened, self.state.scene(id)) {
@@ -389,6 +417,7 @@ impl ControlThread {
                 let frames = Box::new(frames);
                 self.tell_frames(FrameCommand::Open { id, scene, frames });
                 self.liveness.adopt(id, origin);
+                self.signals.insert(id, signals);
                 self.log
                     .info(format_args!("scene {id} created by client {origin:x}"));
                 reply

@@ -29,7 +29,7 @@ use super::log::{Cause, Level, Logger, Subject};
 use super::schedule::FrameKey;
 use crate::math::Pose;
 use crate::pipeline::{
-    self, Completeness, ContactPoint, Deadline, FrameResults, PairResult, PairToi,
+    self, Abandon, Completeness, ContactPoint, Deadline, FrameResults, PairResult, PairToi,
     PipelineWorkspace, Query, StepReport, WorkerPool,
 };
 use crate::scene::{BodyId, Scene};
@@ -45,6 +45,7 @@ use proxima_ipc::wire::{
 };
 use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION, SceneToken};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Initial number of result records a result sample can hold (grows by powers of two).
@@ -53,9 +54,9 @@ const INITIAL_RESULT_RECORDS: usize = 1024;
 /// A received pose frame, still in shared memory.
 type PoseSample<S> = Sample<S, [PoseRecord], PoseFrameHeader>;
 
-/// Who a scene's frames are for: the secrets its services and frames carry, and the daemon
-/// run answering them.
-#[derive(Clone, Copy)]
+/// Who a scene's frames are for: the secrets its services and frames carry, the daemon
+/// run answering them, and the flag that abandons them.
+#[derive(Clone)]
 pub struct SceneKeys {
     /// Names the scene's services.
     pub token: SceneToken,
@@ -63,6 +64,44 @@ pub struct SceneKeys {
     pub frame_key: u64,
     /// This daemon run's instance id, in every result header.
     pub instance: u64,
+    /// What the control thread tells the scene's frames while one may be in progress.
+    pub signals: SceneSignals,
+}
+
+/// What the control thread tells a scene's frames at any moment, without the scene's lock
+/// (which a frame in progress holds). Clones share the signals.
+#[derive(Clone, Default)]
+pub struct SceneSignals {
+    /// Stops the frame in progress at its next poll (its answers then conservative).
+    abandon: Abandon,
+    /// Frames answered from now on say `OWNER_GONE`, and so does the release frame.
+    owner_gone: Arc<AtomicBool>,
+}
+
+impl SceneSignals {
+    /// Fresh signals, none raised.
+    #[must_use]
+    pub fn new() -> Self {
+        Self {
+            abandon: Abandon::new(),
+            owner_gone: Arc::default(),
+        }
+    }
+
+    /// The scene's owner is gone: its frames' work is abandoned from now on, and they say so.
+    pub fn owner_gone(&self) {
+        self.owner_gone.store(true, Ordering::Relaxed);
+        self.abandon.raise();
+    }
+
+    /// The scene is being let go of: the frame in progress, if any, stops at its next poll.
+    pub fn releasing(&self) {
+        self.abandon.raise();
+    }
+
+    fn is_owner_gone(&self) -> bool {
+        self.owner_gone.load(Ordering::Relaxed)
+    }
 }
 
 /// A scene's ports, the frame waiting for its turn and per-frame scratch space.
@@ -131,16 +170,17 @@ impl<S: Service> SceneFrames<S> {
             .create()
             .map_err(|e| format!("poses-ready listener: {e:?}"))?;
         Ok(Self {
-            keys,
             poses,
             results,
             notifier,
             poses_ready,
             waiting: None,
             lateness: Lateness::default(),
-            workspace: PipelineWorkspace::with_workers(Arc::clone(workers)),
+            workspace: PipelineWorkspace::with_workers(Arc::clone(workers))
+                .abandon_on(keys.signals.abandon.clone()),
             output: FrameResults::default(),
             validated: Vec::new(),
+            keys,
         })
     }
 
@@ -246,6 +286,9 @@ impl<S: Service> SceneFrames<S> {
                 let report = self.step(scene, query, key);
                 scene.end_frame();
                 fill_header(&mut result, &report);
+                if self.keys.signals.is_owner_gone() {
+                    result.flags |= wire::frame_flags::OWNER_GONE;
+                }
                 if let Some(needed) = report.budget_too_small {
                     result.flags |= wire::frame_flags::BUDGET_TOO_SMALL;
                     result.min_budget_ns = ingest_ns.saturating_add(needed);
@@ -273,6 +316,36 @@ impl<S: Service> SceneFrames<S> {
     /// Drops the waiting frame unanswered (its scene is gone).
     pub fn discard_waiting(&mut self) {
         self.waiting = None;
+    }
+
+    /// Publishes the scene's last result frame, which tells whoever reads its results (its
+    /// owner, a monitor holding its token) that the daemon let go of it: status
+    /// `SceneReleased`, no records, `OWNER_GONE` when the owner's absence was why.
+    ///
+    /// # Errors
+    /// The iceoryx2 failure, as text.
+    pub fn publish_release(&self) -> Result<(), String> {
+        let mut header = ResultFrameHeader {
+            protocol_version: PROTOCOL_VERSION,
+            status: ErrorCode::SceneReleased as u32,
+            error_body: u32::MAX,
+            instance: self.keys.instance,
+            ..ResultFrameHeader::default()
+        };
+        if self.keys.signals.is_owner_gone() {
+            header.flags |= wire::frame_flags::OWNER_GONE;
+        }
+        let mut sample = self
+            .results
+            .loan_slice_uninit(0)
+            .map_err(|e| format!("results loan: {e:?}"))?
+            .write_from_fn(|_| ResultRecord::default());
+        *sample.user_header_mut() = header;
+        sample.send().map_err(|e| format!("results send: {e:?}"))?;
+        self.notifier
+            .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
+            .map_err(|e| format!("results notify: {e:?}"))?;
+        Ok(())
     }
 
     /// Runs the pipeline for `query`: exact without a deadline (no budget, or one beyond
@@ -463,6 +536,7 @@ mod tests {
             token: SceneToken([n, 7]),
             frame_key: 1,
             instance: 1,
+            signals: SceneSignals::default(),
         };
         // Each of the four services, set up ahead with hostile settings (one event id, a
         // deadline, safe overflow off): the scene is refused, whichever it is.

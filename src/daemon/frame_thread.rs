@@ -142,6 +142,12 @@ impl FrameThread {
                 "{}: quarantined after a fault on its services: {why}",
                 Subject::Scene(id)
             ));
+        } else if let Err(why) = frames.publish_release() {
+            // Readers of its results then learn it from their waits ending without frames.
+            self.log.warn(format_args!(
+                "{}: publishing its release failed: {why}",
+                Subject::Scene(id)
+            ));
         }
         self.log.release(Subject::Scene(id));
         // Should the control thread be gone, the scene is let go of here after all.

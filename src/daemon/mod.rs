@@ -51,6 +51,7 @@ mod ingest;
 mod lateness;
 pub mod liveness;
 pub mod log;
+pub mod node_counter;
 mod schedule;
 mod secrets;
 mod service_loop;

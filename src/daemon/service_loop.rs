@@ -21,6 +21,7 @@ use super::error::{DaemonRunError, DaemonStartError};
 use super::frame_thread::{ControlLinks, FrameThread};
 use super::gate::Gate;
 use super::log::{Level, Logger};
+use super::node_counter;
 use super::secrets;
 use super::stop::{StopHandle, StopOnDrop};
 use crate::geometry::MeshLimits;
@@ -61,7 +62,15 @@ impl Daemon {
         let instance = secrets::random_u64().map_err(|e| {
             DaemonStartError::Ipc(format!("no randomness for the instance id: {e}"))
         })?;
-        let node = create_node(&config)?;
+        let ipc_config = iceoryx_config(&config)?;
+        // Before the node (a counter another user set up stops it with an unclear error)
+        // and after (the node may have made the counter).
+        secure_node_counter(&ipc_config, &config)?;
+        let node = NodeBuilder::new()
+            .config(&ipc_config)
+            .create::<Ipc>()
+            .map_err(|e| DaemonStartError::Ipc(format!("node: {e:?}")))?;
+        secure_node_counter(&ipc_config, &config)?;
         let (wake, wake_listener) = frame_wake(&node, &config.root)?;
         let (commands, incoming) = channel::bounded(FRAME_COMMANDS);
         let (retire, retired) = channel::bounded(FRAME_COMMANDS);
@@ -183,17 +192,32 @@ impl Daemon {
     }
 }
 
-/// The daemon's node, under `config.iceoryx_prefix` when set.
-fn create_node(config: &DaemonConfig) -> Result<Node<Ipc>, DaemonStartError> {
+/// The iceoryx2 configuration of the daemon's node: the global one, under
+/// `config.iceoryx_prefix` when set.
+fn iceoryx_config(config: &DaemonConfig) -> Result<iceoryx2::config::Config, DaemonStartError> {
     let mut ipc_config = iceoryx2::config::Config::global_config().clone();
     if let Some(prefix) = &config.iceoryx_prefix {
         ipc_config.global.prefix = FileName::new(prefix.as_bytes())
             .map_err(|e| DaemonStartError::Config(format!("iceoryx2 prefix {prefix:?}: {e:?}")))?;
     }
-    NodeBuilder::new()
-        .config(&ipc_config)
-        .create::<Ipc>()
-        .map_err(|e| DaemonStartError::Ipc(format!("node: {e:?}")))
+    Ok(ipc_config)
+}
+
+/// Makes the node counter of `ipc_config`'s prefix private, logging it, or refuses a
+/// counter another user owns ([`node_counter`]).
+fn secure_node_counter(
+    ipc_config: &iceoryx2::config::Config,
+    config: &DaemonConfig,
+) -> Result<(), DaemonStartError> {
+    let prefix = ipc_config.global.prefix.to_string();
+    for counter in node_counter::secure(&prefix)?.restricted {
+        Logger::new(config.log_level).info(format_args!(
+            "made iceoryx2's node counter {} private (mode 0600): other users could stop \
+             new clients from connecting",
+            counter.display()
+        ));
+    }
+    Ok(())
 }
 
 /// The notifier and listener of the frame thread's wake-up event (`<root>/frame-wake`, the

@@ -80,7 +80,7 @@ mod separation;
 mod toi;
 pub mod workers;
 
-pub use crate::budget::Budget;
+pub use crate::budget::{Abandon, Budget};
 pub use crate::narrow::dispatch::PathCounts;
 pub use costs::FrameCosts;
 use pair_loop::answer_candidates;
@@ -402,6 +402,8 @@ pub struct PipelineWorkspace {
     frontier_run: FrontierRun,
     /// The scene's uninterruptible stages, measured (the daemon adds its publishing).
     costs: FrameCosts,
+    /// Raised to abandon the frame's work at its next poll ([`Self::abandon_on`]).
+    abandon: Abandon,
 }
 
 impl PipelineWorkspace {
@@ -430,6 +432,18 @@ impl PipelineWorkspace {
             workers: Some(workers),
             ..Self::default()
         }
+    }
+
+    /// This workspace with every frame's work stopped at its next poll once `abandon` is
+    /// raised (the daemon raises a scene's when its owner is gone): the frontier, the pair
+    /// loop, the narrow routes' long steps, the pool's mesh pairs and time of impact, as if
+    /// the deadline had come, with conservative answers marked `Truncated`; an unlimited
+    /// frame then is not exact. What no poll interrupts (the broad phase, one mesh pair's
+    /// distance search) runs to its end.
+    #[must_use]
+    pub fn abandon_on(mut self, abandon: Abandon) -> Self {
+        self.abandon = abandon;
+        self
     }
 
     /// This workspace with its budgeted frontier polling the budget once at least `visits`
@@ -579,7 +593,7 @@ pub fn step_within(
         &mut workspace.candidates,
         &mut workspace.toi_candidates,
     );
-    workspace.narrow.clock = plan.clock();
+    workspace.narrow.clock = plan.clock(&workspace.abandon);
     let (hull_tests, frontier) = mid_phase(scene, query, budget, &plan, started, workspace);
     let mid_ns = if plan.limited { elapsed_ns(started) } else { 0 };
     // Unbudgeted, the hull tests answer pairs as the narrow phase does: its time.
@@ -643,6 +657,7 @@ fn mid_phase(
     let mut reserved = budget.deadline().map(|d| FrontierClock {
         deadline: frontier_deadline(started, d, tail),
         ps_per_pending_entry,
+        abandon: workspace.abandon.clone(),
     });
     let frontier_budget: &mut dyn Budget = match reserved.as_mut() {
         Some(deadline) => deadline,
@@ -676,6 +691,7 @@ fn answer_on_pool(
         workers,
         outcomes,
         job_contacts,
+        abandon,
         ..
     } = workspace;
     outcomes.clear();
@@ -701,6 +717,7 @@ fn answer_on_pool(
             mesh_b: Arc::clone(mesh_b),
             query,
             cache: memory.mesh_cache(pair),
+            abandon: abandon.clone(),
         }
     });
     pool.answer_all(jobs, outcomes, mesh, job_contacts);

@@ -8,7 +8,7 @@
 
 use super::costs::FrameCosts;
 use super::{MIN_PARALLEL_MESH_PAIRS, Query};
-use crate::budget::{Budget, Stop, WORK_PER_CLOCK_READ, WorkClock};
+use crate::budget::{Abandon, Budget, Stop, WORK_PER_CLOCK_READ, WorkClock};
 pub use crate::budget::{Deadline, Unlimited, VisitBudget};
 use crate::narrow::dispatch::{self, Route};
 use crate::narrow::{MeshShape, Shape};
@@ -53,20 +53,26 @@ pub fn frontier_deadline(start: Instant, frame_deadline: Instant, tail: Duration
 /// the entries left waiting will take once it stops (their answers and a round's sort,
 /// [`FrameCosts::pending_entry_ps`] each), so the frontier stops growing while extracting
 /// its answers still fits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// It also stops once its [`Abandon`] flag is raised.
+#[derive(Debug, Clone)]
 pub struct FrontierClock {
     /// When the frontier's work must end, its answers extracted.
     pub deadline: Deadline,
     /// What one waiting entry costs after the frontier stops, picoseconds.
     pub ps_per_pending_entry: u64,
+    /// Raised when the frame's work is to stop now.
+    pub abandon: Abandon,
 }
 
 impl Budget for FrontierClock {
     fn allows(&mut self, visits: u64) -> bool {
-        self.deadline.allows(visits)
+        !self.abandon.is_raised() && self.deadline.allows(visits)
     }
 
     fn allows_pending(&mut self, _visits: u64, pending: u64) -> bool {
+        if self.abandon.is_raised() {
+            return false;
+        }
         let reserve =
             Duration::from_nanos(pending.saturating_mul(self.ps_per_pending_entry) / 1000);
         Instant::now()
@@ -155,9 +161,10 @@ impl FramePlan {
     /// its stop the frame's tail before it, so a pair started just before then stops soon
     /// after; it never stops without a deadline. The pipeline keeps it in
     /// [`NarrowScratch::clock`](crate::narrow::dispatch::NarrowScratch::clock), where the
-    /// dispatcher's routes poll it.
-    pub(super) fn clock(&self) -> WorkClock {
-        WorkClock::new(self.deadline.map_or(Stop::Never, Stop::At))
+    /// dispatcher's routes poll it. It stops at once when `abandon` is raised, deadline or
+    /// not.
+    pub(super) fn clock(&self, abandon: &Abandon) -> WorkClock {
+        WorkClock::new(self.deadline.map_or(Stop::Never, Stop::At)).abandonable(abandon.clone())
     }
 
     /// Moves `clock`'s stop to the frame's deadline less its tail from here
@@ -236,6 +243,8 @@ impl FramePlan {
             Route::Direct => PairPlan::Direct,
             Route::MeshMesh(ma, mb) if self.limited => PairPlan::Frontier(ma, mb),
             Route::MeshMesh(..) if self.pool => PairPlan::Pooled,
+            // An exact mesh search starts only while the frame is not abandoned.
+            Route::MeshMesh(..) if clock.is_abandoned() => PairPlan::Conservative,
             Route::MeshMesh(ma, mb) => PairPlan::MeshMesh(ma, mb),
         }
     }
@@ -261,6 +270,7 @@ mod tests {
         let mut clock = FrontierClock {
             deadline: Deadline(Instant::now() + Duration::from_millis(50)),
             ps_per_pending_entry: 1_000_000,
+            abandon: Abandon::default(),
         };
         assert!(clock.allows(0) && clock.allows_pending(0, 0));
         assert!(clock.allows_pending(0, 1_000), "1 ms of entries fits in 50");
@@ -273,8 +283,17 @@ mod tests {
         let mut past = FrontierClock {
             deadline: Deadline(Instant::now()),
             ps_per_pending_entry: 0,
+            abandon: Abandon::default(),
         };
         assert!(!past.allows_pending(0, 0) && !past.allows(0));
+        let abandoned = FrontierClock {
+            abandon: Abandon::new(),
+            ..clock
+        };
+        let mut abandoned_clock = abandoned.clone();
+        assert!(abandoned_clock.allows(0) && abandoned_clock.allows_pending(0, 0));
+        abandoned.abandon.raise();
+        assert!(!abandoned_clock.allows(0) && !abandoned_clock.allows_pending(0, 0));
     }
 
     #[test]

@@ -208,6 +208,85 @@ fn the_worker_pool_changes_nothing_but_who_answers() {
     );
 }
 
+/// A frame abandoned from its start (its owner gone) is conservative, never wrong: every
+/// pair the exact frame reports is reported, at a distance no greater (a lower bound, within
+/// its error bound), and a pair it calls exact has the exact answer; on the pool or not.
+/// A flag never raised changes nothing.
+#[test]
+fn an_abandoned_frame_answers_conservatively_and_misses_nothing() {
+    let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.6, 0.15, 20, 8))));
+    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let mut rng = rng(131);
+    for i in 0..12 {
+        let shape = match i % 4 {
+            0 => Shape::Sphere(Sphere::new(0.3)),
+            1 => Shape::Cuboid(Cuboid::new(DVec3::new(0.3, 0.2, 0.4))),
+            _ => torus.clone(),
+        };
+        add(&mut scene, shape, point_in_cube(&mut rng, 1.2), 0.2);
+    }
+    let raised = Abandon::new();
+    raised.raise();
+    let pool = Arc::new(WorkerPool::new(2));
+    let mut exact = PipelineWorkspace::default();
+    let mut never_raised = PipelineWorkspace::default().abandon_on(Abandon::new());
+    let mut abandoned = [
+        PipelineWorkspace::default().abandon_on(raised.clone()),
+        PipelineWorkspace::with_workers(pool).abandon_on(raised),
+    ];
+    let queries = [
+        Query::CLOSE.union(Query::CONTACTS),
+        Query::DISTANCE,
+        Query::OVERLAP,
+    ];
+    let (mut truncated_frames, mut approximate_pairs, mut touching) = (0, 0, 0);
+    for frame in 0..60 {
+        let ids: Vec<BodyId> = scene.bodies().map(|(id, _)| id).collect();
+        for id in ids {
+            let pose = scene.body(id).unwrap().pose;
+            let moved = (pose.position + point_in_cube(&mut rng, 0.1)).clamp_length_max(1.4);
+            let pose = Pose::new(moved, rotation(&mut rng));
+            scene.set_pose(id, pose).unwrap();
+        }
+        let query = queries[frame % queries.len()];
+        let truth = run(&scene, query, &mut exact);
+        assert_eq!(run(&scene, query, &mut never_raised).pairs, truth.pairs);
+        touching += truth.pairs.iter().filter(|p| p.distance <= 0.0).count();
+        for workspace in &mut abandoned {
+            let mut found = FrameResults::default();
+            let report = step_within(&scene, query, &mut Unlimited, workspace, &mut found);
+            assert_links(&found);
+            for pair in &truth.pairs {
+                let seen = found.pairs.iter().find(|p| (p.a, p.b) == (pair.a, pair.b));
+                let seen = seen.unwrap_or_else(|| panic!("frame {frame}: missed {pair:?}"));
+                if seen.exact {
+                    assert_eq!(seen.distance, pair.distance, "frame {frame}");
+                } else {
+                    assert!(
+                        seen.distance <= pair.distance + 1e-12
+                            && pair.distance - seen.distance <= seen.error_bound + 1e-12,
+                        "frame {frame}: {seen:?} against {pair:?}"
+                    );
+                }
+            }
+            let approximate = found.pairs.iter().filter(|p| !p.exact).count();
+            approximate_pairs += approximate;
+            if approximate > 0 {
+                assert!(matches!(
+                    report.completeness,
+                    Completeness::Truncated { .. }
+                ));
+                truncated_frames += 1;
+            }
+        }
+    }
+    assert!(
+        truncated_frames > 60 && approximate_pairs > 200 && touching > 20,
+        "truncated frames {truncated_frames}, approximate pairs {approximate_pairs}, \
+         touching pairs {touching}"
+    );
+}
+
 #[test]
 fn mesh_pairs_answer_each_query_as_the_mesh_queries_do_directly() {
     let (mut scene, a, b, mesh) = torus_scene();

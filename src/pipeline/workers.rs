@@ -30,7 +30,7 @@
 use super::answer::{self, Answer, MeshScratch};
 use super::{ContactPoint, Query};
 use crate::broad::CandidatePair;
-use crate::budget::WorkClock;
+use crate::budget::{Abandon, WorkClock};
 use crate::math::DVec3;
 use crate::narrow::MANIFOLD_POINTS;
 use crate::narrow::MeshShape;
@@ -59,6 +59,8 @@ pub(super) struct MeshJob {
     pub mesh_b: Arc<MeshShape>,
     pub query: Query,
     pub cache: DistanceCache,
+    /// The frame's abandon flag.
+    pub abandon: Abandon,
 }
 
 /// A pair's answer, its contacts and its updated warm-start cache.
@@ -117,8 +119,12 @@ pub(super) fn run(
         (&job.b, &job.mesh_b),
         job.query,
         &mut cache,
-        // The pool answers only frames without a limited budget: an unlimited clock.
-        (scratch, &mut WorkClock::default()),
+        // The pool answers only frames without a limited budget: an unlimited clock, which
+        // stops only when the frame is abandoned.
+        (
+            scratch,
+            &mut WorkClock::default().abandonable(job.abandon.clone()),
+        ),
         contacts,
     );
     MeshOutcome::new(job.slot, answer, contacts, cache)

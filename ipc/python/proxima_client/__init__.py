@@ -51,6 +51,7 @@ from .errors import (
     ProximaError,
     ReplyTimeout,
     SceneQuarantinedError,
+    SceneReleasedError,
     ShapeNotReadyError,
     TransportError,
     UnexpectedDaemon,

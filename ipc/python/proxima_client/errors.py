@@ -212,6 +212,23 @@ class SceneQuarantinedError(DaemonError):
     CODE = ErrorCode.SCENE_QUARANTINED
 
 
+class SceneReleasedError(DaemonError):
+    """The scene's last result frame: the daemon let go of it (its owner dropped it, or its
+    owner was gone for the daemon's grace period, ``owner_gone``). Raised by result
+    receives; a monitor learns from it that the scene is over."""
+
+    CODE = ErrorCode.SCENE_RELEASED
+
+    @property
+    def owner_gone(self) -> bool:
+        """Whether the owner's absence was why."""
+        return self.reason == OWNER_GONE_REASON
+
+
+#: The reason of a :class:`SceneReleasedError` whose frame says ``OWNER_GONE``.
+OWNER_GONE_REASON = "its owner is gone"
+
+
 class UnknownStatusError(DaemonError):
     """The status is a value this protocol version does not define."""
 
@@ -233,6 +250,7 @@ _BY_CODE: dict[ErrorCode, type[DaemonError]] = {
         ShapeNotReadyError,
         NotOwnerError,
         SceneQuarantinedError,
+        SceneReleasedError,
     )
     if cls.CODE is not None
 }

@@ -34,10 +34,17 @@ import iceoryx2 as iox
 import numpy as np
 
 from . import services
-from .errors import DaemonLost, NoSuchScene, TransportError, error_for
+from .errors import (
+    OWNER_GONE_REASON,
+    DaemonLost,
+    NoSuchScene,
+    SceneReleasedError,
+    TransportError,
+    error_for,
+)
 from .services import SceneToken
 from .transport import RESULTS_SPIN_S, now, release_ports
-from .wire import RESULT_DTYPE, Completeness, ErrorCode, ResultFrameHeader
+from .wire import RESULT_DTYPE, Completeness, ErrorCode, ResultFrameHeader, frame_flags
 
 _RECORD_BYTES = RESULT_DTYPE.itemsize
 _HEADER_BYTES = ctypes.sizeof(ResultFrameHeader)
@@ -258,6 +265,7 @@ class ResultFeed:
 
         Raises:
             DaemonLost: the frame comes from another daemon instance than the one expected.
+            SceneReleasedError: the scene's last frame: the daemon let go of it.
             TransportError: iceoryx2 failed (e.g. two frames are still held).
         """
         try:
@@ -270,6 +278,12 @@ class ResultFeed:
         if self._instance and frame.header.instance != self._instance:
             frame.release()
             raise DaemonLost("a result frame came from another daemon instance (a restart)")
+        header = frame.header
+        if header.status == ErrorCode.SCENE_RELEASED:
+            owner_gone = bool(header.flags & frame_flags.OWNER_GONE)
+            frame.release()
+            reason = OWNER_GONE_REASON if owner_gone else "its owner dropped it"
+            raise SceneReleasedError(ErrorCode.SCENE_RELEASED, reason)
         return frame
 
     def daemon_is_alive(self) -> bool:

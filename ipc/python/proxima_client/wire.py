@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 #: The protocol version; a client and a daemon whose versions differ refuse to talk.
-PROTOCOL_VERSION: int = 9
+PROTOCOL_VERSION: int = 10
 
 #: Most contact records per pair (one manifold).
 MAX_CONTACTS_PER_PAIR: int = 4
@@ -75,6 +75,9 @@ class frame_flags:  # noqa: N801 (mirrors `wire::frame_flags`)
     #: The budget could not hold the uninterruptible work; nothing was answered and
     #: ``min_budget_ns`` says what budget the frame would need.
     BUDGET_TOO_SMALL: int = 1 << 1
+    #: The scene's owner is gone: the frame's work was abandoned (conservative,
+    #: ``Truncated`` answers), and the scene is released after the daemon's grace period.
+    OWNER_GONE: int = 1 << 2
 
 
 class record_flags:  # noqa: N801 (mirrors `wire::record_flags`)
@@ -125,6 +128,8 @@ class ErrorCode(enum.IntEnum):
     #: The daemon stopped serving the scene after a shared-memory fault; only
     #: ``DropScene`` is accepted.
     SCENE_QUARANTINED = 14
+    #: In a result frame only: the daemon let go of the scene; its last frame.
+    SCENE_RELEASED = 15
 
 
 class Command(enum.IntEnum):

@@ -30,11 +30,13 @@ from proxima_client import (
     ResultFrame,
     SceneAccess,
     SceneLink,
+    SceneReleasedError,
     SceneToken,
     Sphere,
     TransportError,
     UnknownBodyError,
     UnknownSceneError,
+    frame_flags,
     pose_array,
     query,
 )
@@ -399,6 +401,23 @@ def test_a_monitor_opens_the_results_with_the_owners_token_and_sees_the_owners_f
             monitor.open_scene(s.scene)
         with pytest.raises(NotOwnerError):
             monitor.drop_scene(s.scene)
+
+
+def test_a_monitor_learns_from_the_last_frame_that_the_owner_dropped_the_scene(
+    daemon: DaemonProcess, client: Client
+) -> None:
+    s = spheres(client, [0.5, 0.5], [(0.0, 0.0, 0.0), (0.9, 0.0, 0.0)], margin=0.0)
+    with connect(daemon) as monitor, monitor.open_result_feed(s.link.access.token) as feed:
+        with answer(s.link, 1, query.CLOSE, s.bodies, [(0.0, 0.0, 0.0), (0.9, 0.0, 0.0)]) as frame:
+            assert not frame.header.flags & frame_flags.OWNER_GONE
+        seen = feed.receive_for(1, FRAME_TIMEOUT)
+        assert seen is not None
+        seen.release()
+        client.drop_scene(s.scene)
+        with pytest.raises(SceneReleasedError) as released:
+            feed.receive(FRAME_TIMEOUT)
+        assert released.value.code == ErrorCode.SCENE_RELEASED
+        assert not released.value.owner_gone
 
 
 def test_a_token_no_scene_has_opens_nothing(client: Client) -> None:
