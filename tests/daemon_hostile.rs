@@ -235,7 +235,8 @@ const DOOMED_SPHERES: u32 = 24;
 /// once): a scene of [`DOOMED_SPHERES`] coincident sphere meshes, its token on stdout (as an
 /// owner hands it to a monitor); then, for each line on stdin, `GO` publishes one
 /// unbudgeted frame asking every pair's contacts (answered by no one: it prints `SENT`),
-/// and `DROP` drops the scene (`DROPPED`). It waits to be killed.
+/// `DROP` drops the scene (`DROPPED`), and `ADD` adds a body (`ADDING`, then `ADDED` and
+/// the outcome once answered). It waits to be killed.
 #[test]
 fn doomed_client_role() {
     let Some((root, prefix, _)) = role_spec(DOOMED_ROLE) else {
@@ -272,6 +273,13 @@ fn doomed_client_role() {
             "DROP" => {
                 client.drop_scene(scene).unwrap();
                 writeln!(out, "DROPPED").unwrap();
+            }
+            "ADD" => {
+                // Says so first: the reply waits for the frame in progress.
+                writeln!(out, "ADDING").unwrap();
+                out.flush().unwrap();
+                let added = client.add_body(scene, &body(mesh, 0.0));
+                writeln!(out, "ADDED {added:?}").unwrap();
             }
             other => panic!("unknown order {other:?}"),
         }
@@ -378,29 +386,69 @@ fn a_client_killed_mid_frame_has_its_frame_abandoned_and_its_release_seen_by_a_m
 }
 
 #[test]
-fn a_scene_dropped_mid_frame_stops_the_frame_and_its_release_is_seen_by_a_monitor() {
+fn a_clients_long_frame_holds_up_no_other_clients_requests() {
     let daemon = Daemon::start();
-    let mut victim = Victim::new(&daemon);
     let mut doomed = Doomed::start(&daemon);
     let monitor = daemon.client();
     let feed = ResultFeed::open(monitor.node(), daemon.root(), doomed.token).unwrap();
     doomed.order("GO", "SENT");
     std::thread::sleep(INTO_THE_FRAME);
-    // The drop waits for the frame in progress to stop, not to end.
-    doomed.order("DROP", "DROPPED");
-    let stopped = monitored(&feed).expect("the frame in progress is answered");
-    assert_eq!(stopped.frame_seq, 1);
-    assert_eq!(
-        stopped.flags & frame_flags::OWNER_GONE,
-        0,
-        "the owner is alive"
+    // Its own request on its scene waits for its frame...
+    doomed.order("ADD", "ADDING");
+    std::thread::sleep(INTO_THE_FRAME);
+    // ...and another client's requests do not: each is answered while the frame runs.
+    let victim = Victim::new(&daemon);
+    let shape = victim
+        .client
+        .register_primitive(victim.scene, Primitive::Sphere { radius: 0.1 })
+        .unwrap();
+    victim
+        .client
+        .add_body(victim.scene, &body(shape, 30.0))
+        .unwrap();
+    assert!(
+        feed.try_receive().unwrap().is_none(),
+        "the long frame had ended: the test shows nothing"
     );
-    assert_eq!(stopped.completeness, Completeness::Truncated as u32);
-    assert_eq!(
-        monitored(&feed).map(|h| h.frame_seq),
-        Err(FrameReceiveError::SceneReleased { owner_gone: false })
-    );
-    victim.assert_untouched();
+    // (The victim's frames still wait for an unbudgeted frame of another scene to end:
+    // frames are answered one at a time, issue #29.)
+}
+
+#[test]
+fn a_scene_dropped_mid_frame_stops_the_frame_and_its_release_is_seen_by_a_monitor() {
+    let daemon = Daemon::start();
+    let mut victim = Victim::new(&daemon);
+    let monitor = daemon.client();
+    // On a loaded host the daemon may not have taken the frame up by the drop: then the
+    // frame is dropped unanswered, and the test is run again.
+    for _ in 0..3 {
+        let mut doomed = Doomed::start(&daemon);
+        let feed = ResultFeed::open(monitor.node(), daemon.root(), doomed.token).unwrap();
+        doomed.order("GO", "SENT");
+        std::thread::sleep(INTO_THE_FRAME);
+        // The drop waits for the frame in progress to stop, not to end.
+        doomed.order("DROP", "DROPPED");
+        let released = FrameReceiveError::SceneReleased { owner_gone: false };
+        let stopped = match monitored(&feed) {
+            Ok(stopped) => stopped,
+            Err(not_taken) if not_taken == released => {
+                eprintln!("the daemon had not taken the frame up by the drop: again");
+                continue;
+            }
+            Err(e) => panic!("monitor: {e}"),
+        };
+        assert_eq!(stopped.frame_seq, 1);
+        assert_eq!(
+            stopped.flags & frame_flags::OWNER_GONE,
+            0,
+            "the owner is alive"
+        );
+        assert_eq!(stopped.completeness, Completeness::Truncated as u32);
+        assert_eq!(monitored(&feed).map(|h| h.frame_seq), Err(released));
+        victim.assert_untouched();
+        return;
+    }
+    panic!("three times the daemon had not taken the frame up in {INTO_THE_FRAME:?}");
 }
 
 /// Publishes a pose frame on the scene with token `token` without its frame key.

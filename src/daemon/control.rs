@@ -14,7 +14,9 @@
 //! its owner is told why until it drops the id.
 //!
 //! Every request is O(1) or a copy: scene edits take the scene's lock
-//! ([`shared_scene`]) for one edit; a convex or mesh registration is
+//! ([`shared_scene`]) for one edit, and never wait for it: while a frame or a build holds it
+//! the request is not handled ([`ControlState::handle_unless_busy`]) and the control thread
+//! asks again later, so one client's long frame holds up no other client's requests; a convex or mesh registration is
 //! checked ([`convert::shape_request`]), gets its shape id, and its payload is copied into a
 //! [`BuildJob`] for the builder thread; the reply says the shape is being built.
 
@@ -25,7 +27,7 @@ use super::convert::{self, Rejection, ShapeRequest};
 use super::liveness::OwnerId;
 use super::secrets;
 use super::shape_table::ShapeState;
-use super::shared_scene::{self, SharedScene, lock};
+use super::shared_scene::{self, SceneCell, SharedScene, lock};
 use crate::broad::{BroadPhaseChoice, BroadPhaseKind};
 use crate::scene::{BodyDesc, BodyId, Scene};
 use proxima_ipc::wire::{
@@ -33,7 +35,7 @@ use proxima_ipc::wire::{
 };
 use proxima_ipc::{PROTOCOL_VERSION, SceneToken};
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, MutexGuard, TryLockError};
 
 /// The scenes a daemon serves, by id, and the queue of shapes to build.
 #[derive(Debug)]
@@ -121,19 +123,22 @@ impl ControlState {
     }
 
     /// Answers one request from client port `origin`; the state changes only when the
-    /// reply is a success. A `CreateScene` reply carries the new scene's keys.
-    pub fn handle(
+    /// reply is a success. A `CreateScene` reply carries the new scene's keys. `None` when
+    /// the request needs its scene's lock and a frame or a build holds it: nothing changed,
+    /// ask again later (the control thread never waits for a frame, which may be long).
+    pub fn handle_unless_busy(
         &mut self,
         origin: OwnerId,
         request: &ControlRequest,
         payload: &[u8],
-    ) -> ControlReply {
+    ) -> Option<ControlReply> {
         let mut reply = match self.try_handle(origin, request, payload) {
             Ok(Answer { id, flags }) => ControlReply {
                 instance: self.instance,
                 ..ControlReply::ok_with(id, flags)
             },
-            Err(r) => self.refusal(r.code, &r.reason),
+            Err(Refusal::SceneBusy) => return None,
+            Err(Refusal::Rejected(r)) => self.refusal(r.code, &r.reason),
         };
         if request.command == Command::CreateScene as u32
             && let Some(entry) = self.scenes.get(&reply.id)
@@ -141,7 +146,24 @@ impl ControlState {
             reply.frame_key = entry.frame_key;
             reply.scene_token = entry.token.0;
         }
-        reply
+        Some(reply)
+    }
+
+    /// [`handle_unless_busy`](Self::handle_unless_busy), asking again until the scene's
+    /// lock is free (for callers that may wait: tests, the fuzz suite).
+    #[cfg(test)]
+    pub fn handle(
+        &mut self,
+        origin: OwnerId,
+        request: &ControlRequest,
+        payload: &[u8],
+    ) -> ControlReply {
+        loop {
+            if let Some(reply) = self.handle_unless_busy(origin, request, payload) {
+                return reply;
+            }
+            std::thread::yield_now();
+        }
     }
 
     /// Stops serving scene `id` after a fault on its services: frees its state and answers
@@ -163,45 +185,20 @@ impl ControlState {
         origin: OwnerId,
         request: &ControlRequest,
         payload: &[u8],
-    ) -> Result<Answer, Rejection> {
-        if request.protocol_version != PROTOCOL_VERSION {
-            return Err(Rejection::new(
-                ErrorCode::ProtocolMismatch,
-                format!(
-                    "client speaks protocol {}, the daemon {PROTOCOL_VERSION}",
-                    request.protocol_version
-                ),
-            ));
-        }
-        if request.reserved != 0 {
-            return Err(Rejection::new(
-                ErrorCode::MalformedMessage,
-                "the reserved field is not 0",
-            ));
-        }
-        let Some(command) = Command::from_u32(request.command) else {
-            return Err(Rejection::new(
-                ErrorCode::MalformedMessage,
-                format!("unknown command {}", request.command),
-            ));
-        };
-        if !payload.is_empty() && command != Command::RegisterShape {
-            return Err(Rejection::new(
-                ErrorCode::MalformedMessage,
-                "only RegisterShape carries a payload",
-            ));
-        }
+    ) -> Result<Answer, Refusal> {
+        let command = command_of(request, payload)?;
         match command {
             Command::Hello => Ok(PROTOCOL_VERSION.into()),
-            Command::CreateScene => self.create_scene(origin).map(Answer::from),
+            Command::CreateScene => Ok(self.create_scene(origin)?.into()),
             Command::DropScene => {
                 self.owned_entry(origin, request.scene)?;
-                self.drop_scene(request.scene)
-                    .map(|()| request.scene.into())
+                self.drop_scene(request.scene)?;
+                Ok(request.scene.into())
             }
             Command::RegisterShape => self.register_shape(origin, request, payload),
             Command::ShapeState => {
-                let building = match lock(self.owned_scene(origin, request.scene)?)
+                let building = match self
+                    .owned_cell(origin, request.scene)?
                     .shapes
                     .state(request.target)?
                 {
@@ -216,14 +213,14 @@ impl ControlState {
             Command::AddBody => self.add_body(origin, request).map(Answer::from),
             Command::RemoveBody => {
                 let body = BodyId(request.target);
-                let mut cell = lock(self.owned_scene(origin, request.scene)?);
+                let mut cell = self.owned_cell(origin, request.scene)?;
                 cell.scene.remove_body(body).map_err(scene_rejection)?;
                 Ok(request.target.into())
             }
             Command::UpdateBody => {
                 let motion = convert::motion(request.motion)?;
                 let (filter, margin) = (convert::filter(request), convert::margin(request.margin));
-                let mut cell = lock(self.owned_scene(origin, request.scene)?);
+                let mut cell = self.owned_cell(origin, request.scene)?;
                 cell.scene
                     .update_body(BodyId(request.target), motion, filter, margin)
                     .map_err(scene_rejection)?;
@@ -231,7 +228,7 @@ impl ControlState {
             }
             Command::SetSceneParams => {
                 let choice = broad_phase(request.broad_phase)?;
-                lock(self.owned_scene(origin, request.scene)?)
+                self.owned_cell(origin, request.scene)?
                     .scene
                     .set_broad_phase(choice);
                 Ok(request.scene.into())
@@ -240,10 +237,10 @@ impl ControlState {
     }
 
     /// Adds a body of a built shape: the request is checked before the scene is locked.
-    fn add_body(&self, origin: OwnerId, request: &ControlRequest) -> Result<u32, Rejection> {
+    fn add_body(&self, origin: OwnerId, request: &ControlRequest) -> Result<u32, Refusal> {
         let pose = convert::pose(request.position, request.orientation)?;
         let motion = convert::motion(request.motion)?;
-        let mut cell = lock(self.owned_scene(origin, request.scene)?);
+        let mut cell = self.owned_cell(origin, request.scene)?;
         let desc = BodyDesc {
             shape: cell.shapes.usable(request.target)?,
             pose,
@@ -261,7 +258,7 @@ impl ControlState {
         origin: OwnerId,
         request: &ControlRequest,
         payload: &[u8],
-    ) -> Result<Answer, Rejection> {
+    ) -> Result<Answer, Refusal> {
         let config = &self.config;
         let max_shapes = config.scene_limits.max_shapes;
         let shape = convert::shape_request(
@@ -273,13 +270,13 @@ impl ControlState {
         let shared = self.owned_scene(origin, request.scene)?;
         let geometry = match shape {
             ShapeRequest::Primitive(shape) => {
-                let mut cell = lock(shared);
+                let mut cell = try_lock(shared)?;
                 // The table hands out no more ids than the scene takes shapes, so the
                 // scene has room for this one.
                 let id = cell.shapes.reserve(max_shapes)?;
                 let registered = cell.scene.register_shape(shape).map_err(scene_rejection);
                 cell.shapes.finish(id, registered.clone());
-                return registered.map(|_| id.into());
+                return Ok(registered.map(|_| id.into())?);
             }
             ShapeRequest::Geometry(geometry) => geometry,
         };
@@ -289,7 +286,7 @@ impl ControlState {
         let charge = budget_memory::geometry_estimate(&geometry);
         let (in_use, budget) = (self.geometry_bytes, config.max_geometry_bytes);
         if in_use.saturating_add(charge) > budget {
-            return Err(Rejection::new(
+            return Err(Refusal::Rejected(Rejection::new(
                 ErrorCode::LimitExceeded,
                 format!(
                     "the shape needs about {} MiB; the daemon's {} MiB for shapes has {} MiB left",
@@ -297,9 +294,10 @@ impl ControlState {
                     budget >> 20,
                     budget.saturating_sub(in_use) >> 20
                 ),
-            ));
+            )));
         }
-        let shape = lock(shared).shapes.reserve(max_shapes)?;
+        // The last point where the request may wait for the scene: nothing changed yet.
+        let shape = try_lock(shared)?.shapes.reserve(max_shapes)?;
         let job = BuildJob {
             scene_id: request.scene,
             shape,
@@ -309,7 +307,7 @@ impl ControlState {
         };
         if let Err(refused) = self.builds.submit(job) {
             lock(shared).shapes.finish(shape, Err(refused.clone()));
-            return Err(refused);
+            return Err(refused.into());
         }
         self.geometry_bytes += charge;
         if let Some(entry) = self.scenes.get_mut(&request.scene) {
@@ -392,6 +390,12 @@ impl ControlState {
         Ok(entry)
     }
 
+    /// Scene `id`'s cell, locked, if it belongs to client port `origin`, is not
+    /// quarantined and nobody else holds its lock ([`Refusal::SceneBusy`] then).
+    fn owned_cell(&self, origin: OwnerId, id: u32) -> Result<MutexGuard<'_, SceneCell>, Refusal> {
+        try_lock(self.owned_scene(origin, id)?)
+    }
+
     /// Scene `id`'s state, if it belongs to client port `origin` and is not quarantined.
     fn owned_scene(&self, origin: OwnerId, id: u32) -> Result<&SharedScene, Rejection> {
         self.owned_entry(origin, id)?
@@ -400,6 +404,63 @@ impl ControlState {
             .map_err(|reason| {
                 Rejection::new(ErrorCode::SceneQuarantined, format!("scene {id}: {reason}"))
             })
+    }
+}
+
+/// The command of `request`, once its header is one this daemon answers: its protocol
+/// version, a zero `reserved` field, a known command, a payload only with RegisterShape.
+fn command_of(request: &ControlRequest, payload: &[u8]) -> Result<Command, Rejection> {
+    if request.protocol_version != PROTOCOL_VERSION {
+        return Err(Rejection::new(
+            ErrorCode::ProtocolMismatch,
+            format!(
+                "client speaks protocol {}, the daemon {PROTOCOL_VERSION}",
+                request.protocol_version
+            ),
+        ));
+    }
+    if request.reserved != 0 {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            "the reserved field is not 0",
+        ));
+    }
+    let Some(command) = Command::from_u32(request.command) else {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            format!("unknown command {}", request.command),
+        ));
+    };
+    if !payload.is_empty() && command != Command::RegisterShape {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            "only RegisterShape carries a payload",
+        ));
+    }
+    Ok(command)
+}
+
+/// Why a request got no answer: refused (its reply says why), or its scene's lock was
+/// held by a frame or a build (asked again later; nothing changed).
+#[derive(Debug)]
+enum Refusal {
+    Rejected(Rejection),
+    SceneBusy,
+}
+
+impl From<Rejection> for Refusal {
+    fn from(rejection: Rejection) -> Self {
+        Self::Rejected(rejection)
+    }
+}
+
+/// `scene`'s lock, unless another thread holds it. A lock poisoned by a thread that
+/// panicked is taken over, as [`lock`] does.
+fn try_lock(scene: &SharedScene) -> Result<MutexGuard<'_, SceneCell>, Refusal> {
+    match scene.try_lock() {
+        Ok(guard) => Ok(guard),
+        Err(TryLockError::Poisoned(poisoned)) => Ok(poisoned.into_inner()),
+        Err(TryLockError::WouldBlock) => Err(Refusal::SceneBusy),
     }
 }
 

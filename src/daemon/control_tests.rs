@@ -773,3 +773,63 @@ fn one_client_port_holds_at_most_its_quota_of_scenes_and_others_still_get_theirs
     assert_eq!(code(&state.handle(OWNER, &drop, &[])), ErrorCode::Ok);
     assert_eq!(code(&state.handle(OWNER, &create, &[])), ErrorCode::Ok);
 }
+
+/// While a frame holds a scene's lock, every request that needs it is given back unanswered
+/// and changes nothing (no shape id, no memory charge, no body); other clients' requests and
+/// requests that need no scene are answered; once the lock is free, the same request is.
+#[test]
+fn a_request_whose_scene_is_busy_waits_for_nothing_and_changes_nothing() {
+    let (mut state, jobs) = state_with(DaemonConfig::default(), 4);
+    let scene = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    let sphere = state.handle(OWNER, &sphere_request(scene), &[]).id;
+    let shared = Arc::clone(state.scene(scene).unwrap());
+    let add = ControlRequest {
+        scene,
+        target: sphere,
+        ..request(Command::AddBody)
+    };
+    let mesh = mesh_request(scene, 4, 12);
+    let payload = mesh_payload(&TETRA, &TETRA_INDICES);
+    let busy_requests = [
+        (add, Vec::new()),
+        (mesh, payload.clone()),
+        (sphere_request(scene), Vec::new()),
+        (
+            ControlRequest {
+                scene,
+                target: sphere,
+                ..request(Command::ShapeState)
+            },
+            Vec::new(),
+        ),
+    ];
+    {
+        let _frame = lock(&shared);
+        for (busy, payload) in &busy_requests {
+            assert_eq!(state.handle_unless_busy(OWNER, busy, payload), None);
+        }
+        assert_eq!(state.geometry_bytes, 0, "no memory charged");
+        assert_eq!(jobs.len(), 0, "no build queued");
+        let other = state.handle_unless_busy(OWNER + 1, &request(Command::CreateScene), &[]);
+        assert_eq!(other.map(|r| code(&r)), Some(ErrorCode::Ok));
+        let hello = state.handle_unless_busy(OWNER, &request(Command::Hello), &[]);
+        assert_eq!(hello.map(|r| r.id), Some(PROTOCOL_VERSION));
+        // Another client naming the busy scene is refused without its lock.
+        let trespass = state.handle_unless_busy(OWNER + 1, &add, &[]);
+        assert_eq!(trespass.map(|r| code(&r)), Some(ErrorCode::NotOwner));
+    }
+    let added = state
+        .handle_unless_busy(OWNER, &add, &[])
+        .expect("answered");
+    assert_eq!((code(&added), added.id), (ErrorCode::Ok, 0));
+    let registered = state
+        .handle_unless_busy(OWNER, &mesh, &payload)
+        .expect("answered");
+    assert_eq!(
+        (code(&registered), registered.id),
+        (ErrorCode::Ok, 1),
+        "the next shape id"
+    );
+    assert_eq!(build_all(&jobs), 1);
+    assert_eq!(lock(&shared).scene.body_count(), 1);
+}

@@ -2,7 +2,10 @@
 //! ports opened and closed, the periodic sweep, termination signals.
 //!
 //! Each request is answered by [`ControlState`] against the shared scenes (an O(1) edit under
-//! a scene's lock, or a registration queued for the builder). A created scene's ports are
+//! a scene's lock, or a registration queued for the builder). A request whose scene's lock a
+//! frame holds is kept and asked again every round (at least every 100 µs) behind the
+//! frame, its scene's later requests behind it: the thread never waits for a frame, so one
+//! client's long frame delays no other client's requests. A created scene's ports are
 //! opened here, not on the frame thread, and handed over with [`FrameCommand::Open`]; a
 //! dropped scene is marked dropped at once and its ports come back
 //! ([`FrameCommand::Close`]) to be closed here too. Each hand-over notifies the frame thread's
@@ -34,12 +37,13 @@ use super::stop::StopHandle;
 use super::wait::{Wake, wait_for_events};
 use crate::pipeline::WorkerPool;
 use crossbeam::channel::{Receiver, Sender};
+use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
 use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -103,6 +107,23 @@ pub struct ControlThread {
     connected: Vec<OwnerId>,
     /// Each served scene's signals to its frames (owner gone, being released).
     signals: HashMap<u32, SceneSignals>,
+    /// Requests whose scene's lock was held, oldest first: asked again each round.
+    deferred: VecDeque<ActiveControlRequest>,
+    /// Scratch list of the scenes still busy in one round of asking again.
+    still_busy: Vec<u32>,
+}
+
+/// A control request received and not answered yet.
+type ActiveControlRequest = ActiveRequest<Ipc, [u8], ControlRequest, ControlReply, ()>;
+
+/// How often requests whose scene was busy are asked again while the thread would
+/// otherwise block.
+const ASK_AGAIN_EVERY: Duration = Duration::from_micros(100);
+
+/// The scene a request names, for the commands that take its lock.
+fn scene_named(request: &ControlRequest) -> Option<u32> {
+    let scene_free = [Command::Hello as u32, Command::CreateScene as u32];
+    (!scene_free.contains(&request.command)).then_some(request.scene)
 }
 
 impl ControlThread {
@@ -159,6 +180,8 @@ impl ControlThread {
             sweep_interval: config.sweep_interval,
             connected: Vec::new(),
             signals: HashMap::new(),
+            deferred: VecDeque::new(),
+            still_busy: Vec::new(),
         })
     }
 
@@ -217,7 +240,10 @@ impl ControlThread {
                 continue;
             }
             let listeners = || std::iter::once(&self.requests_sent);
-            let timeout = next_sweep.saturating_duration_since(now);
+            let mut timeout = next_sweep.saturating_duration_since(now);
+            if !self.deferred.is_empty() {
+                timeout = timeout.min(ASK_AGAIN_EVERY);
+            }
             if wait_for_events(waitset, listeners, timeout)? == Wake::Stop {
                 return Ok(());
             }
@@ -225,11 +251,11 @@ impl ControlThread {
         }
     }
 
-    /// Answers every waiting control request; returns how many.
+    /// Answers every waiting control request, those asked again first; returns how many.
     /// A failure to receive (a client's segment that cannot be mapped, say) is logged and
     /// ends this round; it never ends the daemon.
     fn serve_requests(&mut self) -> usize {
-        let mut served = 0;
+        let mut served = self.ask_again();
         loop {
             let active = match self.server.receive() {
                 Ok(Some(active)) => active,
@@ -248,20 +274,71 @@ impl ControlThread {
             if let Some(gate) = &self.gate {
                 gate.pass();
             }
-            let request = *active.user_header();
-            let origin = active.origin().value();
-            self.stop_frame_before_drop(&request, origin);
-            let mut reply = self.state.handle(origin, &request, active.payload());
-            if reply.status == ErrorCode::Ok as u32 {
-                reply = self.follow_scene_changes(&request, reply, origin);
-            } else {
-                self.log_refusal(&request, &reply, origin);
+            // Behind a request of its scene that waits: its turn comes after.
+            let scene = scene_named(active.user_header());
+            if scene.is_some()
+                && self
+                    .deferred
+                    .iter()
+                    .any(|d| scene_named(d.user_header()) == scene)
+            {
+                self.deferred.push_back(active);
+                continue;
             }
-            // A client that went away no longer wants the reply: not an error of the daemon.
-            let _ = active.send_copy(reply);
-            served += 1;
+            match self.answer(active) {
+                None => served += 1,
+                Some(busy) => self.deferred.push_back(busy),
+            }
         }
         served
+    }
+
+    /// Asks the requests whose scene was busy again, oldest first, keeping each scene's in
+    /// order; returns how many were answered.
+    fn ask_again(&mut self) -> usize {
+        let mut served = 0;
+        self.still_busy.clear();
+        for _ in 0..self.deferred.len() {
+            let Some(active) = self.deferred.pop_front() else {
+                break;
+            };
+            let scene = scene_named(active.user_header());
+            if scene.is_some_and(|id| self.still_busy.contains(&id)) {
+                self.deferred.push_back(active);
+                continue;
+            }
+            match self.answer(active) {
+                None => served += 1,
+                Some(busy) => {
+                    self.still_busy.extend(scene);
+                    self.deferred.push_back(busy);
+                }
+            }
+        }
+        served
+    }
+
+    /// Answers `active` and sends the reply, or gives it back when its scene's lock is held
+    /// (a frame or a build in progress): it is asked again later, so the control thread
+    /// never waits for a frame.
+    fn answer(&mut self, active: ActiveControlRequest) -> Option<ActiveControlRequest> {
+        let request = *active.user_header();
+        let origin = active.origin().value();
+        self.stop_frame_before_drop(&request, origin);
+        let Some(mut reply) = self
+            .state
+            .handle_unless_busy(origin, &request, active.payload())
+        else {
+            return Some(active);
+        };
+        if reply.status == ErrorCode::Ok as u32 {
+            reply = self.follow_scene_changes(&request, reply, origin);
+        } else {
+            self.log_refusal(&request, &reply, origin);
+        }
+        // A client that went away no longer wants the reply: not an error of the daemon.
+        let _ = active.send_copy(reply);
+        None
     }
 
     /// Before its owner's DropScene is handled (which takes the scene's lock), stops the
