@@ -207,6 +207,10 @@ impl ControlThread {
             .map_err(|e| DaemonRunError::Ipc(format!("wait set: {e:?}")))
             .and_then(|waitset| self.serve(stop, &waitset));
         stop.stop();
+        // A long frame in progress (on the lane, say) stops at its next poll.
+        for signals in self.signals.values() {
+            signals.releasing();
+        }
         let _ = self.frames.wake.notify();
         result
     }

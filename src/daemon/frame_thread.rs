@@ -3,7 +3,10 @@
 //!
 //! Each pass takes the oldest waiting frame of every scene that has none in hand (stamped
 //! with its receipt), answers the most urgent one ([`schedule`](super::schedule)) under its
-//! scene's lock, and starts over, so a frame that arrives meanwhile competes at once. Scenes
+//! scene's lock, and starts over, so a frame that arrives meanwhile competes at once. The
+//! most urgent frame without a deadline (`budget_ns == 0`, exact whatever it costs) is not
+//! answered here: its scene goes to the [`lane`](super::lane), a thread of its own, and comes
+//! back after it, so no such frame holds up a frame with a deadline. Scenes
 //! come and go by [`FrameCommand`]s from the control thread, read between frames; their ports
 //! arrive opened, and a closed scene goes back whole ([`Retired`]) to be let go of on the
 //! control thread. A frame of a scene dropped since it was taken is dropped unanswered.
@@ -17,7 +20,8 @@
 //! # Waiting (hybrid)
 //! After the last frame the thread keeps polling for [`DaemonConfig::spin`], then blocks in
 //! its WaitSet on every scene's poses-ready listener and its own wake-up listener (the
-//! control thread notifies it after each command) until a notification, a termination
+//! control thread notifies it after each command, the lane after each frame) until a
+//! notification, a termination
 //! signal, or [`DaemonConfig::sweep_interval`] (when it looks at the stop flag again).
 //!
 //! # Allocation
@@ -30,13 +34,15 @@ use super::config::DaemonConfig;
 use super::control_thread::{FrameCommand, Retired};
 use super::error::DaemonRunError;
 use super::frame_loop::SceneFrames;
-use super::log::{Logger, Subject};
+use super::lane::{Answered, Lane};
+use super::log::{Level, Logger, Subject};
 use super::schedule::most_urgent;
 use super::shared_scene::{SharedScene, lock};
 use super::stop::StopHandle;
 use super::wait::{Wake, wait_for_events};
 use crossbeam::channel::{Receiver, Sender};
 use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
 use iceoryx2::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -47,24 +53,46 @@ const PRESIZED_SCENES: u32 = 1024;
 pub struct ControlLinks {
     /// Scenes to serve and to stop serving.
     pub commands: Receiver<FrameCommand>,
-    /// Notified after each command.
+    /// Notified after each command (and by the lane after each frame).
     pub wake: Listener<Ipc>,
     /// Where a closed scene goes to be let go of.
     pub retire: Sender<Retired>,
 }
 
 /// A scene the frame thread serves.
-struct LiveScene {
-    id: u32,
+pub struct LiveScene {
+    /// The scene's id.
+    pub id: u32,
     scene: SharedScene,
     frames: Box<SceneFrames<Ipc>>,
+}
+
+impl LiveScene {
+    /// Answers the scene's waiting frame under its lock (drops it unanswered if the scene
+    /// was dropped since the frame was taken).
+    ///
+    /// # Errors
+    /// An iceoryx2 failure on the scene's ports, as text.
+    pub fn answer_waiting(&mut self, log: &mut Logger) -> Result<(), String> {
+        let mut cell = lock(&self.scene);
+        if cell.dropped {
+            self.frames.discard_waiting();
+            return Ok(());
+        }
+        self.frames
+            .answer_waiting(self.id, &mut cell.scene, log)
+            .map(drop)
+    }
 }
 
 /// The frame thread's state (see the module docs).
 pub struct FrameThread {
     scenes: Vec<LiveScene>,
     control: ControlLinks,
+    /// Handed to the lane when the thread starts.
+    lane_wake: Option<Notifier<Ipc>>,
     log: Logger,
+    level: Level,
     spin: Duration,
     max_block: Duration,
 }
@@ -72,64 +100,44 @@ pub struct FrameThread {
 impl FrameThread {
     /// No scenes yet; they come from `control`.
     #[must_use]
-    pub fn new(config: &DaemonConfig, control: ControlLinks) -> Self {
+    pub fn new(config: &DaemonConfig, control: ControlLinks, lane_wake: Notifier<Ipc>) -> Self {
         Self {
             scenes: Vec::with_capacity(config.max_scenes.min(PRESIZED_SCENES) as usize),
             control,
+            lane_wake: Some(lane_wake),
             log: Logger::new(config.log_level),
+            level: config.log_level,
             spin: config.spin,
             max_block: config.sweep_interval,
         }
     }
 
-    /// Serves frames until `stop` or a termination signal, which it then passes on.
+    /// Serves frames until `stop` or a termination signal, which it then passes on; frames
+    /// without a deadline go to the [`lane`](super::lane).
     ///
     /// # Errors
-    /// [`DaemonRunError`] when iceoryx2 fails to move a frame or to wait.
+    /// [`DaemonRunError`] when iceoryx2 fails to wait, or the lane cannot start.
     pub fn run(&mut self, stop: &StopHandle) -> Result<(), DaemonRunError> {
         let waitset = WaitSetBuilder::new()
             .create::<Ipc>()
             .map_err(|e| DaemonRunError::Ipc(format!("wait set: {e:?}")))?;
-        let mut last_work = Instant::now();
-        while !stop.is_stopped() {
-            self.follow_commands();
-            if self.serve_next() {
-                last_work = Instant::now();
-                continue;
+        let lane_wake = self
+            .lane_wake
+            .take()
+            .ok_or_else(|| DaemonRunError::Ipc("the frame thread ran twice".to_owned()))?;
+        std::thread::scope(|scope| {
+            let lane = Lane::spawn(scope, lane_wake, self.level)
+                .map_err(|e| DaemonRunError::Ipc(format!("starting the lane: {e}")))?;
+            let mut running = Running { thread: self, lane };
+            let served = running.serve(stop, &waitset);
+            if let Some(back) = running.lane.stop() {
+                running.take_back(back);
             }
-            if last_work.elapsed() < self.spin {
-                std::hint::spin_loop();
-                continue;
+            for live in &running.thread.scenes {
+                log_lateness(&mut running.thread.log, live.id, &live.frames);
             }
-            let listeners = || {
-                let scenes = self.scenes.iter().map(|s| s.frames.poses_ready());
-                std::iter::once(&self.control.wake).chain(scenes)
-            };
-            if wait_for_events(&waitset, listeners, self.max_block)? == Wake::Stop {
-                stop.stop();
-            }
-            last_work = Instant::now();
-        }
-        for live in &self.scenes {
-            log_lateness(&mut self.log, live.id, &live.frames);
-        }
-        Ok(())
-    }
-
-    /// Takes on the scenes the control thread opened and lets go of those it closed.
-    fn follow_commands(&mut self) {
-        while let Ok(command) = self.control.commands.try_recv() {
-            match command {
-                FrameCommand::Open { id, scene, frames } => {
-                    self.scenes.push(LiveScene { id, scene, frames });
-                }
-                FrameCommand::Close(id) => {
-                    if let Some(index) = self.scenes.iter().position(|s| s.id == id) {
-                        self.retire(index, None);
-                    }
-                }
-            }
-        }
+            served
+        })
     }
 
     /// Stops serving the scene at `index` and hands it back to the control thread, with the
@@ -159,34 +167,121 @@ impl FrameThread {
         };
         let _ = self.control.retire.try_send(retired);
     }
+}
 
-    /// Takes each scene's next frame, answers the most urgent of those waiting; returns
-    /// whether there was one. A scene whose ports fail is quarantined.
-    fn serve_next(&mut self) -> bool {
-        let mut index = 0;
-        while index < self.scenes.len() {
-            match self.scenes[index].frames.take_next() {
-                Ok(()) => index += 1,
-                Err(fault) => self.retire(index, Some(fault)),
+/// The frame thread while it runs: its state, and its end of the lane.
+struct Running<'t, 'scope> {
+    thread: &'t mut FrameThread,
+    lane: Lane<'scope>,
+}
+
+impl Running<'_, '_> {
+    fn serve(&mut self, stop: &StopHandle, waitset: &WaitSet<Ipc>) -> Result<(), DaemonRunError> {
+        let mut last_work = Instant::now();
+        while !stop.is_stopped() {
+            self.follow_commands();
+            if let Some(back) = self.lane.take_back() {
+                self.take_back(back);
+            }
+            if self.serve_next() {
+                last_work = Instant::now();
+                continue;
+            }
+            let thread = &*self.thread;
+            if last_work.elapsed() < thread.spin {
+                std::hint::spin_loop();
+                continue;
+            }
+            let listeners = || {
+                let scenes = thread.scenes.iter().map(|s| s.frames.poses_ready());
+                std::iter::once(&thread.control.wake).chain(scenes)
+            };
+            if wait_for_events(waitset, listeners, thread.max_block)? == Wake::Stop {
+                stop.stop();
+            }
+            last_work = Instant::now();
+        }
+        Ok(())
+    }
+
+    /// Takes on the scenes the control thread opened and lets go of those it closed (one
+    /// out on the lane when it comes back).
+    fn follow_commands(&mut self) {
+        while let Ok(command) = self.thread.control.commands.try_recv() {
+            match command {
+                FrameCommand::Open { id, scene, frames } => {
+                    self.thread.scenes.push(LiveScene { id, scene, frames });
+                }
+                FrameCommand::Close(id) => {
+                    if let Some(index) = self.thread.scenes.iter().position(|s| s.id == id) {
+                        self.thread.retire(index, None);
+                    } else {
+                        self.lane.close_when_back(id);
+                    }
+                }
             }
         }
-        let waiting = self.scenes.iter().enumerate();
-        let waiting = waiting.filter_map(|(i, live)| Some((i, live.frames.waiting()?)));
+    }
+
+    /// Serves a scene back from the lane again, or retires it (closed meanwhile, or its
+    /// ports failed).
+    fn take_back(&mut self, (answered, close): (Answered, bool)) {
+        let Answered { live, outcome } = answered;
+        self.thread.scenes.push(live);
+        let index = self.thread.scenes.len() - 1;
+        match outcome {
+            Err(fault) => self.thread.retire(index, Some(fault)),
+            Ok(()) if close => self.thread.retire(index, None),
+            Ok(()) => {}
+        }
+    }
+
+    /// Takes each scene's next frame and answers the most urgent of those waiting, or hands
+    /// it to the lane when it has no deadline (then frames without one are not taken until
+    /// the lane is free); returns whether there was one. A scene whose ports fail is
+    /// quarantined.
+    fn serve_next(&mut self) -> bool {
+        let thread = &mut *self.thread;
+        let mut index = 0;
+        while index < thread.scenes.len() {
+            match thread.scenes[index].frames.take_next() {
+                Ok(()) => index += 1,
+                Err(fault) => thread.retire(index, Some(fault)),
+            }
+        }
+        let lane_free = self.lane.is_free();
+        let waiting = thread.scenes.iter().enumerate();
+        let waiting = waiting.filter_map(|(i, live)| {
+            let key = live.frames.waiting()?;
+            (lane_free || key.deadline().is_some()).then_some((i, key))
+        });
         let Some(index) = most_urgent(waiting) else {
             return false;
         };
-        let LiveScene { id, scene, frames } = &mut self.scenes[index];
-        let mut cell = lock(scene);
-        if cell.dropped {
-            frames.discard_waiting();
+        let has_deadline = thread.scenes[index]
+            .frames
+            .waiting()
+            .is_some_and(|key| key.deadline().is_some());
+        if !has_deadline {
+            let live = thread.scenes.swap_remove(index);
+            if let Err(live) = self.lane.send(live) {
+                // The lane is gone (the daemon is stopping): answered here instead.
+                thread.scenes.push(*live);
+                let index = thread.scenes.len() - 1;
+                answer_here(thread, index);
+            }
             return true;
         }
-        let answered = frames.answer_waiting(*id, &mut cell.scene, &mut self.log);
-        drop(cell);
-        if let Err(fault) = answered {
-            self.retire(index, Some(fault));
-        }
+        answer_here(thread, index);
         true
+    }
+}
+
+/// Answers the waiting frame of the scene at `index` on the frame thread; a scene whose
+/// ports fail is quarantined.
+fn answer_here(thread: &mut FrameThread, index: usize) {
+    if let Err(fault) = thread.scenes[index].answer_waiting(&mut thread.log) {
+        thread.retire(index, Some(fault));
     }
 }
 

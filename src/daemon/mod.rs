@@ -48,6 +48,7 @@ mod frame_loop;
 mod frame_thread;
 mod gate;
 mod ingest;
+mod lane;
 mod lateness;
 pub mod liveness;
 pub mod log;

@@ -71,7 +71,7 @@ impl Daemon {
             .create::<Ipc>()
             .map_err(|e| DaemonStartError::Ipc(format!("node: {e:?}")))?;
         secure_node_counter(&ipc_config, &config)?;
-        let (wake, wake_listener) = frame_wake(&node, &config.root)?;
+        let wake = frame_wake(&node, &config.root)?;
         let (commands, incoming) = channel::bounded(FRAME_COMMANDS);
         let (retire, retired) = channel::bounded(FRAME_COMMANDS);
         let (builds, build_jobs) = BuildQueue::bounded(config.max_queued_builds);
@@ -80,13 +80,14 @@ impl Daemon {
             &config,
             ControlLinks {
                 commands: incoming,
-                wake: wake_listener,
+                wake: wake.listener,
                 retire,
             },
+            wake.lane,
         );
         let links = FrameLinks {
             commands,
-            wake,
+            wake: wake.control,
             retired,
         };
         let state = ControlState::new(config.clone(), builds, instance);
@@ -220,18 +221,24 @@ fn secure_node_counter(
     Ok(())
 }
 
-/// The notifier and listener of the frame thread's wake-up event (`<root>/frame-wake`, the
-/// daemon's own: no client opens it).
-fn frame_wake(
-    node: &Node<Ipc>,
-    root: &str,
-) -> Result<
-    (
-        iceoryx2::port::notifier::Notifier<Ipc>,
-        iceoryx2::port::listener::Listener<Ipc>,
-    ),
-    DaemonStartError,
-> {
+/// Notifiers of `<root>/frame-wake`: the control thread's and the lane's, twice over, so that
+/// a second daemon started on the same root by mistake gets as far as the control service
+/// and says why it refuses to start (`claim`).
+const FRAME_WAKE_NOTIFIERS: usize = 2 * 2;
+
+/// The ports of the frame thread's wake-up event.
+struct FrameWake {
+    /// The control thread's notifier.
+    control: iceoryx2::port::notifier::Notifier<Ipc>,
+    /// The lane's notifier.
+    lane: iceoryx2::port::notifier::Notifier<Ipc>,
+    /// The frame thread's listener.
+    listener: iceoryx2::port::listener::Listener<Ipc>,
+}
+
+/// The ports of the frame thread's wake-up event (`<root>/frame-wake`, the daemon's own: no
+/// client opens it).
+fn frame_wake(node: &Node<Ipc>, root: &str) -> Result<FrameWake, DaemonStartError> {
     let text = format!("{root}/frame-wake");
     let name = ServiceName::new(&text)
         .map_err(|e| DaemonStartError::Config(format!("service root {root:?}: {e:?}")))?;
@@ -239,10 +246,10 @@ fn frame_wake(
     let builder = node
         .service_builder(&name)
         .event()
-        .max_notifiers(ports)
+        .max_notifiers(FRAME_WAKE_NOTIFIERS)
         .max_listeners(ports);
     let expected = EventSettings {
-        notifiers: ports,
+        notifiers: FRAME_WAKE_NOTIFIERS,
         listeners: ports,
         nodes: None,
     };
@@ -251,9 +258,17 @@ fn frame_wake(
         .notifier_builder()
         .create()
         .map_err(DaemonStartError::ipc("frame wake-up notifier"))?;
+    let lane_notifier = service
+        .notifier_builder()
+        .create()
+        .map_err(DaemonStartError::ipc("the lane's frame wake-up notifier"))?;
     let listener = service
         .listener_builder()
         .create()
         .map_err(DaemonStartError::ipc("frame wake-up listener"))?;
-    Ok((notifier, listener))
+    Ok(FrameWake {
+        control: notifier,
+        lane: lane_notifier,
+        listener,
+    })
 }
