@@ -897,3 +897,59 @@ fn a_budgeted_torus_pile_frame_is_truncated_and_conservative_and_budget_zero_is_
         "an exact frame"
     );
 }
+
+/// A frame without a budget that takes longer than the frame thread's slice is finished on
+/// the daemon's second thread: still exact and complete, and the scene's next frame follows
+/// it in order.
+#[test]
+fn a_long_frame_without_a_budget_is_answered_exactly_and_in_order() {
+    let daemon = Daemon::start();
+    let client = daemon.client();
+    let scene = client.create_scene().unwrap();
+    let sphere = proxima::geometry::TriMesh::uv_sphere(0.5, 48, 24);
+    let vertices: Vec<[f64; 3]> = sphere.vertices().iter().map(|v| v.to_array()).collect();
+    let mesh = client
+        .register_mesh(scene, &vertices, sphere.triangles())
+        .unwrap();
+    // Six coincident 2,304-triangle spheres: 15 pairs touching all over, far more work than
+    // the slice (each pair's contacts are thousands of triangle pairs).
+    let bodies: Vec<u32> = (0..6)
+        .map(|_| client.add_body(scene, &body(mesh, 0.0)).unwrap())
+        .collect();
+    let link = client.open_scene(scene).unwrap();
+    let at = |x: f64| -> Vec<PoseRecord> {
+        (bodies.iter().enumerate())
+            .map(|(i, &b)| daemon_harness::pose_at(b, x * i as f64))
+            .collect()
+    };
+    link.publish_poses(1, 0, query::CONTACTS, &at(0.0)).unwrap();
+    // The next frame is sent at once: it is answered after the first, never before it.
+    link.publish_poses(2, 0, query::CONTACTS, &at(3.0)).unwrap();
+    let first = link
+        .receive_results_for(1, TIMEOUT)
+        .unwrap()
+        .expect("frame 1");
+    let header = *first.header();
+    assert_eq!(ErrorCode::from_u32(header.status), Some(ErrorCode::Ok));
+    assert_eq!(header.completeness, wire::Completeness::Exact as u32);
+    assert_eq!(
+        header.pair_count, 15,
+        "every pair of coincident spheres touches"
+    );
+    assert!(
+        first
+            .pairs()
+            .iter()
+            .all(|p| p.count > 0 && p.distance <= 0.0)
+    );
+    drop(first);
+    let second = link
+        .receive_results_for(2, TIMEOUT)
+        .unwrap()
+        .expect("frame 2");
+    assert_eq!(
+        second.header().completeness,
+        wire::Completeness::Exact as u32
+    );
+    assert_eq!(second.header().pair_count, 0, "3 m apart, nothing touches");
+}

@@ -54,6 +54,44 @@ const INITIAL_RESULT_RECORDS: usize = 1024;
 /// A received pose frame, still in shared memory.
 type PoseSample<S> = Sample<S, [PoseRecord], PoseFrameHeader>;
 
+/// What [`SceneFrames::answer_waiting`] did with the waiting frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Answer {
+    /// There was none, or it was not the owner's (dropped unanswered).
+    Nothing,
+    /// Answered and published.
+    Published,
+    /// Its slice ended first: its poses are applied, nothing is published, and
+    /// [`SceneFrames::answer_parked`] finishes it.
+    Parked,
+}
+
+/// A pose frame taken in and applied, with what its answer needs from its receipt.
+struct Ingested {
+    header: PoseFrameHeader,
+    key: FrameKey,
+    /// The frame thread's CPU time at the frame's receipt.
+    cpu_at_receipt: u64,
+    ingest_ns: u64,
+    /// Its query, once parked.
+    query: Option<Query>,
+}
+
+impl Ingested {
+    /// The header of the frame's result, as far as ingest knows it.
+    fn result_header(&self, instance: u64) -> ResultFrameHeader {
+        let mut result = ResultFrameHeader {
+            protocol_version: PROTOCOL_VERSION,
+            frame_seq: self.header.frame_seq,
+            error_body: u32::MAX,
+            instance,
+            ..ResultFrameHeader::default()
+        };
+        result.stage_ns[wire::stage::INGEST] = self.ingest_ns;
+        result
+    }
+}
+
 /// Who a scene's frames are for: the secrets its services and frames carry, the daemon
 /// run answering them, and the flag that abandons them.
 #[derive(Clone)]
@@ -115,6 +153,8 @@ pub struct SceneFrames<S: Service> {
     /// The oldest pose frame taken from `poses` and not answered yet, with its receipt and
     /// the frame thread's CPU time then ([`thread_cpu_ns`]).
     waiting: Option<(PoseSample<S>, FrameKey, u64)>,
+    /// The frame whose slice ended before its answer ([`Answer::Parked`]).
+    parked: Option<Ingested>,
     /// Its budgeted frames that were late, and why.
     lateness: Lateness,
     workspace: PipelineWorkspace,
@@ -175,6 +215,7 @@ impl<S: Service> SceneFrames<S> {
             notifier,
             poses_ready,
             waiting: None,
+            parked: None,
             lateness: Lateness::default(),
             workspace: PipelineWorkspace::with_workers(Arc::clone(workers))
                 .abandon_on(keys.signals.abandon.clone()),
@@ -190,12 +231,13 @@ impl<S: Service> SceneFrames<S> {
     }
 
     /// Takes the next pose frame from the subscriber, stamped with its receipt, unless one
-    /// is already waiting.
+    /// is already waiting or parked (the scene's frames are answered in order).
     ///
     /// # Errors
     /// The iceoryx2 failure, as text.
     pub fn take_next(&mut self) -> Result<(), String> {
         if self.waiting.is_none()
+            && self.parked.is_none()
             && let Some(sample) = self
                 .poses
                 .receive()
@@ -216,8 +258,9 @@ impl<S: Service> SceneFrames<S> {
     }
 
     /// Answers the waiting frame (see [`take_next`](Self::take_next)) over `scene` (id
-    /// `scene_id`); returns whether it answered one (a frame without the scene's frame key
-    /// is dropped unanswered).
+    /// `scene_id`). A frame without a deadline is tried until `slice_end`, when given: one
+    /// not done by then is [`Answer::Parked`], its poses applied and nothing published, for
+    /// [`answer_parked`](Self::answer_parked) to finish (on another thread: the lane).
     ///
     /// # Errors
     /// The iceoryx2 failure, as text (client mistakes are answered in the result header).
@@ -226,9 +269,10 @@ impl<S: Service> SceneFrames<S> {
         scene_id: u32,
         scene: &mut Scene,
         log: &mut Logger,
-    ) -> Result<bool, String> {
+        slice_end: Option<Instant>,
+    ) -> Result<Answer, String> {
         let Some((sample, key, cpu_at_receipt)) = self.waiting.take() else {
-            return Ok(false);
+            return Ok(Answer::Nothing);
         };
         let header = *sample.user_header();
         if header.frame_key != self.keys.frame_key {
@@ -241,7 +285,7 @@ impl<S: Service> SceneFrames<S> {
             log.once(Level::Warn, Subject::Scene(scene_id), cause, || {
                 "pose frame without the scene's frame key ignored (not its owner's)".to_owned()
             });
-            return Ok(false);
+            return Ok(Answer::Nothing);
         }
         let ingest_started = Instant::now();
         let outcome = apply_pose_frame(
@@ -252,18 +296,14 @@ impl<S: Service> SceneFrames<S> {
             &mut self.validated,
         );
         drop(sample);
-        let mut result = ResultFrameHeader {
-            protocol_version: PROTOCOL_VERSION,
-            frame_seq: header.frame_seq,
-            error_body: u32::MAX,
-            instance: self.keys.instance,
-            ..ResultFrameHeader::default()
+        let mut frame = Ingested {
+            header,
+            key,
+            cpu_at_receipt,
+            ingest_ns: elapsed_ns(ingest_started),
+            query: None,
         };
-        let ingest_ns = elapsed_ns(ingest_started);
-        result.stage_ns[wire::stage::INGEST] = ingest_ns;
-        self.output.pairs.clear();
-        self.output.contacts.clear();
-        self.output.tois.clear();
+        let mut result = frame.result_header(self.keys.instance);
         match outcome {
             Err(FrameRejection {
                 rejection: Rejection { code, reason },
@@ -279,33 +319,92 @@ impl<S: Service> SceneFrames<S> {
                     },
                     || format!("frame {seq} refused: {reason}"),
                 );
+                self.output.pairs.clear();
+                self.output.contacts.clear();
+                self.output.tois.clear();
                 result.status = code as u32;
                 result.error_body = body.unwrap_or(u32::MAX);
             }
             Ok(query) => {
-                let report = self.step(scene, query, key);
-                scene.end_frame();
-                fill_header(&mut result, &report);
-                if self.keys.signals.is_owner_gone() {
-                    result.flags |= wire::frame_flags::OWNER_GONE;
-                }
-                if let Some(needed) = report.budget_too_small {
-                    result.flags |= wire::frame_flags::BUDGET_TOO_SMALL;
-                    result.min_budget_ns = ingest_ns.saturating_add(needed);
-                }
+                let slice_end = slice_end.filter(|_| key.deadline().is_none());
+                let Some(report) = self.step(scene, query, key, slice_end) else {
+                    frame.query = Some(query);
+                    self.parked = Some(frame);
+                    return Ok(Answer::Parked);
+                };
+                self.end_frame(scene, &mut result, &report, frame.ingest_ns);
             }
         }
-        let published = self.publish(result, key.received, header.budget_ns)?;
+        self.publish_answer(scene_id, result, &frame, log)?;
+        Ok(Answer::Published)
+    }
+
+    /// Finishes the [parked](Answer::Parked) frame, if any, exactly, and publishes it.
+    ///
+    /// # Errors
+    /// The iceoryx2 failure, as text.
+    pub fn answer_parked(
+        &mut self,
+        scene_id: u32,
+        scene: &mut Scene,
+        log: &mut Logger,
+    ) -> Result<Answer, String> {
+        let Some(frame) = self.parked.take() else {
+            return Ok(Answer::Nothing);
+        };
+        let Some(query) = frame.query else {
+            return Ok(Answer::Nothing);
+        };
+        let mut result = frame.result_header(self.keys.instance);
+        let report = pipeline::step(scene, query, &mut self.workspace, &mut self.output);
+        self.end_frame(scene, &mut result, &report, frame.ingest_ns);
+        self.publish_answer(scene_id, result, &frame, log)?;
+        Ok(Answer::Published)
+    }
+
+    /// Whether a frame is parked (its scene then takes no next frame until it is answered).
+    pub fn is_parked(&self) -> bool {
+        self.parked.is_some()
+    }
+
+    /// Ends the scene's frame after the pipeline's `report`: the poses become where the
+    /// next frame's motion starts, and the report goes into `result`.
+    fn end_frame(
+        &self,
+        scene: &mut Scene,
+        result: &mut ResultFrameHeader,
+        report: &StepReport,
+        ingest_ns: u64,
+    ) {
+        scene.end_frame();
+        fill_header(result, report);
+        if self.keys.signals.is_owner_gone() {
+            result.flags |= wire::frame_flags::OWNER_GONE;
+        }
+        if let Some(needed) = report.budget_too_small {
+            result.flags |= wire::frame_flags::BUDGET_TOO_SMALL;
+            result.min_budget_ns = ingest_ns.saturating_add(needed);
+        }
+    }
+
+    /// Publishes `result` and the output of `frame`, and notes its publishing time and
+    /// lateness.
+    fn publish_answer(
+        &mut self,
+        scene_id: u32,
+        result: ResultFrameHeader,
+        frame: &Ingested,
+        log: &mut Logger,
+    ) -> Result<(), String> {
+        let budget_ns = frame.header.budget_ns;
+        let published = self.publish(result, frame.key.received, budget_ns)?;
         let records = self.output.record_count() as u64;
         self.workspace.note_publish(published.publish_ns, records);
-        let cpu_ns = published.cpu_ns.saturating_sub(cpu_at_receipt);
-        if let Some(late) = self
-            .lateness
-            .note(header.budget_ns, published.elapsed_ns, cpu_ns)
-        {
-            log_late(log, scene_id, header.frame_seq, late);
+        let cpu_ns = published.cpu_ns.saturating_sub(frame.cpu_at_receipt);
+        if let Some(late) = self.lateness.note(budget_ns, published.elapsed_ns, cpu_ns) {
+            log_late(log, scene_id, frame.header.frame_seq, late);
         }
-        Ok(true)
+        Ok(())
     }
 
     /// Its budgeted frames that were late, and why.
@@ -313,9 +412,10 @@ impl<S: Service> SceneFrames<S> {
         &self.lateness
     }
 
-    /// Drops the waiting frame unanswered (its scene is gone).
+    /// Drops the waiting and the parked frame unanswered (its scene is gone).
     pub fn discard_waiting(&mut self) {
         self.waiting = None;
+        self.parked = None;
     }
 
     /// Publishes the scene's last result frame, which tells whoever reads its results (its
@@ -349,17 +449,26 @@ impl<S: Service> SceneFrames<S> {
     }
 
     /// Runs the pipeline for `query`: exact without a deadline (no budget, or one beyond
-    /// what an [`Instant`] holds), else within the frame's deadline.
-    fn step(&mut self, scene: &Scene, query: Query, key: FrameKey) -> StepReport {
-        match key.deadline() {
-            None => pipeline::step(scene, query, &mut self.workspace, &mut self.output),
-            Some(deadline) => pipeline::step_within(
+    /// what an [`Instant`] holds), within `slice_end` when given (`None` if that came
+    /// first), else within the frame's deadline.
+    fn step(
+        &mut self,
+        scene: &Scene,
+        query: Query,
+        key: FrameKey,
+        slice_end: Option<Instant>,
+    ) -> Option<StepReport> {
+        let (workspace, output) = (&mut self.workspace, &mut self.output);
+        match (key.deadline(), slice_end) {
+            (Some(deadline), _) => Some(pipeline::step_within(
                 scene,
                 query,
                 &mut Deadline(deadline),
-                &mut self.workspace,
-                &mut self.output,
-            ),
+                workspace,
+                output,
+            )),
+            (None, Some(end)) => pipeline::step_sliced(scene, query, end, workspace, output),
+            (None, None) => Some(pipeline::step(scene, query, workspace, output)),
         }
     }
 

@@ -3,10 +3,11 @@
 //!
 //! Each pass takes the oldest waiting frame of every scene that has none in hand (stamped
 //! with its receipt), answers the most urgent one ([`schedule`](super::schedule)) under its
-//! scene's lock, and starts over, so a frame that arrives meanwhile competes at once. The
-//! most urgent frame without a deadline (`budget_ns == 0`, exact whatever it costs) is not
-//! answered here: its scene goes to the [`lane`](super::lane), a thread of its own, and comes
-//! back after it, so no such frame holds up a frame with a deadline. Scenes
+//! scene's lock, and starts over, so a frame that arrives meanwhile competes at once. A
+//! frame without a deadline (`budget_ns == 0`, exact whatever it costs) is worked on here
+//! for at most a short slice; one that takes longer is parked, and its scene goes to the
+//! [`lane`](super::lane), a thread of its own, to finish it and come back, so no such frame
+//! holds up a frame with a deadline for more than the slice. Scenes
 //! come and go by [`FrameCommand`]s from the control thread, read between frames; their ports
 //! arrive opened, and a closed scene goes back whole ([`Retired`]) to be let go of on the
 //! control thread. A frame of a scene dropped since it was taken is dropped unanswered.
@@ -33,7 +34,7 @@ use super::Ipc;
 use super::config::DaemonConfig;
 use super::control_thread::{FrameCommand, Retired};
 use super::error::DaemonRunError;
-use super::frame_loop::SceneFrames;
+use super::frame_loop::{Answer, SceneFrames};
 use super::lane::{Answered, Lane};
 use super::log::{Level, Logger, Subject};
 use super::schedule::most_urgent;
@@ -68,22 +69,51 @@ pub struct LiveScene {
 }
 
 impl LiveScene {
-    /// Answers the scene's waiting frame under its lock (drops it unanswered if the scene
-    /// was dropped since the frame was taken).
+    /// Answers the scene's waiting frame under its lock, one without a deadline within
+    /// `slice_end` (else it is parked); drops it unanswered if the scene was dropped since
+    /// the frame was taken.
     ///
     /// # Errors
     /// An iceoryx2 failure on the scene's ports, as text.
-    pub fn answer_waiting(&mut self, log: &mut Logger) -> Result<(), String> {
+    fn answer_waiting(
+        &mut self,
+        log: &mut Logger,
+        slice_end: Option<Instant>,
+    ) -> Result<Answer, String> {
+        let mut cell = lock(&self.scene);
+        if cell.dropped {
+            self.frames.discard_waiting();
+            return Ok(Answer::Nothing);
+        }
+        self.frames
+            .answer_waiting(self.id, &mut cell.scene, log, slice_end)
+    }
+
+    /// Finishes the scene's parked frame under its lock (drops it if the scene was
+    /// dropped meanwhile).
+    ///
+    /// # Errors
+    /// An iceoryx2 failure on the scene's ports, as text.
+    pub fn answer_parked(&mut self, log: &mut Logger) -> Result<(), String> {
         let mut cell = lock(&self.scene);
         if cell.dropped {
             self.frames.discard_waiting();
             return Ok(());
         }
         self.frames
-            .answer_waiting(self.id, &mut cell.scene, log)
+            .answer_parked(self.id, &mut cell.scene, log)
             .map(drop)
     }
+
+    fn is_parked(&self) -> bool {
+        self.frames.is_parked()
+    }
 }
+
+/// How long a frame without a deadline is worked on here before it is parked and handed to
+/// the lane: most such frames take less and are answered at once; a longer one holds up
+/// frames with a deadline by at most this (plus the one exact mesh search it may be in).
+const INLINE_SLICE: Duration = Duration::from_micros(250);
 
 /// The frame thread's state (see the module docs).
 pub struct FrameThread {
@@ -236,10 +266,10 @@ impl Running<'_, '_> {
         }
     }
 
-    /// Takes each scene's next frame and answers the most urgent of those waiting, or hands
-    /// it to the lane when it has no deadline (then frames without one are not taken until
-    /// the lane is free); returns whether there was one. A scene whose ports fail is
-    /// quarantined.
+    /// Takes each scene's next frame and answers the most urgent of those waiting (one
+    /// without a deadline for at most [`INLINE_SLICE`], then it is parked), or hands a
+    /// parked frame's scene to the lane when the lane is free; returns whether there was
+    /// work. A scene whose ports fail is quarantined.
     fn serve_next(&mut self) -> bool {
         let thread = &mut *self.thread;
         let mut index = 0;
@@ -249,39 +279,38 @@ impl Running<'_, '_> {
                 Err(fault) => thread.retire(index, Some(fault)),
             }
         }
-        let lane_free = self.lane.is_free();
+        if self.lane.is_free()
+            && let Some(parked) = thread.scenes.iter().position(LiveScene::is_parked)
+        {
+            self.hand_to_lane(parked);
+            return true;
+        }
         let waiting = thread.scenes.iter().enumerate();
-        let waiting = waiting.filter_map(|(i, live)| {
-            let key = live.frames.waiting()?;
-            (lane_free || key.deadline().is_some()).then_some((i, key))
-        });
+        let waiting = waiting.filter_map(|(i, live)| Some((i, live.frames.waiting()?)));
         let Some(index) = most_urgent(waiting) else {
             return false;
         };
-        let has_deadline = thread.scenes[index]
-            .frames
-            .waiting()
-            .is_some_and(|key| key.deadline().is_some());
-        if !has_deadline {
-            let live = thread.scenes.swap_remove(index);
-            if let Err(live) = self.lane.send(live) {
-                // The lane is gone (the daemon is stopping): answered here instead.
-                thread.scenes.push(*live);
-                let index = thread.scenes.len() - 1;
-                answer_here(thread, index);
-            }
-            return true;
+        let slice_end = Instant::now() + INLINE_SLICE;
+        match thread.scenes[index].answer_waiting(&mut thread.log, Some(slice_end)) {
+            Err(fault) => thread.retire(index, Some(fault)),
+            Ok(Answer::Parked) if self.lane.is_free() => self.hand_to_lane(index),
+            Ok(_) => {}
         }
-        answer_here(thread, index);
         true
     }
-}
 
-/// Answers the waiting frame of the scene at `index` on the frame thread; a scene whose
-/// ports fail is quarantined.
-fn answer_here(thread: &mut FrameThread, index: usize) {
-    if let Err(fault) = thread.scenes[index].answer_waiting(&mut thread.log) {
-        thread.retire(index, Some(fault));
+    /// Hands the scene at `index`, whose frame is parked, to the lane; should the lane be
+    /// gone (the daemon is stopping), finishes the frame here.
+    fn hand_to_lane(&mut self, index: usize) {
+        let thread = &mut *self.thread;
+        let live = thread.scenes.swap_remove(index);
+        if let Err(live) = self.lane.send(live) {
+            thread.scenes.push(*live);
+            let index = thread.scenes.len() - 1;
+            if let Err(fault) = thread.scenes[index].answer_parked(&mut thread.log) {
+                thread.retire(index, Some(fault));
+            }
+        }
     }
 }
 

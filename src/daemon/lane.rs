@@ -1,18 +1,18 @@
-//! Frames without a deadline, answered on a thread of their own (the *lane*), so that no
-//! such frame, however long, holds up a frame that has one (DESIGN §8).
+//! Frames without a deadline that take long, finished on a thread of their own (the
+//! *lane*), so that no such frame, however long, holds up a frame that has one (DESIGN §8).
 //!
 //! A frame with `budget_ns == 0` asks for exact answers whatever they cost: seconds, for a
-//! scene of large meshes in deep contact. The frame thread answers frames one at a time, so
-//! it hands such a frame's scene (ports, workspace and all) to the lane and goes on serving
-//! every other scene; the lane answers that one frame under the scene's lock, hands the
-//! scene back and wakes the frame thread. One scene is out at a time: while the lane is
-//! busy, other scenes' frames without a deadline wait (as they would anyway, behind every
-//! frame with one). A scene's frames stay in order: while it is out, none of its frames is
-//! taken.
+//! scene of large meshes in deep contact. The frame thread tries such a frame for a short
+//! slice (most finish in it, answered at once); one that does not is *parked*, its poses
+//! applied and nothing published. The frame thread then hands its scene (ports, workspace
+//! and all) to the lane and goes on serving every other scene; the lane finishes the frame
+//! exactly under the scene's lock, hands the scene back and wakes the frame thread. One
+//! scene is out at a time; other parked scenes wait their turn. A scene's frames stay in
+//! order: while one is parked or out, none of its frames is taken.
 //!
-//! The price: a frame without a deadline crosses two threads, about one thread wake-up
-//! (60–120 µs on this project's VMs) more than on the frame thread. Such a frame asked for
-//! no deadline; frames that want speed give a budget.
+//! The price, for the long frames only: the hand-over (one thread wake-up, 60–120 µs on
+//! this project's VMs) and the slice's work, done again by the lane (less what the slice
+//! kept: exact pair answers are reused).
 
 use super::Ipc;
 use super::frame_thread::LiveScene;
@@ -57,7 +57,7 @@ impl<'scope> Lane<'scope> {
             .spawn_scoped(scope, move || {
                 let mut log = Logger::new(level);
                 for mut live in scenes {
-                    let outcome = live.answer_waiting(&mut log);
+                    let outcome = live.answer_parked(&mut log);
                     if answers.send(Answered { live, outcome }).is_err() {
                         break;
                     }
@@ -80,8 +80,8 @@ impl<'scope> Lane<'scope> {
         self.out.is_none()
     }
 
-    /// Hands `live`, whose waiting frame has no deadline, to the lane. Gives it back when the
-    /// lane is busy or gone.
+    /// Hands `live`, whose frame is parked, to the lane. Gives it back when the lane is busy
+    /// or gone.
     ///
     /// # Errors
     /// `live`, not sent.

@@ -404,6 +404,8 @@ pub struct PipelineWorkspace {
     costs: FrameCosts,
     /// Raised to abandon the frame's work at its next poll ([`Self::abandon_on`]).
     abandon: Abandon,
+    /// The end of an unlimited frame's slice, during [`step_sliced`].
+    slice: Option<Instant>,
 }
 
 impl PipelineWorkspace {
@@ -479,6 +481,30 @@ pub fn step(
     results: &mut FrameResults,
 ) -> StepReport {
     step_within(scene, query, &mut Unlimited, workspace, results)
+}
+
+/// [`step`], stopped at `slice_end` if it is not done by then: the daemon's first try of a
+/// frame without a deadline, on its frame thread, before it hands a frame that takes
+/// longer to a thread of its own. Returns `None` when the slice ended first: the results
+/// are then incomplete and must not be used; the scene is untouched and `workspace` still
+/// valid, so [`step`] run next over the same scene gives the exact answers (faster, by
+/// what the slice kept). Otherwise exactly [`step`]'s report and results. The worker pool
+/// is not used, and a mesh pair's exact search, once started, ends before the slice does.
+pub fn step_sliced(
+    scene: &Scene,
+    query: Query,
+    slice_end: Instant,
+    workspace: &mut PipelineWorkspace,
+    results: &mut FrameResults,
+) -> Option<StepReport> {
+    workspace.slice = Some(slice_end);
+    let report = step(scene, query, workspace, results);
+    workspace.slice = None;
+    // An unlimited frame is truncated only by its slice, or when it was abandoned (then the
+    // conservative answers are the frame's answers).
+    let sliced_out = matches!(report.completeness, Completeness::Truncated { .. })
+        && !workspace.abandon.is_raised();
+    (!sliced_out).then_some(report)
 }
 
 /// [`step`] under a budget (DESIGN §5): the frame's mesh–mesh pairs are answered through
@@ -587,7 +613,7 @@ pub fn step_within(
         workspace.costs.note_broad(bodies, broad_ns);
     }
     let started = Instant::now();
-    let mut plan = FramePlan::new(&*budget, query);
+    let mut plan = FramePlan::new(&*budget, query, workspace.slice);
     let over_time = plan.cap_to_time(
         &workspace.costs,
         &mut workspace.candidates,

@@ -140,18 +140,22 @@ pub(super) struct FramePlan {
     pub(super) pool: bool,
     /// The frame's deadline, when its budget has one.
     deadline: Option<Instant>,
+    /// An unlimited frame's slice: when its work stops for the caller to run it again
+    /// elsewhere ([`step_sliced`](super::step_sliced)).
+    slice: Option<Instant>,
 }
 
 impl FramePlan {
     /// The plan of a frame asking `query` under `budget` (the pool decided later, by
     /// [`wants_pool`](Self::wants_pool)).
-    pub(super) fn new(budget: &dyn Budget, query: Query) -> Self {
+    pub(super) fn new(budget: &dyn Budget, query: Query, slice: Option<Instant>) -> Self {
         let limited = !budget.is_unlimited() && query.at_current_poses();
         Self {
             limited,
             pool: false,
             // Time of impact keeps to the deadline whatever the frame asks.
             deadline: budget.deadline(),
+            slice: slice.filter(|_| budget.is_unlimited()),
         }
     }
 
@@ -162,9 +166,10 @@ impl FramePlan {
     /// after; it never stops without a deadline. The pipeline keeps it in
     /// [`NarrowScratch::clock`](crate::narrow::dispatch::NarrowScratch::clock), where the
     /// dispatcher's routes poll it. It stops at once when `abandon` is raised, deadline or
-    /// not.
+    /// not, and an unlimited frame's at the end of its slice.
     pub(super) fn clock(&self, abandon: &Abandon) -> WorkClock {
-        WorkClock::new(self.deadline.map_or(Stop::Never, Stop::At)).abandonable(abandon.clone())
+        let stop = self.deadline.or(self.slice).map_or(Stop::Never, Stop::At);
+        WorkClock::new(stop).abandonable(abandon.clone())
     }
 
     /// Moves `clock`'s stop to the frame's deadline less its tail from here
@@ -216,10 +221,12 @@ impl FramePlan {
     }
 
     /// Whether a frame with these mesh pairs to answer uses the worker pool: never under a
-    /// limited budget (the frontier runs on one thread), and only with at least
+    /// limited budget (the frontier runs on one thread) nor in a slice (the pool's pairs are
+    /// not polled), and only with at least
     /// [`MIN_PARALLEL_MESH_PAIRS`] of them.
     pub(super) fn wants_pool<T>(&self, mut needed: impl Iterator<Item = T>) -> bool {
         !self.limited
+            && self.slice.is_none()
             && needed.by_ref().take(MIN_PARALLEL_MESH_PAIRS).count() == MIN_PARALLEL_MESH_PAIRS
     }
 
@@ -243,8 +250,9 @@ impl FramePlan {
             Route::Direct => PairPlan::Direct,
             Route::MeshMesh(ma, mb) if self.limited => PairPlan::Frontier(ma, mb),
             Route::MeshMesh(..) if self.pool => PairPlan::Pooled,
-            // An exact mesh search starts only while the frame is not abandoned.
-            Route::MeshMesh(..) if clock.is_abandoned() => PairPlan::Conservative,
+            // An exact mesh search (not polled inside) starts only while the frame is not
+            // abandoned and its slice, if any, lasts.
+            Route::MeshMesh(..) if !clock.allows(WORK_PER_CLOCK_READ) => PairPlan::Conservative,
             Route::MeshMesh(ma, mb) => PairPlan::MeshMesh(ma, mb),
         }
     }

@@ -13,7 +13,7 @@ use crate::test_support::{meshes, point_in_cube, rng, rotation};
 use rand::Rng;
 use std::ops::ControlFlow;
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 fn add(scene: &mut Scene, shape: Shape, at: DVec3, margin: f64) -> BodyId {
     let shape = scene.register_shape(shape).unwrap();
@@ -284,6 +284,68 @@ fn an_abandoned_frame_answers_conservatively_and_misses_nothing() {
         truncated_frames > 60 && approximate_pairs > 200 && touching > 20,
         "truncated frames {truncated_frames}, approximate pairs {approximate_pairs}, \
          touching pairs {touching}"
+    );
+}
+
+/// A frame tried in a slice either gives exactly the exact frame's results, or says the
+/// slice ended; then the exact frame run next on the same workspace gives exactly the
+/// results of a workspace that never sliced, frame after frame.
+#[test]
+fn a_sliced_frame_is_exact_or_stops_and_the_frame_run_again_is_exact() {
+    let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.6, 0.15, 20, 8))));
+    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let mut rng = rng(173);
+    for i in 0..10 {
+        let shape = match i % 3 {
+            0 => Shape::Sphere(Sphere::new(0.3)),
+            _ => torus.clone(),
+        };
+        add(&mut scene, shape, point_in_cube(&mut rng, 1.2), 0.2);
+    }
+    let (mut never_sliced, mut sliced) =
+        (PipelineWorkspace::default(), PipelineWorkspace::default());
+    let queries = [
+        Query::CLOSE.union(Query::CONTACTS),
+        Query::DISTANCE,
+        Query::OVERLAP.union(Query::TOI),
+    ];
+    let (mut stopped, mut finished) = (0, 0);
+    for frame in 0..90 {
+        let ids: Vec<BodyId> = scene.bodies().map(|(id, _)| id).collect();
+        for id in ids {
+            let pose = scene.body(id).unwrap().pose;
+            let moved = (pose.position + point_in_cube(&mut rng, 0.1)).clamp_length_max(1.4);
+            scene
+                .set_pose(id, Pose::new(moved, rotation(&mut rng)))
+                .unwrap();
+        }
+        let query = queries[frame % queries.len()];
+        let truth = run(&scene, query, &mut never_sliced);
+        // Every third frame gets a slice that has already ended, the others an hour.
+        let slice_end = if frame % 3 == 0 {
+            Instant::now()
+        } else {
+            Instant::now() + Duration::from_secs(3600)
+        };
+        let mut found = FrameResults::default();
+        match step_sliced(&scene, query, slice_end, &mut sliced, &mut found) {
+            Some(report) => {
+                finished += 1;
+                assert_eq!(report.completeness, Completeness::Exact, "frame {frame}");
+            }
+            None => {
+                stopped += 1;
+                found = run(&scene, query, &mut sliced);
+            }
+        }
+        assert_eq!(found.pairs, truth.pairs, "frame {frame}");
+        assert_eq!(found.contacts, truth.contacts, "frame {frame}");
+        assert_eq!(found.tois, truth.tois, "frame {frame}");
+        scene.end_frame();
+    }
+    assert!(
+        stopped > 10 && finished > 40,
+        "stopped {stopped}, finished {finished}"
     );
 }
 
