@@ -21,6 +21,7 @@
 //! | 8 endless add/remove | `endless_add_remove_cycles_reuse_body_slots_so_the_scene_stays_its_size` |
 //! | 9 a client killed mid-frame | `a_client_killed_mid_frame_has_its_frame_abandoned_and_its_release_seen_by_a_monitor`, `a_scene_dropped_mid_frame_stops_the_frame_and_its_release_is_seen_by_a_monitor` |
 //! | 10 another OS user's `global_mgmt` | `another_os_user_can_neither_use_the_daemon_nor_stop_new_clients`, `a_node_counter_another_user_set_up_first_stops_the_daemon_at_start` (run as root, which can start a process as `nobody`; otherwise they say they did not run) |
+//! | (not in the table) a frame of seconds, then a request on its scene | `a_clients_long_frame_holds_up_no_other_clients_requests_or_frames` |
 //!
 //! Same-user limits (README "Who can use the daemon"): iceoryx2 0.10 lets any process of
 //! the daemon's user list services, so the attacker here learns the victim's scene token
