@@ -1,0 +1,411 @@
+//! One frame of the settling pile, Proxima against parry3d-f64 0.31 on the same pairs.
+//!
+//! # The frame
+//! The pile of `examples/scenes/pile.rs` (seed [`SEED`]: 100 bodies, spheres, capsules,
+//! boxes, cylinders and convex hulls of 20–60 points, 2–7 cm, 5 mm margins, in a 40 cm box
+//! of 5 static boxes) is dropped and settled before timing: [`SETTLE_FRAMES`] frames at
+//! `PILE_RATE_HZ`, each a `CLOSE | CONTACTS` [`step`] whose contacts the point-mass solver
+//! of `examples/scenes/point_mass.rs` bounces the bodies with, as the `pile` scene of
+//! `examples/deadline_bench.rs` does through the daemon. The poses of the last two frames
+//! (`k` and `k + 1`) are kept; the statistics of frame `k` are printed once.
+//!
+//! # What is measured (group `pile`)
+//! - `proxima/frame`: one whole [`step`] (broad phase, narrow phase, contacts) at
+//!   `CLOSE | CONTACTS`, after setting every moving body's pose, alternating frames `k` and
+//!   `k + 1`. The pipeline keeps the answer of a pair whose two bodies did not move, so
+//!   pairs of sleeping bodies are answered from memory, as the daemon answers them on such a
+//!   frame; the printed `kept answers` says how many.
+//! - `proxima/frame-all-pairs`: the same, alternating frame `k` and frame `k` with every
+//!   moving body shifted by [`SHIFT_M`] (the same shift for all, so their relative poses do
+//!   not change): every candidate pair is answered afresh each frame.
+//! - `proxima/narrow`: the narrow phase alone on frame `k`'s candidate pairs (the
+//!   all-pairs broad phase of `proxima::broad::brute_force`, equal to the pipeline's), as
+//!   the pipeline answers a pair: `dispatch::distance` exact up to the two margins, then
+//!   `dispatch::manifold` (up to 4 points) when touching.
+//! - `proxima/distance`: the same without the manifolds: one signed distance, witness
+//!   pair and normal per pair, what `parry/contacts` returns.
+//! - `parry/contacts`: `parry3d_f64::query::contact` on the same pairs at the same poses,
+//!   with prediction the sum of the two margins (one deepest point per pair). Shapes are
+//!   converted once: `Ball`, `Capsule::new_z`, `Cuboid`, `Cylinder` turned from parry's
+//!   Y axis to Proxima's Z axis, `ConvexPolyhedron::from_convex_hull` of the same points.
+//!
+//! Before timing, both engines answer every candidate pair once and the agreement is
+//! printed: the pairs each reports within the prediction and touching, and the largest
+//! distance difference where both report one.
+//!
+//! `cargo bench --bench pile`; names are `pile/<engine>/<what>`.
+
+#[path = "common/cycle.rs"]
+mod cycle;
+#[path = "../examples/scenes/pile.rs"]
+mod pile;
+#[path = "../examples/scenes/point_mass.rs"]
+mod point_mass;
+// The daemon-facing half (registration over the protocol, meshes) is not used here.
+#[path = "../examples/scenes/spec.rs"]
+#[allow(dead_code)]
+mod spec;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use cycle::cycle_bench;
+use parry3d_f64::math::{Pose as ParryPose, Rotation as ParryRotation, Vector as ParryVector};
+use parry3d_f64::shape::SharedShape;
+use pile::{PILE_RATE_HZ, pile_scene, pile_world};
+use proxima::broad::CandidatePair;
+use proxima::broad::brute_force::pairs_brute_force;
+use proxima::math::{DQuat, DVec3, Pose};
+use proxima::narrow::dispatch::{self, NarrowScratch};
+use proxima::narrow::{Manifold, Shape};
+use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, step};
+use proxima::scene::{BodyId, Motion, Scene};
+use proxima_ipc::client::Primitive;
+use proxima_ipc::wire::{RecordKind, ResultRecord};
+use spec::{SceneSpec, ShapeSpec};
+use std::f64::consts::FRAC_PI_2;
+use std::hint::black_box;
+
+/// The pile's seed (the one `examples/deadline_bench.rs` drops).
+const SEED: u64 = 29;
+/// Frames simulated before the kept frame `k`: 1.5 s at 240 Hz, when the pile has landed
+/// and most bodies rest on others.
+const SETTLE_FRAMES: usize = 360;
+/// What every frame asks, as the pile's client does.
+const QUERY: Query = Query::CLOSE.union(Query::CONTACTS);
+/// Shift of every moving body in `proxima/frame-all-pairs`'s second pose set, metres:
+/// enough to change every body's pose, far below any tolerance of the answers.
+const SHIFT_M: f64 = 1e-9;
+
+/// Each moving body's pose in one frame.
+type PoseSet = Vec<(BodyId, Pose)>;
+
+/// The settled pile: the scene at frame `k`, the poses of frames `k` and `k + 1`.
+struct Settled {
+    spec: SceneSpec,
+    scene: Scene,
+    frame_k: PoseSet,
+    frame_k1: PoseSet,
+}
+
+/// Drops the pile and runs [`SETTLE_FRAMES`] + 2 frames; the scene is left at frame `k`.
+fn settle() -> Settled {
+    let spec = pile_scene(SEED);
+    let mut scene = spec.local_scene().expect("the pile is a valid scene");
+    let ids: Vec<u32> = (0..spec.bodies.len())
+        .map(|i| u32::try_from(i).expect("few bodies"))
+        .collect();
+    let mut world = pile_world(&spec, &ids, SEED);
+    let (mut workspace, mut results) = (PipelineWorkspace::default(), FrameResults::default());
+    let (mut pairs, mut contacts) = (Vec::new(), Vec::new());
+    let mut kept = Vec::new();
+    for _ in 0..SETTLE_FRAMES + 2 {
+        world.integrate(1.0 / PILE_RATE_HZ);
+        for i in 0..world.moving_count() {
+            let r = world.pose(i);
+            let [x, y, z, w] = r.orientation;
+            let pose = Pose::try_new(DVec3::from_array(r.position), DQuat::from_xyzw(x, y, z, w))
+                .expect("the solver keeps poses valid");
+            scene.set_pose(BodyId(r.body), pose).expect("a pile body");
+        }
+        step(&scene, QUERY, &mut workspace, &mut results);
+        scene.end_frame();
+        records(&results, &mut pairs, &mut contacts);
+        world.resolve(&pairs, &contacts);
+        kept.push(moving_poses(&scene));
+    }
+    let frame_k1 = kept.pop().expect("two frames kept");
+    let frame_k = kept.pop().expect("two frames kept");
+    set_poses(&mut scene, &frame_k);
+    println!(
+        "pile: seed {SEED}, frame {SETTLE_FRAMES} at {PILE_RATE_HZ} Hz: {} bodies, {} at rest",
+        scene.body_count(),
+        world.resting()
+    );
+    Settled {
+        spec,
+        scene,
+        frame_k,
+        frame_k1,
+    }
+}
+
+/// The records of a frame's pairs and contacts, the fields `World::resolve` reads filled as
+/// the daemon's frame loop fills them.
+fn records(
+    results: &FrameResults,
+    pairs: &mut Vec<ResultRecord>,
+    contacts: &mut Vec<ResultRecord>,
+) {
+    pairs.clear();
+    pairs.extend(results.pairs.iter().map(|p| ResultRecord {
+        kind: RecordKind::Pair as u32,
+        body_a: p.a,
+        body_b: p.b,
+        index: p.first_contact,
+        count: p.contact_count,
+        distance: p.distance,
+        normal: p.normal.to_array(),
+        ..ResultRecord::default()
+    }));
+    contacts.clear();
+    contacts.extend(results.contacts.iter().map(|c| {
+        let pair = &results.pairs[c.pair as usize];
+        ResultRecord {
+            kind: RecordKind::Contact as u32,
+            body_a: pair.a,
+            body_b: pair.b,
+            index: c.pair,
+            distance: c.distance,
+            normal: c.normal.to_array(),
+            ..ResultRecord::default()
+        }
+    }));
+}
+
+fn moving_poses(scene: &Scene) -> PoseSet {
+    scene
+        .bodies()
+        .filter(|(_, b)| b.motion != Motion::Static)
+        .map(|(id, b)| (id, b.pose))
+        .collect()
+}
+
+fn set_poses(scene: &mut Scene, poses: &PoseSet) {
+    for &(id, pose) in poses {
+        scene.set_pose(id, pose).expect("a pile body");
+    }
+}
+
+/// One candidate pair, in both engines' terms.
+struct Pair<'s> {
+    shapes: (&'s Shape, &'s Shape),
+    poses: (Pose, Pose),
+    /// The sum of the two margins, metres: Proxima's reporting limit, parry's prediction.
+    margins: f64,
+    parry_shapes: (&'s SharedShape, &'s SharedShape),
+    parry_poses: (ParryPose, ParryPose),
+}
+
+/// parry's copy of a shape, with the pose of parry's shape in Proxima's shape frame.
+struct ParryShape {
+    shape: SharedShape,
+    offset: Pose,
+}
+
+fn parry_shape(spec: &ShapeSpec) -> ParryShape {
+    let plain = |shape| ParryShape {
+        shape,
+        offset: Pose::IDENTITY,
+    };
+    match *spec {
+        ShapeSpec::Primitive(Primitive::Sphere { radius }) => plain(SharedShape::ball(radius)),
+        ShapeSpec::Primitive(Primitive::Capsule {
+            radius,
+            half_height,
+        }) => plain(SharedShape::capsule_z(half_height, radius)),
+        ShapeSpec::Primitive(Primitive::Cuboid {
+            half_extents: [x, y, z],
+        }) => plain(SharedShape::cuboid(x, y, z)),
+        // parry's cylinder is along Y, Proxima's along Z: a quarter turn about X maps Y to Z.
+        ShapeSpec::Primitive(Primitive::Cylinder {
+            radius,
+            half_height,
+        }) => ParryShape {
+            shape: SharedShape::cylinder(half_height, radius),
+            offset: Pose::from_rotation(DQuat::from_rotation_x(FRAC_PI_2)),
+        },
+        ShapeSpec::Convex(ref points) => {
+            let points: Vec<ParryVector> = points.iter().map(|p| parry_vector(*p)).collect();
+            plain(SharedShape::convex_hull(&points).expect("the pile's hulls are valid"))
+        }
+        ShapeSpec::Primitive(Primitive::Cone { .. }) | ShapeSpec::Mesh(_) => {
+            unreachable!("the pile has no cones or meshes")
+        }
+    }
+}
+
+fn parry_vector(v: DVec3) -> ParryVector {
+    ParryVector::new(v.x, v.y, v.z)
+}
+
+fn parry_pose(pose: &Pose) -> ParryPose {
+    let (t, q) = (pose.position, pose.rotation);
+    ParryPose::from_parts(
+        parry_vector(t),
+        ParryRotation::from_xyzw(q.x, q.y, q.z, q.w),
+    )
+}
+
+/// The candidate pairs of `scene` at its current poses, both engines' shapes and poses.
+fn candidate_pairs<'s>(scene: &'s Scene, parry: &'s [ParryShape]) -> Vec<Pair<'s>> {
+    let (mut proxies, mut candidates) = (Vec::new(), Vec::new());
+    scene.proxies(&mut proxies);
+    pairs_brute_force(&proxies, &mut candidates);
+    candidates
+        .iter()
+        .map(|&CandidatePair { a, b }| {
+            let body = |id| scene.body(BodyId(id)).expect("a candidate's body");
+            let (ba, bb) = (body(a), body(b));
+            let shape = |id| scene.shape(id).expect("a body's shape");
+            let (pa, pb) = (&parry[ba.shape.0 as usize], &parry[bb.shape.0 as usize]);
+            Pair {
+                shapes: (shape(ba.shape), shape(bb.shape)),
+                poses: (ba.pose, bb.pose),
+                margins: ba.margin + bb.margin,
+                parry_shapes: (&pa.shape, &pb.shape),
+                parry_poses: (
+                    parry_pose(&ba.pose.compose(&pa.offset)),
+                    parry_pose(&bb.pose.compose(&pb.offset)),
+                ),
+            }
+        })
+        .collect()
+}
+
+/// Proxima's answer to `pair` as the pipeline gives it: the signed distance (exact up to
+/// the margins), and when touching the manifold into `manifold` (else left empty).
+fn proxima_pair(
+    pair: &Pair<'_>,
+    with_manifold: bool,
+    scratch: &mut NarrowScratch,
+    manifold: &mut Manifold,
+) -> f64 {
+    let (sa, sb) = pair.shapes;
+    let pose_ab = Pose::relative(&pair.poses.0, &pair.poses.1);
+    let d = dispatch::distance(sa, sb, &pose_ab, pair.margins, scratch);
+    manifold.reset(DVec3::ZERO);
+    if with_manifold && d.distance <= 0.0 {
+        dispatch::manifold(sa, sb, &pose_ab, &d, scratch, manifold);
+    }
+    d.distance
+}
+
+/// parry's signed distance of `pair` when within the prediction.
+fn parry_pair(pair: &Pair<'_>) -> Option<f64> {
+    let (pa, pb) = pair.parry_poses;
+    let (sa, sb) = pair.parry_shapes;
+    parry3d_f64::query::contact(&pa, &**sa, &pb, &**sb, pair.margins)
+        .expect("parry supports every convex pair")
+        .map(|c| c.dist)
+}
+
+/// Prints frame `k`'s statistics and both engines' agreement on its candidate pairs.
+fn print_frame(scene: &Scene, pairs: &[Pair<'_>]) {
+    let mut results = FrameResults::default();
+    let report = step(
+        scene,
+        QUERY,
+        &mut PipelineWorkspace::default(),
+        &mut results,
+    );
+    let touching = results.pairs.iter().filter(|p| p.distance <= 0.0).count();
+    println!(
+        "pile: {} candidate pairs ({} by brute force), {} close, {touching} touching, {} contacts",
+        report.candidates,
+        pairs.len(),
+        results.pairs.len(),
+        results.contacts.len()
+    );
+    let (mut scratch, mut manifold) = (NarrowScratch::default(), Manifold::default());
+    let (mut close, mut touch) = ([0_usize; 3], [0_usize; 3]);
+    let (mut max_close_m, mut max_touch_m) = (0.0_f64, 0.0_f64);
+    for pair in pairs {
+        let ours = proxima_pair(pair, false, &mut scratch, &mut manifold);
+        let ours = (ours <= pair.margins).then_some(ours);
+        let theirs = parry_pair(pair);
+        let count = |counts: &mut [usize; 3], x: Option<f64>, y: Option<f64>| {
+            counts[0] += usize::from(x.is_some());
+            counts[1] += usize::from(y.is_some());
+            if let (Some(x), Some(y)) = (x, y) {
+                counts[2] += 1;
+                return (x - y).abs();
+            }
+            0.0
+        };
+        max_close_m = max_close_m.max(count(&mut close, ours, theirs));
+        let touching = |d: Option<f64>| d.filter(|&d| d <= 0.0);
+        max_touch_m = max_touch_m.max(count(&mut touch, touching(ours), touching(theirs)));
+    }
+    println!(
+        "pile: within prediction: proxima {}, parry {}, both {}; largest |distance difference| {max_close_m:.3e} m",
+        close[0], close[1], close[2]
+    );
+    println!(
+        "pile: touching: proxima {}, parry {}, both {}; largest |depth difference| {max_touch_m:.3e} m",
+        touch[0], touch[1], touch[2]
+    );
+}
+
+fn bench_pile(c: &mut Criterion) {
+    let Settled {
+        spec,
+        mut scene,
+        frame_k,
+        frame_k1,
+    } = settle();
+    let frozen = scene.clone();
+    let parry: Vec<ParryShape> = spec.shapes.iter().map(parry_shape).collect();
+    let pairs = candidate_pairs(&frozen, &parry);
+    print_frame(&frozen, &pairs);
+    let shifted: PoseSet = frame_k
+        .iter()
+        .map(|&(id, pose)| {
+            (
+                id,
+                Pose::new(pose.position + DVec3::splat(SHIFT_M), pose.rotation),
+            )
+        })
+        .collect();
+
+    let mut group = c.benchmark_group("pile");
+    let (mut workspace, mut results) = (PipelineWorkspace::default(), FrameResults::default());
+    for (name, sets) in [
+        ("frame", [&frame_k, &frame_k1]),
+        ("frame-all-pairs", [&frame_k, &shifted]),
+    ] {
+        let mut frame = |poses: &PoseSet| {
+            set_poses(&mut scene, poses);
+            let report = step(&scene, QUERY, &mut workspace, &mut results);
+            scene.end_frame();
+            report
+        };
+        // Untimed: the alternation's steady state, as the timed frames see it.
+        frame(sets[0]);
+        let report = frame(sets[1]);
+        println!(
+            "pile: proxima/{name}: {} of {} candidate answers kept from the frame before",
+            report.reused_pairs, report.candidates
+        );
+        cycle_bench(
+            &mut group,
+            BenchmarkId::new("proxima", name),
+            &sets,
+            |_, poses| f64::from(frame(poses).contacts),
+        );
+    }
+
+    let (mut scratch, mut manifold) = (NarrowScratch::default(), Manifold::default());
+    for (name, with_manifold) in [("narrow", true), ("distance", false)] {
+        group.bench_function(BenchmarkId::new("proxima", name), |bench| {
+            bench.iter(|| {
+                let mut contacts = 0;
+                for pair in black_box(&pairs) {
+                    proxima_pair(pair, with_manifold, &mut scratch, &mut manifold);
+                    contacts += manifold.len();
+                }
+                contacts
+            });
+        });
+    }
+    group.bench_function(BenchmarkId::new("parry", "contacts"), |bench| {
+        bench.iter(|| {
+            black_box(&pairs)
+                .iter()
+                .filter(|pair| parry_pair(pair).is_some())
+                .count()
+        });
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_pile);
+criterion_main!(benches);
