@@ -53,13 +53,14 @@ use parry3d_f64::shape::SharedShape;
 use pile::{PILE_RATE_HZ, pile_scene, pile_world};
 use proxima::broad::CandidatePair;
 use proxima::broad::brute_force::pairs_brute_force;
+use proxima::daemon::records::{contact_record, pair_record};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::narrow::dispatch::{self, NarrowScratch};
 use proxima::narrow::{Manifold, Shape};
 use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, step};
 use proxima::scene::{BodyId, Motion, Scene};
 use proxima_ipc::client::Primitive;
-use proxima_ipc::wire::{RecordKind, ResultRecord};
+use proxima_ipc::wire::ResultRecord;
 use spec::{SceneSpec, ShapeSpec};
 use std::f64::consts::FRAC_PI_2;
 use std::hint::black_box;
@@ -128,37 +129,16 @@ fn settle() -> Settled {
     }
 }
 
-/// The records of a frame's pairs and contacts, the fields `World::resolve` reads filled as
-/// the daemon's frame loop fills them.
+/// The records of a frame's pairs and contacts, as the daemon writes them.
 fn records(
     results: &FrameResults,
     pairs: &mut Vec<ResultRecord>,
     contacts: &mut Vec<ResultRecord>,
 ) {
     pairs.clear();
-    pairs.extend(results.pairs.iter().map(|p| ResultRecord {
-        kind: RecordKind::Pair as u32,
-        body_a: p.a,
-        body_b: p.b,
-        index: p.first_contact,
-        count: p.contact_count,
-        distance: p.distance,
-        normal: p.normal.to_array(),
-        ..ResultRecord::default()
-    }));
+    pairs.extend(results.pairs.iter().map(pair_record));
     contacts.clear();
-    contacts.extend(results.contacts.iter().map(|c| {
-        let pair = &results.pairs[c.pair as usize];
-        ResultRecord {
-            kind: RecordKind::Contact as u32,
-            body_a: pair.a,
-            body_b: pair.b,
-            index: c.pair,
-            distance: c.distance,
-            normal: c.normal.to_array(),
-            ..ResultRecord::default()
-        }
-    }));
+    contacts.extend((results.contacts.iter()).map(|c| contact_record(&results.pairs, c)));
 }
 
 fn moving_poses(scene: &Scene) -> PoseSet {

@@ -19,6 +19,7 @@
 
 use clap::Parser;
 use iceoryx2::prelude::{LogLevel, ipc, set_log_level_from_env_or};
+use proxima::geometry::TriMesh;
 use proxima_ipc::client::{BodySpec, ClientBuilder, Motion, Primitive};
 use proxima_ipc::tools::daemon_process::{ChildProcess, Isolation, sibling_daemon};
 use proxima_ipc::wire::{PoseRecord, query};
@@ -279,8 +280,10 @@ fn run_client(root: &str, prefix: &str, seconds: f64) -> Result<(), Box<dyn Erro
         },
     )?;
     let ball = client.register_primitive(scene, Primitive::Sphere { radius: 0.2 })?;
-    let (vertices, triangles) = ring_mesh(10);
-    let ring = client.register_mesh(scene, &vertices, &triangles)?;
+    // A 200-triangle torus.
+    let torus = TriMesh::torus(0.2, 0.05, 10, 10);
+    let vertices: Vec<[f64; 3]> = torus.vertices().iter().map(|v| v.to_array()).collect();
+    let torus = client.register_mesh(scene, &vertices, torus.triangles())?;
     let spec = |shape, position: [f64; 3], motion| BodySpec {
         shape,
         position,
@@ -293,7 +296,7 @@ fn run_client(root: &str, prefix: &str, seconds: f64) -> Result<(), Box<dyn Erro
     client.add_body(scene, &spec(floor, [0.0, 0.0, -0.1], Motion::Static))?;
     let mut bodies = Vec::new();
     for i in 0..24 {
-        let shape = if i % 6 == 0 { ring } else { ball };
+        let shape = if i % 6 == 0 { torus } else { ball };
         let x = f64::from(i % 6) * 0.5 - 1.25;
         let y = f64::from(i / 6) * 0.5 - 0.75;
         bodies.push((
@@ -337,26 +340,4 @@ fn run_client(root: &str, prefix: &str, seconds: f64) -> Result<(), Box<dyn Erro
     }
     println!("ANSWERED {answered} SENT {sent}");
     Ok(())
-}
-
-/// A closed ring of `n` segments with a square cross-section: 4n vertices, 8n triangles.
-fn ring_mesh(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let mut vertices = Vec::new();
-    for i in 0..n {
-        let a = f64::from(i) / f64::from(n) * std::f64::consts::TAU;
-        for (r, z) in [(0.15, -0.03), (0.25, -0.03), (0.25, 0.03), (0.15, 0.03)] {
-            vertices.push([r * a.cos(), r * a.sin(), z]);
-        }
-    }
-    let mut triangles = Vec::new();
-    for i in 0..n {
-        let (this, next) = (i * 4, ((i + 1) % n) * 4);
-        for k in 0..4 {
-            let (a, b) = (this + k, this + (k + 1) % 4);
-            let (c, d) = (next + k, next + (k + 1) % 4);
-            triangles.push([a, b, d]);
-            triangles.push([a, d, c]);
-        }
-    }
-    (vertices, triangles)
 }

@@ -215,13 +215,6 @@ impl WorkClock {
         !self.stopped
     }
 
-    /// Whether this clock's [`Abandon`] flag was raised (read now, whether or not the clock
-    /// has stopped yet).
-    #[must_use]
-    pub fn is_abandoned(&self) -> bool {
-        self.abandon.is_raised()
-    }
-
     /// Whether the clock has stopped the work.
     #[must_use]
     pub fn stopped(&self) -> bool {

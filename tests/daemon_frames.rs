@@ -9,7 +9,7 @@
 mod daemon_harness;
 mod support;
 
-use daemon_harness::{Daemon, body};
+use daemon_harness::{Daemon, body, register_trimesh};
 use iceoryx2::prelude::ipc;
 use proxima::geometry::{Cuboid, Sphere};
 use proxima::math::{DQuat, DVec3, Pose};
@@ -68,10 +68,7 @@ fn twin_scenes(client: &Client<ipc::Service>) -> TwinScenes {
     let scene_id = client.create_scene().unwrap();
     let mut oracle = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
     let torus = support::meshes::torus(0.5, 0.15, 16, 8);
-    let vertices: Vec<[f64; 3]> = torus.vertices().iter().map(|v| v.to_array()).collect();
-    let torus_id = client
-        .register_mesh(scene_id, &vertices, torus.triangles())
-        .unwrap();
+    let torus_id = register_trimesh(client, scene_id, &torus).unwrap();
     let torus_local = oracle
         .register_shape(Shape::Mesh(Arc::new(MeshShape::new(torus))))
         .unwrap();
@@ -748,10 +745,7 @@ fn twin_tori_pile(client: &Client<ipc::Service>) -> (TwinScenes, Vec<PoseRecord>
     let scene_id = client.create_scene().unwrap();
     let mut oracle = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
     let torus = support::meshes::torus(0.45, 0.12, 16, 8);
-    let vertices: Vec<[f64; 3]> = torus.vertices().iter().map(|v| v.to_array()).collect();
-    let remote = client
-        .register_mesh(scene_id, &vertices, torus.triangles())
-        .unwrap();
+    let remote = register_trimesh(client, scene_id, &torus).unwrap();
     let local = oracle
         .register_shape(Shape::Mesh(Arc::new(MeshShape::new(torus))))
         .unwrap();
@@ -907,10 +901,7 @@ fn a_long_frame_without_a_budget_is_answered_exactly_and_in_order() {
     let client = daemon.client();
     let scene = client.create_scene().unwrap();
     let sphere = proxima::geometry::TriMesh::uv_sphere(0.5, 48, 24);
-    let vertices: Vec<[f64; 3]> = sphere.vertices().iter().map(|v| v.to_array()).collect();
-    let mesh = client
-        .register_mesh(scene, &vertices, sphere.triangles())
-        .unwrap();
+    let mesh = register_trimesh(&client, scene, &sphere).unwrap();
     // Six coincident 2,304-triangle spheres: 15 pairs touching all over, far more work than
     // the slice (each pair's contacts are thousands of triangle pairs).
     let bodies: Vec<u32> = (0..6)

@@ -31,12 +31,12 @@
 #[path = "support/daemon.rs"]
 mod daemon_harness;
 
-use daemon_harness::{Daemon, body, pose_at};
+use daemon_harness::{Daemon, body, pose_at, register_trimesh};
 use iceoryx2::prelude::*;
 use proxima::daemon::node_counter;
 use proxima::geometry::TriMesh;
 use proxima_ipc::client::{Client, ClientBuilder, Motion, Primitive};
-use proxima_ipc::error::{ControlError, FrameReceiveError};
+use proxima_ipc::error::{ClientConnectError, ControlError, FrameReceiveError};
 use proxima_ipc::result_feed::ResultFeed;
 use proxima_ipc::scene_link::SceneLink;
 use proxima_ipc::wire::{
@@ -164,33 +164,44 @@ fn role_process(role: &str, var: &str, daemon: &Daemon, extra: &str) -> Command 
     command
 }
 
-/// The daemon's root and prefix and the extra word [`role_process`] put in `var`, when this
-/// process runs as that role.
-fn role_spec(var: &str) -> Option<(String, String, String)> {
-    let spec = std::env::var(var).ok()?;
-    let mut words = spec.splitn(3, ' ').map(str::to_owned);
-    Some((
-        words.next()?,
-        words.next()?,
-        words.next().unwrap_or_default(),
-    ))
+/// What [`role_process`] told a role: the daemon's root and prefix, and the extra word.
+struct Role {
+    root: String,
+    prefix: String,
+    extra: String,
+}
+
+impl Role {
+    /// The role's orders when this process runs as the role of `var`.
+    fn from_env(var: &str) -> Option<Self> {
+        let spec = std::env::var(var).ok()?;
+        let mut words = spec.splitn(3, ' ').map(str::to_owned);
+        Some(Self {
+            root: words.next()?,
+            prefix: words.next()?,
+            extra: words.next().unwrap_or_default(),
+        })
+    }
+
+    /// A client of the role's daemon, waiting `timeout` for each reply.
+    fn connect(&self, timeout: Duration) -> Result<Client<ipc::Service>, ClientConnectError> {
+        ClientBuilder::new()
+            .root(&self.root)
+            .iceoryx_prefix(&self.prefix)
+            .reply_timeout(timeout)
+            .connect::<ipc::Service>()
+    }
 }
 
 /// The attacker (only when spawned with [`ATTACKER_ROLE`]; otherwise it returns at once):
 /// every command on the victim's scene, then a forged pose frame on its pose service.
 #[test]
 fn attacker_role() {
-    let Some((root, prefix, scene)) = role_spec(ATTACKER_ROLE) else {
+    let Some(role) = Role::from_env(ATTACKER_ROLE) else {
         return;
     };
-    let (root, prefix) = (root.as_str(), prefix.as_str());
-    let scene: u32 = scene.parse().unwrap();
-    let client = ClientBuilder::new()
-        .root(root)
-        .iceoryx_prefix(prefix)
-        .reply_timeout(TIMEOUT)
-        .connect::<ipc::Service>()
-        .expect("the attacker connects");
+    let scene: u32 = role.extra.parse().unwrap();
+    let client = role.connect(TIMEOUT).expect("the attacker connects");
     let mut out = std::io::stdout().lock();
     let mut report = |step: &str, result: Result<(), ControlError>| {
         let code = match result {
@@ -222,6 +233,7 @@ fn attacker_role() {
     writeln!(out, "OPEN {open:?}").unwrap();
     // A forged frame on the victim's own pose service, found by listing: it would move body 1
     // away and, with every flag, cost the daemon work.
+    let (root, prefix) = (&role.root, &role.prefix);
     forge_frame(client.node(), root, listed_token(root, prefix), scene);
     writeln!(out, "SENT forged\nDONE").unwrap();
     out.flush().unwrap();
@@ -240,22 +252,13 @@ const DOOMED_SPHERES: u32 = 24;
 /// the outcome once answered). It waits to be killed.
 #[test]
 fn doomed_client_role() {
-    let Some((root, prefix, _)) = role_spec(DOOMED_ROLE) else {
+    let Some(role) = Role::from_env(DOOMED_ROLE) else {
         return;
     };
-    let (root, prefix) = (root.as_str(), prefix.as_str());
-    let client = ClientBuilder::new()
-        .root(root)
-        .iceoryx_prefix(prefix)
-        .reply_timeout(TIMEOUT)
-        .connect::<ipc::Service>()
-        .expect("the doomed client connects");
+    let client = role.connect(TIMEOUT).expect("the doomed client connects");
     let scene = client.create_scene().unwrap();
     let sphere = TriMesh::uv_sphere(0.5, 48, 24);
-    let vertices: Vec<[f64; 3]> = sphere.vertices().iter().map(|v| v.to_array()).collect();
-    let mesh = client
-        .register_mesh(scene, &vertices, sphere.triangles())
-        .unwrap();
+    let mesh = register_trimesh(&client, scene, &sphere).unwrap();
     let poses: Vec<PoseRecord> = (0..DOOMED_SPHERES)
         .map(|_| client.add_body(scene, &body(mesh, 0.0)).unwrap())
         .map(|id| pose_at(id, 0.0))
@@ -760,14 +763,13 @@ const OUTSIDER_UID: u32 = 65534;
 /// writes nothing: opening is the test.
 #[test]
 fn outsider_role() {
-    let Some((root, prefix, _)) = role_spec(OUTSIDER_ROLE) else {
+    let Some(role) = Role::from_env(OUTSIDER_ROLE) else {
         return;
     };
-    let (root, prefix) = (root.as_str(), prefix.as_str());
     let mut out = std::io::stdout().lock();
     for entry in std::fs::read_dir(node_counter::SHM_DIR).unwrap() {
         let name = entry.unwrap().file_name().to_string_lossy().into_owned();
-        if !name.starts_with(prefix) {
+        if !name.starts_with(&role.prefix) {
             continue;
         }
         let path = std::path::Path::new(node_counter::SHM_DIR).join(&name);
@@ -778,12 +780,7 @@ fn outsider_role() {
             writeln!(out, "READABLE {name}").unwrap();
         }
     }
-    let connected = ClientBuilder::new()
-        .root(root)
-        .iceoryx_prefix(prefix)
-        .reply_timeout(Duration::from_secs(2))
-        .connect::<ipc::Service>();
-    match connected {
+    match role.connect(Duration::from_secs(2)) {
         Ok(_) => writeln!(out, "CONNECTED").unwrap(),
         Err(e) => writeln!(out, "REFUSED {e}").unwrap(),
     }

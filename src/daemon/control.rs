@@ -27,7 +27,7 @@ use super::convert::{self, Rejection, ShapeRequest};
 use super::liveness::OwnerId;
 use super::secrets;
 use super::shape_table::ShapeState;
-use super::shared_scene::{self, SceneCell, SharedScene, lock};
+use super::shared_scene::{self, SceneCell, SceneSignals, SharedScene, lock};
 use crate::broad::{BroadPhaseChoice, BroadPhaseKind};
 use crate::scene::{BodyDesc, BodyId, Scene};
 use proxima_ipc::wire::{
@@ -65,6 +65,8 @@ pub struct SceneEntry {
     pub state: Result<SharedScene, String>,
     /// Bytes charged to its convex and mesh shapes.
     pub geometry_bytes: u64,
+    /// What the control thread tells its frames while one may be in progress.
+    pub signals: SceneSignals,
 }
 
 /// A successful request's reply: the id and the [`reply_flags`].
@@ -114,6 +116,13 @@ impl ControlState {
     #[must_use]
     pub fn entry(&self, id: u32) -> Option<&SceneEntry> {
         self.scenes.get(&id)
+    }
+
+    /// Stops every scene's frame in progress at its next poll (the daemon is stopping).
+    pub fn stop_all_frames(&self) {
+        for entry in self.scenes.values() {
+            entry.signals.releasing();
+        }
     }
 
     /// Scene `id`, if it lives (not quarantined).
@@ -373,6 +382,7 @@ impl ControlState {
             frame_key: secret("a frame key")?,
             state: Ok(shared_scene::share(scene)),
             geometry_bytes: 0,
+            signals: SceneSignals::new(),
         };
         self.scenes.insert(id, entry);
         Ok(id)

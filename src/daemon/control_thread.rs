@@ -28,7 +28,7 @@ use super::claim::{self, ControlFactory, EventSettings};
 use super::config::DaemonConfig;
 use super::control::ControlState;
 use super::error::{DaemonRunError, DaemonStartError};
-use super::frame_loop::{SceneFrames, SceneKeys, SceneSignals};
+use super::frame_loop::{SceneFrames, SceneKeys};
 use super::gate::Gate;
 use super::liveness::{Liveness, OwnerId};
 use super::log::{Cause, Level, Logger, Subject};
@@ -43,7 +43,7 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
 use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
-use std::collections::{HashMap, VecDeque};
+use std::collections::VecDeque;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -105,18 +105,17 @@ pub struct ControlThread {
     sweep_interval: Duration,
     /// Scratch list of the connected control clients, refilled at each sweep.
     connected: Vec<OwnerId>,
-    /// Each served scene's signals to its frames (owner gone, being released).
-    signals: HashMap<u32, SceneSignals>,
-    /// Requests whose scene's lock was held, oldest first: asked again each round.
-    deferred: VecDeque<ActiveControlRequest>,
-    /// Scratch list of the scenes still busy in one round of asking again.
+    /// Requests not answered yet, oldest first: those whose scene's lock was held stay, and
+    /// are asked again each round.
+    queue: VecDeque<ActiveControlRequest>,
+    /// Scratch list of the scenes found busy in one round of answering the queue.
     still_busy: Vec<u32>,
 }
 
 /// A control request received and not answered yet.
 type ActiveControlRequest = ActiveRequest<Ipc, [u8], ControlRequest, ControlReply, ()>;
 
-/// How often requests whose scene was busy are asked again while the thread would
+/// How often queued requests whose scene was busy are asked again while the thread would
 /// otherwise block.
 const ASK_AGAIN_EVERY: Duration = Duration::from_micros(100);
 
@@ -179,8 +178,7 @@ impl ControlThread {
             spin: config.spin,
             sweep_interval: config.sweep_interval,
             connected: Vec::new(),
-            signals: HashMap::new(),
-            deferred: VecDeque::new(),
+            queue: VecDeque::new(),
             still_busy: Vec::new(),
         })
     }
@@ -208,9 +206,7 @@ impl ControlThread {
             .and_then(|waitset| self.serve(stop, &waitset));
         stop.stop();
         // A long frame in progress (on the lane, say) stops at its next poll.
-        for signals in self.signals.values() {
-            signals.releasing();
-        }
+        self.state.stop_all_frames();
         let _ = self.frames.wake.notify();
         result
     }
@@ -245,7 +241,7 @@ impl ControlThread {
             }
             let listeners = || std::iter::once(&self.requests_sent);
             let mut timeout = next_sweep.saturating_duration_since(now);
-            if !self.deferred.is_empty() {
+            if !self.queue.is_empty() {
                 timeout = timeout.min(ASK_AGAIN_EVERY);
             }
             if wait_for_events(waitset, listeners, timeout)? == Wake::Stop {
@@ -255,11 +251,11 @@ impl ControlThread {
         }
     }
 
-    /// Answers every waiting control request, those asked again first; returns how many.
-    /// A failure to receive (a client's segment that cannot be mapped, say) is logged and
-    /// ends this round; it never ends the daemon.
+    /// Takes every waiting control request into the queue, behind those whose scene was
+    /// busy, and answers the queue ([`answer_queue`](Self::answer_queue)); returns how many
+    /// were answered. A failure to receive (a client's segment that cannot be mapped, say)
+    /// is logged and ends the taking; it never ends the daemon.
     fn serve_requests(&mut self) -> usize {
-        let mut served = self.ask_again();
         loop {
             let active = match self.server.receive() {
                 Ok(Some(active)) => active,
@@ -278,44 +274,30 @@ impl ControlThread {
             if let Some(gate) = &self.gate {
                 gate.pass();
             }
-            // Behind a request of its scene that waits: its turn comes after.
-            let scene = scene_named(active.user_header());
-            if scene.is_some()
-                && self
-                    .deferred
-                    .iter()
-                    .any(|d| scene_named(d.user_header()) == scene)
-            {
-                self.deferred.push_back(active);
-                continue;
-            }
-            match self.answer(active) {
-                None => served += 1,
-                Some(busy) => self.deferred.push_back(busy),
-            }
+            self.queue.push_back(active);
         }
-        served
+        self.answer_queue()
     }
 
-    /// Asks the requests whose scene was busy again, oldest first, keeping each scene's in
-    /// order; returns how many were answered.
-    fn ask_again(&mut self) -> usize {
+    /// Answers the queued requests, oldest first; one whose scene is busy stays queued, and
+    /// so do its scene's later ones, in order. Returns how many were answered.
+    fn answer_queue(&mut self) -> usize {
         let mut served = 0;
         self.still_busy.clear();
-        for _ in 0..self.deferred.len() {
-            let Some(active) = self.deferred.pop_front() else {
+        for _ in 0..self.queue.len() {
+            let Some(active) = self.queue.pop_front() else {
                 break;
             };
             let scene = scene_named(active.user_header());
             if scene.is_some_and(|id| self.still_busy.contains(&id)) {
-                self.deferred.push_back(active);
+                self.queue.push_back(active);
                 continue;
             }
             match self.answer(active) {
                 None => served += 1,
                 Some(busy) => {
                     self.still_busy.extend(scene);
-                    self.deferred.push_back(busy);
+                    self.queue.push_back(busy);
                 }
             }
         }
@@ -349,13 +331,11 @@ impl ControlThread {
     /// scene's frame in progress at its next poll, so the drop waits for a poll step, not
     /// for the frame's end. Anyone else's DropScene changes nothing, here as in the reply.
     fn stop_frame_before_drop(&self, request: &ControlRequest, origin: OwnerId) {
-        let owners_drop = request.command == Command::DropScene as u32
-            && self
-                .state
-                .entry(request.scene)
-                .is_some_and(|entry| entry.owner == origin);
-        if owners_drop && let Some(signals) = self.signals.get(&request.scene) {
-            signals.releasing();
+        if request.command == Command::DropScene as u32
+            && let Some(entry) = self.state.entry(request.scene)
+            && entry.owner == origin
+        {
+            entry.signals.releasing();
         }
     }
 
@@ -400,8 +380,8 @@ impl ControlThread {
             Subject::Scene(_) | Subject::Daemon => false,
         });
         for &id in &outcome.orphaned {
-            if let Some(signals) = self.signals.get(&id) {
-                signals.owner_gone();
+            if let Some(entry) = self.state.entry(id) {
+                entry.signals.owner_gone();
             }
             self.log.warn(format_args!(
                 "scene {id}: the client that created it is gone; its frames are abandoned at \
@@ -442,8 +422,8 @@ impl ControlThread {
     /// Drops scene `id`'s state (if it still lives) and takes its ports off the frame thread.
     fn release_scene(&mut self, id: u32) {
         // A frame in progress stops at its next poll, so the lock comes free soon.
-        if let Some(signals) = self.signals.remove(&id) {
-            signals.releasing();
+        if let Some(entry) = self.state.entry(id) {
+            entry.signals.releasing();
         }
         // A scene already dropped by request has nothing left to release.
         let _ = self.state.drop_scene(id);
@@ -484,12 +464,11 @@ impl ControlThread {
                 .state
                 .refusal(ErrorCode::Internal, "the new scene is gone");
         };
-        let signals = SceneSignals::new();
         let keys = SceneKeys {
             token: entry.token,
             frame_key: entry.frame_key,
             instance: self.state.instance(),
-            signals: signals.clone(),
+            signals: entry.signals.clone(),
         };
         let opened = SceneFrames::open(&self.node, &self.root, keys, &self.workers);
         match (opened, self.state.scene(id)) {
@@ -498,7 +477,6 @@ impl ControlThread {
                 let frames = Box::new(frames);
                 self.tell_frames(FrameCommand::Open { id, scene, frames });
                 self.liveness.adopt(id, origin);
-                self.signals.insert(id, signals);
                 self.log
                     .info(format_args!("scene {id} created by client {origin:x}"));
                 reply

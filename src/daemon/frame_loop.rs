@@ -26,11 +26,12 @@ use super::convert::Rejection;
 use super::ingest::{FrameRejection, apply_pose_frame};
 use super::lateness::{LateFrame, Lateness, thread_cpu_ns};
 use super::log::{Cause, Level, Logger, Subject};
+use super::records::{contact_record, pair_record, toi_record};
 use super::schedule::FrameKey;
+use super::shared_scene::SceneSignals;
 use crate::math::Pose;
 use crate::pipeline::{
-    self, Abandon, Completeness, ContactPoint, Deadline, FrameResults, PairResult, PairToi,
-    PipelineWorkspace, Query, StepReport, WorkerPool,
+    self, Completeness, Deadline, FrameResults, PipelineWorkspace, Query, StepReport, WorkerPool,
 };
 use crate::scene::{BodyId, Scene};
 use iceoryx2::port::listener::Listener;
@@ -39,13 +40,12 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use iceoryx2::sample::Sample;
+use iceoryx2::sample_mut::SampleMut;
 use proxima_ipc::wire::{
-    self, ErrorCode, PoseFrameHeader, PoseRecord, RecordKind, ResultFrameHeader, ResultRecord,
-    record_flags,
+    self, ErrorCode, PoseFrameHeader, PoseRecord, ResultFrameHeader, ResultRecord,
 };
 use proxima_ipc::{EVENT_RESULTS_READY, PROTOCOL_VERSION, SceneToken};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Initial number of result records a result sample can hold (grows by powers of two).
@@ -53,6 +53,9 @@ const INITIAL_RESULT_RECORDS: usize = 1024;
 
 /// A received pose frame, still in shared memory.
 type PoseSample<S> = Sample<S, [PoseRecord], PoseFrameHeader>;
+
+/// A result frame written in shared memory, not sent yet.
+type ResultSample<S> = SampleMut<S, [ResultRecord], ResultFrameHeader>;
 
 /// What [`SceneFrames::answer_waiting`] did with the waiting frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -73,8 +76,6 @@ struct Ingested {
     /// The frame thread's CPU time at the frame's receipt.
     cpu_at_receipt: u64,
     ingest_ns: u64,
-    /// Its query, once parked.
-    query: Option<Query>,
 }
 
 impl Ingested {
@@ -106,42 +107,6 @@ pub struct SceneKeys {
     pub signals: SceneSignals,
 }
 
-/// What the control thread tells a scene's frames at any moment, without the scene's lock
-/// (which a frame in progress holds). Clones share the signals.
-#[derive(Clone, Default)]
-pub struct SceneSignals {
-    /// Stops the frame in progress at its next poll (its answers then conservative).
-    abandon: Abandon,
-    /// Frames answered from now on say `OWNER_GONE`, and so does the release frame.
-    owner_gone: Arc<AtomicBool>,
-}
-
-impl SceneSignals {
-    /// Fresh signals, none raised.
-    #[must_use]
-    pub fn new() -> Self {
-        Self {
-            abandon: Abandon::new(),
-            owner_gone: Arc::default(),
-        }
-    }
-
-    /// The scene's owner is gone: its frames' work is abandoned from now on, and they say so.
-    pub fn owner_gone(&self) {
-        self.owner_gone.store(true, Ordering::Relaxed);
-        self.abandon.raise();
-    }
-
-    /// The scene is being let go of: the frame in progress, if any, stops at its next poll.
-    pub fn releasing(&self) {
-        self.abandon.raise();
-    }
-
-    fn is_owner_gone(&self) -> bool {
-        self.owner_gone.load(Ordering::Relaxed)
-    }
-}
-
 /// A scene's ports, the frame waiting for its turn and per-frame scratch space.
 pub struct SceneFrames<S: Service> {
     keys: SceneKeys,
@@ -153,8 +118,8 @@ pub struct SceneFrames<S: Service> {
     /// The oldest pose frame taken from `poses` and not answered yet, with its receipt and
     /// the frame thread's CPU time then ([`thread_cpu_ns`]).
     waiting: Option<(PoseSample<S>, FrameKey, u64)>,
-    /// The frame whose slice ended before its answer ([`Answer::Parked`]).
-    parked: Option<Ingested>,
+    /// The frame whose slice ended before its answer ([`Answer::Parked`]), and its query.
+    parked: Option<(Ingested, Query)>,
     /// Its budgeted frames that were late, and why.
     lateness: Lateness,
     workspace: PipelineWorkspace,
@@ -218,7 +183,7 @@ impl<S: Service> SceneFrames<S> {
             parked: None,
             lateness: Lateness::default(),
             workspace: PipelineWorkspace::with_workers(Arc::clone(workers))
-                .abandon_on(keys.signals.abandon.clone()),
+                .abandon_on(keys.signals.abandon().clone()),
             output: FrameResults::default(),
             validated: Vec::new(),
             keys,
@@ -296,12 +261,11 @@ impl<S: Service> SceneFrames<S> {
             &mut self.validated,
         );
         drop(sample);
-        let mut frame = Ingested {
+        let frame = Ingested {
             header,
             key,
             cpu_at_receipt,
             ingest_ns: elapsed_ns(ingest_started),
-            query: None,
         };
         let mut result = frame.result_header(self.keys.instance);
         match outcome {
@@ -326,10 +290,8 @@ impl<S: Service> SceneFrames<S> {
                 result.error_body = body.unwrap_or(u32::MAX);
             }
             Ok(query) => {
-                let slice_end = slice_end.filter(|_| key.deadline().is_none());
                 let Some(report) = self.step(scene, query, key, slice_end) else {
-                    frame.query = Some(query);
-                    self.parked = Some(frame);
+                    self.parked = Some((frame, query));
                     return Ok(Answer::Parked);
                 };
                 self.end_frame(scene, &mut result, &report, frame.ingest_ns);
@@ -349,10 +311,7 @@ impl<S: Service> SceneFrames<S> {
         scene: &mut Scene,
         log: &mut Logger,
     ) -> Result<Answer, String> {
-        let Some(frame) = self.parked.take() else {
-            return Ok(Answer::Nothing);
-        };
-        let Some(query) = frame.query else {
+        let Some((frame, query)) = self.parked.take() else {
             return Ok(Answer::Nothing);
         };
         let mut result = frame.result_header(self.keys.instance);
@@ -441,11 +400,7 @@ impl<S: Service> SceneFrames<S> {
             .map_err(|e| format!("results loan: {e:?}"))?
             .write_from_fn(|_| ResultRecord::default());
         *sample.user_header_mut() = header;
-        sample.send().map_err(|e| format!("results send: {e:?}"))?;
-        self.notifier
-            .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
-            .map_err(|e| format!("results notify: {e:?}"))?;
-        Ok(())
+        self.send(sample)
     }
 
     /// Runs the pipeline for `query`: exact without a deadline (no budget, or one beyond
@@ -500,15 +455,21 @@ impl<S: Service> SceneFrames<S> {
         let cpu_ns = thread_cpu_ns();
         header.budget_met = u32::from(budget_ns == 0 || header.elapsed_ns <= budget_ns);
         *sample.user_header_mut() = header;
-        sample.send().map_err(|e| format!("results send: {e:?}"))?;
-        self.notifier
-            .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
-            .map_err(|e| format!("results notify: {e:?}"))?;
+        self.send(sample)?;
         Ok(Published {
             publish_ns: elapsed_ns(publish_started),
             elapsed_ns: header.elapsed_ns,
             cpu_ns,
         })
+    }
+
+    /// Sends a written result frame and notifies its readers.
+    fn send(&self, sample: ResultSample<S>) -> Result<(), String> {
+        sample.send().map_err(|e| format!("results send: {e:?}"))?;
+        self.notifier
+            .notify_with_custom_event_id(EventId::new(EVENT_RESULTS_READY))
+            .map_err(|e| format!("results notify: {e:?}"))?;
+        Ok(())
     }
 }
 
@@ -568,66 +529,6 @@ fn fill_header(header: &mut ResultFrameHeader, report: &StepReport) {
     header.dropped_candidates = report.dropped_candidates;
     if report.dropped_candidates > 0 {
         header.flags |= wire::frame_flags::PAIRS_CAPPED;
-    }
-}
-
-fn pair_record(r: &PairResult) -> ResultRecord {
-    ResultRecord {
-        kind: RecordKind::Pair as u32,
-        body_a: r.a,
-        body_b: r.b,
-        index: r.first_contact,
-        count: r.contact_count,
-        flags: approximate_flag(r.exact),
-        distance: r.distance,
-        error_bound: r.error_bound,
-        point_a: r.point_a.to_array(),
-        point_b: r.point_b.to_array(),
-        normal: r.normal.to_array(),
-        time: 0.0,
-    }
-}
-
-/// [`record_flags::APPROXIMATE`] when a record is not `exact`.
-fn approximate_flag(exact: bool) -> u32 {
-    if exact { 0 } else { record_flags::APPROXIMATE }
-}
-
-/// The record of contact `c`, naming its pair's bodies (from `pairs`).
-fn contact_record(pairs: &[PairResult], c: &ContactPoint) -> ResultRecord {
-    let pair = &pairs[c.pair as usize];
-    ResultRecord {
-        kind: RecordKind::Contact as u32,
-        body_a: pair.a,
-        body_b: pair.b,
-        index: c.pair,
-        count: 0,
-        flags: approximate_flag(pair.exact),
-        distance: c.distance,
-        error_bound: c.error_bound,
-        point_a: c.point_a.to_array(),
-        point_b: c.point_b.to_array(),
-        normal: c.normal.to_array(),
-        time: 0.0,
-    }
-}
-
-/// The record of a pair's time of impact (`count` 1 when the search reached contact;
-/// approximate when the deadline came before its search).
-fn toi_record(r: &PairToi) -> ResultRecord {
-    ResultRecord {
-        kind: RecordKind::Toi as u32,
-        body_a: r.a,
-        body_b: r.b,
-        index: 0,
-        count: u32::from(r.reached),
-        flags: approximate_flag(r.exact),
-        distance: r.distance,
-        error_bound: r.error_bound,
-        point_a: r.point_a.to_array(),
-        point_b: r.point_b.to_array(),
-        normal: r.normal.to_array(),
-        time: r.time,
     }
 }
 

@@ -305,7 +305,7 @@ impl Running<'_, '_> {
         let thread = &mut *self.thread;
         let live = thread.scenes.swap_remove(index);
         if let Err(live) = self.lane.send(live) {
-            thread.scenes.push(*live);
+            thread.scenes.push(live);
             let index = thread.scenes.len() - 1;
             if let Err(fault) = thread.scenes[index].answer_parked(&mut thread.log) {
                 thread.retire(index, Some(fault));

@@ -85,9 +85,9 @@ impl<'scope> Lane<'scope> {
     ///
     /// # Errors
     /// `live`, not sent.
-    pub fn send(&mut self, live: LiveScene) -> Result<(), Box<LiveScene>> {
+    pub fn send(&mut self, live: LiveScene) -> Result<(), LiveScene> {
         let Some(to) = self.to.as_ref().filter(|_| self.out.is_none()) else {
-            return Err(Box::new(live));
+            return Err(live);
         };
         let id = live.id;
         match to.try_send(live) {
@@ -95,19 +95,16 @@ impl<'scope> Lane<'scope> {
                 self.out = Some((id, false));
                 Ok(())
             }
-            Err(e) => Err(Box::new(e.into_inner())),
+            Err(e) => Err(e.into_inner()),
         }
     }
 
-    /// Marks scene `id`, if it is out, to be closed when it comes back; returns whether it
-    /// was out.
-    pub fn close_when_back(&mut self, id: u32) -> bool {
-        match &mut self.out {
-            Some((out, close)) if *out == id => {
-                *close = true;
-                true
-            }
-            _ => false,
+    /// Marks scene `id`, if it is out, to be closed when it comes back.
+    pub fn close_when_back(&mut self, id: u32) {
+        if let Some((out, close)) = &mut self.out
+            && *out == id
+        {
+            *close = true;
         }
     }
 

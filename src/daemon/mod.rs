@@ -53,6 +53,7 @@ mod lateness;
 pub mod liveness;
 pub mod log;
 pub mod node_counter;
+pub mod records;
 mod schedule;
 mod secrets;
 mod service_loop;

@@ -208,6 +208,17 @@ fn the_worker_pool_changes_nothing_but_who_answers() {
     );
 }
 
+/// Moves every body of `scene` by up to 0.1 m per axis, kept within 1.4 m of the origin,
+/// and turns it to a random orientation.
+fn shake(scene: &mut Scene, rng: &mut crate::test_support::TestRng) {
+    let ids: Vec<BodyId> = scene.bodies().map(|(id, _)| id).collect();
+    for id in ids {
+        let pose = scene.body(id).unwrap().pose;
+        let moved = (pose.position + point_in_cube(rng, 0.1)).clamp_length_max(1.4);
+        scene.set_pose(id, Pose::new(moved, rotation(rng))).unwrap();
+    }
+}
+
 /// A frame abandoned from its start (its owner gone) is conservative, never wrong: every
 /// pair the exact frame reports is reported, at a distance no greater (a lower bound, within
 /// its error bound), and a pair it calls exact has the exact answer; on the pool or not.
@@ -241,13 +252,7 @@ fn an_abandoned_frame_answers_conservatively_and_misses_nothing() {
     ];
     let (mut truncated_frames, mut approximate_pairs, mut touching) = (0, 0, 0);
     for frame in 0..60 {
-        let ids: Vec<BodyId> = scene.bodies().map(|(id, _)| id).collect();
-        for id in ids {
-            let pose = scene.body(id).unwrap().pose;
-            let moved = (pose.position + point_in_cube(&mut rng, 0.1)).clamp_length_max(1.4);
-            let pose = Pose::new(moved, rotation(&mut rng));
-            scene.set_pose(id, pose).unwrap();
-        }
+        shake(&mut scene, &mut rng);
         let query = queries[frame % queries.len()];
         let truth = run(&scene, query, &mut exact);
         assert_eq!(run(&scene, query, &mut never_raised).pairs, truth.pairs);
@@ -311,14 +316,7 @@ fn a_sliced_frame_is_exact_or_stops_and_the_frame_run_again_is_exact() {
     ];
     let (mut stopped, mut finished) = (0, 0);
     for frame in 0..90 {
-        let ids: Vec<BodyId> = scene.bodies().map(|(id, _)| id).collect();
-        for id in ids {
-            let pose = scene.body(id).unwrap().pose;
-            let moved = (pose.position + point_in_cube(&mut rng, 0.1)).clamp_length_max(1.4);
-            scene
-                .set_pose(id, Pose::new(moved, rotation(&mut rng)))
-                .unwrap();
-        }
+        shake(&mut scene, &mut rng);
         let query = queries[frame % queries.len()];
         let truth = run(&scene, query, &mut never_sliced);
         // Every third frame gets a slice that has already ended, the others an hour.

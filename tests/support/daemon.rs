@@ -197,3 +197,13 @@ pub fn pose_at(body: u32, x: f64) -> PoseRecord {
         orientation: [0.0, 0.0, 0.0, 1.0],
     }
 }
+
+/// Registers `mesh` in `scene` over the protocol and waits for its build; its shape id.
+pub fn register_trimesh(
+    client: &Client<ipc::Service>,
+    scene: u32,
+    mesh: &proxima::geometry::TriMesh,
+) -> Result<u32, proxima_ipc::error::ControlError> {
+    let vertices: Vec<[f64; 3]> = mesh.vertices().iter().map(|v| v.to_array()).collect();
+    client.register_mesh(scene, &vertices, mesh.triangles())
+}
