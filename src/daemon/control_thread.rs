@@ -8,7 +8,8 @@
 //! client's long frame delays no other client's requests. A created scene's ports are
 //! opened here, not on the frame thread, and handed over with [`FrameCommand::Open`]; a
 //! dropped scene is marked dropped at once and its ports come back
-//! ([`FrameCommand::Close`]) to be closed here too. Each hand-over notifies the frame thread's
+//! ([`FrameCommand::Close`]) to be closed here too, a sweep later, once readers had time to
+//! take its release frame. Each hand-over notifies the frame thread's
 //! wake-up listener, so a frame thread blocked without the new scene's listener wakes for it.
 //!
 //! # Waiting (hybrid)
@@ -108,12 +109,18 @@ pub struct ControlThread {
     /// Requests not answered yet, oldest first: those whose scene's lock was held stay, and
     /// are asked again each round.
     queue: VecDeque<ActiveControlRequest>,
+    /// Ports of let-go scenes, each with when it was let go, closed at the first sweep at
+    /// least [`LINGER`] later (so readers still get the release frame).
+    closing: Vec<(Instant, Box<SceneFrames<Ipc>>)>,
     /// Scratch list of the scenes found busy in one round of answering the queue.
     still_busy: Vec<u32>,
 }
 
 /// A control request received and not answered yet.
 type ActiveControlRequest = ActiveRequest<Ipc, [u8], ControlRequest, ControlReply, ()>;
+
+/// How long a let-go scene's ports stay open for readers to take its last frames.
+const LINGER: Duration = Duration::from_millis(100);
 
 /// How often queued requests whose scene was busy are asked again while the thread would
 /// otherwise block.
@@ -179,6 +186,7 @@ impl ControlThread {
             sweep_interval: config.sweep_interval,
             connected: Vec::new(),
             queue: VecDeque::new(),
+            closing: Vec::new(),
             still_busy: Vec::new(),
         })
     }
@@ -230,6 +238,8 @@ impl ControlThread {
                     return Ok(());
                 }
                 self.sweep(now);
+                self.closing
+                    .retain(|(since, _)| now.saturating_duration_since(*since) < LINGER);
                 next_sweep = Instant::now() + self.sweep_interval;
             }
             if stop.is_stopped() {
@@ -407,8 +417,10 @@ impl ControlThread {
             frames,
             fault,
         } = retired;
-        drop(frames);
         drop(scene);
+        // Its last frame (the release) may still be unread: a sample in a subscriber's queue
+        // is lost with its publisher, so the ports close a sweep later, not now.
+        self.closing.push((Instant::now(), frames));
         if let Some(why) = fault
             && self.state.quarantine(id, why)
         {
