@@ -7,7 +7,8 @@
 //! named in the variable and prints one line per step (`CODE <step> <error code>`,
 //! `SENT <step>`), then `DONE`; with [`DOOMED_ROLE`] set it runs only `doomed_client_role`,
 //! a client whose long frame is cut short: it is killed, or drops its scene, mid-frame; with
-//! [`OUTSIDER_ROLE`] set, run as another OS user, only `outsider_role`.
+//! [`OUTSIDER_ROLE`] set, run as another OS user, only `outsider_role`; with [`HOARDER_ROLE`]
+//! set, only `hoarder_role`, which takes all it can over many control ports.
 //!
 //! | attack (issue #31's table) | test |
 //! |---|---|
@@ -22,6 +23,7 @@
 //! | 9 a client killed mid-frame | `a_client_killed_mid_frame_has_its_frame_abandoned_and_its_release_seen_by_a_monitor`, `a_scene_dropped_mid_frame_stops_the_frame_and_its_release_is_seen_by_a_monitor` |
 //! | 10 another OS user's `global_mgmt` | `another_os_user_can_neither_use_the_daemon_nor_stop_new_clients`, `a_node_counter_another_user_set_up_first_stops_the_daemon_at_start` (run as root, which can start a process as `nobody`; otherwise they say they did not run) |
 //! | (not in the table) a frame of seconds, then a request on its scene | `a_clients_long_frame_holds_up_no_other_clients_requests_or_frames` |
+//! | (not in the table) one process taking every scene and body over many ports | `a_process_with_many_ports_holds_one_quota_and_leaves_the_rest_to_others` |
 //!
 //! Same-user limits (README "Who can use the daemon"): iceoryx2 0.10 lets any process of
 //! the daemon's user list services, so the attacker here learns the victim's scene token
@@ -31,7 +33,7 @@
 #[path = "support/daemon.rs"]
 mod daemon_harness;
 
-use daemon_harness::{Daemon, body, pose_at, register_trimesh};
+use daemon_harness::{ConfigFile, Daemon, body, pose_at, register_trimesh};
 use iceoryx2::prelude::*;
 use proxima::daemon::node_counter;
 use proxima::geometry::TriMesh;
@@ -60,6 +62,9 @@ const DOOMED_ROLE: &str = "PROXIMA_HOSTILE_DOOMED";
 /// Environment variable that turns this binary into another OS user's process (its value:
 /// the daemon's root and prefix).
 const OUTSIDER_ROLE: &str = "PROXIMA_HOSTILE_OUTSIDER";
+/// Environment variable that turns this binary into a client taking all it can over many
+/// control ports (its value: the daemon's root and prefix).
+const HOARDER_ROLE: &str = "PROXIMA_HOSTILE_HOARDER";
 
 /// The victim: a scene of two unit spheres (bodies 0 and 1) overlapping by 0.1 m, and its
 /// frame link.
@@ -865,4 +870,125 @@ fn a_node_counter_another_user_set_up_first_stops_the_daemon_at_start() {
         "{stderr}"
     );
     victim.assert_untouched();
+}
+
+/// Control ports the hoarder opens, each its own node (as many as separate clients).
+const HOARDER_PORTS: usize = 4;
+
+/// The hoarder (only when spawned with [`HOARDER_ROLE`]; otherwise it returns at once):
+/// over [`HOARDER_PORTS`] control ports it creates scenes until every port is refused, then
+/// registers a sphere in each and adds bodies round the scenes until each is refused. It
+/// prints `SCENES <n>`, `BODIES <n>` and each refusal's `REFUSED <code> <reason>`, then
+/// `READY`, and holds what it took until its stdin closes.
+#[test]
+fn hoarder_role() {
+    let Some(role) = Role::from_env(HOARDER_ROLE) else {
+        return;
+    };
+    let ports: Vec<Client<ipc::Service>> = (0..HOARDER_PORTS)
+        .map(|_| role.connect(TIMEOUT).expect("the hoarder connects"))
+        .collect();
+    let mut out = std::io::stdout().lock();
+    // The test harness's `test hoarder_role ... ` has no line end of its own.
+    writeln!(out).unwrap();
+    let mut refused = |result: Result<u32, ControlError>| match result {
+        Ok(id) => Some(id),
+        Err(ControlError::Rejected { code, reason }) => {
+            writeln!(out, "REFUSED {code:?} {reason}").unwrap();
+            None
+        }
+        Err(e) => panic!("the hoarder's request failed: {e:?}"),
+    };
+    let mut scenes = Vec::new();
+    for (port, client) in ports.iter().enumerate() {
+        // One more than a port could ever need, so every port meets its refusal.
+        for _ in 0..=HOARDER_PORTS {
+            if let Some(scene) = refused(client.create_scene()) {
+                scenes.push((port, scene));
+            }
+        }
+    }
+    let spheres: Vec<u32> = scenes
+        .iter()
+        .map(|&(port, scene)| {
+            ports[port]
+                .register_primitive(scene, Primitive::Sphere { radius: 0.1 })
+                .expect("a sphere is registered")
+        })
+        .collect();
+    let mut bodies = 0;
+    for attempt in 0..16 {
+        let i = attempt % scenes.len();
+        let (port, scene) = scenes[i];
+        let added = ports[port].add_body(scene, &body(spheres[i], attempt as f64));
+        bodies += usize::from(refused(added).is_some());
+    }
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "SCENES {}\nBODIES {bodies}\nREADY", scenes.len()).unwrap();
+    out.flush().unwrap();
+    drop(out);
+    let mut held = String::new();
+    let _ = std::io::stdin().read_line(&mut held);
+}
+
+/// One process opening several control ports gets one quota (2 scenes, 4 bodies), not one
+/// per port: it cannot take the daemon's 5 scenes, and another process still gets its own
+/// scenes and bodies and is served.
+#[test]
+fn a_process_with_many_ports_holds_one_quota_and_leaves_the_rest_to_others() {
+    let file = ConfigFile::new(
+        "[limits]\n\
+         max_scenes = 5\n\
+         max_scenes_per_client = 2\n\
+         max_bodies_per_client = 4\n",
+    );
+    let daemon = Daemon::start_plain(&["--config", file.path()]);
+    let mut hoarder = role_process("hoarder_role", HOARDER_ROLE, &daemon, "")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("the hoarder starts");
+    let mut output = BufReader::new(hoarder.stdout.take().unwrap()).lines();
+    let lines: Vec<String> = output
+        .by_ref()
+        .map_while(Result::ok)
+        .take_while(|line| line != "READY")
+        .collect();
+    let count = |what: &str| -> usize {
+        lines
+            .iter()
+            .find_map(|line| line.strip_prefix(what)?.trim().parse().ok())
+            .unwrap_or_else(|| panic!("the hoarder reports {what}: {lines:?}"))
+    };
+    assert_eq!(count("SCENES "), 2, "{lines:?}");
+    assert_eq!(count("BODIES "), 4, "{lines:?}");
+    let refusals: Vec<&String> = lines.iter().filter(|l| l.starts_with("REFUSED")).collect();
+    // Every port was refused scenes past the first two, then every body past the fourth.
+    assert_eq!(
+        refusals.len(),
+        (HOARDER_PORTS + 1) * HOARDER_PORTS - 2 + 16 - 4,
+        "{lines:?}"
+    );
+    for refusal in &refusals {
+        assert!(
+            refusal.starts_with("REFUSED LimitExceeded this client process holds its limit of"),
+            "{refusal}"
+        );
+    }
+    // Another process: two scenes of its own, each served.
+    let mut victims = [Victim::new(&daemon), Victim::new(&daemon)];
+    for victim in &mut victims {
+        victim.assert_untouched();
+    }
+    // Its own quota holds too, though the daemon has a scene left.
+    let refused = victims[0].client.create_scene().unwrap_err();
+    assert!(
+        matches!(&refused, ControlError::Rejected { code: ErrorCode::LimitExceeded, reason }
+            if reason.contains("this client process")),
+        "{refused:?}"
+    );
+    drop(hoarder.stdin.take());
+    let rest: Vec<String> = output.map_while(Result::ok).collect();
+    assert!(hoarder.wait().unwrap().success(), "the hoarder ends well: {rest:?}");
+    victims[1].assert_untouched();
 }

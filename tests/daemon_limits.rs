@@ -9,7 +9,7 @@
 #[path = "support/daemon.rs"]
 mod daemon_harness;
 
-use daemon_harness::{Daemon, body, pose_at};
+use daemon_harness::{ConfigFile, Daemon, body, pose_at};
 use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::prelude::{EventId, ipc};
@@ -21,41 +21,12 @@ use proxima_ipc::scene_link::SceneLink;
 use proxima_ipc::wire::{Completeness, ErrorCode, PoseFrameHeader, PoseRecord, frame_flags, query};
 use proxima_ipc::{EVENT_POSES_SENT, PROTOCOL_VERSION};
 use std::io::Read;
-use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 const TIMEOUT: Duration = Duration::from_secs(10);
 const RADIUS: f64 = 0.5;
-
-/// A configuration file at a unique temporary path, removed on drop.
-struct ConfigFile {
-    path: PathBuf,
-}
-
-impl ConfigFile {
-    fn new(text: &str) -> Self {
-        static NEXT: AtomicU32 = AtomicU32::new(0);
-        let path = std::env::temp_dir().join(format!(
-            "proxima-limits-{}-{}.toml",
-            std::process::id(),
-            NEXT.fetch_add(1, Ordering::Relaxed)
-        ));
-        std::fs::write(&path, text).expect("the temporary configuration file is written");
-        Self { path }
-    }
-
-    fn path(&self) -> &str {
-        self.path.to_str().expect("a UTF-8 temporary path")
-    }
-}
-
-impl Drop for ConfigFile {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.path);
-    }
-}
 
 /// The code of a refused control request (panics on success or another failure).
 fn refusal<T: std::fmt::Debug>(result: Result<T, ControlError>) -> (ErrorCode, String) {

@@ -14,8 +14,20 @@ fn the_documented_limits_are_the_daemons_defaults() {
     let coded = [
         ("scenes alive at once", f64::from(config.max_scenes)),
         (
-            "scenes alive at once per control client port",
-            f64::from(config.max_scenes_per_client),
+            "scenes alive at once per client process",
+            f64::from(config.client_quota.scenes),
+        ),
+        (
+            "shapes per client process (all its scenes)",
+            f64::from(config.client_quota.shapes),
+        ),
+        (
+            "bodies per client process (all its scenes)",
+            f64::from(config.client_quota.bodies),
+        ),
+        (
+            "shape memory per client process, MiB",
+            (config.client_quota.geometry_bytes >> 20) as f64,
         ),
         (
             "shapes per scene",

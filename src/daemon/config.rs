@@ -1,6 +1,7 @@
 //! The daemon's configuration: service names, limits and defaults.
 
 use super::log::Level;
+use super::quota::ClientQuota;
 use crate::geometry::MeshLimits;
 use crate::scene::SceneLimits;
 use std::time::Duration;
@@ -15,9 +16,9 @@ pub struct DaemonConfig {
     pub iceoryx_prefix: Option<String>,
     /// Most scenes alive at once.
     pub max_scenes: u32,
-    /// Most scenes alive at once created by one control client port (so one client cannot
-    /// take every scene).
-    pub max_scenes_per_client: u32,
+    /// The most one client process may hold: scenes, shapes, bodies and shape memory (so
+    /// one client cannot take what the others need, however many ports it opens).
+    pub client_quota: ClientQuota,
     /// Limits of each scene.
     pub scene_limits: SceneLimits,
     /// Limits of each registered mesh.
@@ -62,7 +63,7 @@ impl Default for DaemonConfig {
             root: proxima_ipc::DEFAULT_ROOT.to_string(),
             iceoryx_prefix: None,
             max_scenes: 64,
-            max_scenes_per_client: 16,
+            client_quota: ClientQuota::STANDARD,
             scene_limits: SceneLimits::STANDARD,
             mesh_limits: MeshLimits {
                 max_vertices: 1 << 22,

@@ -11,7 +11,10 @@
 //!
 //! [limits]
 //! max_scenes = 64
-//! max_scenes_per_client = 16      # scenes one control client port may hold
+//! max_scenes_per_client = 16      # what one client process may hold, over all its ports:
+//! max_shapes_per_client = 16384   #   scenes, shapes, bodies
+//! max_bodies_per_client = 262144
+//! max_geometry_mib_per_client = 2048  # and convex and mesh shape memory
 //! max_shapes_per_scene = 4096
 //! max_bodies_per_scene = 100000
 //! max_pairs_per_frame = 16384     # candidate pairs a frame answers; more are dropped and counted
@@ -78,8 +81,14 @@ pub struct ServiceLoopSection {
 pub struct LimitsSection {
     /// Most scenes alive at once.
     pub max_scenes: Option<u32>,
-    /// Most scenes one control client port may hold.
+    /// Most scenes one client process may hold.
     pub max_scenes_per_client: Option<u32>,
+    /// Most shapes one client process may hold, over its scenes.
+    pub max_shapes_per_client: Option<u32>,
+    /// Most live bodies one client process may hold, over its scenes.
+    pub max_bodies_per_client: Option<u32>,
+    /// Convex and mesh shape memory one client process may hold, MiB.
+    pub max_geometry_mib_per_client: Option<u64>,
     /// Most shapes registered in one scene.
     pub max_shapes_per_scene: Option<u32>,
     /// Most live bodies in one scene.
@@ -192,11 +201,29 @@ impl ConfigFile {
         }
         let l = &self.limits;
         set_positive(&mut out.max_scenes, l.max_scenes, "limits.max_scenes")?;
+        let quota = &mut out.client_quota;
         set_positive(
-            &mut out.max_scenes_per_client,
+            &mut quota.scenes,
             l.max_scenes_per_client,
             "limits.max_scenes_per_client",
         )?;
+        set_positive(
+            &mut quota.shapes,
+            l.max_shapes_per_client,
+            "limits.max_shapes_per_client",
+        )?;
+        set_positive(
+            &mut quota.bodies,
+            l.max_bodies_per_client,
+            "limits.max_bodies_per_client",
+        )?;
+        let mut client_mib = quota.geometry_bytes >> 20;
+        set_positive(
+            &mut client_mib,
+            l.max_geometry_mib_per_client,
+            "limits.max_geometry_mib_per_client",
+        )?;
+        quota.geometry_bytes = client_mib.saturating_mul(1 << 20);
         set_positive(
             &mut out.scene_limits.max_shapes,
             l.max_shapes_per_scene,
@@ -311,6 +338,9 @@ mod tests {
             max_queued_builds = 60
             max_geometry_mib = 70
             max_scenes_per_client = 80
+            max_shapes_per_client = 81
+            max_bodies_per_client = 82
+            max_geometry_mib_per_client = 83
             [scene]
             default_margin_m = 0.25
             [service_loop]
@@ -336,7 +366,16 @@ mod tests {
         assert_eq!((c.max_convex_points, c.default_margin), (50, 0.25));
         assert_eq!(c.max_queued_builds, 60);
         assert_eq!(c.max_geometry_bytes, 70 << 20);
-        assert_eq!(c.max_scenes_per_client, 80);
+        let quota = c.client_quota;
+        assert_eq!(
+            (
+                quota.scenes,
+                quota.shapes,
+                quota.bodies,
+                quota.geometry_bytes
+            ),
+            (80, 81, 82, 83 << 20)
+        );
         assert_eq!(
             (c.log_level, c.workers),
             (super::super::log::Level::Debug, 13)

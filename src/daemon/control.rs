@@ -25,6 +25,7 @@ use super::builder::{BuildJob, BuildQueue};
 use super::config::DaemonConfig;
 use super::convert::{self, Rejection, ShapeRequest};
 use super::liveness::OwnerId;
+use super::quota::{ProcessId, Quotas, Usage};
 use super::secrets;
 use super::shape_table::ShapeState;
 use super::shared_scene::{self, SceneCell, SceneSignals, SharedScene, lock};
@@ -50,6 +51,18 @@ pub struct ControlState {
     /// Bytes charged to convex and mesh shapes of every scene alive
     /// ([`budget_memory`](super::budget_memory)), at most `config.max_geometry_bytes`.
     geometry_bytes: u64,
+    /// What each client process holds, against `config.client_quota`.
+    quotas: Quotas,
+}
+
+/// Who sent a request: the control client port, which owns the scenes it creates, and the
+/// process behind it, which their [quota](super::quota) is charged to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Origin {
+    /// The port (iceoryx2's `UniqueClientId` value).
+    pub port: OwnerId,
+    /// The process that created the port's node.
+    pub process: ProcessId,
 }
 
 /// A scene as the control service knows it.
@@ -57,14 +70,16 @@ pub struct ControlState {
 pub struct SceneEntry {
     /// The client port that created it, the only one it answers.
     pub owner: OwnerId,
+    /// The process of `owner`, which `usage` is charged to.
+    pub process: ProcessId,
     /// The secret that names its services.
     pub token: SceneToken,
     /// The secret its pose frames carry.
     pub frame_key: u64,
     /// Its state, or why it was quarantined.
     pub state: Result<SharedScene, String>,
-    /// Bytes charged to its convex and mesh shapes.
-    pub geometry_bytes: u64,
+    /// What it holds, charged to `process` (only the scene itself once quarantined).
+    pub usage: Usage,
     /// What the control thread tells its frames while one may be in progress.
     pub signals: SceneSignals,
 }
@@ -88,6 +103,7 @@ impl ControlState {
     #[must_use]
     pub fn new(config: DaemonConfig, builds: BuildQueue, instance: u64) -> Self {
         Self {
+            quotas: Quotas::new(config.client_quota),
             config,
             instance,
             scenes: HashMap::new(),
@@ -131,13 +147,13 @@ impl ControlState {
         self.scenes.get(&id)?.state.as_ref().ok()
     }
 
-    /// Answers one request from client port `origin`; the state changes only when the
+    /// Answers one request from `origin`; the state changes only when the
     /// reply is a success. A `CreateScene` reply carries the new scene's keys. `None` when
     /// the request needs its scene's lock and a frame or a build holds it: nothing changed,
     /// ask again later (the control thread never waits for a frame, which may be long).
     pub fn handle_unless_busy(
         &mut self,
-        origin: OwnerId,
+        origin: Origin,
         request: &ControlRequest,
         payload: &[u8],
     ) -> Option<ControlReply> {
@@ -163,7 +179,7 @@ impl ControlState {
     #[cfg(test)]
     pub fn handle(
         &mut self,
-        origin: OwnerId,
+        origin: Origin,
         request: &ControlRequest,
         payload: &[u8],
     ) -> ControlReply {
@@ -175,9 +191,29 @@ impl ControlState {
         }
     }
 
+    /// Whether every charge is where the [quota](super::quota) invariant puts it: each
+    /// process's usage is the sum of its scenes', each live scene's bodies are its charged
+    /// bodies, and the daemon-wide shape memory is the sum over all scenes.
+    #[cfg(test)]
+    pub fn accounts_balance(&self) -> bool {
+        let mut sums: HashMap<ProcessId, Usage> = HashMap::new();
+        for entry in self.scenes.values() {
+            sums.entry(entry.process).or_default().add(entry.usage);
+            if let Ok(shared) = &entry.state
+                && lock(shared).scene.body_count() != entry.usage.bodies as usize
+            {
+                return false;
+            }
+        }
+        let memory: u64 = sums.values().map(|u| u.geometry_bytes).sum();
+        memory == self.geometry_bytes
+            && sums.len() == self.quotas.processes()
+            && sums.iter().all(|(&p, &u)| self.quotas.usage(p) == u)
+    }
+
     /// Stops serving scene `id` after a fault on its services: frees its state and answers
-    /// its owner's requests with `SceneQuarantined` and `reason` until it drops the id.
-    /// Returns whether the scene was live.
+    /// its owner's requests with `SceneQuarantined` and `reason` until it drops the id (its
+    /// process's quota keeps only the scene itself). Returns whether the scene was live.
     pub fn quarantine(&mut self, id: u32, reason: String) -> bool {
         let Some(entry) = self.scenes.get_mut(&id).filter(|e| e.state.is_ok()) else {
             return false;
@@ -185,13 +221,18 @@ impl ControlState {
         if let Ok(shared) = std::mem::replace(&mut entry.state, Err(reason)) {
             lock(&shared).dropped = true;
         }
-        self.geometry_bytes -= std::mem::take(&mut entry.geometry_bytes);
+        let freed = Usage {
+            scenes: 0,
+            ..std::mem::replace(&mut entry.usage, Usage::SCENE)
+        };
+        self.geometry_bytes -= freed.geometry_bytes;
+        self.quotas.refund(entry.process, freed);
         true
     }
 
     fn try_handle(
         &mut self,
-        origin: OwnerId,
+        origin: Origin,
         request: &ControlRequest,
         payload: &[u8],
     ) -> Result<Answer, Refusal> {
@@ -200,14 +241,14 @@ impl ControlState {
             Command::Hello => Ok(PROTOCOL_VERSION.into()),
             Command::CreateScene => Ok(self.create_scene(origin)?.into()),
             Command::DropScene => {
-                self.owned_entry(origin, request.scene)?;
+                self.owned_entry(origin.port, request.scene)?;
                 self.drop_scene(request.scene)?;
                 Ok(request.scene.into())
             }
             Command::RegisterShape => self.register_shape(origin, request, payload),
             Command::ShapeState => {
                 let building = match self
-                    .owned_cell(origin, request.scene)?
+                    .owned_cell(origin.port, request.scene)?
                     .shapes
                     .state(request.target)?
                 {
@@ -219,17 +260,25 @@ impl ControlState {
                     flags: building,
                 })
             }
-            Command::AddBody => self.add_body(origin, request).map(Answer::from),
+            Command::AddBody => {
+                self.owned_entry(origin.port, request.scene)?;
+                self.quotas.check(origin.process, Usage::BODY)?;
+                let body = self.add_body(origin, request)?;
+                self.charge(request.scene, Usage::BODY);
+                Ok(body.into())
+            }
             Command::RemoveBody => {
                 let body = BodyId(request.target);
-                let mut cell = self.owned_cell(origin, request.scene)?;
+                let mut cell = self.owned_cell(origin.port, request.scene)?;
                 cell.scene.remove_body(body).map_err(scene_rejection)?;
+                drop(cell);
+                self.refund(request.scene, Usage::BODY);
                 Ok(request.target.into())
             }
             Command::UpdateBody => {
                 let motion = convert::motion(request.motion)?;
                 let (filter, margin) = (convert::filter(request), convert::margin(request.margin));
-                let mut cell = self.owned_cell(origin, request.scene)?;
+                let mut cell = self.owned_cell(origin.port, request.scene)?;
                 cell.scene
                     .update_body(BodyId(request.target), motion, filter, margin)
                     .map_err(scene_rejection)?;
@@ -237,7 +286,7 @@ impl ControlState {
             }
             Command::SetSceneParams => {
                 let choice = broad_phase(request.broad_phase)?;
-                self.owned_cell(origin, request.scene)?
+                self.owned_cell(origin.port, request.scene)?
                     .scene
                     .set_broad_phase(choice);
                 Ok(request.scene.into())
@@ -246,10 +295,10 @@ impl ControlState {
     }
 
     /// Adds a body of a built shape: the request is checked before the scene is locked.
-    fn add_body(&self, origin: OwnerId, request: &ControlRequest) -> Result<u32, Refusal> {
+    fn add_body(&self, origin: Origin, request: &ControlRequest) -> Result<u32, Refusal> {
         let pose = convert::pose(request.position, request.orientation)?;
         let motion = convert::motion(request.motion)?;
-        let mut cell = self.owned_cell(origin, request.scene)?;
+        let mut cell = self.owned_cell(origin.port, request.scene)?;
         let desc = BodyDesc {
             shape: cell.shapes.usable(request.target)?,
             pose,
@@ -264,7 +313,7 @@ impl ControlState {
     /// the builder with a copy of its payload (the reply says it is being built).
     fn register_shape(
         &mut self,
-        origin: OwnerId,
+        origin: Origin,
         request: &ControlRequest,
         payload: &[u8],
     ) -> Result<Answer, Refusal> {
@@ -276,15 +325,19 @@ impl ControlState {
             &config.mesh_limits,
             config.max_convex_points,
         )?;
-        let shared = self.owned_scene(origin, request.scene)?;
+        let shared = self.owned_scene(origin.port, request.scene)?;
         let geometry = match shape {
             ShapeRequest::Primitive(shape) => {
+                self.quotas.check(origin.process, Usage::shape(0))?;
                 let mut cell = try_lock(shared)?;
                 // The table hands out no more ids than the scene takes shapes, so the
                 // scene has room for this one.
                 let id = cell.shapes.reserve(max_shapes)?;
                 let registered = cell.scene.register_shape(shape).map_err(scene_rejection);
                 cell.shapes.finish(id, registered.clone());
+                // A refused primitive keeps its id (refused), so it is charged too.
+                drop(cell);
+                self.charge(request.scene, Usage::shape(0));
                 return Ok(registered.map(|_| id.into())?);
             }
             ShapeRequest::Geometry(geometry) => geometry,
@@ -305,6 +358,7 @@ impl ControlState {
                 ),
             )));
         }
+        self.quotas.check(origin.process, Usage::shape(charge))?;
         // The last point where the request may wait for the scene: nothing changed yet.
         let shape = try_lock(shared)?.shapes.reserve(max_shapes)?;
         let job = BuildJob {
@@ -318,10 +372,7 @@ impl ControlState {
             lock(shared).shapes.finish(shape, Err(refused.clone()));
             return Err(refused.into());
         }
-        self.geometry_bytes += charge;
-        if let Some(entry) = self.scenes.get_mut(&request.scene) {
-            entry.geometry_bytes += charge;
-        }
+        self.charge(request.scene, Usage::shape(charge));
         Ok(Answer {
             id: shape,
             flags: reply_flags::SHAPE_BUILDING,
@@ -338,11 +389,30 @@ impl ControlState {
         if let Ok(shared) = entry.state {
             lock(&shared).dropped = true;
         }
-        self.geometry_bytes -= entry.geometry_bytes;
+        self.geometry_bytes -= entry.usage.geometry_bytes;
+        self.quotas.refund(entry.process, entry.usage);
         Ok(())
     }
 
-    fn create_scene(&mut self, owner: OwnerId) -> Result<u32, Rejection> {
+    /// Charges `more` to scene `id` and its process (the daemon-wide shape memory too).
+    fn charge(&mut self, id: u32, more: Usage) {
+        if let Some(entry) = self.scenes.get_mut(&id) {
+            entry.usage.add(more);
+            self.quotas.charge(entry.process, more);
+            self.geometry_bytes += more.geometry_bytes;
+        }
+    }
+
+    /// Gives `back` (charged to scene `id` before) back.
+    fn refund(&mut self, id: u32, back: Usage) {
+        if let Some(entry) = self.scenes.get_mut(&id) {
+            entry.usage.remove(back);
+            self.quotas.refund(entry.process, back);
+            self.geometry_bytes -= back.geometry_bytes;
+        }
+    }
+
+    fn create_scene(&mut self, origin: Origin) -> Result<u32, Rejection> {
         if self.scenes.len() >= self.config.max_scenes as usize {
             return Err(Rejection::new(
                 ErrorCode::LimitExceeded,
@@ -352,13 +422,7 @@ impl ControlState {
                 ),
             ));
         }
-        let quota = self.config.max_scenes_per_client;
-        if self.scenes.values().filter(|e| e.owner == owner).count() >= quota as usize {
-            return Err(Rejection::new(
-                ErrorCode::LimitExceeded,
-                format!("this client holds its limit of {quota} scenes"),
-            ));
-        }
+        self.quotas.check(origin.process, Usage::SCENE)?;
         let scene = Scene::try_new(self.config.default_margin, self.config.scene_limits)
             .map_err(scene_rejection)?;
         let secret = |what| {
@@ -377,14 +441,16 @@ impl ControlState {
             }
         };
         let entry = SceneEntry {
-            owner,
+            owner: origin.port,
+            process: origin.process,
             token: SceneToken([secret("a scene token")?, secret("a scene token")?]),
             frame_key: secret("a frame key")?,
             state: Ok(shared_scene::share(scene)),
-            geometry_bytes: 0,
+            usage: Usage::NOTHING,
             signals: SceneSignals::new(),
         };
         self.scenes.insert(id, entry);
+        self.charge(id, Usage::SCENE);
         Ok(id)
     }
 

@@ -1,12 +1,23 @@
 use super::super::builder::{self, BuildJob};
-use super::super::liveness::OwnerId;
 use super::super::log::{Level, Logger};
+use super::super::quota::ClientQuota;
 use super::*;
 use crossbeam::channel::Receiver;
 use proxima_ipc::wire::{MotionCode, ShapeKindCode};
 
-/// The client port every test request comes from, unless a test says otherwise.
-const OWNER: OwnerId = 0x0A;
+/// The client every test request comes from, unless a test says otherwise.
+const OWNER: Origin = Origin {
+    port: 0x0A,
+    process: 100,
+};
+
+/// Another client, in another process.
+fn other(n: u32) -> Origin {
+    Origin {
+        port: OWNER.port + u128::from(n),
+        process: OWNER.process + n,
+    }
+}
 /// The daemon instance id of the tests' states.
 const INSTANCE: u64 = 0x1234_5678;
 
@@ -602,7 +613,7 @@ fn only_the_creating_client_port_may_use_a_scene_and_the_reply_hands_it_the_keys
         ..request(Command::AddBody)
     };
     assert_eq!(state.handle(OWNER, &add, &[]).id, 0);
-    let intruder: OwnerId = OWNER + 1;
+    let intruder = other(1);
     for command in scene_commands(scene) {
         let reply = state.handle(intruder, &command, &[]);
         assert_eq!(code(&reply), ErrorCode::NotOwner, "{command:?}");
@@ -629,7 +640,10 @@ fn only_the_creating_client_port_may_use_a_scene_and_the_reply_hands_it_the_keys
 fn scene_ids_and_keys_are_random_and_never_repeat_among_live_scenes() {
     let config = DaemonConfig {
         max_scenes: 200,
-        max_scenes_per_client: 200,
+        client_quota: ClientQuota {
+            scenes: 200,
+            ..ClientQuota::STANDARD
+        },
         ..DaemonConfig::default()
     };
     let (mut state, _jobs) = state_with(config, 4);
@@ -674,7 +688,7 @@ fn a_quarantined_scene_tells_its_owner_why_until_dropped_and_frees_its_slot() {
             "{}",
             reply.reason()
         );
-        let other = state.handle(OWNER + 1, &command, &[]);
+        let other = state.handle(other(1), &command, &[]);
         assert_eq!(code(&other), ErrorCode::NotOwner, "{command:?}");
     }
     // It still counts against the limit until its owner lets go of the id.
@@ -738,40 +752,207 @@ fn shapes_are_charged_against_the_memory_budget_before_anything_is_copied_and_sc
     );
 }
 
+/// Another port of [`OWNER`]'s process.
+const OWNER_SECOND_PORT: Origin = Origin {
+    port: 0x0B,
+    process: OWNER.process,
+};
+
 #[test]
-fn one_client_port_holds_at_most_its_quota_of_scenes_and_others_still_get_theirs() {
+fn one_client_process_holds_at_most_its_quota_of_scenes_over_all_its_ports() {
     let config = DaemonConfig {
         max_scenes: 5,
-        max_scenes_per_client: 2,
+        client_quota: ClientQuota {
+            scenes: 2,
+            ..ClientQuota::STANDARD
+        },
         ..DaemonConfig::default()
     };
     let (mut state, _jobs) = state_with(config, 4);
     let create = request(Command::CreateScene);
-    let mine: Vec<u32> = (0..2)
-        .map(|_| state.handle(OWNER, &create, &[]).id)
-        .collect();
-    let refused = state.handle(OWNER, &create, &[]);
-    assert_eq!(code(&refused), ErrorCode::LimitExceeded);
-    assert!(
-        refused.reason().contains("this client"),
-        "{}",
-        refused.reason()
+    let first = state.handle(OWNER, &create, &[]).id;
+    assert_eq!(
+        code(&state.handle(OWNER_SECOND_PORT, &create, &[])),
+        ErrorCode::Ok
     );
-    for other in [OWNER + 1, OWNER + 2] {
-        assert_eq!(code(&state.handle(other, &create, &[])), ErrorCode::Ok);
+    // A third port of the same process gets nothing more.
+    for port in [OWNER, OWNER_SECOND_PORT] {
+        let refused = state.handle(port, &create, &[]);
+        assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+        assert!(
+            refused
+                .reason()
+                .contains("this client process holds its limit of 2 scenes"),
+            "{}",
+            refused.reason()
+        );
+    }
+    for client in [other(1), other(2)] {
+        assert_eq!(code(&state.handle(client, &create, &[])), ErrorCode::Ok);
     }
     // The daemon-wide limit (5) still holds, and a dropped scene frees the quota.
-    assert_eq!(code(&state.handle(OWNER + 3, &create, &[])), ErrorCode::Ok);
+    assert_eq!(code(&state.handle(other(3), &create, &[])), ErrorCode::Ok);
     assert_eq!(
-        code(&state.handle(OWNER + 4, &create, &[])),
+        code(&state.handle(other(4), &create, &[])),
         ErrorCode::LimitExceeded
     );
     let drop = ControlRequest {
-        scene: mine[0],
+        scene: first,
         ..request(Command::DropScene)
     };
     assert_eq!(code(&state.handle(OWNER, &drop, &[])), ErrorCode::Ok);
-    assert_eq!(code(&state.handle(OWNER, &create, &[])), ErrorCode::Ok);
+    assert_eq!(
+        code(&state.handle(OWNER_SECOND_PORT, &create, &[])),
+        ErrorCode::Ok
+    );
+    assert!(state.accounts_balance());
+}
+
+/// Shapes and bodies are counted over all of a process's scenes, whichever port made them;
+/// removing a body or dropping a scene gives its share back; others are not touched.
+#[test]
+fn one_client_process_holds_at_most_its_quota_of_shapes_and_bodies() {
+    let config = DaemonConfig {
+        client_quota: ClientQuota {
+            shapes: 3,
+            bodies: 4,
+            ..ClientQuota::STANDARD
+        },
+        ..DaemonConfig::default()
+    };
+    let (mut state, _jobs) = state_with(config, 4);
+    let create = request(Command::CreateScene);
+    let scenes = [
+        state.handle(OWNER, &create, &[]).id,
+        state.handle(OWNER_SECOND_PORT, &create, &[]).id,
+    ];
+    let ports = [OWNER, OWNER_SECOND_PORT];
+    let mut spheres = Vec::new();
+    for i in 0..3 {
+        let reply = state.handle(ports[i % 2], &sphere_request(scenes[i % 2]), &[]);
+        assert_eq!(code(&reply), ErrorCode::Ok);
+        spheres.push(reply.id);
+    }
+    let refused = state.handle(OWNER, &sphere_request(scenes[0]), &[]);
+    assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+    assert!(
+        refused.reason().contains("3 shapes"),
+        "{}",
+        refused.reason()
+    );
+    let add = |i: usize| ControlRequest {
+        scene: scenes[i % 2],
+        target: spheres[i % 2],
+        ..request(Command::AddBody)
+    };
+    let mut bodies = Vec::new();
+    for i in 0..4 {
+        let reply = state.handle(ports[i % 2], &add(i), &[]);
+        assert_eq!(code(&reply), ErrorCode::Ok);
+        bodies.push(reply.id);
+    }
+    let refused = state.handle(OWNER_SECOND_PORT, &add(1), &[]);
+    assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+    assert!(
+        refused.reason().contains("4 bodies"),
+        "{}",
+        refused.reason()
+    );
+    // Another process has its own quota.
+    let theirs = state.handle(other(1), &create, &[]).id;
+    let sphere = state.handle(other(1), &sphere_request(theirs), &[]).id;
+    let their_body = ControlRequest {
+        scene: theirs,
+        target: sphere,
+        ..request(Command::AddBody)
+    };
+    assert_eq!(
+        code(&state.handle(other(1), &their_body, &[])),
+        ErrorCode::Ok
+    );
+    // A removed body makes room for one more.
+    let remove = ControlRequest {
+        scene: scenes[0],
+        target: bodies[0],
+        ..request(Command::RemoveBody)
+    };
+    assert_eq!(code(&state.handle(OWNER, &remove, &[])), ErrorCode::Ok);
+    assert_eq!(
+        code(&state.handle(OWNER_SECOND_PORT, &add(1), &[])),
+        ErrorCode::Ok
+    );
+    assert_eq!(
+        code(&state.handle(OWNER_SECOND_PORT, &add(1), &[])),
+        ErrorCode::LimitExceeded
+    );
+    assert!(state.accounts_balance());
+    // A dropped scene gives back its shapes and bodies.
+    let drop = ControlRequest {
+        scene: scenes[1],
+        ..request(Command::DropScene)
+    };
+    assert_eq!(
+        code(&state.handle(OWNER_SECOND_PORT, &drop, &[])),
+        ErrorCode::Ok
+    );
+    assert_eq!(
+        code(&state.handle(OWNER, &sphere_request(scenes[0]), &[])),
+        ErrorCode::Ok
+    );
+    assert_eq!(code(&state.handle(OWNER, &add(0), &[])), ErrorCode::Ok);
+    assert!(state.accounts_balance());
+}
+
+/// Shape memory is counted per process besides the daemon-wide budget; a quarantined scene
+/// gives its shapes back but still counts as a scene.
+#[test]
+fn one_client_process_holds_at_most_its_quota_of_shape_memory() {
+    use super::super::budget_memory::MESH_BYTES_PER_TRIANGLE;
+    let one_mesh = 4 * MESH_BYTES_PER_TRIANGLE + 4 * 64;
+    let config = DaemonConfig {
+        client_quota: ClientQuota {
+            scenes: 2,
+            geometry_bytes: one_mesh + one_mesh / 2,
+            ..ClientQuota::STANDARD
+        },
+        ..DaemonConfig::default()
+    };
+    let (mut state, jobs) = state_with(config, 4);
+    let payload = mesh_payload(&TETRA, &TETRA_INDICES);
+    let create = request(Command::CreateScene);
+    let mine = state.handle(OWNER, &create, &[]).id;
+    let second = state.handle(OWNER_SECOND_PORT, &create, &[]).id;
+    let theirs = state.handle(other(1), &create, &[]).id;
+    assert_eq!(
+        code(&state.handle(OWNER, &mesh_request(mine, 4, 12), &payload)),
+        ErrorCode::Ok
+    );
+    let refused = state.handle(OWNER_SECOND_PORT, &mesh_request(second, 4, 12), &payload);
+    assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+    assert!(
+        refused.reason().contains("this client process's"),
+        "{}",
+        refused.reason()
+    );
+    assert_eq!(
+        code(&state.handle(other(1), &mesh_request(theirs, 4, 12), &payload)),
+        ErrorCode::Ok,
+        "another process has its own shape memory"
+    );
+    assert_eq!(build_all(&jobs), 2, "the refused one was never queued");
+    assert!(state.quarantine(mine, "test fault".to_owned()));
+    assert!(state.accounts_balance());
+    assert_eq!(
+        code(&state.handle(OWNER_SECOND_PORT, &mesh_request(second, 4, 12), &payload)),
+        ErrorCode::Ok,
+        "the quarantined scene's shapes were given back"
+    );
+    assert_eq!(
+        code(&state.handle(OWNER_SECOND_PORT, &create, &[])),
+        ErrorCode::LimitExceeded,
+        "the quarantined scene still counts as one"
+    );
+    assert!(state.accounts_balance());
 }
 
 /// While a frame holds a scene's lock, every request that needs it is given back unanswered
@@ -810,12 +991,12 @@ fn a_request_whose_scene_is_busy_waits_for_nothing_and_changes_nothing() {
         }
         assert_eq!(state.geometry_bytes, 0, "no memory charged");
         assert_eq!(jobs.len(), 0, "no build queued");
-        let other = state.handle_unless_busy(OWNER + 1, &request(Command::CreateScene), &[]);
-        assert_eq!(other.map(|r| code(&r)), Some(ErrorCode::Ok));
+        let created = state.handle_unless_busy(other(1), &request(Command::CreateScene), &[]);
+        assert_eq!(created.map(|r| code(&r)), Some(ErrorCode::Ok));
         let hello = state.handle_unless_busy(OWNER, &request(Command::Hello), &[]);
         assert_eq!(hello.map(|r| r.id), Some(PROTOCOL_VERSION));
         // Another client naming the busy scene is refused without its lock.
-        let trespass = state.handle_unless_busy(OWNER + 1, &add, &[]);
+        let trespass = state.handle_unless_busy(other(1), &add, &[]);
         assert_eq!(trespass.map(|r| code(&r)), Some(ErrorCode::NotOwner));
     }
     let added = state

@@ -27,12 +27,13 @@
 use super::Ipc;
 use super::claim::{self, ControlFactory, EventSettings};
 use super::config::DaemonConfig;
-use super::control::ControlState;
+use super::control::{ControlState, Origin};
 use super::error::{DaemonRunError, DaemonStartError};
 use super::frame_loop::{SceneFrames, SceneKeys};
 use super::gate::Gate;
 use super::liveness::{Liveness, OwnerId};
 use super::log::{Cause, Level, Logger, Subject};
+use super::quota::ProcessId;
 use super::shared_scene::SharedScene;
 use super::stop::StopHandle;
 use super::wait::{Wake, wait_for_events};
@@ -44,7 +45,7 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
 use proxima_ipc::wire::{Command, ControlReply, ControlRequest, ErrorCode};
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -104,8 +105,9 @@ pub struct ControlThread {
     root: String,
     spin: Duration,
     sweep_interval: Duration,
-    /// Scratch list of the connected control clients, refilled at each sweep.
-    connected: Vec<OwnerId>,
+    /// The connected control client ports and their processes, refilled at each sweep and
+    /// when a request comes from a port not in it yet.
+    connected: HashMap<OwnerId, ProcessId>,
     /// Requests not answered yet, oldest first: those whose scene's lock was held stay, and
     /// are asked again each round.
     queue: VecDeque<ActiveControlRequest>,
@@ -184,7 +186,7 @@ impl ControlThread {
             root: config.root.clone(),
             spin: config.spin,
             sweep_interval: config.sweep_interval,
-            connected: Vec::new(),
+            connected: HashMap::new(),
             queue: VecDeque::new(),
             closing: Vec::new(),
             still_busy: Vec::new(),
@@ -319,8 +321,17 @@ impl ControlThread {
     /// never waits for a frame.
     fn answer(&mut self, active: ActiveControlRequest) -> Option<ActiveControlRequest> {
         let request = *active.user_header();
-        let origin = active.origin().value();
-        self.stop_frame_before_drop(&request, origin);
+        let port = active.origin().value();
+        let Some(origin) = self.origin_of(port) else {
+            let reply = self.state.refusal(
+                ErrorCode::Internal,
+                "the control service does not list this client port's process",
+            );
+            self.log_refusal(&request, &reply, port);
+            let _ = active.send_copy(reply);
+            return None;
+        };
+        self.stop_frame_before_drop(&request, port);
         let Some(mut reply) = self
             .state
             .handle_unless_busy(origin, &request, active.payload())
@@ -328,13 +339,39 @@ impl ControlThread {
             return Some(active);
         };
         if reply.status == ErrorCode::Ok as u32 {
-            reply = self.follow_scene_changes(&request, reply, origin);
+            reply = self.follow_scene_changes(&request, reply, port);
         } else {
-            self.log_refusal(&request, &reply, origin);
+            self.log_refusal(&request, &reply, port);
         }
         // A client that went away no longer wants the reply: not an error of the daemon.
         let _ = active.send_copy(reply);
         None
+    }
+
+    /// Who sent a request from client `port`: the port and its process, as the control
+    /// service lists them (listed again when the port is new). `None` when the port is not
+    /// listed (it has gone) or iceoryx2 does not tell its process.
+    fn origin_of(&mut self, port: OwnerId) -> Option<Origin> {
+        if !self.connected.contains_key(&port) {
+            self.list_connected();
+        }
+        let process = *self.connected.get(&port)?;
+        Some(Origin { port, process })
+    }
+
+    /// Refills [`connected`](Self::connected) from the control service's client list.
+    fn list_connected(&mut self) {
+        self.connected.clear();
+        let connected = &mut self.connected;
+        self.control_service
+            .dynamic_config()
+            .list_clients(|client| {
+                if let Ok(pid) = client.node_id.pid::<Ipc>() {
+                    // A pid is never negative; the cast keeps it as it is.
+                    connected.insert(client.client_id.value(), pid.value() as ProcessId);
+                }
+                CallbackProgression::Continue
+            });
     }
 
     /// Before its owner's DropScene is handled (which takes the scene's lock), stops the
@@ -375,18 +412,13 @@ impl ControlThread {
                 cleanup.cleanups, cleanup.failed_cleanups
             ));
         }
-        self.connected.clear();
-        let connected = &mut self.connected;
-        self.control_service
-            .dynamic_config()
-            .list_clients(|client| {
-                connected.push(client.client_id.value());
-                CallbackProgression::Continue
-            });
+        self.list_connected();
         let connected = &self.connected;
-        let outcome = self.liveness.sweep(now, |owner| connected.contains(&owner));
+        let outcome = self
+            .liveness
+            .sweep(now, |owner| connected.contains_key(&owner));
         self.log.release_if(|subject| match subject {
-            Subject::Client(id) => !connected.contains(&id),
+            Subject::Client(id) => !connected.contains_key(&id),
             Subject::Scene(_) | Subject::Daemon => false,
         });
         for &id in &outcome.orphaned {

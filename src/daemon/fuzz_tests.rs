@@ -12,9 +12,8 @@
 
 use super::builder::{self, BuildJob, BuildQueue};
 use super::config::DaemonConfig;
-use super::control::ControlState;
+use super::control::{ControlState, Origin};
 use super::ingest::apply_pose_frame;
-use super::liveness::OwnerId;
 use super::log::{Level, Logger};
 use crate::geometry::MeshLimits;
 use crate::math::{DQuat, DVec3, Pose};
@@ -32,8 +31,21 @@ use rand_pcg::Pcg64Mcg;
 const CASES: usize = 1_000_000;
 /// The daemon instance id of the fuzzed state.
 const INSTANCE: u64 = 0xf022;
-/// The client ports requests come from.
-const OWNERS: [OwnerId; 3] = [11, 12, 13];
+/// The clients requests come from: two ports of one process, and another process.
+const OWNERS: [Origin; 3] = [
+    Origin {
+        port: 11,
+        process: 1,
+    },
+    Origin {
+        port: 12,
+        process: 1,
+    },
+    Origin {
+        port: 13,
+        process: 2,
+    },
+];
 
 fn edge_u32(rng: &mut Pcg64Mcg) -> u32 {
     const EDGES: [u32; 8] = [0, 1, 2, 3, 7, 1 << 31, u32::MAX - 1, u32::MAX];
@@ -181,9 +193,15 @@ fn a_million_mutated_control_requests_get_defined_codes_and_never_panic() {
     let mut state = ControlState::new(config, builds, INSTANCE);
     let mut log = Logger::in_memory(Level::Error);
     let mut rng = Pcg64Mcg::seed_from_u64(31);
-    let mut scenes: Vec<(u32, OwnerId)> = Vec::new();
+    let mut scenes: Vec<(u32, Origin)> = Vec::new();
     let mut outcomes = [0usize; 16];
-    for _ in 0..CASES {
+    for case in 0..CASES {
+        if case % 10_000 == 0 {
+            assert!(
+                state.accounts_balance(),
+                "quota charges balance at case {case}"
+            );
+        }
         let (scene, owner) = match scenes.get(rng.random_range(0..scenes.len() + 1)) {
             Some(&known) if rng.random_bool(0.9) => known,
             _ => (edge_u32(&mut rng), OWNERS[0]),
@@ -214,6 +232,10 @@ fn a_million_mutated_control_requests_get_defined_codes_and_never_panic() {
         }
     }
     build_queued(&jobs, &limits, &mut log);
+    assert!(
+        state.accounts_balance(),
+        "every quota charge is where it belongs"
+    );
     // Every built shape's state is a defined code, never a caught panic (Internal).
     for &(scene, owner) in &scenes {
         for shape in 0..16 {

@@ -31,6 +31,7 @@
 //!   scene's frame path through `ingest`, the pipeline and publication;
 //! - `wait`, `stop`: how the threads block, and stop together;
 //! - [`liveness`]: which client owns each scene, and which scenes outlived their owner;
+//! - [`quota`]: what each client process holds, and the most it may;
 //! - [`log`]: leveled stderr lines, once per (scene or client, cause);
 //! - `gate`: [`Gate`], a test hook that holds builds or control requests;
 //! - `error`: start-up and run failures (client mistakes are wire error codes instead).
@@ -53,6 +54,7 @@ mod lateness;
 pub mod liveness;
 pub mod log;
 pub mod node_counter;
+pub mod quota;
 pub mod records;
 mod schedule;
 mod secrets;

@@ -7,6 +7,7 @@
 use iceoryx2::prelude::ipc;
 use proxima_ipc::client::{BodySpec, Client, ClientBuilder, Motion};
 use proxima_ipc::wire::PoseRecord;
+use std::path::PathBuf;
 use std::process::{Child, Command, ExitStatus};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
@@ -206,4 +207,32 @@ pub fn register_trimesh(
 ) -> Result<u32, proxima_ipc::error::ControlError> {
     let vertices: Vec<[f64; 3]> = mesh.vertices().iter().map(|v| v.to_array()).collect();
     client.register_mesh(scene, &vertices, mesh.triangles())
+}
+
+/// A configuration file at a unique temporary path, removed on drop.
+pub struct ConfigFile {
+    path: PathBuf,
+}
+
+impl ConfigFile {
+    pub fn new(text: &str) -> Self {
+        static NEXT: AtomicU32 = AtomicU32::new(0);
+        let path = std::env::temp_dir().join(format!(
+            "proxima-test-config-{}-{}.toml",
+            std::process::id(),
+            NEXT.fetch_add(1, Ordering::Relaxed)
+        ));
+        std::fs::write(&path, text).expect("the temporary configuration file is written");
+        Self { path }
+    }
+
+    pub fn path(&self) -> &str {
+        self.path.to_str().expect("a UTF-8 temporary path")
+    }
+}
+
+impl Drop for ConfigFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+    }
 }
