@@ -26,8 +26,8 @@ fn the_documented_limits_are_the_daemons_defaults() {
             f64::from(config.client_quota.bodies),
         ),
         (
-            "shape memory per client process, MiB",
-            (config.client_quota.geometry_bytes >> 20) as f64,
+            "memory of shapes and bodies per client process, MiB",
+            (config.client_quota.memory_bytes >> 20) as f64,
         ),
         (
             "shapes per scene",
@@ -45,8 +45,8 @@ fn the_documented_limits_are_the_daemons_defaults() {
             config.max_queued_builds as f64,
         ),
         (
-            "shape memory, MiB (all scenes)",
-            (config.max_geometry_bytes >> 20) as f64,
+            "memory of shapes and bodies, MiB (all scenes)",
+            (config.max_memory_bytes >> 20) as f64,
         ),
         (
             "candidate pairs answered per frame",

@@ -1,11 +1,17 @@
-//! The daemon-wide memory budget of convex and mesh shapes: each registration is charged
-//! an estimate of what its shape will take, from its header alone, before its payload is
-//! copied or anything is built; a scene gives its charges back when it goes.
+//! The memory budgets (the daemon's, and each client process's [quota](super::quota)) of
+//! shapes and bodies: each convex or mesh registration is charged an estimate of what its
+//! shape will take, from its header alone, before its payload is copied or anything is
+//! built; each body is charged [`BODY_BYTES`]; a removed body and a dropped scene give their
+//! charges back.
 //!
-//! The estimates are measured upper bounds (release build, resident memory around one
-//! build, temporaries included): a mesh took 884–1,082 bytes per triangle (grids of 20,000
-//! to 980,000 triangles, its two BVHs, edges and hull included), a convex hull 668–1,024
-//! bytes per input point (4,096 to 65,536 points on a sphere, every one a hull vertex).
+//! The estimates are measured upper bounds (release build, resident memory, temporaries
+//! included):
+//! - a mesh took 884–1,082 bytes per triangle (grids of 20,000 to 980,000 triangles, its
+//!   two BVHs, edges and hull included), a convex hull 668–1,024 bytes per input point
+//!   (4,096 to 65,536 points on a sphere, every one a hull vertex);
+//! - a body took 2.1–3.3 KB once stepped (its record, broad phase, pair memory and the
+//!   frame's workspace: 10,000 to 100,000 spheres in a grid, three `CLOSE` frames). Fewer
+//!   bodies take more each (9.4 KB at 1,000) but less in all than the charge of 1,000.
 
 use super::convert::GeometryRequest;
 
@@ -15,6 +21,18 @@ pub const MESH_BYTES_PER_TRIANGLE: u64 = 1_200;
 pub const MESH_BYTES_PER_VERTEX: u64 = 64;
 /// Bytes charged per convex input point (measured at most 1,024).
 pub const CONVEX_BYTES_PER_POINT: u64 = 1_100;
+/// Bytes charged per body (measured at most 3.3 KB at 10,000 bodies and more).
+pub const BODY_BYTES: u64 = 4_096;
+
+/// `bytes` as a person reads it: KiB below a MiB, MiB above, rounded up.
+#[must_use]
+pub fn readable(bytes: u64) -> String {
+    if bytes < 1 << 20 {
+        format!("{} KiB", bytes.div_ceil(1 << 10))
+    } else {
+        format!("{} MiB", bytes.div_ceil(1 << 20))
+    }
+}
 
 /// The bytes a convex or mesh registration is charged.
 #[must_use]

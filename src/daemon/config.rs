@@ -16,7 +16,7 @@ pub struct DaemonConfig {
     pub iceoryx_prefix: Option<String>,
     /// Most scenes alive at once.
     pub max_scenes: u32,
-    /// The most one client process may hold: scenes, shapes, bodies and shape memory (so
+    /// The most one client process may hold: scenes, shapes, bodies and memory (so
     /// one client cannot take what the others need, however many ports it opens).
     pub client_quota: ClientQuota,
     /// Limits of each scene.
@@ -29,12 +29,12 @@ pub struct DaemonConfig {
     /// clients together); a registration beyond is refused with `LimitExceeded`. Each holds
     /// a copy of its geometry payload.
     pub max_queued_builds: usize,
-    /// Memory all convex and mesh shapes of all scenes may take, bytes, as estimated from
-    /// each registration's header before anything is copied or built (1,200 B per mesh
-    /// triangle plus 64 B per mesh vertex, 1,100 B per convex point: measured upper
-    /// bounds); a registration beyond is refused with `LimitExceeded`. A dropped scene
-    /// gives its share back.
-    pub max_geometry_bytes: u64,
+    /// Memory the shapes and bodies of all scenes may take, bytes, as estimated before
+    /// anything is copied, built or added (1,200 B per mesh triangle plus 64 B per mesh
+    /// vertex, 1,100 B per convex point, 4,096 B per body: measured upper bounds, see
+    /// `budget_memory`); a registration or body beyond is refused with `LimitExceeded`. A
+    /// removed body or dropped scene gives its share back.
+    pub max_memory_bytes: u64,
     /// Close-pair margin of bodies that do not set one, metres.
     pub default_margin: f64,
     /// How long the frame thread (after its last frame) and the control thread (after its
@@ -71,7 +71,7 @@ impl Default for DaemonConfig {
             },
             max_convex_points: 1 << 16,
             max_queued_builds: 4,
-            max_geometry_bytes: 8 << 30,
+            max_memory_bytes: 8 << 30,
             default_margin: 0.0,
             spin: Duration::from_micros(50),
             sweep_interval: Duration::from_millis(100),

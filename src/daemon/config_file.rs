@@ -14,7 +14,7 @@
 //! max_scenes_per_client = 16      # what one client process may hold, over all its ports:
 //! max_shapes_per_client = 16384   #   scenes, shapes, bodies
 //! max_bodies_per_client = 262144
-//! max_geometry_mib_per_client = 2048  # and convex and mesh shape memory
+//! max_memory_mib_per_client = 2048  #   and the memory of its shapes and bodies
 //! max_shapes_per_scene = 4096
 //! max_bodies_per_scene = 100000
 //! max_pairs_per_frame = 16384     # candidate pairs a frame answers; more are dropped and counted
@@ -22,7 +22,7 @@
 //! max_mesh_triangles = 4194304
 //! max_convex_points = 65536
 //! max_queued_builds = 4           # convex and mesh shapes waiting for the builder
-//! max_geometry_mib = 8192         # memory of all convex and mesh shapes, estimated up front
+//! max_memory_mib = 8192           # memory of all shapes and bodies, estimated up front
 //!
 //! [scene]
 //! default_margin_m = 0.0          # close-pair margin of bodies that set none, metres
@@ -87,8 +87,8 @@ pub struct LimitsSection {
     pub max_shapes_per_client: Option<u32>,
     /// Most live bodies one client process may hold, over its scenes.
     pub max_bodies_per_client: Option<u32>,
-    /// Convex and mesh shape memory one client process may hold, MiB.
-    pub max_geometry_mib_per_client: Option<u64>,
+    /// Memory of the shapes and bodies one client process may hold, MiB.
+    pub max_memory_mib_per_client: Option<u64>,
     /// Most shapes registered in one scene.
     pub max_shapes_per_scene: Option<u32>,
     /// Most live bodies in one scene.
@@ -103,8 +103,8 @@ pub struct LimitsSection {
     pub max_convex_points: Option<u32>,
     /// Most convex and mesh shapes waiting to be built.
     pub max_queued_builds: Option<usize>,
-    /// Memory of all convex and mesh shapes, MiB.
-    pub max_geometry_mib: Option<u64>,
+    /// Memory of all shapes and bodies, MiB.
+    pub max_memory_mib: Option<u64>,
 }
 
 /// `[scene]`: defaults of every scene.
@@ -217,13 +217,13 @@ impl ConfigFile {
             l.max_bodies_per_client,
             "limits.max_bodies_per_client",
         )?;
-        let mut client_mib = quota.geometry_bytes >> 20;
+        let mut client_mib = quota.memory_bytes >> 20;
         set_positive(
             &mut client_mib,
-            l.max_geometry_mib_per_client,
-            "limits.max_geometry_mib_per_client",
+            l.max_memory_mib_per_client,
+            "limits.max_memory_mib_per_client",
         )?;
-        quota.geometry_bytes = client_mib.saturating_mul(1 << 20);
+        quota.memory_bytes = client_mib.saturating_mul(1 << 20);
         set_positive(
             &mut out.scene_limits.max_shapes,
             l.max_shapes_per_scene,
@@ -259,13 +259,9 @@ impl ConfigFile {
             l.max_queued_builds,
             "limits.max_queued_builds",
         )?;
-        let mut geometry_mib = out.max_geometry_bytes >> 20;
-        set_positive(
-            &mut geometry_mib,
-            l.max_geometry_mib,
-            "limits.max_geometry_mib",
-        )?;
-        out.max_geometry_bytes = geometry_mib.saturating_mul(1 << 20);
+        let mut memory_mib = out.max_memory_bytes >> 20;
+        set_positive(&mut memory_mib, l.max_memory_mib, "limits.max_memory_mib")?;
+        out.max_memory_bytes = memory_mib.saturating_mul(1 << 20);
         if let Some(margin) = self.scene.default_margin_m {
             if !(margin.is_finite() && margin >= 0.0) {
                 return Err(ConfigFileError::Invalid {
@@ -336,11 +332,11 @@ mod tests {
             max_mesh_triangles = 40
             max_convex_points = 50
             max_queued_builds = 60
-            max_geometry_mib = 70
+            max_memory_mib = 70
             max_scenes_per_client = 80
             max_shapes_per_client = 81
             max_bodies_per_client = 82
-            max_geometry_mib_per_client = 83
+            max_memory_mib_per_client = 83
             [scene]
             default_margin_m = 0.25
             [service_loop]
@@ -365,15 +361,10 @@ mod tests {
         );
         assert_eq!((c.max_convex_points, c.default_margin), (50, 0.25));
         assert_eq!(c.max_queued_builds, 60);
-        assert_eq!(c.max_geometry_bytes, 70 << 20);
+        assert_eq!(c.max_memory_bytes, 70 << 20);
         let quota = c.client_quota;
         assert_eq!(
-            (
-                quota.scenes,
-                quota.shapes,
-                quota.bodies,
-                quota.geometry_bytes
-            ),
+            (quota.scenes, quota.shapes, quota.bodies, quota.memory_bytes),
             (80, 81, 82, 83 << 20)
         );
         assert_eq!(
@@ -416,7 +407,7 @@ mod tests {
                 "[limits]\nmax_queued_builds = 0",
                 "limits.max_queued_builds",
             ),
-            ("[limits]\nmax_geometry_mib = 0", "limits.max_geometry_mib"),
+            ("[limits]\nmax_memory_mib = 0", "limits.max_memory_mib"),
             ("[scene]\ndefault_margin_m = -0.1", "scene.default_margin_m"),
             ("[scene]\ndefault_margin_m = nan", "scene.default_margin_m"),
             ("[scene]\ndefault_margin_m = inf", "scene.default_margin_m"),

@@ -48,9 +48,9 @@ pub struct ControlState {
     /// owner drops it or is gone).
     scenes: HashMap<u32, SceneEntry>,
     builds: BuildQueue,
-    /// Bytes charged to convex and mesh shapes of every scene alive
-    /// ([`budget_memory`](super::budget_memory)), at most `config.max_geometry_bytes`.
-    geometry_bytes: u64,
+    /// Bytes charged to the shapes and bodies of every scene alive
+    /// ([`budget_memory`](super::budget_memory)), at most `config.max_memory_bytes`.
+    memory_bytes: u64,
     /// What each client process holds, against `config.client_quota`.
     quotas: Quotas,
 }
@@ -108,7 +108,7 @@ impl ControlState {
             instance,
             scenes: HashMap::new(),
             builds,
-            geometry_bytes: 0,
+            memory_bytes: 0,
         }
     }
 
@@ -193,7 +193,7 @@ impl ControlState {
 
     /// Whether every charge is where the [quota](super::quota) invariant puts it: each
     /// process's usage is the sum of its scenes', each live scene's bodies are its charged
-    /// bodies, and the daemon-wide shape memory is the sum over all scenes.
+    /// bodies, and the daemon-wide memory is the sum over all scenes.
     #[cfg(test)]
     pub fn accounts_balance(&self) -> bool {
         let mut sums: HashMap<ProcessId, Usage> = HashMap::new();
@@ -205,8 +205,8 @@ impl ControlState {
                 return false;
             }
         }
-        let memory: u64 = sums.values().map(|u| u.geometry_bytes).sum();
-        memory == self.geometry_bytes
+        let memory: u64 = sums.values().map(|u| u.memory_bytes).sum();
+        memory == self.memory_bytes
             && sums.len() == self.quotas.processes()
             && sums.iter().all(|(&p, &u)| self.quotas.usage(p) == u)
     }
@@ -225,7 +225,7 @@ impl ControlState {
             scenes: 0,
             ..std::mem::replace(&mut entry.usage, Usage::SCENE)
         };
-        self.geometry_bytes -= freed.geometry_bytes;
+        self.memory_bytes -= freed.memory_bytes;
         self.quotas.refund(entry.process, freed);
         true
     }
@@ -262,7 +262,7 @@ impl ControlState {
             }
             Command::AddBody => {
                 self.owned_entry(origin.port, request.scene)?;
-                self.quotas.check(origin.process, Usage::BODY)?;
+                self.check_room(origin.process, Usage::BODY)?;
                 let body = self.add_body(origin, request)?;
                 self.charge(request.scene, Usage::BODY);
                 Ok(body.into())
@@ -328,7 +328,7 @@ impl ControlState {
         let shared = self.owned_scene(origin.port, request.scene)?;
         let geometry = match shape {
             ShapeRequest::Primitive(shape) => {
-                self.quotas.check(origin.process, Usage::shape(0))?;
+                self.check_room(origin.process, Usage::shape(0))?;
                 let mut cell = try_lock(shared)?;
                 // The table hands out no more ids than the scene takes shapes, so the
                 // scene has room for this one.
@@ -346,19 +346,7 @@ impl ControlState {
         // found here is still there below.
         self.builds.check_room()?;
         let charge = budget_memory::geometry_estimate(&geometry);
-        let (in_use, budget) = (self.geometry_bytes, config.max_geometry_bytes);
-        if in_use.saturating_add(charge) > budget {
-            return Err(Refusal::Rejected(Rejection::new(
-                ErrorCode::LimitExceeded,
-                format!(
-                    "the shape needs about {} MiB; the daemon's {} MiB for shapes has {} MiB left",
-                    charge.div_ceil(1 << 20),
-                    budget >> 20,
-                    budget.saturating_sub(in_use) >> 20
-                ),
-            )));
-        }
-        self.quotas.check(origin.process, Usage::shape(charge))?;
+        self.check_room(origin.process, Usage::shape(charge))?;
         // The last point where the request may wait for the scene: nothing changed yet.
         let shape = try_lock(shared)?.shapes.reserve(max_shapes)?;
         let job = BuildJob {
@@ -389,17 +377,34 @@ impl ControlState {
         if let Ok(shared) = entry.state {
             lock(&shared).dropped = true;
         }
-        self.geometry_bytes -= entry.usage.geometry_bytes;
+        self.memory_bytes -= entry.usage.memory_bytes;
         self.quotas.refund(entry.process, entry.usage);
         Ok(())
     }
 
-    /// Charges `more` to scene `id` and its process (the daemon-wide shape memory too).
+    /// Whether the daemon's memory budget and `process`'s quota have room for `more`.
+    fn check_room(&self, process: ProcessId, more: Usage) -> Result<(), Rejection> {
+        let (in_use, budget) = (self.memory_bytes, self.config.max_memory_bytes);
+        if in_use.saturating_add(more.memory_bytes) > budget {
+            return Err(Rejection::new(
+                ErrorCode::LimitExceeded,
+                format!(
+                    "it needs about {}; the daemon's {} for shapes and bodies has {} left",
+                    budget_memory::readable(more.memory_bytes),
+                    budget_memory::readable(budget),
+                    budget_memory::readable(budget.saturating_sub(in_use))
+                ),
+            ));
+        }
+        self.quotas.check(process, more)
+    }
+
+    /// Charges `more` to scene `id` and its process (the daemon-wide memory too).
     fn charge(&mut self, id: u32, more: Usage) {
         if let Some(entry) = self.scenes.get_mut(&id) {
             entry.usage.add(more);
             self.quotas.charge(entry.process, more);
-            self.geometry_bytes += more.geometry_bytes;
+            self.memory_bytes += more.memory_bytes;
         }
     }
 
@@ -408,7 +413,7 @@ impl ControlState {
         if let Some(entry) = self.scenes.get_mut(&id) {
             entry.usage.remove(back);
             self.quotas.refund(entry.process, back);
-            self.geometry_bytes -= back.geometry_bytes;
+            self.memory_bytes -= back.memory_bytes;
         }
     }
 
@@ -422,7 +427,7 @@ impl ControlState {
                 ),
             ));
         }
-        self.quotas.check(origin.process, Usage::SCENE)?;
+        self.check_room(origin.process, Usage::SCENE)?;
         let scene = Scene::try_new(self.config.default_margin, self.config.scene_limits)
             .map_err(scene_rejection)?;
         let secret = |what| {

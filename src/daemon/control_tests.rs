@@ -714,7 +714,7 @@ fn shapes_are_charged_against_the_memory_budget_before_anything_is_copied_and_sc
     // Room for one 4-triangle tetrahedron mesh, not two.
     let one_mesh = 4 * MESH_BYTES_PER_TRIANGLE + 4 * 64;
     let config = DaemonConfig {
-        max_geometry_bytes: one_mesh + one_mesh / 2,
+        max_memory_bytes: one_mesh + one_mesh / 2,
         ..DaemonConfig::default()
     };
     let (mut state, jobs) = state_with(config, 4);
@@ -727,7 +727,13 @@ fn shapes_are_charged_against_the_memory_budget_before_anything_is_copied_and_sc
     );
     let refused = state.handle(OWNER, &mesh_request(second, 4, 12), &payload);
     assert_eq!(code(&refused), ErrorCode::LimitExceeded);
-    assert!(refused.reason().contains("MiB"), "{}", refused.reason());
+    assert!(
+        refused
+            .reason()
+            .contains("the daemon's 8 KiB for shapes and bodies has 3 KiB left"),
+        "{}",
+        refused.reason()
+    );
     assert_eq!(build_all(&jobs), 1, "the refused one was never queued");
     // Primitives cost nothing against it.
     assert_eq!(
@@ -903,6 +909,51 @@ fn one_client_process_holds_at_most_its_quota_of_shapes_and_bodies() {
     assert!(state.accounts_balance());
 }
 
+/// Bodies are charged to the daemon's memory budget too: whoever adds the body past it is
+/// refused, and a removed body makes room again.
+#[test]
+fn bodies_are_charged_against_the_daemons_memory_budget() {
+    use super::super::budget_memory::BODY_BYTES;
+    let config = DaemonConfig {
+        max_memory_bytes: 3 * BODY_BYTES,
+        ..DaemonConfig::default()
+    };
+    let (mut state, _jobs) = state_with(config, 4);
+    let create = request(Command::CreateScene);
+    let [mine, theirs] = [OWNER, other(1)].map(|client| {
+        let scene = state.handle(client, &create, &[]).id;
+        let sphere = state.handle(client, &sphere_request(scene), &[]).id;
+        ControlRequest {
+            scene,
+            target: sphere,
+            ..request(Command::AddBody)
+        }
+    });
+    let first = state.handle(OWNER, &mine, &[]).id;
+    for _ in 0..2 {
+        assert_eq!(code(&state.handle(other(1), &theirs, &[])), ErrorCode::Ok);
+    }
+    for (client, add) in [(OWNER, &mine), (other(1), &theirs)] {
+        let refused = state.handle(client, add, &[]);
+        assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+        assert!(
+            refused.reason().contains(
+                "it needs about 4 KiB; the daemon's 12 KiB for shapes and bodies has 0 KiB left"
+            ),
+            "{}",
+            refused.reason()
+        );
+    }
+    let remove = ControlRequest {
+        scene: mine.scene,
+        target: first,
+        ..request(Command::RemoveBody)
+    };
+    assert_eq!(code(&state.handle(OWNER, &remove, &[])), ErrorCode::Ok);
+    assert_eq!(code(&state.handle(other(1), &theirs, &[])), ErrorCode::Ok);
+    assert!(state.accounts_balance());
+}
+
 /// Shape memory is counted per process besides the daemon-wide budget; a quarantined scene
 /// gives its shapes back but still counts as a scene.
 #[test]
@@ -912,7 +963,7 @@ fn one_client_process_holds_at_most_its_quota_of_shape_memory() {
     let config = DaemonConfig {
         client_quota: ClientQuota {
             scenes: 2,
-            geometry_bytes: one_mesh + one_mesh / 2,
+            memory_bytes: one_mesh + one_mesh / 2,
             ..ClientQuota::STANDARD
         },
         ..DaemonConfig::default()
@@ -989,7 +1040,7 @@ fn a_request_whose_scene_is_busy_waits_for_nothing_and_changes_nothing() {
         for (busy, payload) in &busy_requests {
             assert_eq!(state.handle_unless_busy(OWNER, busy, payload), None);
         }
-        assert_eq!(state.geometry_bytes, 0, "no memory charged");
+        assert_eq!(state.memory_bytes, 0, "no memory charged");
         assert_eq!(jobs.len(), 0, "no build queued");
         let created = state.handle_unless_busy(other(1), &request(Command::CreateScene), &[]);
         assert_eq!(created.map(|r| code(&r)), Some(ErrorCode::Ok));

@@ -1,18 +1,19 @@
-//! What each client process holds, and the most it may: scenes, shapes, bodies and shape
-//! memory, charged before the work is done and given back when it goes.
+//! What each client process holds, and the most it may: scenes, shapes, bodies and memory,
+//! charged before the work is done and given back when it goes.
 //!
 //! Pure bookkeeping, no IPC. A quota belongs to a client *process*, not to a control port:
 //! a process that opens many ports (up to the control service's client limit) still holds
-//! one quota, so it cannot take every scene or all the shape memory from the others. The
+//! one quota, so it cannot take every scene or all the memory from the others. The
 //! process is the one iceoryx2 records as having created the port's node (its pid); the
 //! daemon-wide limits ([`DaemonConfig::max_scenes`](super::DaemonConfig),
-//! [`max_geometry_bytes`](super::DaemonConfig)) hold besides.
+//! [`max_memory_bytes`](super::DaemonConfig)) hold besides.
 //!
 //! # Invariant
 //! A process's [`Usage`] is the sum of the usages charged to its scenes ([`Quotas::charge`])
 //! and not yet refunded ([`Quotas::refund`]); the control state refunds a scene's whole
 //! usage when the scene goes, so a process that holds nothing has no entry.
 
+use super::budget_memory::{BODY_BYTES, readable};
 use super::convert::Rejection;
 use proxima_ipc::wire::ErrorCode;
 use std::collections::HashMap;
@@ -30,19 +31,19 @@ pub struct ClientQuota {
     pub shapes: u32,
     /// Bodies alive, over all its scenes.
     pub bodies: u32,
-    /// Convex and mesh shape memory, bytes, as estimated before building
-    /// ([`budget_memory`](super::budget_memory)).
-    pub geometry_bytes: u64,
+    /// Memory of its shapes and bodies, bytes, as estimated before anything is built or
+    /// added ([`budget_memory`](super::budget_memory)).
+    pub memory_bytes: u64,
 }
 
 impl ClientQuota {
-    /// The defaults: a quarter of the daemon's 64 scenes and 8 GiB of shape memory, four
-    /// scenes' worth of shapes (4,096 each) and 262,144 bodies.
+    /// The defaults: a quarter of the daemon's 64 scenes and 8 GiB of memory, four scenes'
+    /// worth of shapes (4,096 each) and 262,144 bodies (1 GiB of body charges).
     pub const STANDARD: Self = Self {
         scenes: 16,
         shapes: 16_384,
         bodies: 1 << 18,
-        geometry_bytes: 2 << 30,
+        memory_bytes: 2 << 30,
     };
 }
 
@@ -55,8 +56,8 @@ pub struct Usage {
     pub shapes: u32,
     /// Bodies alive.
     pub bodies: u32,
-    /// Convex and mesh shape memory, bytes.
-    pub geometry_bytes: u64,
+    /// Memory of shapes and bodies, bytes.
+    pub memory_bytes: u64,
 }
 
 impl Usage {
@@ -65,20 +66,21 @@ impl Usage {
         scenes: 1,
         shapes: 0,
         bodies: 0,
-        geometry_bytes: 0,
+        memory_bytes: 0,
     };
-    /// One shape, of `geometry_bytes` estimated bytes (0 for a primitive).
+    /// One shape, of `memory_bytes` estimated bytes (0 for a primitive).
     #[must_use]
-    pub const fn shape(geometry_bytes: u64) -> Self {
+    pub const fn shape(memory_bytes: u64) -> Self {
         Self {
             shapes: 1,
-            geometry_bytes,
+            memory_bytes,
             ..Self::NOTHING
         }
     }
-    /// One body.
+    /// One body, of [`BODY_BYTES`].
     pub const BODY: Self = Self {
         bodies: 1,
+        memory_bytes: BODY_BYTES,
         ..Self::NOTHING
     };
     /// Nothing.
@@ -86,7 +88,7 @@ impl Usage {
         scenes: 0,
         shapes: 0,
         bodies: 0,
-        geometry_bytes: 0,
+        memory_bytes: 0,
     };
 
     /// Adds `other`.
@@ -94,7 +96,7 @@ impl Usage {
         self.scenes += other.scenes;
         self.shapes += other.shapes;
         self.bodies += other.bodies;
-        self.geometry_bytes += other.geometry_bytes;
+        self.memory_bytes += other.memory_bytes;
     }
 
     /// Takes `other` off; `other` must have been added before (the invariant above).
@@ -102,7 +104,7 @@ impl Usage {
         self.scenes -= other.scenes;
         self.shapes -= other.shapes;
         self.bodies -= other.bodies;
-        self.geometry_bytes -= other.geometry_bytes;
+        self.memory_bytes -= other.memory_bytes;
     }
 
     fn is_nothing(&self) -> bool {
@@ -150,16 +152,12 @@ impl Quotas {
                 "this client process holds its limit of {} bodies",
                 limit.bodies
             )
-        } else if over(
-            held.geometry_bytes,
-            more.geometry_bytes,
-            limit.geometry_bytes,
-        ) {
+        } else if over(held.memory_bytes, more.memory_bytes, limit.memory_bytes) {
             format!(
-                "the shape needs about {} MiB; this client process's {} MiB for shapes has {} MiB left",
-                more.geometry_bytes.div_ceil(1 << 20),
-                limit.geometry_bytes >> 20,
-                (limit.geometry_bytes - held.geometry_bytes) >> 20
+                "it needs about {}; this client process's {} for shapes and bodies has {} left",
+                readable(more.memory_bytes),
+                readable(limit.memory_bytes),
+                readable(limit.memory_bytes - held.memory_bytes)
             )
         } else {
             return Ok(());
@@ -203,7 +201,7 @@ mod tests {
         scenes: 2,
         shapes: 3,
         bodies: 4,
-        geometry_bytes: 1000,
+        memory_bytes: 4 * BODY_BYTES,
     };
 
     #[test]
@@ -231,14 +229,20 @@ mod tests {
     fn shape_memory_is_refused_past_the_limit_and_given_back_with_its_scene() {
         let mut quotas = Quotas::new(LIMIT);
         let scene = Usage {
-            geometry_bytes: 900,
+            memory_bytes: 4 * BODY_BYTES - 100,
             shapes: 1,
             ..Usage::SCENE
         };
         quotas.check(7, scene).unwrap();
         quotas.charge(7, scene);
         let refused = quotas.check(7, Usage::shape(101)).unwrap_err();
-        assert!(refused.reason.contains("MiB"), "{}", refused.reason);
+        assert!(
+            refused
+                .reason
+                .contains("needs about 1 KiB; this client process's 16 KiB"),
+            "{}",
+            refused.reason
+        );
         quotas.check(7, Usage::shape(100)).unwrap();
         quotas.refund(7, scene);
         assert_eq!(quotas.usage(7), Usage::NOTHING);
@@ -247,6 +251,6 @@ mod tests {
             0,
             "a process holding nothing has no entry"
         );
-        quotas.check(7, Usage::shape(1000)).unwrap();
+        quotas.check(7, Usage::shape(4 * BODY_BYTES)).unwrap();
     }
 }
