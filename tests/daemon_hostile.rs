@@ -989,6 +989,9 @@ fn a_process_with_many_ports_holds_one_quota_and_leaves_the_rest_to_others() {
     );
     drop(hoarder.stdin.take());
     let rest: Vec<String> = output.map_while(Result::ok).collect();
-    assert!(hoarder.wait().unwrap().success(), "the hoarder ends well: {rest:?}");
+    assert!(
+        hoarder.wait().unwrap().success(),
+        "the hoarder ends well: {rest:?}"
+    );
     victims[1].assert_untouched();
 }
