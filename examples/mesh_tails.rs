@@ -62,17 +62,21 @@ struct Args {
     profile_pose: Option<Vec<usize>>,
 }
 
-/// Each pose's fastest time over `laps` laps, µs.
-fn fastest_per_pose(poses: usize, laps: usize, mut query: impl FnMut(usize) -> f64) -> Vec<f64> {
-    let mut best = vec![f64::INFINITY; poses];
+/// Each pose's fastest time over `laps` laps, µs, and its answer (a distance or a count).
+fn fastest_per_pose(
+    poses: usize,
+    laps: usize,
+    mut query: impl FnMut(usize) -> f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let (mut best, mut answers) = (vec![f64::INFINITY; poses], vec![0.0; poses]);
     for _ in 0..laps {
         for (i, slot) in best.iter_mut().enumerate() {
             let start = Instant::now();
-            black_box(query(i));
+            answers[i] = black_box(query(i));
             *slot = slot.min(start.elapsed().as_secs_f64() * 1e6);
         }
     }
-    best
+    (best, answers)
 }
 
 /// `mean p50 p95 p99 max` of `times`.
@@ -84,7 +88,15 @@ fn summary(times: &[f64]) -> [f64; 5] {
     [mean, at(0.5), at(0.95), at(0.99), sorted[sorted.len() - 1]]
 }
 
-fn report(scene: &str, proxima: &[f64], parry: &[f64], slowest: usize) {
+/// Prints the time table of `proxima` and `parry` (µs per pose) and Proxima's slowest
+/// poses with their `answers` (`what`).
+fn report(
+    scene: &str,
+    (proxima, answers): (&[f64], &[f64]),
+    parry: &[f64],
+    what: &str,
+    slowest: usize,
+) {
     let (p, q) = (summary(proxima), summary(parry));
     println!("\n{scene}: {} poses, µs", proxima.len());
     println!(
@@ -106,8 +118,8 @@ fn report(scene: &str, proxima: &[f64], parry: &[f64], slowest: usize) {
     order.sort_by(|&i, &j| proxima[j].total_cmp(&proxima[i]));
     for &i in order.iter().take(slowest) {
         println!(
-            "  slow pose {i:>5}: proxima {:>9.1} µs, parry {:>9.1} µs",
-            proxima[i], parry[i]
+            "  slow pose {i:>5}: proxima {:>9.1} µs, parry {:>9.1} µs, {what} {}",
+            proxima[i], parry[i], answers[i]
         );
     }
 }
@@ -226,7 +238,13 @@ fn tray_spot_distance(args: &Args) {
             .expect("parry supports trimesh distance")
             .distance
     });
-    report("tray-spot distance", &proxima, &parry, args.slowest);
+    report(
+        "tray-spot distance",
+        (&proxima.0, &proxima.1),
+        &parry.0,
+        "distance (m)",
+        args.slowest,
+    );
 }
 
 fn env_rob_contacts(args: &Args) {
@@ -295,7 +313,13 @@ fn env_rob_contacts(args: &Args) {
     let parry = fastest_per_pose(poses.len(), args.laps, |i| {
         count_parry(&parry_poses[i]) as f64
     });
-    report("env-rob contacts", &proxima, &parry, args.slowest);
+    report(
+        "env-rob contacts",
+        (&proxima.0, &proxima.1),
+        &parry.0,
+        "contacts",
+        args.slowest,
+    );
 }
 
 fn main() {
