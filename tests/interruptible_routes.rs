@@ -217,3 +217,58 @@ fn stopped_mesh_contacts_are_the_first_of_the_full_set_and_grow_with_work() {
     println!("{intersecting} intersecting, {apart} apart, {stopped} stopped runs");
     assert!(intersecting > 30 && apart > 30 && stopped > 200);
 }
+
+/// A mesh–mesh distance search stopped after a growing amount of work (counted clocks, each
+/// about a quarter more than the last) holds the exact run's distance between its lower
+/// bound (`distance − error_bound`) and its closest pair found (`distance`), never loosens
+/// with more work, and once it finishes is the exact run, bit for bit.
+#[test]
+fn a_stopped_mesh_distance_holds_the_exact_distance_and_tightens_with_work() {
+    use proxima::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
+    let a = MeshShape::new(meshes::torus(0.5, 0.15, 32, 12));
+    let b = MeshShape::new(meshes::uv_sphere(0.3, 16, 10));
+    let mut r = rng(2904);
+    let workspace = &mut MeshMeshWorkspace::default();
+    let mut seen = Seen::default();
+    for case in 0..150 {
+        let pose = Pose::new(point_in_cube(&mut r, 0.9), rotation(&mut r));
+        let exact = a.distance_to(&b, &pose, &mut DistanceCache::default(), workspace);
+        if exact.distance <= 0.0 {
+            seen.touching += 1;
+        } else {
+            seen.apart += 1;
+        }
+        let tol = RELATIVE * (1.0 + exact.distance);
+        let (mut lower_before, mut upper_before) = (f64::NEG_INFINITY, f64::INFINITY);
+        let mut work = 0;
+        loop {
+            let mut clock = WorkClock::new(Stop::AfterWork(work));
+            let cache = &mut DistanceCache::default();
+            let d = a.distance_to_within(&b, &pose, cache, workspace, &mut clock);
+            if !clock.stopped() {
+                assert_eq!(d, exact, "case {case}: finished after {work} units otherwise");
+                seen.finished += 1;
+                break;
+            }
+            seen.stopped += 1;
+            let (lower, upper) = (d.distance - d.error_bound, d.distance);
+            assert!(
+                lower <= exact.distance + tol && exact.distance <= upper + tol,
+                "case {case}, stopped after {work} units: [{lower}, {upper}] does not hold \
+                 the exact {}",
+                exact.distance
+            );
+            assert!(
+                lower >= lower_before - tol && upper <= upper_before + tol,
+                "case {case}, stopped after {work} units: [{lower}, {upper}] looser than \
+                 [{lower_before}, {upper_before}] with less work"
+            );
+            (lower_before, upper_before) = (lower, upper);
+            assert!(work < 100_000_000, "case {case}: the search never finished");
+            work = (work + work / 4).max(work + 8);
+        }
+    }
+    println!("{seen:?}");
+    assert!(seen.touching > 20 && seen.apart > 20, "{seen:?}");
+    assert!(seen.stopped > 500 && seen.finished == 150, "{seen:?}");
+}

@@ -11,12 +11,14 @@
 //!   (overlap, or "within distance d"), in depth-first order;
 //! - [`nearest_leaf_pairs`]: best-first branch and bound for a minimum, expanding the pair
 //!   with the smallest lower bound first and stopping when no waiting pair can beat the best
-//!   value found so far.
+//!   value found so far, or when its clock stops it (then with a lower bound of the
+//!   minimum: the bound of the pair it would have expanded next).
 //!
 //! Both keep their stack or queue in caller-owned storage and allocate only while it grows
 //! (the stack to the deepest descent, at most the sum of the two trees' depths plus one).
 
 use super::{Bvh, BvhNode};
+use crate::budget::WorkClock;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 use std::ops::ControlFlow;
@@ -115,15 +117,20 @@ impl PartialOrd for RankedPair {
 /// Pairs are expanded in increasing order of their bound, so the search stops as soon as
 /// the smallest waiting bound is pruned, and expands no pair whose bound is above the final
 /// answer (a depth-first search can, before its best value has come down).
+///
+/// `clock` is polled before each pair is expanded ([`WORK_PER_EXPANSION`] units). When it
+/// stops the search, the minimum is at least [`Nearest::lower_bound`]: the largest bound
+/// the search popped (every pair waiting had a bound at least that one's when it was
+/// popped), capped at the best value; it never falls with more work.
 pub fn nearest_leaf_pairs<B, L, P, V>(
     a: &Bvh<B>,
     b: &Bvh<B>,
     queue: &mut BinaryHeap<RankedPair>,
     mut best: f64,
-    bound: L,
-    prune: P,
+    (bound, prune): (L, P),
+    clock: &mut WorkClock,
     mut visit: V,
-) -> f64
+) -> Nearest
 where
     L: Fn(&B, &B, f64) -> f64,
     P: Fn(f64, f64) -> bool,
@@ -136,9 +143,18 @@ where
         a: 0,
         b: 0,
     });
+    // The largest lower bound seen: every pair waiting (and every leaf pair beneath) has a
+    // bound at least the one popped (a heap), so each popped bound, or the best value when
+    // smaller, is a lower bound of the minimum. Children need not bound higher than their
+    // parent (volumes are fitted, not nested), hence the running maximum.
+    let mut lower_bound = f64::NEG_INFINITY;
     while let Some(pair) = queue.pop() {
         if prune(pair.bound, best) {
             break;
+        }
+        lower_bound = lower_bound.max(pair.bound.min(best));
+        if !clock.allows(WORK_PER_EXPANSION) {
+            return Nearest { best, lower_bound };
         }
         let (x, y) = (&na[pair.a as usize], &nb[pair.b as usize]);
         if x.is_leaf() && y.is_leaf() {
@@ -167,5 +183,22 @@ where
             }
         }
     }
-    best
+    Nearest {
+        best,
+        lower_bound: best,
+    }
+}
+
+/// Clock units one expansion of [`nearest_leaf_pairs`] counts: two volume bounds or a leaf
+/// visit, each a few closed-form pairs' worth (about 0.2–0.5 µs).
+pub const WORK_PER_EXPANSION: u64 = 8;
+
+/// What [`nearest_leaf_pairs`] found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Nearest {
+    /// The smallest leaf-pair value found.
+    pub best: f64,
+    /// A lower bound of the smallest value over all leaf pairs: `best` when the search
+    /// finished (to its `prune` rule), less when its clock stopped it.
+    pub lower_bound: f64,
 }

@@ -4,6 +4,7 @@
 //! need, built once when it is registered.
 
 use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
+use crate::budget::WorkClock;
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::mesh::MeshEdges;
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
@@ -13,8 +14,8 @@ use crate::narrow::convex_manifold::ContactFeatures;
 use crate::narrow::gjk::POINT;
 use crate::narrow::mesh_hull::MeshHull;
 use crate::narrow::mesh_mesh::{
-    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity, distance_mesh_mesh,
-    proximity_mesh_mesh, rounding_bound,
+    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity,
+    distance_mesh_mesh_within, proximity_mesh_mesh, rounding_bound,
 };
 use std::sync::Arc;
 
@@ -76,19 +77,39 @@ impl MeshShape {
         cache: &mut DistanceCache,
         workspace: &mut MeshMeshWorkspace,
     ) -> MeshDistance {
+        let mut unlimited = WorkClock::default();
+        self.distance_to_within(other, pose_ab, cache, workspace, &mut unlimited)
+    }
+
+    /// [`distance_to`](Self::distance_to), stopped when `clock` stops
+    /// ([`distance_mesh_mesh_within`]): then `clock.stopped()`, and the distance is the
+    /// closest pair found, with an error bound down to the search's lower bound.
+    #[must_use]
+    pub fn distance_to_within(
+        &self,
+        other: &Self,
+        pose_ab: &Pose,
+        cache: &mut DistanceCache,
+        workspace: &mut MeshMeshWorkspace,
+        clock: &mut WorkClock,
+    ) -> MeshDistance {
         let exact = &DistanceParams::EXACT;
         match QueryVolume::for_pair(self.query_volume, other.query_volume) {
             QueryVolume::Obb => {
                 let (a, b) = (&self.overlap_tree, &other.overlap_tree);
-                let d = distance_mesh_mesh(a, b, pose_ab, exact, cache, workspace);
+                let d = distance_mesh_mesh_within(a, b, pose_ab, exact, cache, workspace, clock);
+                // The RSS trees' rounding, whichever trees were searched, plus what the
+                // search left unsearched (the OBB trees' own rounding is replaced).
+                let unsearched = d.error_bound - rounding_bound(a, b, &pose_ab.to_isometry());
                 MeshDistance {
-                    error_bound: self.rounding_with(other, &pose_ab.to_isometry()),
+                    error_bound: self.rounding_with(other, &pose_ab.to_isometry())
+                        + unsearched.max(0.0),
                     ..d
                 }
             }
             QueryVolume::Rss => {
                 let (a, b) = (&self.distance_tree, &other.distance_tree);
-                distance_mesh_mesh(a, b, pose_ab, exact, cache, workspace)
+                distance_mesh_mesh_within(a, b, pose_ab, exact, cache, workspace, clock)
             }
         }
     }

@@ -18,7 +18,8 @@ use crate::narrow::contact::{DistanceBound, Manifold, Reached, ShapeDistance};
 use crate::narrow::dispatch::{self, NarrowScratch};
 use crate::narrow::mesh_mesh::frontier::FrontierAnswer;
 use crate::narrow::mesh_mesh::{
-    DistanceCache, MeshMeshWorkspace, Proximity, contacts_mesh_mesh_within, intersects_mesh_mesh,
+    DistanceCache, MeshDistance, MeshMeshWorkspace, Proximity, contacts_mesh_mesh_within,
+    intersects_mesh_mesh,
 };
 use crate::narrow::{MANIFOLD_POINTS, reduce_manifold};
 use crate::narrow::{MeshShape, Shape};
@@ -205,15 +206,19 @@ pub(super) fn mesh_mesh(
     {
         return apart(pair, Some(lower_bound));
     }
-    let known = (query.close || query.distance).then(|| {
-        let d = ma.distance_to(mb, &pose_ab, cache, &mut scratch.traversal);
-        KnownDistance {
+    let mut known = None;
+    if query.close || query.distance {
+        let d = ma.distance_to_within(mb, &pose_ab, cache, &mut scratch.traversal, clock);
+        if clock.stopped() {
+            return mesh_distance_stopped(pair, (a, b), query, &d, contacts);
+        }
+        known = Some(KnownDistance {
             distance: d.distance,
             error_bound: d.error_bound,
             point_a: d.point_a,
             point_b: d.point_b,
-        }
-    });
+        });
+    }
     mesh_mesh_tail(
         pair,
         (a, ma),
@@ -224,6 +229,43 @@ pub(super) fn mesh_mesh(
         (scratch, clock),
         contacts,
     )
+}
+
+/// A mesh pair whose distance search the clock stopped (the frame's slice ended, or its
+/// client is gone): the conservative answer DESIGN §4 asks for, as
+/// [`mesh_mesh_truncated`] gives the frontier's. Distance: the search's lower bound
+/// (`d.distance − d.error_bound`, never above the truth) with error bound `d.error_bound`
+/// (the truth is at most the closest pair found, `d.distance`), `exact` false; witnesses
+/// and normal: that closest pair's. The pair may touch when the lower bound is `≤ 0`; its
+/// contact (when asked) is then one point, the record's witnesses and normal, distance 0
+/// (meshes have no depth) with the record's error bound.
+fn mesh_distance_stopped(
+    pair: &CandidatePair,
+    (a, b): (&Body, &Body),
+    query: Query,
+    d: &MeshDistance,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    let mut result = world_boxes(pair, a, b);
+    let (point_a, point_b) = (
+        a.pose.transform_point(d.point_a),
+        a.pose.transform_point(d.point_b),
+    );
+    if let Some(normal) = (point_b - point_a).try_normalize() {
+        (result.point_a, result.point_b, result.normal) = (point_a, point_b, normal);
+    }
+    result.distance = d.distance - d.error_bound;
+    result.error_bound = d.error_bound;
+    result.exact = false;
+    let touching = result.distance <= 0.0;
+    if query.contacts && touching {
+        contacts.push(witness_contact(&result, 0.0));
+    }
+    Answer {
+        result,
+        touching,
+        apart_by: None,
+    }
 }
 
 /// The exact distance of a mesh pair, witnesses in A's frame.

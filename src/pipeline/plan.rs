@@ -250,8 +250,9 @@ impl FramePlan {
             Route::Direct => PairPlan::Direct,
             Route::MeshMesh(ma, mb) if self.limited => PairPlan::Frontier(ma, mb),
             Route::MeshMesh(..) if self.pool => PairPlan::Pooled,
-            // An exact mesh search (not polled inside) starts only while the frame is not
-            // abandoned and its slice, if any, lasts.
+            // An exact mesh search starts only while the frame is not abandoned and its
+            // slice, if any, lasts (its distance search and contacts poll the clock inside,
+            // its proximity and overlap tests do not).
             Route::MeshMesh(..) if !clock.allows(WORK_PER_CLOCK_READ) => PairPlan::Conservative,
             Route::MeshMesh(ma, mb) => PairPlan::MeshMesh(ma, mb),
         }

@@ -1,5 +1,6 @@
 use super::*;
 use crate::bounding::Aabb;
+use crate::budget::{Stop, WorkClock};
 use crate::geometry::{Cuboid, Sphere};
 use crate::math::Pose;
 use crate::narrow::MeshShape;
@@ -882,4 +883,70 @@ fn a_frame_too_short_for_the_broad_phase_and_publishing_is_not_started() {
     let unbudgeted = step(&scene, query, workspace, results);
     assert_eq!(unbudgeted.budget_too_small, None);
     assert_eq!(results.contacts, exact_results.contacts);
+}
+
+/// A mesh pair's exact route stopped mid-search by its clock (a slice that ended, an owner
+/// gone) answers conservatively: a lower bound of the exact distance within its error
+/// bound, marked inexact, touching whenever the exact answer touches; with enough work it
+/// is the exact answer. Counted clocks, growing by a quarter each run.
+#[test]
+fn a_mesh_pair_whose_distance_search_stops_answers_conservatively() {
+    let torus = Arc::new(MeshShape::new(meshes::torus(0.6, 0.15, 20, 8)));
+    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let a = add(&mut scene, Shape::Mesh(Arc::clone(&torus)), DVec3::ZERO, 0.1);
+    let b = add(&mut scene, Shape::Mesh(Arc::clone(&torus)), DVec3::X, 0.1);
+    let pair = CandidatePair::of(a.0, b.0);
+    let mut rng = rng(77);
+    let (mut stopped, mut touching, mut apart) = (0, 0, 0);
+    let answer = |scene: &Scene, query, stop| {
+        let (ba, bb) = (body(scene, pair.a), body(scene, pair.b));
+        let mut clock = WorkClock::new(stop);
+        let mut contacts = Vec::new();
+        let found = answer::mesh_mesh(
+            &pair,
+            (ba, &torus),
+            (bb, &torus),
+            query,
+            &mut DistanceCache::default(),
+            (&mut answer::MeshScratch::default(), &mut clock),
+            &mut contacts,
+        );
+        (found, contacts)
+    };
+    for case in 0..60 {
+        let pose = Pose::new(point_in_cube(&mut rng, 0.9), rotation(&mut rng));
+        scene.set_pose(b, pose).unwrap();
+        for query in [Query::CLOSE.union(Query::CONTACTS), Query::DISTANCE] {
+            let (exact, _) = answer(&scene, query, Stop::Never);
+            assert!(exact.result.exact);
+            if exact.touching {
+                touching += 1;
+            } else {
+                apart += 1;
+            }
+            let mut work = 0;
+            loop {
+                let (found, contacts) = answer(&scene, query, Stop::AfterWork(work));
+                if found.result.exact {
+                    assert_eq!(found.result, exact.result, "case {case}: {work} units");
+                    break;
+                }
+                stopped += 1;
+                let (seen, truth) = (found.result, exact.result);
+                assert!(
+                    seen.distance <= truth.distance + 1e-12
+                        && truth.distance - seen.distance <= seen.error_bound + 1e-12,
+                    "case {case}, {work} units: {seen:?} against {truth:?}"
+                );
+                assert!(!exact.touching || found.touching, "case {case}: missed contact");
+                assert_eq!(contacts.is_empty(), !(found.touching && query.contacts));
+                work = (work + work / 4).max(work + 8);
+                assert!(work < 100_000_000, "case {case}: never finished");
+            }
+        }
+    }
+    assert!(
+        stopped > 300 && touching > 10 && apart > 10,
+        "stopped {stopped}, touching {touching}, apart {apart}"
+    );
 }

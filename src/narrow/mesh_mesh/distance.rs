@@ -4,6 +4,7 @@ use super::{
     DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, for_each_triangle_pair,
 };
 use crate::bounding::BoundingVolume;
+use crate::budget::WorkClock;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::{for_each_leaf_pair, nearest_leaf_pairs};
 use crate::math::{Isometry, Pose, conservative_slack};
@@ -34,6 +35,27 @@ pub fn distance_mesh_mesh<B: BoundingVolume>(
     cache: &mut DistanceCache,
     workspace: &mut MeshMeshWorkspace,
 ) -> MeshDistance {
+    let mut unlimited = WorkClock::default();
+    distance_mesh_mesh_within(a, b, pose_ab, params, cache, workspace, &mut unlimited)
+}
+
+/// [`distance_mesh_mesh`], polling `clock` before each step of the search
+/// ([`WORK_PER_EXPANSION`](crate::bvh::tandem::WORK_PER_EXPANSION) units). When the clock stops it, the answer is the closest
+/// triangle pair found so far, an upper bound of the distance, with an error bound that
+/// reaches down to the search's lower bound (`distance − error_bound ≤ true distance ≤
+/// distance`), and `clock.stopped()` says so. More work never loosens it.
+///
+/// # Allocation
+/// None once `workspace` has grown to the deepest descent.
+pub fn distance_mesh_mesh_within<B: BoundingVolume>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    params: &DistanceParams,
+    cache: &mut DistanceCache,
+    workspace: &mut MeshMeshWorkspace,
+    clock: &mut WorkClock,
+) -> MeshDistance {
     let iso = pose_ab.to_isometry();
     let (ta, tb) = (a.triangles(), b.triangles());
     let pair_distance =
@@ -48,13 +70,16 @@ pub fn distance_mesh_mesh<B: BoundingVolume>(
         _ => [0, 0],
     };
     let mut closest = (pair_distance(start_a, start_b), [start_a, start_b]);
-    let best = nearest_leaf_pairs(
+    let nearest = nearest_leaf_pairs(
         a,
         b,
         &mut workspace.ranked,
         closest.0.distance,
-        |x, y, limit| x.distance_lower_bound_within(y, &iso, limit),
-        |bound, best| params.can_skip(bound, best),
+        (
+            |x: &B, y: &B, limit| x.distance_lower_bound_within(y, &iso, limit),
+            |bound, best| params.can_skip(bound, best),
+        ),
+        clock,
         |la, lb| {
             for sb in b.nodes()[lb].slots() {
                 for sa in a.nodes()[la].slots() {
@@ -82,14 +107,18 @@ pub fn distance_mesh_mesh<B: BoundingVolume>(
         },
         [sa, sb],
     ) = closest;
-    debug_assert_eq!(best, distance);
+    debug_assert_eq!(nearest.best, distance);
     cache.slots = Some([sa as u32, sb as u32]);
+    // Stopped, the untried pairs may be closer, down to the search's lower bound.
+    let unsearched = (distance - nearest.lower_bound).max(0.0);
     MeshDistance {
         distance,
         point_a,
         point_b,
         triangles: [a.triangle_id(sa), b.triangle_id(sb)],
-        error_bound: params.abs_err.max(params.rel_err * distance) + rounding_bound(a, b, &iso),
+        error_bound: params.abs_err.max(params.rel_err * distance)
+            + unsearched
+            + rounding_bound(a, b, &iso),
     }
 }
 

@@ -36,8 +36,8 @@ pub use collide::{
     TRIANGLE_PAIR_WORK, contacts_mesh_mesh, contacts_mesh_mesh_within, intersects_mesh_mesh,
 };
 pub use distance::{
-    Proximity, distance_mesh_mesh, precedes_in_ties, proximity_mesh_mesh, rounding_bound,
-    within_distance_mesh_mesh,
+    Proximity, distance_mesh_mesh, distance_mesh_mesh_within, precedes_in_ties,
+    proximity_mesh_mesh, rounding_bound, within_distance_mesh_mesh,
 };
 
 use crate::bvh::Bvh;
