@@ -33,6 +33,13 @@
 //! printed: the pairs each reports within the prediction and touching, and the largest
 //! distance difference where both report one.
 //!
+//! Then the cost per pair kind (`pile: cost per pair kind`): for each pair of shape kinds
+//! (canonical order), its candidate and touching pairs, and the median over
+//! [`KIND_ROUNDS`] rounds (a plain `Instant` loop, outside criterion) of Proxima's
+//! `distance` on every pair, Proxima's `manifold` on the touching ones (their distance
+//! not counted) and parry's `contact` on every pair, in µs in total and per pair, with
+//! parry's time over Proxima's (distance plus manifold).
+//!
 //! `cargo bench --bench pile`; names are `pile/<engine>/<what>`.
 
 #[path = "common/cycle.rs"]
@@ -268,6 +275,147 @@ fn parry_pair(pair: &Pair<'_>) -> Option<f64> {
         .map(|c| c.dist)
 }
 
+/// Name of a shape's kind, as the per-kind table writes it.
+fn kind_name(shape: &Shape) -> &'static str {
+    match shape {
+        Shape::Sphere(_) => "sphere",
+        Shape::Capsule(_) => "capsule",
+        Shape::Cuboid(_) => "box",
+        Shape::Cylinder(_) => "cylinder",
+        Shape::Cone(_) => "cone",
+        Shape::Convex(_) => "hull",
+        Shape::Mesh(_) => "mesh",
+    }
+}
+
+/// Canonical rank of a kind name (the dispatcher's order), to name a pair's kinds once.
+fn kind_rank(name: &str) -> usize {
+    [
+        "sphere", "capsule", "box", "cylinder", "cone", "hull", "mesh",
+    ]
+    .iter()
+    .position(|k| *k == name)
+    .unwrap_or(usize::MAX)
+}
+
+/// Rounds of the per-kind timing loop; each kind's figure is the median round.
+const KIND_ROUNDS: usize = 201;
+
+/// The median of `rounds` timings of `work` over all its pairs, microseconds.
+fn median_us(rounds: usize, mut work: impl FnMut()) -> f64 {
+    let mut times: Vec<f64> = (0..rounds)
+        .map(|_| {
+            let start = std::time::Instant::now();
+            work();
+            start.elapsed().as_secs_f64() * 1e6
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+/// Prints the cost per pair kind on frame `k`'s candidate pairs: for each pair of kinds,
+/// the pairs and touching pairs, then the median over [`KIND_ROUNDS`] rounds of Proxima's
+/// `distance` (every pair), Proxima's `manifold` (touching pairs, after their distance,
+/// which is not counted) and parry's `contact` (every pair), in total µs and µs per pair.
+fn print_kind_costs(pairs: &[Pair<'_>]) {
+    let mut kinds: Vec<(&str, &str)> = pairs
+        .iter()
+        .map(|p| kind_pair(p))
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    kinds.sort_by_key(|&(a, b)| (kind_rank(a), kind_rank(b)));
+    let (mut scratch, mut manifold) = (NarrowScratch::default(), Manifold::default());
+    println!("pile: cost per pair kind (median of {KIND_ROUNDS} rounds; µs total / µs per pair)");
+    println!(
+        "pile: {:<18} {:>5} {:>5} | {:>16} | {:>16} | {:>16} | {:>6}",
+        "kinds", "pairs", "touch", "distance", "manifold", "parry contact", "parry/ours"
+    );
+    let (mut sum_d, mut sum_m, mut sum_p, mut sum_t) = (0.0, 0.0, 0.0, 0);
+    for (ka, kb) in kinds {
+        let of_kind: Vec<&Pair<'_>> = pairs.iter().filter(|p| kind_pair(p) == (ka, kb)).collect();
+        let answers: Vec<(Pose, proxima::narrow::ShapeDistance)> = of_kind
+            .iter()
+            .map(|p| {
+                let pose_ab = Pose::relative(&p.poses.0, &p.poses.1);
+                let d =
+                    dispatch::distance(p.shapes.0, p.shapes.1, &pose_ab, p.margins, &mut scratch);
+                (pose_ab, d)
+            })
+            .collect();
+        let touching = answers.iter().filter(|(_, d)| d.distance <= 0.0).count();
+        let distance_us = median_us(KIND_ROUNDS, || {
+            for (p, (pose_ab, _)) in of_kind.iter().zip(&answers) {
+                black_box(dispatch::distance(
+                    p.shapes.0,
+                    p.shapes.1,
+                    black_box(pose_ab),
+                    p.margins,
+                    &mut scratch,
+                ));
+            }
+        });
+        let manifold_us = median_us(KIND_ROUNDS, || {
+            for (p, (pose_ab, d)) in of_kind.iter().zip(&answers) {
+                if d.distance <= 0.0 {
+                    dispatch::manifold(
+                        p.shapes.0,
+                        p.shapes.1,
+                        black_box(pose_ab),
+                        d,
+                        &mut scratch,
+                        &mut manifold,
+                    );
+                    black_box(manifold.len());
+                }
+            }
+        });
+        let parry_us = median_us(KIND_ROUNDS, || {
+            for p in &of_kind {
+                black_box(parry_pair(black_box(p)));
+            }
+        });
+        let n = of_kind.len() as f64;
+        let per = |total: f64, count: f64| if count > 0.0 { total / count } else { 0.0 };
+        println!(
+            "pile: {:<18} {:>5} {:>5} | {:>7.1} / {:>6.3} | {:>7.1} / {:>6.3} | {:>7.1} / {:>6.3} | {:>6.2}",
+            format!("{ka}-{kb}"),
+            of_kind.len(),
+            touching,
+            distance_us,
+            per(distance_us, n),
+            manifold_us,
+            per(manifold_us, touching as f64),
+            parry_us,
+            per(parry_us, n),
+            parry_us / (distance_us + manifold_us),
+        );
+        (sum_d, sum_m, sum_p) = (sum_d + distance_us, sum_m + manifold_us, sum_p + parry_us);
+        sum_t += touching;
+    }
+    println!(
+        "pile: {:<18} {:>5} {:>5} | {sum_d:>7.1} µs{:>8} | {sum_m:>7.1} µs{:>8} | {sum_p:>7.1} µs{:>8} | {:>6.2}",
+        "all",
+        pairs.len(),
+        sum_t,
+        "",
+        "",
+        "",
+        sum_p / (sum_d + sum_m),
+    );
+}
+
+/// The pair's kind names in canonical order.
+fn kind_pair(pair: &Pair<'_>) -> (&'static str, &'static str) {
+    let (a, b) = (kind_name(pair.shapes.0), kind_name(pair.shapes.1));
+    if kind_rank(a) <= kind_rank(b) {
+        (a, b)
+    } else {
+        (b, a)
+    }
+}
+
 /// Prints frame `k`'s statistics and both engines' agreement on its candidate pairs.
 fn print_frame(scene: &Scene, pairs: &[Pair<'_>]) {
     let mut results = FrameResults::default();
@@ -326,6 +474,7 @@ fn bench_pile(c: &mut Criterion) {
     let parry: Vec<ParryShape> = spec.shapes.iter().map(parry_shape).collect();
     let pairs = candidate_pairs(&frozen, &parry);
     print_frame(&frozen, &pairs);
+    print_kind_costs(&pairs);
     let shifted: PoseSet = frame_k
         .iter()
         .map(|&(id, pose)| {

@@ -988,3 +988,99 @@ fn large_hull_depths_separate_and_are_no_deeper_than_any_sampled_direction() {
         );
     }
 }
+
+/// The box face certificate (`pairs::face_distance_cuboid_convex`, the dispatcher's route
+/// for a box against a cylinder, cone or hull) against GJK/EPA in f64 on the same pair
+/// (depths, and distances over a face), and the metamorphic check: B moved by `depth + ε`
+/// along the certified normal is apart, by `depth − ε` it still overlaps. Its lower bounds
+/// beyond the limit hold GJK's distance. Poses put B across a random face of the box, so
+/// every outcome occurs often.
+#[test]
+fn the_box_face_certificate_matches_epa_and_moves_apart_by_its_depth() {
+    use proxima::narrow::pairs::{FaceCertificate, face_distance_cuboid_convex};
+    let mut r = rng(31);
+    let limit = 0.02;
+    let (mut exact, mut exact_apart, mut beyond, mut unknown) = ([0_usize; 3], 0, 0, 0);
+    for case in 0..6000 {
+        let a = random_box(&mut r, 0.05, 0.6);
+        let half = a.half_extents;
+        let kind = case % 3;
+        let cylinder = Cylinder::new(r.random_range(0.02..0.3), r.random_range(0.02..0.3));
+        let cone = Cone::new(r.random_range(0.02..0.3), r.random_range(0.02..0.3));
+        // A hull of the pile's size (2–30 cm).
+        let cloud: Vec<DVec3> = (0..20 + case % 40)
+            .map(|_| point_in_cube(&mut r, 0.15) * DVec3::new(1.0, 0.7, 0.4))
+            .collect();
+        let hull = ConvexPolyhedron::try_from_points(&cloud).expect("finite cloud");
+        let b: &dyn SupportMap = match kind {
+            0 => &cylinder,
+            1 => &cone,
+            _ => &hull,
+        };
+        let q = rotation(&mut r);
+        let size = b.support(q.inverse() * DVec3::Z).length();
+        let k = r.random_range(0..3_usize);
+        let sign = if r.random() { 1.0 } else { -1.0 };
+        let mut t = DVec3::ZERO;
+        for j in 0..3 {
+            t[j] = half[j] * r.random_range(-1.2..1.2);
+        }
+        t[k] = sign * (half[k] + size * r.random_range(-0.3..1.3));
+        let pose = Isometry {
+            rotation: proxima::math::DMat3::from_quat(q),
+            translation: t,
+        };
+        let (g, _) = plain(&a, b, &pose);
+        match face_distance_cuboid_convex(&a, b, &pose, limit) {
+            FaceCertificate::Exact(d) => {
+                check_contract(&d, 1e-12);
+                let tol = 1e-9 * d.distance.abs() + 1e-12;
+                assert!(
+                    (d.distance - g.distance).abs() <= tol,
+                    "case {case}: certified {} vs GJK/EPA {}",
+                    d.distance,
+                    g.distance
+                );
+                if d.distance >= 0.0 {
+                    exact_apart += 1;
+                    continue;
+                }
+                exact[kind] += 1;
+                let depth = -d.distance;
+                let eps = 1e-9 * (1.0 + depth);
+                for (shift, apart) in [(depth + eps, true), (depth - eps, false)] {
+                    let moved = Isometry {
+                        translation: pose.translation + d.normal * shift,
+                        ..pose
+                    };
+                    let (m, _) = plain(&a, b, &moved);
+                    assert_eq!(
+                        m.distance > 0.0,
+                        apart,
+                        "case {case}: moved by {shift} of depth {depth}: {}",
+                        m.distance
+                    );
+                }
+            }
+            FaceCertificate::Beyond(d) => {
+                beyond += 1;
+                assert!(d.distance > limit, "case {case}: {d:?}");
+                assert!(
+                    d.distance <= g.distance + 1e-12,
+                    "case {case}: bound {} above GJK's {}",
+                    d.distance,
+                    g.distance
+                );
+            }
+            FaceCertificate::Unknown => unknown += 1,
+        }
+    }
+    println!(
+        "certified overlapping {exact:?} (cylinder, cone, hull), apart {exact_apart}, \
+         beyond {beyond}, unknown {unknown}"
+    );
+    assert!(
+        exact.iter().all(|&n| n > 200) && exact_apart > 500 && beyond > 300 && unknown > 500,
+        "{exact:?} {exact_apart} {beyond} {unknown}"
+    );
+}

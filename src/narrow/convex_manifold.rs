@@ -82,7 +82,8 @@ const CANDIDATES: usize = 2 * FEATURE_POINTS + 1;
 /// `≤ 0` deep to the slack, the deepest at `d.distance`; empty when `d.distance > 0`.
 ///
 /// # Allocation
-/// None (fixed-capacity buffers on the stack).
+/// None (fixed-capacity buffers on the stack; [`manifold_convex_convex_in`] reuses a
+/// [`ManifoldScratch`] instead).
 pub fn manifold_convex_convex<A: ContactFeatures + ?Sized, B: ContactFeatures + ?Sized>(
     a: &A,
     b: &B,
@@ -90,15 +91,76 @@ pub fn manifold_convex_convex<A: ContactFeatures + ?Sized, B: ContactFeatures + 
     d: &ShapeDistance,
     out: &mut Manifold,
 ) {
+    manifold_convex_convex_in(a, b, pose_ab, d, &mut ManifoldScratch::new(), out);
+}
+
+/// The buffers of [`manifold_convex_convex_in`]: five polygons and the candidate points,
+/// about 22 KB, kept by the caller so that no query fills them anew.
+#[derive(Clone)]
+pub struct ManifoldScratch {
+    face_a: Polygon,
+    face_b: Polygon,
+    incident: Polygon,
+    clip: [Polygon; 2],
+    cands: Candidates,
+}
+
+impl ManifoldScratch {
+    /// Empty buffers.
+    #[must_use]
+    pub fn new() -> Self {
+        Self {
+            face_a: Polygon::new(),
+            face_b: Polygon::new(),
+            incident: Polygon::new(),
+            clip: [Polygon::new(), Polygon::new()],
+            cands: Candidates::new(),
+        }
+    }
+}
+
+impl Default for ManifoldScratch {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl std::fmt::Debug for ManifoldScratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ManifoldScratch").finish_non_exhaustive()
+    }
+}
+
+/// [`manifold_convex_convex`] with its buffers in `scratch`: the same manifold.
+///
+/// # Allocation
+/// None.
+// PERF: the buffers are 22 KB; filling them with zeros on every call was a fifth of a
+// box–cylinder manifold (`benches/pile.rs`).
+pub fn manifold_convex_convex_in<A: ContactFeatures + ?Sized, B: ContactFeatures + ?Sized>(
+    a: &A,
+    b: &B,
+    pose_ab: &Isometry,
+    d: &ShapeDistance,
+    scratch: &mut ManifoldScratch,
+    out: &mut Manifold,
+) {
     let n = d.normal;
     out.reset(n);
     if d.distance > 0.0 {
         return;
     }
-    let (mut face_a, mut face_b) = (Polygon::new(), Polygon::new());
-    let fa = a.face_towards(n, &mut face_a);
+    let ManifoldScratch {
+        face_a,
+        face_b,
+        incident,
+        clip,
+        cands,
+    } = scratch;
+    cands.clear();
+    let fa = a.face_towards(n, face_a);
     let fb = b
-        .face_towards(pose_ab.inverse_transform_vector(-n), &mut face_b)
+        .face_towards(pose_ab.inverse_transform_vector(-n), face_b)
         .map(|f| pose_ab.transform_vector(f));
     for p in face_b.points_mut() {
         *p = pose_ab.transform_point(*p);
@@ -109,25 +171,23 @@ pub fn manifold_convex_convex<A: ContactFeatures + ?Sized, B: ContactFeatures + 
         .chain(face_b.points())
         .fold(d.distance.abs(), |s, p| s.max(p.abs().max_element()));
     let slack = CONTACT_SLACK_RELATIVE * scale;
-    let cos_a = fa.filter(|_| has_area(&face_a, scale)).map(|f| f.dot(n));
-    let cos_b = fb.filter(|_| has_area(&face_b, scale)).map(|f| -f.dot(n));
+    let cos_a = fa.filter(|_| has_area(face_a, scale)).map(|f| f.dot(n));
+    let cos_b = fb.filter(|_| has_area(face_b, scale)).map(|f| -f.dot(n));
     let use_a = match (cos_a, cos_b) {
         (Some(ca), Some(cb)) if ca >= FACE_ALIGNMENT || cb >= FACE_ALIGNMENT => Some(ca >= cb),
         (Some(ca), None) if ca >= FACE_ALIGNMENT => Some(true),
         (None, Some(cb)) if cb >= FACE_ALIGNMENT => Some(false),
         _ => None,
     };
-    let mut cands = Candidates::new();
-    let mut incident = Polygon::new();
     match use_a {
         Some(true) => {
             let f = fa.unwrap_or(n);
-            b.feature_towards(pose_ab.inverse_transform_vector(-f), &mut incident);
+            b.feature_towards(pose_ab.inverse_transform_vector(-f), incident);
             for p in incident.points_mut() {
                 *p = pose_ab.transform_point(*p);
             }
             let reference = Reference {
-                outline: &face_a,
+                outline: face_a,
                 normal: f,
                 towards: n,
             };
@@ -136,25 +196,29 @@ pub fn manifold_convex_convex<A: ContactFeatures + ?Sized, B: ContactFeatures + 
                 let v = pose_ab.inverse_transform_vector(-n);
                 pose_ab.transform_point(b.surface_along(local, v))
             };
-            reference.clip(&incident, &to_surface, true, slack, &mut cands);
+            reference.clip(incident, &to_surface, true, slack, clip, cands);
         }
         Some(false) => {
             let f = fb.unwrap_or(-n);
-            a.feature_towards(-f, &mut incident);
+            a.feature_towards(-f, incident);
             let reference = Reference {
-                outline: &face_b,
+                outline: face_b,
                 normal: f,
                 towards: -n,
             };
             reference.clip(
-                &incident,
+                incident,
                 &|c| a.surface_along(c, n),
                 false,
                 slack,
-                &mut cands,
+                clip,
+                cands,
             );
         }
-        None => parallel_lines(a, b, pose_ab, d, slack, &mut cands),
+        None => {
+            let [la, lb] = clip;
+            parallel_lines(a, b, pose_ab, d, slack, [la, lb, face_a, face_b], cands);
+        }
     }
     let deepest = cands
         .points()
@@ -181,12 +245,12 @@ fn parallel_lines<A: ContactFeatures + ?Sized, B: ContactFeatures + ?Sized>(
     pose_ab: &Isometry,
     d: &ShapeDistance,
     slack: f64,
+    [la, lb, next, seg]: [&mut Polygon; 4],
     out: &mut Candidates,
 ) {
     let n = d.normal;
-    let (mut la, mut lb) = (Polygon::new(), Polygon::new());
-    a.feature_towards(n, &mut la);
-    b.feature_towards(pose_ab.inverse_transform_vector(-n), &mut lb);
+    a.feature_towards(n, la);
+    b.feature_towards(pose_ab.inverse_transform_vector(-n), lb);
     for p in lb.points_mut() {
         *p = pose_ab.transform_point(*p);
     }
@@ -218,9 +282,8 @@ fn parallel_lines<A: ContactFeatures + ?Sized, B: ContactFeatures + ?Sized>(
     if lo > hi {
         return;
     }
-    let (mut seg, mut next) = (lb, Polygon::new());
-    seg.clip_plane_into(u, hi, &mut next);
-    next.clip_plane_into(-u, -lo, &mut seg);
+    lb.clip_plane_into(u, hi, next);
+    next.clip_plane_into(-u, -lo, seg);
     // Either B's surface point at q and A's extreme towards B in its column, or (when A
     // answers no column) A's surface point at q's place along A's line and B's extreme
     // towards A in its column.
@@ -285,6 +348,7 @@ impl Reference<'_> {
         to_surface: &dyn Fn(DVec3) -> DVec3,
         reference_is_a: bool,
         slack: f64,
+        buffers: &mut [Polygon; 2],
         out: &mut Candidates,
     ) {
         let (f, m) = (self.normal, self.towards);
@@ -294,7 +358,10 @@ impl Reference<'_> {
             .iter()
             .map(|p| f.dot(*p))
             .fold(f64::NEG_INFINITY, f64::max);
-        let (mut inc, mut next) = (*incident, Polygon::new());
+        // PERF: the two buffers are swapped by reference (`benches/pile.rs`): a polygon is
+        // 3 KB, and swapping the values once per side plane was most of a cylinder cap's
+        // clip.
+        let mut clipped = None;
         for i in 0..ref_pts.len() {
             let (p, q) = (ref_pts[i], ref_pts[(i + 1) % ref_pts.len()]);
             let mut side = (q - p).cross(m);
@@ -302,10 +369,23 @@ impl Reference<'_> {
                 side = -side;
             }
             if side.length_squared() > 0.0 {
-                inc.clip_plane_into(side, side.dot(p), &mut next);
-                std::mem::swap(&mut inc, &mut next);
+                let [first, second] = &mut *buffers;
+                let (from, to) = match clipped {
+                    None => (incident, first),
+                    Some(0) => (&*first, second),
+                    Some(_) => (&*second, first),
+                };
+                from.clip_plane_into(side, side.dot(p), to);
+                clipped = Some(match clipped {
+                    Some(0) => 1,
+                    _ => 0,
+                });
             }
         }
+        let inc = match clipped {
+            None => incident,
+            Some(k) => &buffers[k],
+        };
         let along = f.dot(m);
         for core in inc.points() {
             let on_incident = to_surface(*core);
@@ -329,6 +409,7 @@ impl Reference<'_> {
 }
 
 /// Candidate contact points before reduction (fixed capacity).
+#[derive(Clone)]
 struct Candidates {
     pts: [ManifoldPoint; CANDIDATES],
     len: usize,
@@ -344,6 +425,10 @@ impl Candidates {
             }; CANDIDATES],
             len: 0,
         }
+    }
+
+    fn clear(&mut self) {
+        self.len = 0;
     }
 
     fn push(&mut self, p: ManifoldPoint) {

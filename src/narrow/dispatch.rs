@@ -5,7 +5,8 @@
 //! | pair | distance | manifold |
 //! |---|---|---|
 //! | sphere, capsule, cuboid among themselves | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
-//! | a cylinder, cone or convex hull with any convex shape | GJK on the cores, EPA when they overlap ([`crate::narrow::gjk`]) | reference-face clipping of the shapes' contact features from the distance's normal, ≤ 4 points ([`crate::narrow::convex_manifold`]) |
+//! | a box with a cylinder, cone or convex hull | the box's face certificate when B overlaps under one face, lies over one, or lies beyond a face's plane by more than the limit ([`pairs::face_distance_cuboid_convex`]), else as the next row | as the next row |
+//! | a cylinder, cone or convex hull with any convex shape | GJK on the cores (stopped once a support plane proves the pair beyond the limit), EPA when they overlap ([`crate::narrow::gjk`]) | one point, the distance's witnesses, against a sphere; else reference-face clipping of the shapes' contact features from the distance's normal, ≤ 4 points ([`crate::narrow::convex_manifold`]) |
 //! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`crate::narrow::convex_mesh`]) |
 //! | mesh–mesh | [`Route::MeshMesh`]: the BVH tandem queries with warm starts and the worker pool | intersection segments, reduced |
 //!
@@ -21,15 +22,15 @@
 use crate::budget::WorkClock;
 use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{DistanceBound, Manifold, Reached, ShapeDistance};
-use crate::narrow::convex_manifold::manifold_convex_convex;
+use crate::narrow::convex_manifold::{ManifoldScratch, manifold_convex_convex_in};
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
 use crate::narrow::convex_mesh::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 use crate::narrow::gjk::{
-    EpaWorkspace, GjkCache, GjkParams, Rounded, signed_distance_convex_within,
+    EpaWorkspace, GjkCache, GjkOutcome, GjkParams, Rounded, signed_distance_convex_within,
 };
 use crate::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
-use crate::narrow::pairs;
-use crate::narrow::shape::{core_of, features_of};
+use crate::narrow::pairs::{self, FaceCertificate};
+use crate::narrow::shape::{core_map_of, features_of};
 use crate::narrow::{MeshShape, Shape};
 use std::sync::Arc;
 
@@ -47,13 +48,16 @@ pub const GJK: GjkParams = GjkParams {
 /// entered. Time-of-impact searches count each of their distance steps.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct PathCounts {
-    /// Closed forms: sphere, capsule and cuboid among themselves.
+    /// Closed forms: sphere, capsule and cuboid among themselves, and a box's face
+    /// certificate against a cylinder, cone or hull.
     pub closed_form: u32,
     /// GJK runs: convex pairs without a closed form.
     pub gjk: u32,
-    /// Distance bounds ([`DistanceBound`]): the early-out that proves cuboid–cuboid pairs
-    /// beyond the reporting limit by their separating axes, and the conservative answer of
-    /// capsule and cuboid pairs once the frame's deadline is near.
+    /// Distance bounds ([`DistanceBound`]): the early-outs that prove pairs beyond the
+    /// reporting limit (cuboid–cuboid pairs by their separating axes, a box and a cylinder,
+    /// cone or hull by a face plane of the box, GJK pairs by a support plane, these counted
+    /// in `gjk` too), and the conservative answer of capsule
+    /// and cuboid pairs once the frame's deadline is near.
     pub separating_axes: u32,
     /// EPA runs: GJK found the cores overlapping.
     pub epa: u32,
@@ -84,6 +88,8 @@ pub struct NarrowScratch {
     mesh_mesh: MeshMeshWorkspace,
     /// Convex–mesh contacts: the distance walk's touching triangles and the manifold's.
     pub(crate) mesh_contacts: MeshContactScratch,
+    /// The buffers of the convex pairs' clipped manifolds (boxed: 22 KB).
+    manifold: Box<ManifoldScratch>,
 }
 
 /// Every convex kind, as a pattern (every kind but the mesh).
@@ -268,9 +274,22 @@ fn convex_reach(
         (C(_), S(_)) | (B(_), S(_) | C(_)) => {
             convex_reach(b, a, &pose_ab.inverse(), limit, scratch).flipped(pose_ab)
         }
-        (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        (B(x), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_)) => {
+            let Some((core_b, _)) = core_map_of(b) else {
+                unreachable!("the arm holds convex shapes only");
+            };
+            match pairs::face_distance_cuboid_convex(x, &core_b, pose_ab, limit) {
+                FaceCertificate::Exact(d) => closed(paths, d),
+                FaceCertificate::Beyond(d) => {
+                    paths.separating_axes += 1;
+                    Reached::Exact(d)
+                }
+                FaceCertificate::Unknown => convex_distance(a, b, pose_ab, limit, scratch),
+            }
+        }
+        (S(_) | C(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
-            convex_distance(a, b, pose_ab, scratch)
+            convex_distance(a, b, pose_ab, limit, scratch)
         }
         (M(_), _) | (_, M(_)) => distance_within(a, b, &pose_ab.to_pose(), limit, scratch),
     }
@@ -320,36 +339,47 @@ pub fn manifold_convex(
         (C(x), C(y)) => pairs::manifold_capsule_capsule(x, y, pose_ab, out),
         (C(x), B(y)) => pairs::manifold_capsule_cuboid(x, y, pose_ab, out),
         (B(x), B(y)) => pairs::manifold_cuboid_cuboid(x, y, pose_ab, out),
-        (C(_), S(_)) | (B(_), S(_) | C(_)) => {
+        (B(_), C(_)) => {
             let pose_ba = pose_ab.inverse();
             manifold_convex(b, a, &pose_ba, &d.flipped(&pose_ba), scratch, out);
             out.flip(pose_ab);
         }
-        // One point: sphere pairs (their closed-form manifolds are the distance's
-        // witnesses).
-        (S(_), S(_) | C(_) | B(_)) => out.set_from_distance(d),
+        // One point: every pair with a sphere (a sphere touches a convex shape at one
+        // point, the distance's witnesses; clipping would find the same point again).
+        (S(_), convex!())
+        | (C(_) | B(_) | Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), S(_)) => {
+            out.set_from_distance(d);
+        }
         // GJK pairs: reference-face clipping from the distance's normal.
-        (S(_) | C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
-        | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
-            manifold_convex_convex(features_of(a), features_of(b), pose_ab, d, out);
+        (C(_) | B(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        | (
+            Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_),
+            C(_) | B(_) | Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_),
+        ) => {
+            let (fa, fb) = (features_of(a), features_of(b));
+            manifold_convex_convex_in(fa, fb, pose_ab, d, &mut scratch.manifold, out);
         }
         (M(_), _) | (_, M(_)) => manifold(a, b, &pose_ab.to_pose(), d, scratch, out),
     }
 }
 
-/// GJK/EPA between two convex shapes (the caller's arm guarantees neither is a mesh).
+/// GJK/EPA between two convex shapes (the caller's arm guarantees neither is a mesh):
+/// exact up to `limit` metres; beyond, GJK stops at the first support plane that proves it
+/// and answers that plane's lower bound.
 fn convex_distance(
     a: &Shape,
     b: &Shape,
     pose_ab: &Isometry,
+    limit: f64,
     scratch: &mut NarrowScratch,
 ) -> Reached {
-    let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_of(a), core_of(b)) else {
+    let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_map_of(a), core_map_of(b))
+    else {
         unreachable!("the dispatcher sends only convex pairs here");
     };
     let (ra, rb) = (
-        Rounded::new(core_a.support_map(), radius_a),
-        Rounded::new(core_b.support_map(), radius_b),
+        Rounded::new(&core_a, radius_a),
+        Rounded::new(&core_b, radius_b),
     );
     let (reached, outcome) = signed_distance_convex_within(
         &ra,
@@ -359,8 +389,10 @@ fn convex_distance(
         &mut GjkCache::default(),
         &mut scratch.epa,
         &mut scratch.clock,
+        limit,
     );
     scratch.paths.gjk += 1;
+    scratch.paths.separating_axes += u32::from(outcome.gjk == GjkOutcome::Beyond);
     scratch.paths.epa += u32::from(outcome.epa.is_some());
     reached
 }

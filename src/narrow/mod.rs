@@ -45,7 +45,9 @@ pub mod triangle_triangle;
 pub use contact::{
     DistanceBound, MANIFOLD_POINTS, Manifold, ManifoldPoint, Reached, ShapeDistance,
 };
-pub use convex_manifold::{ContactFeatures, manifold_convex_convex};
+pub use convex_manifold::{
+    ContactFeatures, ManifoldScratch, manifold_convex_convex, manifold_convex_convex_in,
+};
 pub use gjk::{
     GjkCache, GjkOutcome, GjkParams, GjkResult, Rounded, gjk_distance, signed_distance_convex,
 };

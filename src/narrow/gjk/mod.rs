@@ -95,6 +95,10 @@ pub enum GjkOutcome {
     /// The iteration cap was hit; `distance` is an upper bound (it is a real distance
     /// between points of the two sets).
     DidNotConverge,
+    /// A support plane proved the sets farther apart than the caller's stop distance
+    /// ([`gjk_distance_until`]): [`GjkResult::lower_bound`] exceeds it, and `distance` is an
+    /// upper bound (a real distance between points of the two sets).
+    Beyond,
 }
 
 /// The answer of [`gjk_distance`].
@@ -114,6 +118,9 @@ pub struct GjkResult {
     pub simplex: Simplex,
     /// `point_a − point_b`, the point of `A − B` closest to the origin (A's frame).
     pub v: DVec3,
+    /// A lower bound of the distance, metres, rounding included: the last support plane's
+    /// offset for [`GjkOutcome::Beyond`], else 0.
+    pub lower_bound: f64,
 }
 
 impl GjkResult {
@@ -181,6 +188,22 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     params: &GjkParams,
     cache: &mut GjkCache,
 ) -> GjkResult {
+    gjk_distance_until(a, b, pose_ab, params, cache, f64::INFINITY)
+}
+
+/// [`gjk_distance`] that stops as soon as a support plane proves the sets more than
+/// `stop_above` metres apart: the outcome is then [`GjkOutcome::Beyond`], with a lower
+/// bound above `stop_above` (rounding included) and the distance of the points found so
+/// far as an upper bound. Otherwise exactly [`gjk_distance`]'s answer.
+#[must_use]
+pub fn gjk_distance_until<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    a: &A,
+    b: &B,
+    pose_ab: &Isometry,
+    params: &GjkParams,
+    cache: &mut GjkCache,
+    stop_above: f64,
+) -> GjkResult {
     let guess = if cache.direction.is_finite() && cache.direction != DVec3::ZERO {
         cache.direction
     } else if pose_ab.translation != DVec3::ZERO {
@@ -192,6 +215,7 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     let result = descend(
         params,
         guess,
+        stop_above,
         #[inline(always)]
         |d| support(a, b, pose_ab, d, &mut hints),
     );
@@ -203,11 +227,13 @@ pub fn gjk_distance<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
 }
 
 /// GJK's descent from `guess` (the start direction is `−guess`), with `support(d)` the
-/// support point of `A − B` along `d` in A's frame.
+/// support point of `A − B` along `d` in A's frame; stops with [`GjkOutcome::Beyond`] once a
+/// support plane is more than `stop_above` metres from the origin.
 #[inline(always)]
 fn descend(
     params: &GjkParams,
     guess: DVec3,
+    stop_above: f64,
     mut support: impl FnMut(DVec3) -> SupportPoint,
 ) -> GjkResult {
     let first = support(-guess);
@@ -218,6 +244,7 @@ fn descend(
     let mut dir = v;
     let mut last_w = first.w;
     let mut outcome = GjkOutcome::DidNotConverge;
+    let mut lower_bound = 0.0;
     let mut iterations = 0;
     while iterations < params.max_iterations {
         let dist2 = v.length_squared();
@@ -249,6 +276,19 @@ fn descend(
         }
         scale = scale.max(magnitude(&p));
         let dist = dist2.sqrt();
+        // `p.w` minimises `x · dir` over `A − B`, so every point lies beyond the plane ⟂
+        // `dir` through it: the distance is at least `p.w · dir / |dir|`, less the rounding
+        // floor.
+        let along = p.w.dot(dir);
+        if along > 0.0 {
+            let dir_length = if accelerated { dir.length() } else { dist };
+            let plane = along / dir_length - floor;
+            if plane > stop_above {
+                outcome = GjkOutcome::Beyond;
+                lower_bound = plane;
+                break;
+            }
+        }
         let gap = dist2 - v.dot(p.w);
         let converged = gap <= params.rel_tol * dist2 + floor * dist;
         if converged || simplex.contains(p.w) {
@@ -289,6 +329,7 @@ fn descend(
         iterations,
         simplex,
         v,
+        lower_bound,
     }
 }
 
@@ -412,8 +453,16 @@ pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     workspace: &mut EpaWorkspace,
 ) -> (ShapeDistance, ConvexOutcome) {
     let clock = &mut WorkClock::default();
-    let (reached, outcome) =
-        signed_distance_convex_within(a, b, pose_ab, params, cache, workspace, clock);
+    let (reached, outcome) = signed_distance_convex_within(
+        a,
+        b,
+        pose_ab,
+        params,
+        cache,
+        workspace,
+        clock,
+        f64::INFINITY,
+    );
     let distance = match reached {
         Reached::Exact(d) => d,
         // An unlimited clock never stops EPA.
@@ -425,6 +474,12 @@ pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
 /// [`signed_distance_convex`] with EPA polling `clock` ([`epa::penetration`]): exact, or,
 /// when the clock stopped EPA, bounds between its fallback's depth (the lower bound of the
 /// signed distance, with its normal and witnesses) and its polytope's (the upper bound).
+///
+/// Shapes proven more than `limit` metres apart (signed distance) get
+/// [`Reached::Exact`] with a lower bound above `limit` as their distance instead of the
+/// exact value ([`gjk_distance_until`]), GJK's normal and its witnesses of the points found
+/// so far; `f64::INFINITY` asks the exact distance whatever it is.
+#[allow(clippy::too_many_arguments)]
 pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     a: &Rounded<'_, A>,
     b: &Rounded<'_, B>,
@@ -433,12 +488,28 @@ pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Si
     cache: &mut GjkCache,
     workspace: &mut EpaWorkspace,
     clock: &mut WorkClock,
+    limit: f64,
 ) -> (Reached, ConvexOutcome) {
-    let g = gjk_distance(a.core, b.core, pose_ab, params, cache);
+    let radii = a.radius + b.radius;
+    let g = gjk_distance_until(a.core, b.core, pose_ab, params, cache, limit + radii);
     let g_normal = g.normal();
+    if g.outcome == GjkOutcome::Beyond {
+        let normal = g_normal.try_normalize().unwrap_or(DVec3::X);
+        let answer = ShapeDistance {
+            distance: g.lower_bound - radii,
+            point_a: g.point_a + normal * a.radius,
+            point_b: g.point_b - normal * b.radius,
+            normal,
+        };
+        let outcome = ConvexOutcome {
+            gjk: g.outcome,
+            epa: None,
+        };
+        return (Reached::Exact(answer), outcome);
+    }
     let mut depth_lower = None;
     let (core, normal, epa) = match g.outcome {
-        GjkOutcome::Separated | GjkOutcome::DidNotConverge => (
+        GjkOutcome::Separated | GjkOutcome::DidNotConverge | GjkOutcome::Beyond => (
             (g.distance, g.point_a, g.point_b),
             g_normal,
             None::<EpaOutcome>,
@@ -477,7 +548,6 @@ pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Si
         DVec3::X
     };
     let (d, pa, pb) = core;
-    let radii = a.radius + b.radius;
     let answer = ShapeDistance {
         distance: d - radii,
         point_a: pa + normal * a.radius,
