@@ -199,7 +199,24 @@ impl ConfigFile {
         if let Some(workers) = l.workers {
             out.workers = workers;
         }
-        let l = &self.limits;
+        self.limits.apply_to(&mut out)?;
+        if let Some(margin) = self.scene.default_margin_m {
+            if !(margin.is_finite() && margin >= 0.0) {
+                return Err(ConfigFileError::Invalid {
+                    key: "scene.default_margin_m",
+                    reason: format!("{margin} is not a finite distance ≥ 0"),
+                });
+            }
+            out.default_margin = margin;
+        }
+        Ok(out)
+    }
+}
+
+impl LimitsSection {
+    /// Sets the limits this section gives in `out`.
+    fn apply_to(&self, out: &mut DaemonConfig) -> Result<(), ConfigFileError> {
+        let l = self;
         set_positive(&mut out.max_scenes, l.max_scenes, "limits.max_scenes")?;
         let quota = &mut out.client_quota;
         set_positive(
@@ -262,16 +279,7 @@ impl ConfigFile {
         let mut memory_mib = out.max_memory_bytes >> 20;
         set_positive(&mut memory_mib, l.max_memory_mib, "limits.max_memory_mib")?;
         out.max_memory_bytes = memory_mib.saturating_mul(1 << 20);
-        if let Some(margin) = self.scene.default_margin_m {
-            if !(margin.is_finite() && margin >= 0.0) {
-                return Err(ConfigFileError::Invalid {
-                    key: "scene.default_margin_m",
-                    reason: format!("{margin} is not a finite distance ≥ 0"),
-                });
-            }
-            out.default_margin = margin;
-        }
-        Ok(out)
+        Ok(())
     }
 }
 
