@@ -246,7 +246,10 @@ fn a_stopped_mesh_distance_holds_the_exact_distance_and_tightens_with_work() {
             let cache = &mut DistanceCache::default();
             let d = a.distance_to_within(&b, &pose, cache, workspace, &mut clock);
             if !clock.stopped() {
-                assert_eq!(d, exact, "case {case}: finished after {work} units otherwise");
+                assert_eq!(
+                    d, exact,
+                    "case {case}: finished after {work} units otherwise"
+                );
                 seen.finished += 1;
                 break;
             }

@@ -893,7 +893,12 @@ fn a_frame_too_short_for_the_broad_phase_and_publishing_is_not_started() {
 fn a_mesh_pair_whose_distance_search_stops_answers_conservatively() {
     let torus = Arc::new(MeshShape::new(meshes::torus(0.6, 0.15, 20, 8)));
     let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
-    let a = add(&mut scene, Shape::Mesh(Arc::clone(&torus)), DVec3::ZERO, 0.1);
+    let a = add(
+        &mut scene,
+        Shape::Mesh(Arc::clone(&torus)),
+        DVec3::ZERO,
+        0.1,
+    );
     let b = add(&mut scene, Shape::Mesh(Arc::clone(&torus)), DVec3::X, 0.1);
     let pair = CandidatePair::of(a.0, b.0);
     let mut rng = rng(77);
@@ -938,7 +943,10 @@ fn a_mesh_pair_whose_distance_search_stops_answers_conservatively() {
                         && truth.distance - seen.distance <= seen.error_bound + 1e-12,
                     "case {case}, {work} units: {seen:?} against {truth:?}"
                 );
-                assert!(!exact.touching || found.touching, "case {case}: missed contact");
+                assert!(
+                    !exact.touching || found.touching,
+                    "case {case}: missed contact"
+                );
                 assert_eq!(contacts.is_empty(), !(found.touching && query.contacts));
                 work = (work + work / 4).max(work + 8);
                 assert!(work < 100_000_000, "case {case}: never finished");
