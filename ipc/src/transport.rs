@@ -33,18 +33,23 @@ pub(crate) fn open_error(what: &str, e: impl std::fmt::Display) -> SceneOpenErro
     SceneOpenError::Transport(format!("{what}: {e}"))
 }
 
-/// A scene's publish–subscribe service could not be opened: no such scene, or `what` failed.
+/// A scene's publish–subscribe service could not be opened: no such scene (none, or one
+/// being removed: the daemon let the scene go), or `what` failed.
 pub(crate) fn pub_sub_open_error(what: &str, e: PublishSubscribeOpenError) -> SceneOpenError {
     match e {
-        PublishSubscribeOpenError::DoesNotExist => SceneOpenError::NoSuchScene,
+        PublishSubscribeOpenError::DoesNotExist
+        | PublishSubscribeOpenError::IsMarkedForDestruction => SceneOpenError::NoSuchScene,
         e => open_error(what, e),
     }
 }
 
-/// A scene's event service could not be opened: no such scene, or `what` failed.
+/// A scene's event service could not be opened: no such scene (none, or one being
+/// removed), or `what` failed.
 pub(crate) fn event_open_error(what: &str, e: EventOpenError) -> SceneOpenError {
     match e {
-        EventOpenError::DoesNotExist => SceneOpenError::NoSuchScene,
+        EventOpenError::DoesNotExist | EventOpenError::IsMarkedForDestruction => {
+            SceneOpenError::NoSuchScene
+        }
         e => open_error(what, e),
     }
 }

@@ -256,7 +256,7 @@ def results_ready_service_builder(node: Any, root: str, token: SceneToken) -> An
 
 def try_open_service(builder: Any, what: str) -> Optional[Any]:
     """``builder.open()``: the service, or ``None`` when it does not exist (the daemon has
-    not created it, or has removed it). Clients never create a service.
+    not created it, or has removed it or is removing it). Clients never create a service.
 
     Raises:
         TransportError: any other failure (e.g. incompatible settings, too many nodes).
@@ -264,7 +264,9 @@ def try_open_service(builder: Any, what: str) -> Optional[Any]:
     try:
         return builder.open()
     except Exception as e:
-        # The bindings raise <Pattern>OpenError('DoesNotExist').
-        if type(e).__name__.endswith("OpenError") and e.args[:1] == ("DoesNotExist",):
+        # The bindings raise <Pattern>OpenError('DoesNotExist'), or
+        # ('IsMarkedForDestruction') while the daemon is removing the service: gone too.
+        gone = (("DoesNotExist",), ("IsMarkedForDestruction",))
+        if type(e).__name__.endswith("OpenError") and e.args[:1] in gone:
             return None
         raise TransportError(f"opening the {what}", e) from e
