@@ -32,7 +32,7 @@ pub struct ClientQuota {
     /// Bodies alive, over all its scenes.
     pub bodies: u32,
     /// Memory of its shapes and bodies, bytes, as estimated before anything is built or
-    /// added ([`budget_memory`](super::budget_memory)).
+    /// added (the daemon's `budget_memory` estimates).
     pub memory_bytes: u64,
 }
 
@@ -77,7 +77,7 @@ impl Usage {
             ..Self::NOTHING
         }
     }
-    /// One body, of [`BODY_BYTES`].
+    /// One body, of `BODY_BYTES` (4,096 B).
     pub const BODY: Self = Self {
         bodies: 1,
         memory_bytes: BODY_BYTES,

@@ -66,7 +66,8 @@ impl MeshShape {
     }
 
     /// The exact distance between this mesh and `other` placed at `pose_ab` (`other`'s
-    /// frame in this one's), warm-started from `cache`: [`distance_mesh_mesh`] on the trees
+    /// frame in this one's), warm-started from `cache`:
+    /// [`distance_mesh_mesh`](crate::narrow::mesh_mesh::distance_mesh_mesh) on the trees
     /// [`QueryVolume::for_pair`] chooses, with the error bound of
     /// [`rounding_with`](Self::rounding_with).
     #[must_use]
