@@ -1084,3 +1084,87 @@ fn the_box_face_certificate_matches_epa_and_moves_apart_by_its_depth() {
         "{exact:?} {exact_apart} {beyond} {unknown}"
     );
 }
+
+/// The sphere–cylinder closed form against GJK/EPA on the same shapes (the sphere as a
+/// point rounded by its radius), over 6,000 seeded poses around and inside the cylinder:
+/// the same signed distance to 1e-9 relative (where EPA does not converge on the curved
+/// side, no deeper than its upper bound); overlapping, moving the cylinder by `depth + ε`
+/// along the normal leaves it apart, by `depth − ε` still overlapping.
+#[test]
+fn the_sphere_cylinder_closed_form_matches_gjk_and_epa() {
+    use proxima::narrow::gjk::EpaOutcome;
+    use proxima::narrow::pairs::distance_sphere_cylinder;
+    let mut r = rng(32);
+    let (mut overlapping, mut apart, mut epa_fallbacks) = (0, 0, 0);
+    for case in 0..6000 {
+        let sphere = Sphere::new(r.random_range(0.005..0.2));
+        let cylinder = Cylinder::new(r.random_range(0.01..0.3), r.random_range(0.01..0.3));
+        // The sphere's centre in B's frame: around the cylinder, inside it a third of the
+        // time; B's rotation random.
+        let reach = DVec3::new(cylinder.radius, cylinder.radius, cylinder.half_height)
+            + DVec3::splat(sphere.radius);
+        let centre = point_in_cube(&mut r, 1.0) * reach * r.random_range(0.3..1.3);
+        let rotation = proxima::math::DMat3::from_quat(rotation(&mut r));
+        let pose = Isometry {
+            rotation,
+            translation: -(rotation * centre),
+        };
+        let d = distance_sphere_cylinder(&sphere, &cylinder, &pose);
+        check_contract(&d, 1e-12);
+        let (g, outcome) = query(
+            &Rounded::new(&POINT, sphere.radius),
+            &Rounded::plain(&cylinder),
+            &pose,
+            &GjkParams::default(),
+        );
+        let tol = 1e-9 * (1.0 + d.distance.abs());
+        if outcome.epa == Some(EpaOutcome::Fallback) {
+            // EPA did not converge on the curved side: its depth is an upper bound, and the
+            // moves below decide the depth.
+            epa_fallbacks += 1;
+            assert!(
+                d.distance >= g.distance - tol,
+                "case {case}: closed form {} deeper than EPA's upper bound {}",
+                d.distance,
+                g.distance
+            );
+        } else {
+            assert!(
+                (d.distance - g.distance).abs() <= tol,
+                "case {case}: closed form {} vs GJK/EPA {} ({outcome:?})",
+                d.distance,
+                g.distance
+            );
+        }
+        if d.distance > 0.0 {
+            apart += 1;
+            continue;
+        }
+        overlapping += 1;
+        let depth = -d.distance;
+        let eps = 1e-9 * (1.0 + depth);
+        for (shift, separated) in [(depth + eps, true), (depth - eps, false)] {
+            let moved = Isometry {
+                translation: pose.translation + d.normal * shift,
+                ..pose
+            };
+            let (m, _) = query(
+                &Rounded::new(&POINT, sphere.radius),
+                &Rounded::plain(&cylinder),
+                &moved,
+                &GjkParams::default(),
+            );
+            assert_eq!(
+                m.distance > 0.0,
+                separated,
+                "case {case}: moved by {shift} of depth {depth}: {}",
+                m.distance
+            );
+        }
+    }
+    println!("overlapping {overlapping} (EPA fell back on {epa_fallbacks}), apart {apart}");
+    assert!(
+        overlapping > 1000 && apart > 1000 && epa_fallbacks < overlapping / 2,
+        "{overlapping} {apart} {epa_fallbacks}"
+    );
+}

@@ -4,7 +4,7 @@
 //!
 //! | pair | distance | manifold |
 //! |---|---|---|
-//! | sphere, capsule, cuboid among themselves | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
+//! | sphere, capsule, cuboid among themselves; sphere–cylinder | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
 //! | a box with a cylinder, cone or convex hull | the box's face certificate when B overlaps under one face, lies over one, or lies beyond a face's plane by more than the limit ([`pairs::face_distance_cuboid_convex`]), else as the next row | as the next row |
 //! | a cylinder, cone or convex hull with any convex shape | GJK on the cores (stopped once a support plane proves the pair beyond the limit), EPA when they overlap ([`crate::narrow::gjk`]) | one point, the distance's witnesses, against a sphere; else reference-face clipping of the shapes' contact features from the distance's normal, ≤ 4 points ([`crate::narrow::convex_manifold`]) |
 //! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`crate::narrow::convex_mesh`]) |
@@ -259,6 +259,7 @@ fn convex_reach(
         (S(x), S(y)) => closed(paths, pairs::distance_sphere_sphere(x, y, pose_ab)),
         (S(x), C(y)) => closed(paths, pairs::distance_sphere_capsule(x, y, pose_ab)),
         (S(x), B(y)) => closed(paths, pairs::distance_sphere_cuboid(x, y, pose_ab)),
+        (S(x), Shape::Cylinder(y)) => closed(paths, pairs::distance_sphere_cylinder(x, y, pose_ab)),
         // No early-out for a capsule: its closed form costs what the separating axes would.
         (C(x), C(y)) => closed(paths, pairs::distance_capsule_capsule(x, y, pose_ab)),
         (C(x), B(y)) => closed(paths, pairs::distance_capsule_cuboid(x, y, pose_ab)),
@@ -271,7 +272,7 @@ fn convex_reach(
             }
             Reached::Exact(d)
         }
-        (C(_), S(_)) | (B(_), S(_) | C(_)) => {
+        (C(_) | Shape::Cylinder(_), S(_)) | (B(_), S(_) | C(_)) => {
             convex_reach(b, a, &pose_ab.inverse(), limit, scratch).flipped(pose_ab)
         }
         (B(x), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_)) => {
@@ -287,7 +288,8 @@ fn convex_reach(
                 FaceCertificate::Unknown => convex_distance(a, b, pose_ab, limit, scratch),
             }
         }
-        (S(_) | C(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        (S(_), Shape::Cone(_) | Shape::Convex(_))
+        | (C(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
             convex_distance(a, b, pose_ab, limit, scratch)
         }

@@ -36,6 +36,7 @@ mod cuboid_triangle;
 mod face_certificate;
 mod sphere_capsule;
 mod sphere_cuboid;
+mod sphere_cylinder;
 mod sphere_sphere;
 mod sphere_triangle;
 
@@ -54,6 +55,7 @@ pub use cuboid_triangle::{distance_cuboid_triangle, manifold_cuboid_triangle};
 pub use face_certificate::{FaceCertificate, face_distance_cuboid_convex};
 pub use sphere_capsule::{distance_sphere_capsule, manifold_sphere_capsule};
 pub use sphere_cuboid::{distance_sphere_cuboid, manifold_sphere_cuboid};
+pub use sphere_cylinder::{distance_sphere_cylinder, manifold_sphere_cylinder};
 pub use sphere_sphere::{distance_sphere_sphere, manifold_sphere_sphere};
 pub use sphere_triangle::{distance_sphere_triangle, manifold_sphere_triangle};
 
