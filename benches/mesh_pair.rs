@@ -44,11 +44,15 @@ mod support;
 
 mod common;
 
+#[path = "common/parry_convert.rs"]
+mod parry_convert;
+
 use common::cycle::cycle_bench;
 use common::mesh_scenes::{MeshScene, bunny_fandisk, tori};
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, BenchmarkId, Criterion, criterion_group, criterion_main};
-use parry3d_f64::math::{Pose as ParryPose, Rotation as ParryRotation, Vector as ParryVector};
+use parry_convert::{parry_mesh, parry_pose};
+use parry3d_f64::math::Pose as ParryPose;
 use parry3d_f64::query::{
     ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
@@ -181,23 +185,6 @@ impl ParryPair {
         .expect("parry supports trimesh–trimesh distance")
         .distance
     }
-}
-
-fn parry_mesh(mesh: &TriMesh) -> ParryMesh {
-    let vertices = mesh
-        .vertices()
-        .iter()
-        .map(|p| ParryVector::new(p.x, p.y, p.z))
-        .collect();
-    ParryMesh::new(vertices, mesh.triangles().to_vec()).expect("parry accepts the mesh")
-}
-
-fn parry_pose(pose: &Pose) -> ParryPose {
-    let (t, q) = (pose.position, pose.rotation);
-    ParryPose::from_parts(
-        ParryVector::new(t.x, t.y, t.z),
-        ParryRotation::from_xyzw(q.x, q.y, q.z, q.w),
-    )
 }
 
 /// One scene with every engine's structures built.

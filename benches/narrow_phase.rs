@@ -35,9 +35,13 @@ mod support;
 #[path = "common/cycle.rs"]
 mod cycle;
 
+#[path = "common/parry_convert.rs"]
+mod parry_convert;
+
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use cycle::cycle_bench;
-use parry3d_f64::math::{Pose as ParryPose, Rotation as ParryRotation, Vector as ParryVector};
+use parry_convert::{parry_pose, parry_vector};
+use parry3d_f64::math::Pose as ParryPose;
 use parry3d_f64::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d_f64::shape::{
     Ball as ParryBall, Capsule as ParryCapsule, ConvexPolyhedron as ParryHull,
@@ -80,18 +84,6 @@ impl Poses {
             parry: poses.iter().map(parry_pose).collect(),
         }
     }
-}
-
-fn parry_pose(pose: &Pose) -> ParryPose {
-    let (t, q) = (pose.position, pose.rotation);
-    ParryPose::from_parts(
-        ParryVector::new(t.x, t.y, t.z),
-        ParryRotation::from_xyzw(q.x, q.y, q.z, q.w),
-    )
-}
-
-fn parry_vector(v: DVec3) -> ParryVector {
-    ParryVector::new(v.x, v.y, v.z)
 }
 
 /// [`POSES`] separated and [`POSES`] penetrating poses, by Proxima's `signed` distance:

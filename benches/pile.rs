@@ -53,9 +53,13 @@ mod point_mass;
 #[allow(dead_code)]
 mod spec;
 
+#[path = "common/parry_convert.rs"]
+mod parry_convert;
+
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use cycle::cycle_bench;
-use parry3d_f64::math::{Pose as ParryPose, Rotation as ParryRotation, Vector as ParryVector};
+use parry_convert::{parry_pose, parry_vector};
+use parry3d_f64::math::{Pose as ParryPose, Vector as ParryVector};
 use parry3d_f64::shape::SharedShape;
 use pile::{PILE_RATE_HZ, pile_scene, pile_world};
 use proxima::broad::CandidatePair;
@@ -208,18 +212,6 @@ fn parry_shape(spec: &ShapeSpec) -> ParryShape {
             unreachable!("the pile has no cones or meshes")
         }
     }
-}
-
-fn parry_vector(v: DVec3) -> ParryVector {
-    ParryVector::new(v.x, v.y, v.z)
-}
-
-fn parry_pose(pose: &Pose) -> ParryPose {
-    let (t, q) = (pose.position, pose.rotation);
-    ParryPose::from_parts(
-        parry_vector(t),
-        ParryRotation::from_xyzw(q.x, q.y, q.z, q.w),
-    )
 }
 
 /// The candidate pairs of `scene` at its current poses, both engines' shapes and poses.

@@ -26,10 +26,13 @@
 #[path = "../tests/support/mod.rs"]
 mod support;
 
+#[path = "../benches/common/parry_convert.rs"]
+mod parry_convert;
+
 use clap::Parser;
-use parry3d_f64::math::{Pose as ParryPose, Rotation as ParryRotation, Vector as ParryVector};
+use parry_convert::{parry_mesh, parry_pose};
+use parry3d_f64::math::Pose as ParryPose;
 use parry3d_f64::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
-use parry3d_f64::shape::TriMesh as ParryMesh;
 use proxima::geometry::TriMesh;
 use proxima::math::{DVec3, Pose};
 use proxima::narrow::MeshShape;
@@ -124,26 +127,11 @@ fn report(
     }
 }
 
-fn parry_mesh(mesh: &TriMesh) -> ParryMesh {
-    let vertices = mesh
-        .vertices()
-        .iter()
-        .map(|p| ParryVector::new(p.x, p.y, p.z))
-        .collect();
-    ParryMesh::new(vertices, mesh.triangles().to_vec()).expect("parry accepts the mesh")
-}
-
-fn parry_pose(pose: &Pose) -> ParryPose {
-    let (t, q) = (pose.position, pose.rotation);
-    ParryPose::from_parts(
-        ParryVector::new(t.x, t.y, t.z),
-        ParryRotation::from_xyzw(q.x, q.y, q.z, q.w),
-    )
-}
-
 /// The tray and Spot, and Spot's poses over it (see the module docs).
 fn tray_spot(args: &Args) -> (TriMesh, TriMesh, Vec<Pose>) {
-    let tray = tray();
+    // A flat open tray: `[-0.2, 0.2] × [-0.15, 0.15]` at `z = 0`, 6 × 5 rectangles (60
+    // triangles).
+    let tray = meshes::rectangle_grid([0.2, 0.15], [6, 5]);
     let spot = meshes::data_mesh("spot.obj").centered_on_bounds();
     let (low, high) = spot.bounds();
     let size = (high - low).max_element();
@@ -171,31 +159,6 @@ fn tray_spot(args: &Args) -> (TriMesh, TriMesh, Vec<Pose>) {
         })
         .collect();
     (tray, spot, poses)
-}
-
-/// A flat open tray: `[-0.2, 0.2] × [-0.15, 0.15]` at `z = 0`, 6 × 5 squares (60 triangles).
-fn tray() -> TriMesh {
-    let (nx, ny) = (6u32, 5u32);
-    let vertices = (0..=nx)
-        .flat_map(|i| {
-            (0..=ny).map(move |j| {
-                DVec3::new(
-                    -0.2 + 0.4 * f64::from(i) / f64::from(nx),
-                    -0.15 + 0.3 * f64::from(j) / f64::from(ny),
-                    0.0,
-                )
-            })
-        })
-        .collect();
-    let id = |i: u32, j: u32| i * (ny + 1) + j;
-    let mut triangles = Vec::new();
-    for i in 0..nx {
-        for j in 0..ny {
-            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    meshes::mesh(vertices, triangles)
 }
 
 fn tray_spot_distance(args: &Args) {

@@ -30,7 +30,7 @@ use crate::narrow::gjk::{
 };
 use crate::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
 use crate::narrow::pairs::{self, FaceCertificate};
-use crate::narrow::shape::{core_map_of, features_of};
+use crate::narrow::shape::{core_of, features_of};
 use crate::narrow::{MeshShape, Shape};
 use std::sync::Arc;
 
@@ -276,7 +276,7 @@ fn convex_reach(
             convex_reach(b, a, &pose_ab.inverse(), limit, scratch).flipped(pose_ab)
         }
         (B(x), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_)) => {
-            let Some((core_b, _)) = core_map_of(b) else {
+            let Some((core_b, _)) = core_of(b) else {
                 unreachable!("the arm holds convex shapes only");
             };
             match pairs::face_distance_cuboid_convex(x, &core_b, pose_ab, limit) {
@@ -375,8 +375,7 @@ fn convex_distance(
     limit: f64,
     scratch: &mut NarrowScratch,
 ) -> Reached {
-    let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_map_of(a), core_map_of(b))
-    else {
+    let (Some((core_a, radius_a)), Some((core_b, radius_b))) = (core_of(a), core_of(b)) else {
         unreachable!("the dispatcher sends only convex pairs here");
     };
     let (ra, rb) = (

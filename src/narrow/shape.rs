@@ -249,33 +249,13 @@ impl Shape {
 
 /// A convex shape as GJK sees it: a core and a radius (a sphere is a point swept by its
 /// radius, a capsule a segment; the others have no radius).
-pub enum Core<'s> {
-    /// A sphere's centre.
-    Point,
-    /// A capsule's axis.
-    Segment(Segment),
-    /// Any other convex shape, through its support map.
-    Support(&'s dyn SupportMap),
-}
-
-impl Core<'_> {
-    /// The core's support map (a point's is the origin's).
-    #[must_use]
-    pub fn support_map(&self) -> &dyn SupportMap {
-        match self {
-            Core::Point => &POINT,
-            Core::Segment(s) => s,
-            Core::Support(s) => *s,
-        }
-    }
-}
-
-/// A convex shape's core as one concrete support map: [`Core`] with the kind resolved by a
-/// `match` in each support call instead of a virtual call, so GJK and EPA, monomorphised
-/// once for it, inline every kind's support function.
+///
+/// One concrete support map: each support call resolves the kind by a `match` instead of a
+/// virtual call, so GJK and EPA, monomorphised once for it, inline every kind's support
+/// function. [`Support`](Self::Support) takes any other map (a triangle, a test's shape).
 // PERF: `benches/pile.rs` (the GJK pairs: cylinders and hulls against everything).
-#[derive(Debug, Clone, Copy)]
-pub enum CoreMap<'s> {
+#[derive(Clone, Copy)]
+pub enum Core<'s> {
     /// A sphere's centre.
     Point,
     /// A capsule's axis.
@@ -288,9 +268,19 @@ pub enum CoreMap<'s> {
     Cone(&'s Cone),
     /// A convex hull.
     Convex(&'s ConvexPolyhedron),
+    /// Any other convex shape, through its support map.
+    Support(&'s dyn SupportMap),
 }
 
-impl SupportMap for CoreMap<'_> {
+impl Core<'_> {
+    /// The core's support map.
+    #[must_use]
+    pub fn support_map(&self) -> &dyn SupportMap {
+        self
+    }
+}
+
+impl SupportMap for Core<'_> {
     #[inline(always)]
     fn support(&self, direction: DVec3) -> DVec3 {
         match self {
@@ -300,6 +290,7 @@ impl SupportMap for CoreMap<'_> {
             Self::Cylinder(c) => c.support(direction),
             Self::Cone(c) => c.support(direction),
             Self::Convex(c) => c.support(direction),
+            Self::Support(s) => s.support(direction),
         }
     }
 
@@ -307,34 +298,22 @@ impl SupportMap for CoreMap<'_> {
     fn support_from(&self, direction: DVec3, hint: &mut u32) -> DVec3 {
         match self {
             Self::Convex(c) => c.support_from(direction, hint),
+            Self::Support(s) => s.support_from(direction, hint),
             _ => self.support(direction),
         }
     }
 }
 
-/// The core (as a [`CoreMap`]) and radius of a convex shape; `None` for a mesh.
-#[must_use]
-pub fn core_map_of(shape: &Shape) -> Option<(CoreMap<'_>, f64)> {
-    Some(match shape {
-        Shape::Sphere(s) => (CoreMap::Point, s.radius),
-        Shape::Capsule(c) => (CoreMap::Segment(c.segment()), c.radius),
-        Shape::Cuboid(b) => (CoreMap::Cuboid(b), 0.0),
-        Shape::Cylinder(c) => (CoreMap::Cylinder(c), 0.0),
-        Shape::Cone(c) => (CoreMap::Cone(c), 0.0),
-        Shape::Convex(c) => (CoreMap::Convex(c.as_ref()), 0.0),
-        Shape::Mesh(_) => return None,
-    })
-}
-
 /// The core and radius of a convex shape; `None` for a mesh.
+#[must_use]
 pub fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
     Some(match shape {
         Shape::Sphere(s) => (Core::Point, s.radius),
         Shape::Capsule(c) => (Core::Segment(c.segment()), c.radius),
-        Shape::Cuboid(b) => (Core::Support(b), 0.0),
-        Shape::Cylinder(c) => (Core::Support(c), 0.0),
-        Shape::Cone(c) => (Core::Support(c), 0.0),
-        Shape::Convex(c) => (Core::Support(c.as_ref()), 0.0),
+        Shape::Cuboid(b) => (Core::Cuboid(b), 0.0),
+        Shape::Cylinder(c) => (Core::Cylinder(c), 0.0),
+        Shape::Cone(c) => (Core::Cone(c), 0.0),
+        Shape::Convex(c) => (Core::Convex(c.as_ref()), 0.0),
         Shape::Mesh(_) => return None,
     })
 }

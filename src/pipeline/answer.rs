@@ -232,13 +232,9 @@ pub(super) fn mesh_mesh(
 }
 
 /// A mesh pair whose distance search the clock stopped (the frame's slice ended, or its
-/// client is gone): the conservative answer DESIGN §4 asks for, as
-/// [`mesh_mesh_truncated`] gives the frontier's. Distance: the search's lower bound
-/// (`d.distance − d.error_bound`, never above the truth) with error bound `d.error_bound`
-/// (the truth is at most the closest pair found, `d.distance`), `exact` false; witnesses
-/// and normal: that closest pair's. The pair may touch when the lower bound is `≤ 0`; its
-/// contact (when asked) is then one point, the record's witnesses and normal, distance 0
-/// (meshes have no depth) with the record's error bound.
+/// client is gone): [`mesh_bounded`] with the search's lower bound (`d.distance −
+/// d.error_bound`; the truth is at most the closest pair found, `d.distance`) and that
+/// pair's witnesses, as [`mesh_mesh_truncated`] answers the frontier's.
 fn mesh_distance_stopped(
     pair: &CandidatePair,
     (a, b): (&Body, &Body),
@@ -246,26 +242,9 @@ fn mesh_distance_stopped(
     d: &MeshDistance,
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
-    let mut result = world_boxes(pair, a, b);
-    let (point_a, point_b) = (
-        a.pose.transform_point(d.point_a),
-        a.pose.transform_point(d.point_b),
-    );
-    if let Some(normal) = (point_b - point_a).try_normalize() {
-        (result.point_a, result.point_b, result.normal) = (point_a, point_b, normal);
-    }
-    result.distance = d.distance - d.error_bound;
-    result.error_bound = d.error_bound;
-    result.exact = false;
-    let touching = result.distance <= 0.0;
-    if query.contacts && touching {
-        contacts.push(witness_contact(&result, 0.0));
-    }
-    Answer {
-        result,
-        touching,
-        apart_by: None,
-    }
+    let bounds = (d.distance - d.error_bound, d.error_bound);
+    let witnesses = Some((d.point_a, d.point_b));
+    mesh_bounded(pair, (a, b), query, bounds, witnesses, contacts)
 }
 
 /// The exact distance of a mesh pair, witnesses in A's frame.
@@ -411,14 +390,9 @@ pub(super) fn mesh_mesh_finished(
 }
 
 /// A mesh pair whose budgeted frontier traversal was cut short (`frontier` is
-/// [`Truncated`](crate::budget::Completeness::Truncated), hence `maybe_close`): the
-/// conservative answer DESIGN §4 asks for. Distance: the frontier's lower bound (never
-/// above the truth) with its error bound (`true ≤ distance + error_bound`), `exact` false.
-/// The pair *may touch* when that bound is `≤ 0`; its contact (when asked) is then one
-/// point, as the box answer's: the record's witnesses and normal, distance 0 (meshes have
-/// no depth) with the record's error bound. Witnesses: the closest triangle pair the
-/// frontier found so far (`distance_upper` apart), else the points of the two world boxes
-/// nearest each other, with the box normal.
+/// [`Truncated`](crate::budget::Completeness::Truncated), hence `maybe_close`):
+/// [`mesh_bounded`] with the frontier's lower bound and error bound, and the closest
+/// triangle pair it found so far (`distance_upper` apart) as witnesses.
 pub(super) fn mesh_mesh_truncated(
     pair: &CandidatePair,
     (a, b): (&Body, &Body),
@@ -427,18 +401,38 @@ pub(super) fn mesh_mesh_truncated(
     contacts: &mut Vec<ContactPoint>,
 ) -> Answer {
     debug_assert!(!frontier.is_exact() && frontier.maybe_close);
+    let bounds = (frontier.distance_lower, frontier.error_bound);
+    let witnesses = frontier.witnesses.map(|w| (w.point_a, w.point_b));
+    mesh_bounded(pair, (a, b), query, bounds, witnesses, contacts)
+}
+
+/// The conservative answer DESIGN §4 asks for of a mesh pair known only between bounds:
+/// distance `lower` (never above the truth) with `error_bound` (`true ≤ distance +
+/// error_bound`), `exact` false. The pair *may touch* when `lower ≤ 0`; its contact (when
+/// asked) is then one point, the record's witnesses and normal, distance 0 (meshes have no
+/// depth) with the record's error bound. Witnesses: the closest triangle pair found so far
+/// (A's frame), else the points of the two world boxes nearest each other, with the box
+/// normal.
+fn mesh_bounded(
+    pair: &CandidatePair,
+    (a, b): (&Body, &Body),
+    query: Query,
+    (lower, error_bound): (f64, f64),
+    witnesses: Option<(DVec3, DVec3)>,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
     let mut result = world_boxes(pair, a, b);
-    if let Some(w) = frontier.witnesses {
+    if let Some((point_a, point_b)) = witnesses {
         let (point_a, point_b) = (
-            a.pose.transform_point(w.point_a),
-            a.pose.transform_point(w.point_b),
+            a.pose.transform_point(point_a),
+            a.pose.transform_point(point_b),
         );
         if let Some(normal) = (point_b - point_a).try_normalize() {
             (result.point_a, result.point_b, result.normal) = (point_a, point_b, normal);
         }
     }
-    result.distance = frontier.distance_lower;
-    result.error_bound = frontier.error_bound;
+    result.distance = lower;
+    result.error_bound = error_bound;
     result.exact = false;
     let touching = result.distance <= 0.0;
     if query.contacts && touching {

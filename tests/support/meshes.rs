@@ -102,15 +102,23 @@ pub fn subdivided_cuboid(half: DVec3, n: u32) -> TriMesh {
 /// A flat open grid in the plane `z = 0`: `[-half, half]²` cut into `n × n` squares of
 /// two triangles (`2 n²` coplanar triangles), welded.
 pub fn grid(half: f64, n: u32) -> TriMesh {
-    assert!(n >= 1);
-    let at = |i: u32| -half + 2.0 * half * f64::from(i) / f64::from(n);
-    let vertices = (0..=n)
-        .flat_map(|i| (0..=n).map(move |j| DVec3::new(at(i), at(j), 0.0)))
+    rectangle_grid([half, half], [n, n])
+}
+
+/// A flat open grid in the plane `z = 0`: `[-half[0], half[0]] × [-half[1], half[1]]` cut
+/// into `n[0] × n[1]` rectangles of two triangles (`2 n[0] n[1]` coplanar triangles),
+/// welded.
+pub fn rectangle_grid(half: [f64; 2], n: [u32; 2]) -> TriMesh {
+    assert!(n[0] >= 1 && n[1] >= 1);
+    let at =
+        |axis: usize, i: u32| -half[axis] + 2.0 * half[axis] * f64::from(i) / f64::from(n[axis]);
+    let vertices = (0..=n[0])
+        .flat_map(|i| (0..=n[1]).map(move |j| DVec3::new(at(0, i), at(1, j), 0.0)))
         .collect();
-    let id = |i: u32, j: u32| i * (n + 1) + j;
+    let id = |i: u32, j: u32| i * (n[1] + 1) + j;
     let mut tris = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
+    for i in 0..n[0] {
+        for j in 0..n[1] {
             tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
             tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
         }

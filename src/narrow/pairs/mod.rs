@@ -37,6 +37,7 @@ mod face_certificate;
 mod sphere_capsule;
 mod sphere_cuboid;
 mod sphere_cylinder;
+mod sphere_solid;
 mod sphere_sphere;
 mod sphere_triangle;
 

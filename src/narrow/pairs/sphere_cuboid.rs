@@ -6,6 +6,7 @@
 //! nearest face (the first axis on ties), so a centre exactly on a face, edge or corner
 //! gives depth = radius along a face normal. Manifold: one point, the distance's witnesses.
 
+use super::sphere_solid::{sphere_inside, sphere_outside};
 use crate::geometry::{Cuboid, Sphere};
 use crate::math::{DVec3, Isometry};
 use crate::narrow::contact::{Manifold, ShapeDistance};
@@ -18,20 +19,8 @@ pub fn distance_sphere_cuboid(a: &Sphere, b: &Cuboid, pose_ab: &Isometry) -> Sha
     let h = b.half_extents;
     // The sphere's centre (A's origin) in B's frame, and its closest point on the box.
     let centre = pose_ab.inverse_transform_point(DVec3::ZERO);
-    let clamped = centre.clamp(-h, h);
-    let outside = centre - clamped;
-    let gap = outside.length();
-    if gap > 0.0 {
-        // Apart or shallow: the box's closest point; the normal A→B points from the centre
-        // to it.
-        let normal_b = -outside / gap;
-        let normal = pose_ab.transform_vector(normal_b);
-        return ShapeDistance {
-            distance: gap - a.radius,
-            point_a: normal * a.radius,
-            point_b: pose_ab.transform_point(clamped),
-            normal,
-        };
+    if let Some(d) = sphere_outside(a.radius, pose_ab, centre, centre.clamp(-h, h)) {
+        return d;
     }
     // Inside (or on the surface): the nearest face; the first axis on ties. B separates by
     // moving so that this face passes the centre, then the radius.
@@ -46,17 +35,9 @@ pub fn distance_sphere_cuboid(a: &Sphere, b: &Cuboid, pose_ab: &Isometry) -> Sha
     let side = if centre[axis] < 0.0 { -1.0 } else { 1.0 };
     let mut face = centre;
     face[axis] = side * h[axis];
-    let mut normal_b = DVec3::ZERO;
-    normal_b[axis] = -side;
-    let normal = pose_ab.transform_vector(normal_b);
-    let depth = room[axis] + a.radius;
-    ShapeDistance {
-        distance: -depth,
-        // The sphere's point that B's face must clear last: `point_b − depth·normal`.
-        point_a: normal * a.radius,
-        point_b: pose_ab.transform_point(face),
-        normal,
-    }
+    let mut outward = DVec3::ZERO;
+    outward[axis] = side;
+    sphere_inside(a.radius, pose_ab, face, outward, room[axis])
 }
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4
