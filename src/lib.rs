@@ -31,6 +31,9 @@ pub mod budget;
 // Shapes, meshes, convex hulls, exact predicates.
 pub mod geometry;
 
+// Approximate convex decomposition of closed meshes (part of the geometry layer).
+pub use geometry::decompose;
+
 // Bounding volumes.
 pub mod bounding;
 

@@ -1,7 +1,8 @@
 //! Procedural meshes for the integration tests and benches (the single home of them), and
 //! the real meshes kept in `tests/data`.
 //!
-//! Closed solids ([`uv_sphere`], [`torus`], [`cuboid`], [`subdivided_cuboid`]) are welded
+//! Closed solids ([`uv_sphere`], [`torus`], [`cuboid`], [`subdivided_cuboid`], and the
+//! concave prisms [`prism`], [`l_prism`], [`u_prism`]) are welded
 //! (neighbouring triangles share vertex indices) and oriented counter-clockwise seen from
 //! outside. [`grid`] is an open surface of many coplanar triangles, [`triangle_soup`] an
 //! unwelded set of random triangles, [`zero_area_triangles`] a set of nothing but point- and
@@ -46,6 +47,65 @@ pub fn uv_sphere(radius: f64, segments: u32, rings: u32) -> TriMesh {
 /// Closed torus about the z axis: see `TriMesh::torus`.
 pub fn torus(major: f64, minor: f64, around: u32, across: u32) -> TriMesh {
     TriMesh::torus(major, minor, around, across)
+}
+
+/// The closed prism over the counter-clockwise `outline` (x, y), from `z = 0` to `height`;
+/// `cap` triangulates the outline (indices into it, counter-clockwise). Welded, oriented
+/// outward.
+pub fn prism(outline: &[[f64; 2]], cap: &[[u32; 3]], height: f64) -> TriMesh {
+    let n = outline.len() as u32;
+    let mut vertices: Vec<DVec3> = Vec::with_capacity(2 * outline.len());
+    for z in [0.0, height] {
+        vertices.extend(outline.iter().map(|&[x, y]| DVec3::new(x, y, z)));
+    }
+    let mut triangles = Vec::with_capacity(2 * cap.len() + 2 * outline.len());
+    for &[a, b, c] in cap {
+        triangles.push([a, c, b]);
+        triangles.push([n + a, n + b, n + c]);
+    }
+    for i in 0..n {
+        let j = (i + 1) % n;
+        triangles.push([i, j, n + j]);
+        triangles.push([i, n + j, n + i]);
+    }
+    mesh(vertices, triangles)
+}
+
+/// An L-shaped prism: two unit squares' worth of arm on a unit corner, 1 high (volume 3).
+pub fn l_prism() -> TriMesh {
+    let outline = [
+        [0.0, 0.0],
+        [2.0, 0.0],
+        [2.0, 1.0],
+        [1.0, 1.0],
+        [1.0, 2.0],
+        [0.0, 2.0],
+    ];
+    // A fan about the bend (1, 1), which sees every corner.
+    prism(&outline, &[[3, 4, 5], [3, 5, 0], [3, 0, 1], [3, 1, 2]], 1.0)
+}
+
+/// A U-shaped prism, 3 wide, 2 deep and 1 high, its notch 1 × 1 (volume 5).
+pub fn u_prism() -> TriMesh {
+    let outline = [
+        [0.0, 0.0],
+        [3.0, 0.0],
+        [3.0, 2.0],
+        [2.0, 2.0],
+        [2.0, 1.0],
+        [1.0, 1.0],
+        [1.0, 2.0],
+        [0.0, 2.0],
+    ];
+    let cap = [
+        [0, 1, 4],
+        [0, 4, 5],
+        [1, 2, 4],
+        [2, 3, 4],
+        [0, 5, 7],
+        [5, 6, 7],
+    ];
+    prism(&outline, &cap, 1.0)
 }
 
 /// The box `[-half, half]` with 12 triangles (8 vertices).

@@ -78,48 +78,73 @@ fn build(world: &[DVec3], local: &[DVec3], origin: DVec3, eps: f64) -> ConvexPol
         neighbour_start: Vec::new(),
         neighbours: Vec::new(),
     };
+    match start(local, eps) {
+        Start::Point(i0) => hull.vertices = vec![world[i0]],
+        Start::Segment(i0, i1) => {
+            hull.dimension = 1;
+            hull.vertices = vec![world[i0], world[i1]];
+        }
+        Start::Flat(normal, [i0, i1]) => {
+            let outline = flat::polygon(local, normal, eps);
+            if outline.len() < 3 {
+                hull.dimension = 1;
+                hull.vertices = vec![world[i0], world[i1]];
+            } else {
+                finish_flat(&mut hull, world, local, &outline, normal);
+                hull.build_adjacency();
+            }
+        }
+        Start::Solid(simplex) => {
+            let tris = quickhull::quickhull(local, simplex, eps, rounding_noise(world));
+            finish_solid(&mut hull, world, local, &tris);
+            hull.build_adjacency();
+        }
+    }
+    hull
+}
+
+/// How a hull starts: the first points that span it, or the lower dimension it has.
+pub(super) enum Start {
+    Point(usize),
+    Segment(usize, usize),
+    /// Coplanar: the plane's unit normal and two points far apart.
+    Flat(DVec3, [usize; 2]),
+    /// A tetrahedron of points more than `eps` apart in every dimension.
+    Solid([usize; 4]),
+}
+
+/// The start of the hull of distinct points `local` (near the origin) at tolerance `eps`.
+pub(super) fn start(local: &[DVec3], eps: f64) -> Start {
     let centre = local.iter().sum::<DVec3>() / local.len() as f64;
     // The farthest point from the centroid, and the farthest from it, are hull vertices.
     let (i0, _) = argmax(local, |p| (p - centre).length_squared());
     let p0 = local[i0];
     let (i1, d1) = argmax(local, |p| (p - p0).length());
     if d1 <= eps {
-        hull.vertices = vec![world[i0]];
-        return hull;
+        return Start::Point(i0);
     }
     let axis = (local[i1] - p0) / d1;
     let (i2, d2) = argmax(local, |p| (p - p0).cross(axis).length());
     if d2 <= eps {
-        hull.dimension = 1;
-        hull.vertices = vec![world[i0], world[i1]];
-        return hull;
+        return Start::Segment(i0, i1);
     }
     let normal = (local[i1] - p0).cross(local[i2] - p0).normalize();
     let (i3, d3) = argmax(local, |p| (p - p0).dot(normal).abs());
     if d3 <= eps {
-        let outline = flat::polygon(local, normal, eps);
-        if outline.len() < 3 {
-            hull.dimension = 1;
-            hull.vertices = vec![world[i0], world[i1]];
-            return hull;
-        }
-        finish_flat(&mut hull, world, local, &outline, normal);
-        hull.build_adjacency();
-        return hull;
+        return Start::Flat(normal, [i0, i1]);
     }
-    // How far rounding the input coordinates can move a point off a plane: the level below
-    // which an eye's height above a face is noise.
+    Start::Solid([i0, i1, i2, i3])
+}
+
+/// How far rounding the input coordinates can move a point off a plane: the level below
+/// which an eye's height above a face is noise.
+pub(super) fn rounding_noise(world: &[DVec3]) -> f64 {
     let magnitude = world
         .iter()
         .map(|p| p.abs().max_element())
         .fold(0.0, f64::max);
-    let noise = ROUNDING_ULPS * f64::EPSILON * magnitude;
-    let tris = quickhull::quickhull(local, [i0, i1, i2, i3], eps, noise);
-    finish_solid(&mut hull, world, local, &tris);
-    hull.build_adjacency();
-    hull
+    ROUNDING_ULPS * f64::EPSILON * magnitude
 }
-
 /// Compacts the vertices used by `tris` into the hull and merges its faces.
 fn finish_solid(h: &mut ConvexPolyhedron, world: &[DVec3], local: &[DVec3], tris: &[[usize; 3]]) {
     h.dimension = 3;

@@ -75,6 +75,27 @@ pub struct Face {
     pub vertices: Vec<u32>,
 }
 
+/// The hull construction's plane tolerance for a cloud with bounds `lo`, `hi`, metres:
+/// relative to its extent plus the rounding of its distance from the origin.
+fn plane_tolerance(lo: DVec3, hi: DVec3) -> f64 {
+    let extent = (hi - lo).max_element() * 0.5;
+    let magnitude = lo.abs().max(hi.abs()).max_element();
+    tolerance::PLANE_RELATIVE * extent
+        + ROUNDING_ULPS * f64::EPSILON * magnitude
+        + f64::MIN_POSITIVE
+}
+
+/// One triangle of [`ConvexPolyhedron::quick_hull_triangles`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HullTriangle {
+    /// Corners, counter-clockwise seen from outside, metres.
+    pub corners: [DVec3; 3],
+    /// Outward unit normal.
+    pub normal: DVec3,
+    /// Plane offset, metres: `normal · x ≤ offset` inside the hull.
+    pub offset: f64,
+}
+
 /// Multiple of `f64::EPSILON × magnitude` added to the plane tolerance: covers the rounding
 /// of coordinates far from the origin (a flat cloud at 1e6 m is flat only to ~1e-10 m).
 const ROUNDING_ULPS: f64 = 8.0;
@@ -166,11 +187,7 @@ impl ConvexPolyhedron {
         let (lo, hi) = bounds(&unique);
         let origin = (lo + hi) * 0.5;
         let local: Vec<DVec3> = unique.iter().map(|p| *p - origin).collect();
-        let extent = (hi - lo).max_element() * 0.5;
-        let magnitude = lo.abs().max(hi.abs()).max_element();
-        let mut eps = tolerance::PLANE_RELATIVE * extent
-            + ROUNDING_ULPS * f64::EPSILON * magnitude
-            + f64::MIN_POSITIVE;
+        let mut eps = plane_tolerance(lo, hi);
         let mut attempt = 0;
         loop {
             let hull = build_with_corners(&unique, &local, origin, eps);
@@ -184,6 +201,41 @@ impl ConvexPolyhedron {
             }
             eps *= RETRY_FACTOR;
         }
+    }
+
+    /// The triangles of the hull of `points` (counter-clockwise seen from outside) with
+    /// their planes `(unit normal, offset)`, `normal · x ≤ offset` inside; coplanar
+    /// triangles are not merged.
+    ///
+    /// A fast, unchecked measure for searches that weigh many candidate hulls (convex
+    /// decomposition's cut search): no corner pass, no face merging, no validation or retry.
+    /// `None` when a point is not finite or the points do not span a solid.
+    #[must_use]
+    pub fn quick_hull_triangles(points: &[DVec3]) -> Option<Vec<HullTriangle>> {
+        if points.is_empty() || !points.iter().all(|p| p.is_finite()) {
+            return None;
+        }
+        let (lo, hi) = bounds(points);
+        let origin = (lo + hi) * 0.5;
+        let local: Vec<DVec3> = points.iter().map(|p| *p - origin).collect();
+        let eps = plane_tolerance(lo, hi);
+        let build::Start::Solid(simplex) = build::start(&local, eps) else {
+            return None;
+        };
+        let triangles = quickhull::quickhull(&local, simplex, eps, build::rounding_noise(points));
+        Some(
+            triangles
+                .iter()
+                .map(|&t| {
+                    let (normal, offset) = quickhull::triangle_plane(&local, t);
+                    HullTriangle {
+                        corners: t.map(|i| points[i]),
+                        normal,
+                        offset: offset + normal.dot(origin),
+                    }
+                })
+                .collect(),
+        )
     }
 
     /// Whether every point is within tolerance of the hull (the construction contract).

@@ -1,0 +1,290 @@
+//! The quality-first method: concavity-driven cut search (in the manner of CoACD, greedy).
+//!
+//! The most concave piece is cut next, by the plane that leaves the least concavity in its
+//! two halves; cutting stops when every piece is within the allowed concavity or the part
+//! count is reached. Neighbouring pieces whose union stays within the allowed concavity are
+//! then merged back ([`super::merge::merge_within`]), so no cut survives that was not needed.
+//!
+//! A candidate plane is scored on a thinned copy of the piece (at most [`SCORE_SAMPLES`]
+//! surface samples and [`SCORE_EDGES`] edges): each half is the samples on its side plus the
+//! points where edges cross the plane (the section's outline), its concavity measured as in
+//! `concavity.rs` on those. Candidates are the three coordinate axes and the piece's
+//! principal axes, each at [`OFFSETS`] evenly spaced offsets and through the
+//! [`DEEPEST_SAMPLES`] surface samples deepest below the hull; the best few are
+//! refined by halving the step around them, then cut exactly, and the best exact cut is kept
+//! (the thinned score cannot tell apart cuts closer than its samples).
+//!
+//! Citation: X. Wei, M. Liu, Z. Ling, H. Su, "Approximate Convex Decomposition for 3D Meshes
+//! with Collision-Aware Concavity and Tree Search", SIGGRAPH 2022 (CoACD).
+
+use super::concavity::{Surface, concavity};
+use super::fitted::{Fitted, bounds_of};
+use super::nearest::SampleGrid;
+use super::piece::{Piece, Plane};
+use crate::geometry::ConvexPolyhedron;
+use crate::geometry::pca::{point_moments, principal_axes};
+use crate::math::DVec3;
+
+/// Most surface samples a candidate is scored on.
+const SCORE_SAMPLES: usize = 1200;
+/// Most edges whose crossings outline a candidate's section.
+const SCORE_EDGES: usize = 3000;
+/// A candidate's hull is sampled at least this fraction of the piece's extent apart.
+const SCORE_LATTICE_DIVISIONS: f64 = 8.0;
+/// Offsets tried along each axis.
+const OFFSETS: usize = 9;
+/// Refinement rounds around the best candidate (each halves the step).
+const REFINE_ROUNDS: usize = 3;
+/// Cosine above which a principal axis counts as along a coordinate axis (about 8°).
+const NEAR_PARALLEL: f64 = 0.99;
+/// Deepest samples that candidate planes are also put through.
+const DEEPEST_SAMPLES: usize = 3;
+/// Candidates cut exactly after the thinned scoring, best first.
+const EXACT_FINALISTS: usize = 4;
+/// Weight of the lesser half's concavity in a candidate's score (the greater half's is 1):
+/// among cuts that leave the same worst half, prefer the one that also flattens the other.
+const LESSER_HALF_WEIGHT: f64 = 0.25;
+
+/// Cuts the most concave piece until all are within `limit` metres or there are
+/// `max_parts`; returns the pieces (not yet merged).
+pub(super) fn cut_until(root: Fitted, limit: f64, max_parts: usize) -> Vec<Fitted> {
+    let mut pieces = vec![root];
+    // Pieces no plane could cut, set aside with their concavity.
+    let mut uncuttable = Vec::new();
+    while pieces.len() + uncuttable.len() < max_parts {
+        let Some(worst) = most_concave(&pieces) else {
+            break;
+        };
+        if pieces[worst].concavity <= limit {
+            break;
+        }
+        let piece = pieces.swap_remove(worst);
+        match best_cut(&piece, limit) {
+            Some((a, b)) => pieces.extend([a, b]),
+            None => uncuttable.push(piece),
+        }
+    }
+    pieces.extend(uncuttable);
+    pieces
+}
+
+fn most_concave(pieces: &[Fitted]) -> Option<usize> {
+    (0..pieces.len()).max_by(|&a, &b| pieces[a].concavity.total_cmp(&pieces[b].concavity))
+}
+
+/// Cuts a measured piece exactly and measures both halves.
+pub(super) fn cut_fitted(piece: &Fitted, plane: &Plane) -> Option<(Fitted, Fitted)> {
+    let (below, above) = piece.piece.cut(plane)?;
+    Some((
+        Fitted::new(below, piece.spacing)?,
+        Fitted::new(above, piece.spacing)?,
+    ))
+}
+
+/// The cut that leaves the least concavity in the halves of `piece` (see the module docs):
+/// the [`EXACT_FINALISTS`] best candidates by the thinned score, each refined, are cut
+/// exactly and the best exact result is kept.
+fn best_cut(piece: &Fitted, limit: f64) -> Option<(Fitted, Fitted)> {
+    let samples = thinned(&piece.samples, SCORE_SAMPLES);
+    let scorer = Scorer::new(piece, &samples);
+    let mut scored: Vec<(f64, Plane, f64)> = Vec::new(); // (score, plane, step)
+    let deepest = deepest_samples(piece);
+    for axis in candidate_axes(scorer.samples) {
+        let (lo, hi) = extent_along(scorer.samples, axis);
+        let step = (hi - lo) / (OFFSETS + 1) as f64;
+        if !step.is_finite() || step <= 0.0 {
+            continue;
+        }
+        let even = (1..=OFFSETS).map(|k| lo + step * k as f64);
+        let through_deepest = deepest.iter().map(|p| p.dot(axis));
+        for offset in even.chain(through_deepest) {
+            let plane = Plane {
+                normal: axis,
+                offset,
+            };
+            if let Some(score) = scorer.score(&plane) {
+                scored.push((score, plane, step));
+            }
+        }
+    }
+    scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let finalists = scored
+        .into_iter()
+        .take(EXACT_FINALISTS)
+        .map(|(score, plane, step)| refined(&scorer, score, plane, step));
+    // Near convex halves score alike up to the thinned samples' noise: the planes through
+    // the deepest sample, which a concave edge calls for, are always cut exactly too.
+    let through_deepest = deepest.first().into_iter().flat_map(|p| {
+        candidate_axes(scorer.samples)
+            .into_iter()
+            .map(move |normal| Plane {
+                normal,
+                offset: normal.dot(*p),
+            })
+    });
+    finalists
+        .chain(through_deepest)
+        .filter_map(|plane| {
+            let (a, b) = cut_fitted(piece, &plane)?;
+            Some((exact_score(&a, &b, piece.volume, limit), a, b))
+        })
+        .min_by(|x, y| x.0.total_cmp(&y.0))
+        .map(|(_, a, b)| (a, b))
+}
+
+/// The [`DEEPEST_SAMPLES`] surface samples deepest below the piece's hull: a concave edge
+/// is where a cut through it may remove the concavity whole.
+fn deepest_samples(piece: &Fitted) -> Vec<DVec3> {
+    let mut by_depth: Vec<(f64, DVec3)> = piece
+        .samples
+        .iter()
+        .filter_map(|&p| piece.hull.max_plane_distance(p).map(|d| (d, p)))
+        .collect();
+    let k = DEEPEST_SAMPLES.min(by_depth.len());
+    if k == 0 {
+        return Vec::new();
+    }
+    by_depth.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
+    by_depth[..k].iter().map(|&(_, p)| p).collect()
+}
+
+/// Moves `plane` by halving steps while the thinned score improves.
+fn refined(scorer: &Scorer, mut score: f64, mut plane: Plane, mut step: f64) -> Plane {
+    for _ in 0..REFINE_ROUNDS {
+        step *= 0.5;
+        for offset in [plane.offset - step, plane.offset + step] {
+            let moved = Plane { offset, ..plane };
+            if let Some(s) = scorer.score(&moved)
+                && s < score
+            {
+                (score, plane) = (s, moved);
+            }
+        }
+    }
+    plane
+}
+
+/// The exact score of a cut into `a` and `b`, metres (lower is better): the worse half's
+/// concavity, a quarter of the other's, less up to `limit` for the share of the piece's
+/// volume the cut finishes (halves within the limit). The last term settles near ties, as
+/// a U's first cut: taking off a large finished part leaves less to cut.
+fn exact_score(a: &Fitted, b: &Fitted, volume: f64, limit: f64) -> f64 {
+    let finished: f64 = [a, b]
+        .iter()
+        .filter(|h| h.concavity <= limit)
+        .map(|h| h.volume)
+        .sum();
+    let share = if volume > 0.0 { finished / volume } else { 0.0 };
+    a.concavity.max(b.concavity) + LESSER_HALF_WEIGHT * a.concavity.min(b.concavity)
+        - limit * share.clamp(0.0, 1.0)
+}
+
+/// The coordinate axes and the piece's principal axes, a principal axis within a few
+/// degrees of a coordinate axis left out (a model's flat faces and creases usually follow
+/// its coordinate axes; a principal axis just off one cuts them into slivers).
+fn candidate_axes(samples: &[DVec3]) -> Vec<DVec3> {
+    let axes = principal_axes(&point_moments(samples).covariance);
+    let mut candidates = vec![DVec3::X, DVec3::Y, DVec3::Z];
+    for axis in [axes.x_axis, axes.y_axis, axes.z_axis] {
+        if candidates.iter().all(|c| c.dot(axis).abs() < NEAR_PARALLEL) {
+            candidates.push(axis);
+        }
+    }
+    candidates
+}
+
+fn extent_along(points: &[DVec3], axis: DVec3) -> (f64, f64) {
+    points
+        .iter()
+        .map(|p| p.dot(axis))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
+            (lo.min(d), hi.max(d))
+        })
+}
+
+/// A thinned copy of a piece that candidate planes are scored on.
+struct Scorer<'a> {
+    samples: &'a [DVec3],
+    grid: SampleGrid<'a>,
+    edges: Vec<[DVec3; 2]>,
+    piece: &'a Piece,
+    /// Hull lattice spacing, metres: coarser than the piece's for speed.
+    spacing: f64,
+}
+
+impl<'a> Scorer<'a> {
+    fn new(piece: &'a Fitted, samples: &'a [DVec3]) -> Self {
+        let (lo, hi) = bounds_of(samples);
+        Self {
+            samples,
+            grid: SampleGrid::new(samples),
+            edges: thinned(&piece.piece.surface_edges(), SCORE_EDGES),
+            piece: &piece.piece,
+            spacing: piece
+                .spacing
+                .max((hi - lo).max_element() / SCORE_LATTICE_DIVISIONS),
+        }
+    }
+
+    /// The candidate's score, metres (lower is better); `None` when a side is empty.
+    fn score(&self, plane: &Plane) -> Option<f64> {
+        let section: Vec<DVec3> = self
+            .edges
+            .iter()
+            .filter_map(|&[p, q]| {
+                let (sp, sq) = (plane.signed_distance(p), plane.signed_distance(q));
+                ((sp <= 0.0) != (sq <= 0.0)).then(|| p + (q - p) * (sp / (sp - sq)))
+            })
+            .collect();
+        let below: Vec<bool> = self
+            .samples
+            .iter()
+            .map(|&p| plane.signed_distance(p) <= 0.0)
+            .collect();
+        let flipped = Plane {
+            normal: -plane.normal,
+            offset: -plane.offset,
+        };
+        let a = self.half_concavity(&below, true, *plane, &section)?;
+        let b = self.half_concavity(&below, false, flipped, &section)?;
+        Some(a.max(b) + LESSER_HALF_WEIGHT * a.min(b))
+    }
+
+    /// The concavity of the half on side `side` (per sample in `below`), cut off by `cut`.
+    fn half_concavity(
+        &self,
+        below: &[bool],
+        side: bool,
+        cut: Plane,
+        section: &[DVec3],
+    ) -> Option<f64> {
+        let half: Vec<DVec3> = (0..self.samples.len())
+            .filter(|&i| below[i] == side)
+            .map(|i| self.samples[i])
+            .collect();
+        if half.is_empty() {
+            return None;
+        }
+        let mut points = half.clone();
+        points.extend_from_slice(section);
+        // A half that spans no solid (a sliver) holds no concavity.
+        let Some(hull) = ConvexPolyhedron::quick_hull_triangles(&points) else {
+            return Some(0.0);
+        };
+        let surface = Surface {
+            grid: &self.grid,
+            member: &|i| below[i] == side,
+            extra: section,
+            piece: self.piece,
+            pending: Some(cut),
+            spacing: self.spacing,
+        };
+        Some(concavity(&hull, &half, &surface))
+    }
+}
+
+/// Every `len / most`-th item, so at most about `most` remain, spread over the input.
+fn thinned<T: Copy>(items: &[T], most: usize) -> Vec<T> {
+    let stride = items.len().div_ceil(most.max(1)).max(1);
+    items.iter().step_by(stride).copied().collect()
+}

@@ -1,0 +1,175 @@
+//! Pieces and cuts against analytic volumes; the repairs of `solid.rs`.
+
+use super::piece::{Piece, Plane};
+use super::solid::prepare;
+use super::{DecomposeError, Fitted};
+use crate::geometry::TriMesh;
+use crate::math::DVec3;
+use crate::test_support::meshes::{cuboid, l_prism, torus, u_prism, uv_sphere};
+use crate::test_support::{point_in_cube, rng};
+use rand::Rng;
+use std::f64::consts::PI;
+
+fn solid_piece(mesh: &TriMesh) -> Piece {
+    prepare(mesh).expect("closed test mesh").piece
+}
+
+fn random_plane(rng: &mut crate::test_support::TestRng, half: f64) -> Plane {
+    let normal = point_in_cube(rng, 1.0).normalize_or(DVec3::X);
+    Plane {
+        normal,
+        offset: normal.dot(point_in_cube(rng, half)),
+    }
+}
+
+/// Volume of the unit-radius cap of height `h` of a sphere of radius `r`.
+fn cap_volume(r: f64, h: f64) -> f64 {
+    PI * h * h * (3.0 * r - h) / 3.0
+}
+
+#[test]
+fn a_cut_splits_the_volume_exactly_and_keeps_each_half_closed() {
+    let mut r = rng(3301);
+    let meshes = [
+        torus(1.0, 0.3, 48, 24),
+        uv_sphere(1.0, 32, 16),
+        u_prism().translated(DVec3::new(-1.5, -1.0, -0.5)),
+    ];
+    let (mut cut, mut missed) = (0, 0);
+    for mesh in &meshes {
+        let whole = solid_piece(mesh);
+        let total = whole.volume();
+        for _ in 0..60 {
+            let plane = random_plane(&mut r, 1.2);
+            let Some((below, above)) = whole.cut(&plane) else {
+                missed += 1;
+                continue;
+            };
+            cut += 1;
+            let (a, b) = (below.volume(), above.volume());
+            assert!(a > 0.0 && b > 0.0, "both halves hold volume: {a} {b}");
+            assert!(
+                (a + b - total).abs() <= 1e-12 * total,
+                "{a} + {b} ≠ {total}"
+            );
+            assert_eq!(below.forced_caps + above.forced_caps, 0);
+            // Cutting a half again by a second plane also adds up: the caps are closed.
+            let second = random_plane(&mut r, 1.2);
+            if let Some((c, d)) = below.cut(&second) {
+                assert!((c.volume() + d.volume() - a).abs() <= 1e-12 * total);
+            }
+        }
+    }
+    assert!(cut > 100 && missed > 0, "cut {cut}, missed {missed}");
+}
+
+#[test]
+fn sphere_caps_have_their_analytic_volume() {
+    // A fine UV sphere's volume is below the sphere's by its facets: compare ratios.
+    let sphere = solid_piece(&uv_sphere(1.0, 256, 128));
+    let total = sphere.volume();
+    for h in [0.2, 0.7, 1.0, 1.5] {
+        let plane = Plane {
+            normal: DVec3::Z,
+            offset: 1.0 - h,
+        };
+        let (_, above) = sphere.cut(&plane).expect("plane through the sphere");
+        let ratio = above.volume() / total;
+        let analytic = cap_volume(1.0, h) / (4.0 / 3.0 * PI);
+        assert!(
+            (ratio - analytic).abs() < 2e-3,
+            "h {h}: {ratio} vs {analytic}"
+        );
+    }
+}
+
+#[test]
+fn the_corner_where_three_cuts_meet_inside_is_on_the_hull() {
+    // The box octant's corner at the centre is on no input triangle: only the caps bring it.
+    let mut piece = solid_piece(&cuboid(DVec3::ONE));
+    for normal in [DVec3::X, DVec3::Y, DVec3::Z] {
+        piece = piece
+            .cut(&Plane {
+                normal,
+                offset: 0.0,
+            })
+            .expect("cut")
+            .0;
+    }
+    let octant = Fitted::new(piece, 0.01).expect("octant");
+    assert!((octant.volume - 1.0).abs() < 1e-12);
+    assert!((octant.hull.volume() - 1.0).abs() < 1e-9);
+    assert!(octant.hull.contains_point(DVec3::ZERO));
+    // Sampled distances carry the sample spacing (0.01 m) as a floor.
+    assert!(octant.concavity < 0.01, "{}", octant.concavity);
+}
+
+#[test]
+fn an_l_prism_is_concave_until_cut_at_its_bend() {
+    let l = Fitted::new(solid_piece(&l_prism()), 0.01).expect("L");
+    // The notch edge (1, 1, z) is 1/√2 below the hull's diagonal face and z from its bottom
+    // (1 − z from its top): deepest at mid-height, 1/2, which the sample lattice holds.
+    assert!((l.concavity - 0.5).abs() < 1e-9, "{}", l.concavity);
+    let plane = Plane {
+        normal: DVec3::X,
+        offset: 1.0,
+    };
+    let (a, b) = l.piece.cut(&plane).expect("cut");
+    for half in [a, b] {
+        let concavity = Fitted::new(half, 0.01).expect("half").concavity;
+        assert!(concavity < 0.01, "{concavity}");
+    }
+}
+
+#[test]
+fn a_triangle_soup_is_welded_and_a_hole_closed() {
+    let cube = cuboid(DVec3::splat(0.5));
+    // Unweld every triangle, then take one away.
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for t in cube.triangles().iter().skip(1) {
+        let base = vertices.len() as u32;
+        vertices.extend(t.map(|i| cube.vertices()[i as usize]));
+        triangles.push([base, base + 1, base + 2]);
+    }
+    let soup = TriMesh::try_new(vertices, triangles).expect("soup");
+    let solid = prepare(&soup).expect("repairable");
+    assert_eq!(solid.repairs.welded_vertices, 33 - 8);
+    assert_eq!(solid.repairs.holes_closed, 1);
+    assert!((solid.piece.volume() - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn flipped_triangles_are_turned_and_an_inside_out_mesh_too() {
+    let cube = cuboid(DVec3::splat(0.5));
+    let mut r = rng(3302);
+    let mut flipped: Vec<[u32; 3]> = cube.triangles().to_vec();
+    for t in flipped.iter_mut() {
+        if r.random_bool(0.4) {
+            t.swap(1, 2);
+        }
+    }
+    let everted: Vec<[u32; 3]> = cube
+        .triangles()
+        .iter()
+        .map(|t| [t[0], t[2], t[1]])
+        .collect();
+    for triangles in [flipped, everted] {
+        let mesh = TriMesh::try_new(cube.vertices().to_vec(), triangles).expect("mesh");
+        let solid = prepare(&mesh).expect("repairable");
+        assert!((solid.piece.volume() - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn a_flat_mesh_is_not_a_solid() {
+    let square = TriMesh::try_new(
+        vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
+        vec![[0, 1, 2], [0, 2, 3]],
+    )
+    .expect("square");
+    assert!(matches!(
+        prepare(&square).err(),
+        Some(DecomposeError::NotSolid { .. })
+    ));
+}
