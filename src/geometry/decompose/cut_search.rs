@@ -193,7 +193,8 @@ fn candidate_axes(samples: &[DVec3]) -> Vec<DVec3> {
     candidates
 }
 
-fn extent_along(points: &[DVec3], axis: DVec3) -> (f64, f64) {
+/// The least and greatest of `points` along `axis`, metres.
+pub(super) fn extent_along(points: &[DVec3], axis: DVec3) -> (f64, f64) {
     points
         .iter()
         .map(|p| p.dot(axis))

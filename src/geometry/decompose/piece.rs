@@ -22,7 +22,7 @@
 //! from its signed distance (`≤ 0` below), so both pieces and all loops agree on it.
 
 use crate::math::DVec3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// An oriented plane, `normal · x = offset` (metres); "below" is `normal · x ≤ offset`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -139,13 +139,13 @@ impl Piece {
     /// The edges of the surface loops, each once (as `(low, high)` point indices), with the
     /// points they join: what a candidate cut crosses.
     pub fn surface_edges(&self) -> Vec<[DVec3; 2]> {
-        let mut seen: HashMap<(u32, u32), ()> = HashMap::new();
+        let mut seen: HashSet<(u32, u32)> = HashSet::new();
         let mut edges = Vec::new();
         for l in self.loops.iter().filter(|l| l.surface) {
             let corners = self.loop_corners(*l);
             for (k, &a) in corners.iter().enumerate() {
                 let b = corners[(k + 1) % corners.len()];
-                if seen.insert((a.min(b), a.max(b)), ()).is_none() {
+                if seen.insert((a.min(b), a.max(b))) {
                     edges.push([self.points[a as usize], self.points[b as usize]]);
                 }
             }

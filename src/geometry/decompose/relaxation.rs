@@ -8,12 +8,11 @@
 //!    neighbour whose union fills the most of its hull, while the hull's empty fraction
 //!    stays within the threshold; then down to the part count.
 
-use super::cut_search::cut_fitted;
+use super::cut_search::{cut_fitted, extent_along};
 use super::fitted::Fitted;
 use super::merge::merge_by_volume;
 use super::piece::Plane;
 use crate::geometry::pca::{point_moments, principal_axes};
-use crate::math::DVec3;
 
 /// Leaves the split aims for, per allowed part.
 const LEAVES_PER_PART: usize = 4;
@@ -57,17 +56,9 @@ pub(super) fn relax(
 fn box_split(piece: &Fitted) -> Option<Plane> {
     let points = piece.hull.vertices();
     let axes = principal_axes(&point_moments(points).covariance);
-    let extent = |axis: DVec3| {
-        points
-            .iter()
-            .map(|p| p.dot(axis))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| {
-                (lo.min(d), hi.max(d))
-            })
-    };
     let (axis, (lo, hi)) = [axes.x_axis, axes.y_axis, axes.z_axis]
         .into_iter()
-        .map(|a| (a, extent(a)))
+        .map(|a| (a, extent_along(points, a)))
         .max_by(|a, b| (a.1.1 - a.1.0).total_cmp(&(b.1.1 - b.1.0)))?;
     (hi > lo).then_some(Plane {
         normal: axis,
