@@ -277,13 +277,14 @@ fn kind_name(shape: &Shape) -> &'static str {
         Shape::Cone(_) => "cone",
         Shape::Convex(_) => "hull",
         Shape::Mesh(_) => "mesh",
+        Shape::Compound(_) => "compound",
     }
 }
 
 /// Canonical rank of a kind name (the dispatcher's order), to name a pair's kinds once.
 fn kind_rank(name: &str) -> usize {
     [
-        "sphere", "capsule", "box", "cylinder", "cone", "hull", "mesh",
+        "sphere", "capsule", "box", "cylinder", "cone", "hull", "mesh", "compound",
     ]
     .iter()
     .position(|k| *k == name)

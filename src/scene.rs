@@ -740,7 +740,7 @@ fn check_margin(margin: f64) -> Result<(), SceneError> {
 mod tests {
     use super::*;
     use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere};
-    use crate::narrow::MeshShape;
+    use crate::narrow::{CompoundShape, MeshShape};
     use crate::test_support::{meshes, pose, rng};
     use std::sync::Arc;
 
@@ -771,6 +771,10 @@ mod tests {
         let mut s = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
         let torus = meshes::torus(1.0, 0.25, 24, 12);
         let points: Vec<DVec3> = torus.vertices().to_vec();
+        let shifted: Vec<DVec3> = points
+            .iter()
+            .map(|&p| p + DVec3::new(3.0, 0.0, 1.0))
+            .collect();
         let shapes = [
             Shape::Sphere(Sphere::new(0.5)),
             Shape::Capsule(Capsule::new(1.0, 0.25)),
@@ -781,6 +785,13 @@ mod tests {
                 ConvexPolyhedron::try_from_points(&points).unwrap(),
             )),
             Shape::Mesh(Arc::new(MeshShape::new(torus.clone()))),
+            Shape::Compound(Arc::new(
+                CompoundShape::from_hulls(vec![
+                    ConvexPolyhedron::try_from_points(&points).unwrap(),
+                    ConvexPolyhedron::try_from_points(&shifted).unwrap(),
+                ])
+                .unwrap(),
+            )),
         ];
         let ids: Vec<ShapeId> = shapes
             .into_iter()
@@ -810,6 +821,7 @@ mod tests {
                     DVec3::Z * c.half_height,
                 ],
                 Shape::Convex(_) | Shape::Mesh(_) => points.clone(),
+                Shape::Compound(_) => [points.clone(), shifted.clone()].concat(),
             };
             let iso = b.pose.to_isometry();
             for p in local {

@@ -12,23 +12,8 @@ mod support;
 use proxima::decompose::{DecomposeError, Decomposition, Method, Options, decompose};
 use proxima::geometry::TriMesh;
 use proxima::math::DVec3;
-use support::meshes::{self, cuboid, l_prism, torus, u_prism, uv_sphere};
+use support::meshes::{self, cuboid, l_prism, torus, u_prism, uv_sphere, winding_number};
 use support::{point_in_cube, rng};
-
-/// Generalised winding number of the closed `mesh` about `p` (solid angles, Van Oosterom and
-/// Strackee): 1 inside, 0 outside.
-fn winding_number(mesh: &TriMesh, p: DVec3) -> f64 {
-    let mut total = 0.0;
-    for i in 0..mesh.triangle_count() {
-        let t = mesh.triangle(i);
-        let (a, b, c) = (t.a - p, t.b - p, t.c - p);
-        let (la, lb, lc) = (a.length(), b.length(), c.length());
-        let numerator = a.dot(b.cross(c));
-        let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-        total += 2.0 * numerator.atan2(denominator);
-    }
-    total / (4.0 * std::f64::consts::PI)
-}
 
 fn in_union(d: &Decomposition, p: DVec3) -> bool {
     d.parts.iter().any(|part| part.hull.contains_point(p))

@@ -74,6 +74,7 @@ fn total(reports: &[StepReport]) -> PathCounts {
             epa: t.epa + r.paths.epa,
             convex_mesh: t.convex_mesh + r.paths.convex_mesh,
             mesh_mesh: t.mesh_mesh + r.paths.mesh_mesh,
+            compound: t.compound + r.paths.compound,
         })
 }
 

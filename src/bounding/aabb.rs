@@ -96,6 +96,18 @@ impl Aabb {
         }
     }
 
+    /// The eight corners; corner `i` takes `max` on axis `k` when bit `k` of `i` is set.
+    #[must_use]
+    pub fn corners(&self) -> [DVec3; 8] {
+        std::array::from_fn(|i| {
+            DVec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            )
+        })
+    }
+
     /// The enclosing box of `points`, padded by the slack of their largest coordinate.
     fn fit_iter(points: impl Iterator<Item = DVec3>) -> Self {
         let mut min = DVec3::INFINITY;

@@ -9,8 +9,10 @@
 //! | a cylinder, cone or convex hull with any convex shape | GJK on the cores (stopped once a support plane proves the pair beyond the limit), EPA when they overlap ([`crate::narrow::gjk`]) | one point, the distance's witnesses, against a sphere; else reference-face clipping of the shapes' contact features from the distance's normal, ≤ 4 points ([`crate::narrow::convex_manifold`]) |
 //! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`crate::narrow::convex_mesh`]) |
 //! | mesh–mesh | [`Route::MeshMesh`]: the BVH tandem queries with warm starts and the worker pool | intersection segments, reduced |
+//! | a compound with anything | the part pairs the part tree cannot rule out, each by its row above, the smallest ([`crate::narrow::compound`]) | every touching part pair's manifold, reduced under the deepest one's normal |
 //!
-//! Canonical order: sphere < capsule < cuboid < cylinder < cone < convex < mesh. GJK is
+//! Canonical order: sphere < capsule < cuboid < cylinder < cone < convex < mesh < compound,
+//! except that a compound is always answered as A (its queries take any B). GJK is
 //! symmetric, so its pairs are answered in the order given.
 //!
 //! # Meshes are surfaces
@@ -21,6 +23,7 @@
 
 use crate::budget::WorkClock;
 use crate::math::{DVec3, Isometry, Pose};
+use crate::narrow::compound::{self, query::CompoundScratch};
 use crate::narrow::contact::{DistanceBound, Manifold, Reached, ShapeDistance};
 use crate::narrow::convex_manifold::{ManifoldScratch, manifold_convex_convex_in};
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
@@ -65,6 +68,8 @@ pub struct PathCounts {
     pub convex_mesh: u32,
     /// Mesh–mesh BVH tandem queries.
     pub mesh_mesh: u32,
+    /// Compound queries (their part pairs are counted by their own paths too).
+    pub compound: u32,
 }
 
 impl PathCounts {
@@ -90,9 +95,11 @@ pub struct NarrowScratch {
     pub(crate) mesh_contacts: MeshContactScratch,
     /// The buffers of the convex pairs' clipped manifolds (boxed: 22 KB).
     manifold: Box<ManifoldScratch>,
+    /// The compound queries' candidate part pairs and gathered points.
+    pub(crate) compound: CompoundScratch,
 }
 
-/// Every convex kind, as a pattern (every kind but the mesh).
+/// Every convex kind, as a pattern (every kind but the mesh and the compound).
 macro_rules! convex {
     () => {
         Shape::Sphere(_)
@@ -109,7 +116,7 @@ pub enum Route<'s> {
     /// Two meshes: the BVH tandem queries (warm starts, worker pool, manifold of the
     /// intersection set).
     MeshMesh(&'s Arc<MeshShape>, &'s Arc<MeshShape>),
-    /// Everything else: [`distance`] and [`manifold`].
+    /// Everything else (a compound's part pairs included): [`distance`] and [`manifold`].
     Direct,
 }
 
@@ -117,7 +124,10 @@ pub enum Route<'s> {
 pub fn route<'s>(a: &'s Shape, b: &'s Shape) -> Route<'s> {
     match (a, b) {
         (Shape::Mesh(ma), Shape::Mesh(mb)) => Route::MeshMesh(ma, mb),
-        (convex!(), convex!() | Shape::Mesh(_)) | (Shape::Mesh(_), convex!()) => Route::Direct,
+        (convex!(), convex!() | Shape::Mesh(_))
+        | (Shape::Mesh(_), convex!())
+        | (Shape::Compound(_), _)
+        | (_, Shape::Compound(_)) => Route::Direct,
     }
 }
 
@@ -185,8 +195,14 @@ pub fn distance_within(
     limit: f64,
     scratch: &mut NarrowScratch,
 ) -> Reached {
-    use Shape::Mesh as M;
+    use Shape::{Compound as K, Mesh as M};
     match (a, b) {
+        (K(compound), _) => {
+            scratch.paths.compound += 1;
+            compound::query::distance_within(compound, b, pose_ab, limit, scratch)
+        }
+        (_, K(_)) => distance_within(b, a, &pose_ab.inverse(), limit, scratch)
+            .flipped(&pose_ab.to_isometry()),
         (convex!(), convex!()) => convex_reach(a, b, &pose_ab.to_isometry(), limit, scratch),
         (convex!(), M(mesh)) => {
             scratch.paths.convex_mesh += 1;
@@ -249,7 +265,7 @@ fn convex_reach(
     limit: f64,
     scratch: &mut NarrowScratch,
 ) -> Reached {
-    use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
+    use Shape::{Capsule as C, Compound as K, Cuboid as B, Mesh as M, Sphere as S};
     let paths = &mut scratch.paths;
     let closed = |paths: &mut PathCounts, d| {
         paths.closed_form += 1;
@@ -293,7 +309,9 @@ fn convex_reach(
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
             convex_distance(a, b, pose_ab, limit, scratch)
         }
-        (M(_), _) | (_, M(_)) => distance_within(a, b, &pose_ab.to_pose(), limit, scratch),
+        (M(_) | K(_), _) | (_, M(_) | K(_)) => {
+            distance_within(a, b, &pose_ab.to_pose(), limit, scratch)
+        }
     }
 }
 
@@ -310,10 +328,11 @@ pub fn manifold(
     scratch: &mut NarrowScratch,
     out: &mut Manifold,
 ) {
-    use Shape::Mesh as M;
+    use Shape::{Compound as K, Mesh as M};
     match (a, b) {
+        (K(compound), _) => compound::query::manifold(compound, b, pose_ab, d, scratch, out),
         (convex!(), convex!()) => manifold_convex(a, b, &pose_ab.to_isometry(), d, scratch, out),
-        (M(_), convex!()) => {
+        (M(_), convex!()) | (_, K(_)) => {
             let pose_ba = pose_ab.inverse();
             let d_ba = d.flipped(&pose_ba.to_isometry());
             manifold(b, a, &pose_ba, &d_ba, scratch, out);
@@ -335,7 +354,7 @@ pub fn manifold_convex(
     scratch: &mut NarrowScratch,
     out: &mut Manifold,
 ) {
-    use Shape::{Capsule as C, Cuboid as B, Mesh as M, Sphere as S};
+    use Shape::{Capsule as C, Compound as K, Cuboid as B, Mesh as M, Sphere as S};
     out.reset(DVec3::ZERO);
     match (a, b) {
         (C(x), C(y)) => pairs::manifold_capsule_capsule(x, y, pose_ab, out),
@@ -361,7 +380,9 @@ pub fn manifold_convex(
             let (fa, fb) = (features_of(a), features_of(b));
             manifold_convex_convex_in(fa, fb, pose_ab, d, &mut scratch.manifold, out);
         }
-        (M(_), _) | (_, M(_)) => manifold(a, b, &pose_ab.to_pose(), d, scratch, out),
+        (M(_) | K(_), _) | (_, M(_) | K(_)) => {
+            manifold(a, b, &pose_ab.to_pose(), d, scratch, out);
+        }
     }
 }
 

@@ -18,6 +18,7 @@
 //! twice. Degenerate sets shrink the output: all points equal → 1 point, all on one line → 2.
 
 use crate::math::DVec3;
+use crate::narrow::contact::{Manifold, ManifoldPoint};
 
 /// Sets up to this many points get the exact farthest pair (quadratic); larger sets the
 /// linear double sweep.
@@ -63,6 +64,50 @@ pub fn reduce_manifold(points: &[DVec3], out: &mut Vec<usize>) {
     if added > 0.0 {
         out.push(i3);
     }
+}
+
+/// One manifold out of contact points that carry their own normals (the triangles of a
+/// mesh, the part pairs of a compound), into `out`: the deepest point's normal becomes the
+/// manifold's, [`reduce_manifold`] picks at most four points by their A positions, the
+/// deepest always among them, and a point of another normal gets its depth along the
+/// common one (its B point moved onto that normal through its A point). `normals[i]` is
+/// point `i`'s; `positions` and `kept` are scratch. Returns `false`, leaving `out` as it
+/// was, when there is no point.
+pub(crate) fn reduce_under_deepest(
+    points: &[ManifoldPoint],
+    normals: &[DVec3],
+    positions: &mut Vec<DVec3>,
+    kept: &mut Vec<usize>,
+    out: &mut Manifold,
+) -> bool {
+    let Some(deepest) =
+        (0..points.len()).min_by(|&i, &j| points[i].distance.total_cmp(&points[j].distance))
+    else {
+        return false;
+    };
+    let normal = normals[deepest];
+    out.reset(normal);
+    positions.clear();
+    positions.extend(points.iter().map(|p| p.point_a));
+    reduce_manifold(positions, kept);
+    if !kept.contains(&deepest) {
+        kept.pop();
+        kept.insert(0, deepest);
+    }
+    for &i in kept.iter() {
+        let p = points[i];
+        if normals[i] == normal {
+            out.push(p);
+        } else {
+            let distance = (p.point_b - p.point_a).dot(normal).min(0.0);
+            out.push(ManifoldPoint {
+                point_a: p.point_a,
+                point_b: p.point_a + distance * normal,
+                distance,
+            });
+        }
+    }
+    true
 }
 
 /// The farthest pair's indices (exact up to [`EXACT_DIAMETER_POINTS`] points, else the

@@ -20,6 +20,9 @@
 //! [`convex_manifold`] builds multi-point manifolds for the GJK pairs from their signed
 //! distance (reference-face clipping over each shape's contact features).
 //!
+//! [`compound`] answers solids made of convex parts (a convex decomposition's hulls),
+//! part pair by part pair.
+//!
 //! [`convex_mesh`] walks a mesh's BVH for a convex shape; [`toi`] finds the time of impact
 //! over a frame's motion by conservative advancement, on any of these distance queries.
 //!
@@ -27,6 +30,7 @@
 //! segment or point they span.
 
 mod closest_points;
+pub mod compound;
 pub mod contact;
 pub mod convex_manifold;
 pub mod convex_mesh;
@@ -42,6 +46,7 @@ pub mod toi;
 mod triangle_overlap;
 pub mod triangle_triangle;
 
+pub use compound::{CompoundError, CompoundShape};
 pub use contact::{
     DistanceBound, MANIFOLD_POINTS, Manifold, ManifoldPoint, Reached, ShapeDistance,
 };

@@ -1,6 +1,6 @@
 //! The shape set every pair query matches on: [`Shape`], one variant per kind, in the
 //! canonical order the dispatcher writes pairs in (sphere < capsule < cuboid < cylinder <
-//! cone < convex < mesh), and [`MeshShape`], a triangle mesh with everything its queries
+//! cone < convex < mesh < compound), and [`MeshShape`], a triangle mesh with everything its queries
 //! need, built once when it is registered.
 
 use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
@@ -10,6 +10,7 @@ use crate::geometry::mesh::MeshEdges;
 use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
 use crate::geometry::{Segment, SupportMap};
 use crate::math::{DVec3, Isometry, Pose};
+use crate::narrow::CompoundShape;
 use crate::narrow::convex_manifold::ContactFeatures;
 use crate::narrow::gjk::POINT;
 use crate::narrow::mesh_hull::MeshHull;
@@ -225,6 +226,8 @@ pub enum Shape {
     Convex(Arc<ConvexPolyhedron>),
     /// A triangle mesh with its BVHs.
     Mesh(Arc<MeshShape>),
+    /// A solid made of convex parts, with the tree of their boxes.
+    Compound(Arc<CompoundShape>),
 }
 
 impl Shape {
@@ -243,6 +246,7 @@ impl Shape {
                 let (min, max) = m.mesh.bounds();
                 Aabb::new(min, max)
             }
+            Self::Compound(c) => c.local_bounds(),
         }
     }
 }
@@ -304,7 +308,7 @@ impl SupportMap for Core<'_> {
     }
 }
 
-/// The core and radius of a convex shape; `None` for a mesh.
+/// The core and radius of a convex shape; `None` for a mesh or a compound.
 #[must_use]
 pub fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
     Some(match shape {
@@ -314,7 +318,7 @@ pub fn core_of(shape: &Shape) -> Option<(Core<'_>, f64)> {
         Shape::Cylinder(c) => (Core::Cylinder(c), 0.0),
         Shape::Cone(c) => (Core::Cone(c), 0.0),
         Shape::Convex(c) => (Core::Convex(c.as_ref()), 0.0),
-        Shape::Mesh(_) => return None,
+        Shape::Mesh(_) | Shape::Compound(_) => return None,
     })
 }
 
@@ -327,7 +331,9 @@ pub(crate) fn features_of(shape: &Shape) -> &dyn ContactFeatures {
         Shape::Cylinder(c) => c,
         Shape::Cone(c) => c,
         Shape::Convex(c) => c.as_ref(),
-        Shape::Mesh(_) => unreachable!("the dispatcher sends only convex pairs here"),
+        Shape::Mesh(_) | Shape::Compound(_) => {
+            unreachable!("the dispatcher sends only convex pairs here")
+        }
     }
 }
 
@@ -355,22 +361,6 @@ mod tests {
         assert_eq!(pair(QueryVolume::Rss, QueryVolume::Obb), QueryVolume::Rss);
     }
 
-    /// The smallest distance over every triangle pair, in f64: the oracle.
-    fn brute_force(a: &TriMesh, b: &TriMesh, pose_ab: &Pose) -> f64 {
-        let iso = pose_ab.to_isometry();
-        let moved: Vec<_> = (0..b.triangle_count())
-            .map(|j| b.triangle(j).transformed(&iso))
-            .collect();
-        (0..a.triangle_count())
-            .flat_map(|i| {
-                let ta = a.triangle(i);
-                moved
-                    .iter()
-                    .map(move |tb| crate::narrow::distance_triangle_triangle(&ta, tb).distance)
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
-
     /// The exact queries refine the trees the pair's volume names (OBBs for two slabs, RSSs
     /// when a ball is in the pair) and answer as the brute force over every triangle pair
     /// does, with the RSS trees' rounding bound on either path; `proximity` agrees with the
@@ -394,7 +384,7 @@ mod tests {
             let mut cache = DistanceCache::new();
             for case in 0..100 {
                 let pose_ab = pose(&mut r, 0.9);
-                let truth = brute_force(&a.mesh, &b.mesh, &pose_ab);
+                let truth = meshes::brute_force_distance(&a.mesh, &b.mesh, &pose_ab);
                 let d = a.distance_to(b, &pose_ab, &mut cache, &mut workspace);
                 let iso = pose_ab.to_isometry();
                 let rounding = rounding_bound(&a.distance_tree, &b.distance_tree, &iso);

@@ -104,7 +104,8 @@ pub(super) fn pair_toi(
     let params = ToiParams {
         tolerance: TOI_TOLERANCE,
         max_iterations: MAX_ITERATIONS,
-        convex: !matches!(sa, Shape::Mesh(_)) && !matches!(sb, Shape::Mesh(_)),
+        convex: !matches!(sa, Shape::Mesh(_) | Shape::Compound(_))
+            && !matches!(sb, Shape::Mesh(_) | Shape::Compound(_)),
     };
     // The gap to contact (distance minus margins) at two world poses, world frame. The
     // limit is infinite: an upper bound of the distance would not be a safe step.

@@ -13,7 +13,8 @@
 
 use super::{TestRng, point_in_cube};
 use proxima::geometry::{TriMesh, Triangle};
-use proxima::math::DVec3;
+use proxima::math::{DVec3, Pose};
+use proxima::narrow::distance_triangle_triangle;
 use rand::Rng;
 use rand::seq::SliceRandom;
 use std::collections::HashMap;
@@ -22,6 +23,38 @@ use std::path::PathBuf;
 /// A mesh from vertices and index triples the generators made (valid by construction).
 pub fn mesh(vertices: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> TriMesh {
     TriMesh::try_new(vertices, triangles).expect("procedural mesh is valid")
+}
+
+/// Generalised winding number of the closed `mesh` about `p` (solid angles, Van Oosterom
+/// and Strackee): 1 inside, 0 outside. An oracle independent of every query.
+pub fn winding_number(mesh: &TriMesh, p: DVec3) -> f64 {
+    let mut total = 0.0;
+    for i in 0..mesh.triangle_count() {
+        let t = mesh.triangle(i);
+        let (a, b, c) = (t.a - p, t.b - p, t.c - p);
+        let (la, lb, lc) = (a.length(), b.length(), c.length());
+        let numerator = a.dot(b.cross(c));
+        let denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+        total += 2.0 * numerator.atan2(denominator);
+    }
+    total / (4.0 * std::f64::consts::PI)
+}
+
+/// The smallest distance over every triangle pair of `a` and `b` placed by `pose_ab`, in
+/// f64: the brute-force oracle of mesh distance.
+pub fn brute_force_distance(a: &TriMesh, b: &TriMesh, pose_ab: &Pose) -> f64 {
+    let iso = pose_ab.to_isometry();
+    let moved: Vec<Triangle> = (0..b.triangle_count())
+        .map(|j| b.triangle(j).transformed(&iso))
+        .collect();
+    (0..a.triangle_count())
+        .flat_map(|i| {
+            let ta = a.triangle(i);
+            moved
+                .iter()
+                .map(move |tb| distance_triangle_triangle(&ta, tb).distance)
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// The triangles of `mesh`, in its own order (index `i` is triangle id `i`).

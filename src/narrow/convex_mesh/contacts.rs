@@ -36,7 +36,7 @@
 //! longer touch are dropped — plus, for a face normal, the shape's deepest point along it
 //! when it lies over that face. The triangle contacts are then merged as before: the
 //! deepest point's normal for the manifold, at most
-//! [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS) points by [`reduce_manifold`]; a
+//! [`MANIFOLD_POINTS`](crate::narrow::MANIFOLD_POINTS) points by [`reduce_manifold`](crate::narrow::reduce_manifold); a
 //! point of another face keeps its A point and gets its depth along the common normal
 //! (its B point then lies on that normal through the A point, as the contract asks).
 //!
@@ -60,8 +60,8 @@ use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, Reached, ShapeDistance};
 use crate::narrow::dispatch::{GJK, NarrowScratch};
 use crate::narrow::gjk::{EpaWorkspace, GjkCache, Rounded, signed_distance_convex};
+use crate::narrow::manifold_reduction::reduce_under_deepest;
 use crate::narrow::pairs;
-use crate::narrow::reduce_manifold;
 use crate::narrow::shape::core_of;
 use crate::narrow::{MeshShape, Shape};
 use std::ops::ControlFlow;
@@ -289,36 +289,10 @@ pub(crate) fn shape_mesh_manifold(
             },
         );
     }
-    let Some(deepest) =
-        (0..points.len()).min_by(|&i, &j| points[i].distance.total_cmp(&points[j].distance))
-    else {
+    // A ridge's or a valley's points of another face get their depth along the deepest
+    // point's normal.
+    if !reduce_under_deepest(points, normals, positions, kept, out) {
         out.set_from_distance(d);
-        return;
-    };
-    let normal = normals[deepest];
-    out.reset(normal);
-    positions.clear();
-    positions.extend(points.iter().map(|p| p.point_a));
-    reduce_manifold(positions, kept);
-    // The deepest point always stays.
-    if !kept.contains(&deepest) {
-        kept.pop();
-        kept.insert(0, deepest);
-    }
-    for &i in kept.iter() {
-        let p = points[i];
-        if normals[i] == normal {
-            out.push(p);
-        } else {
-            // A point of another face (a ridge or a valley): its depth along the common
-            // normal, its B point moved onto that normal through its A point.
-            let distance = (p.point_b - p.point_a).dot(normal).min(0.0);
-            out.push(ManifoldPoint {
-                point_a: p.point_a,
-                point_b: p.point_a + distance * normal,
-                distance,
-            });
-        }
     }
 }
 
@@ -608,7 +582,11 @@ pub fn shape_triangle_distance(
         Shape::Sphere(s) => pairs::distance_sphere_triangle(s, triangle, &identity),
         Shape::Capsule(c) => pairs::distance_capsule_triangle(c, triangle, &identity),
         Shape::Cuboid(b) => pairs::distance_cuboid_triangle(b, triangle, &identity),
-        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
+        Shape::Cylinder(_)
+        | Shape::Cone(_)
+        | Shape::Convex(_)
+        | Shape::Mesh(_)
+        | Shape::Compound(_) => {
             let Some((core, radius)) = core_of(shape) else {
                 unreachable!("meshes are not convex shapes");
             };
@@ -639,7 +617,11 @@ pub fn shape_triangle_manifold(
         Shape::Sphere(s) => pairs::manifold_sphere_triangle(s, triangle, &identity, out),
         Shape::Capsule(c) => pairs::manifold_capsule_triangle(c, triangle, &identity, out),
         Shape::Cuboid(b) => pairs::manifold_cuboid_triangle(b, triangle, &identity, out),
-        Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
+        Shape::Cylinder(_)
+        | Shape::Cone(_)
+        | Shape::Convex(_)
+        | Shape::Mesh(_)
+        | Shape::Compound(_) => {
             let d = shape_triangle_distance(shape, triangle, epa);
             out.set_from_distance(&d);
         }
@@ -669,9 +651,11 @@ impl ShapeBound for Rss {
                 let h = b.half_extents;
                 Rss::new(DVec3::ZERO, DMat3::IDENTITY, [h.x, h.y], h.z)
             }
-            Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_) | Shape::Mesh(_) => {
-                Rss::fit_points(&box_corners(shape))
-            }
+            Shape::Cylinder(_)
+            | Shape::Cone(_)
+            | Shape::Convex(_)
+            | Shape::Mesh(_)
+            | Shape::Compound(_) => Rss::fit_points(&shape.local_bounds().corners()),
         }
     }
 }
@@ -682,18 +666,6 @@ impl ShapeBound for Obb {
         let local = shape.local_bounds();
         Obb::new(local.center(), DMat3::IDENTITY, local.half_extents())
     }
-}
-
-/// The corners of a shape's local box.
-fn box_corners(shape: &Shape) -> [DVec3; 8] {
-    let local = shape.local_bounds();
-    std::array::from_fn(|i| {
-        DVec3::new(
-            if i & 1 == 0 { local.min.x } else { local.max.x },
-            if i & 2 == 0 { local.min.y } else { local.max.y },
-            if i & 4 == 0 { local.min.z } else { local.max.z },
-        )
-    })
 }
 
 #[cfg(test)]
