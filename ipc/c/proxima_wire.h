@@ -34,7 +34,7 @@ extern "C" {
 
 /** Protocol version. A client and a daemon whose versions differ refuse to talk (Hello
  *  answers ProtocolMismatch); every record carries it. */
-#define PROXIMA_PROTOCOL_VERSION UINT32_C(10)
+#define PROXIMA_PROTOCOL_VERSION UINT32_C(11)
 
 /* iceoryx2 matches services by name and by each type's name, size and alignment: declare
  * the types with exactly these names (C: the *_type_details setters; C++: IOX2_TYPE_NAME). */
@@ -176,6 +176,8 @@ extern "C" {
 #define PROXIMA_MAX_CONTACTS_PER_PAIR 4
 /** Bytes of ControlReply.reason. */
 #define PROXIMA_REASON_BYTES 112
+/** Most parts of a Compound or DecomposedMesh shape. */
+#define PROXIMA_MAX_COMPOUND_PARTS 1024
 
 /** Outcome of a frame (ResultFrameHeader.status) or a request (ControlReply.status). */
 typedef enum proxima_ErrorCode {
@@ -253,7 +255,12 @@ typedef enum proxima_ShapeKindCode {
     /** Convex hull of vertex_count points in the payload. */
     PROXIMA_SHAPE_KIND_CONVEX = 5,
     /** vertex_count points, then index_count indices (three per triangle). */
-    PROXIMA_SHAPE_KIND_MESH = 6
+    PROXIMA_SHAPE_KIND_MESH = 6,
+    /** vertex_count points, then index_count part sizes; each part the hull of its points. */
+    PROXIMA_SHAPE_KIND_COMPOUND = 7,
+    /** A closed mesh (payload as MESH) the daemon decomposes into a compound:
+        [max_concavity, max_parts, method, 0]. */
+    PROXIMA_SHAPE_KIND_DECOMPOSED_MESH = 8
 } proxima_ShapeKindCode;
 
 /** ControlRequest.motion. Static bodies never pair with each other. */

@@ -110,6 +110,41 @@ pub enum ShapeState {
     Ready,
 }
 
+/// How the daemon decomposes a mesh registered with
+/// [`Client::register_decomposed_mesh`] ([`ShapeKindCode::DecomposedMesh`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Decomposition {
+    /// Largest concavity of a part, relative to the mesh's bounding-box diagonal; 0 for
+    /// the daemon's default (0.02).
+    pub max_concavity: f64,
+    /// Most parts, up to [`MAX_COMPOUND_PARTS`](crate::wire::MAX_COMPOUND_PARTS); 0 for
+    /// the daemon's default (64).
+    pub max_parts: u32,
+    /// `false`: the concavity-driven cut search (quality first); `true`: relaxation
+    /// (faster, looser).
+    pub fast: bool,
+}
+
+impl Default for Decomposition {
+    /// The daemon's defaults, quality first.
+    fn default() -> Self {
+        Self {
+            max_concavity: 0.0,
+            max_parts: 0,
+            fast: false,
+        }
+    }
+}
+
+impl Decomposition {
+    /// The request's `dimensions`: `[max_concavity, max_parts, method, 0]`.
+    #[must_use]
+    pub fn to_wire(self) -> [f64; 4] {
+        let method = if self.fast { 1.0 } else { 0.0 };
+        [self.max_concavity, f64::from(self.max_parts), method, 0.0]
+    }
+}
+
 /// A primitive shape, dimensions in metres in the shape's local frame; round shapes' axes
 /// run along local Z.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -590,7 +625,52 @@ impl<S: Service> Client<S> {
         scene: u32,
         points: &[[f64; 3]],
     ) -> Result<Registration, ControlError> {
-        self.register_geometry(scene, ShapeKindCode::Convex, points, &[])
+        self.register_geometry(scene, ShapeKindCode::Convex, [0.0; 4], points, &[])
+    }
+
+    /// Registers a solid made of convex parts, each the hull of its points (metres, the
+    /// shape's local frame), and waits until the daemon has built it; returns the shape id.
+    /// Its contacts report true penetration depth, part pair by part pair.
+    ///
+    /// # Errors
+    /// See [`ControlError`]; [`ControlError::TooLarge`] beyond `u32::MAX` points or parts
+    /// (the daemon takes at most
+    /// [`MAX_COMPOUND_PARTS`](crate::wire::MAX_COMPOUND_PARTS) parts);
+    /// [`ControlError::BuildTimeout`] when it is not built within the build timeout.
+    pub fn register_compound(
+        &self,
+        scene: u32,
+        parts: &[&[[f64; 3]]],
+    ) -> Result<u32, ControlError> {
+        let points: Vec<[f64; 3]> = parts.iter().flat_map(|p| p.iter().copied()).collect();
+        let sizes = parts
+            .iter()
+            .map(|p| u32::try_from(p.len()).map_err(|_| ControlError::TooLarge(p.len())))
+            .collect::<Result<Vec<u32>, _>>()?;
+        let kind = ShapeKindCode::Compound;
+        let registration = self.register_geometry(scene, kind, [0.0; 4], &points, &sizes)?;
+        self.wait_registered(scene, registration)
+    }
+
+    /// Registers a closed triangle mesh (as [`register_mesh`](Self::register_mesh)) that
+    /// the daemon decomposes into convex parts as `how` says, answered as that compound
+    /// (true penetration depth); waits until it is built (a decomposition takes seconds to
+    /// a minute: set the build timeout accordingly) and returns the shape id.
+    ///
+    /// # Errors
+    /// As [`register_mesh`](Self::register_mesh); a mesh that encloses no volume is
+    /// [`ControlError::Rejected`] with `InvalidShape`.
+    pub fn register_decomposed_mesh(
+        &self,
+        scene: u32,
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        how: Decomposition,
+    ) -> Result<u32, ControlError> {
+        let kind = ShapeKindCode::DecomposedMesh;
+        let indices = triangles.as_flattened();
+        let registration = self.register_geometry(scene, kind, how.to_wire(), vertices, indices)?;
+        self.wait_registered(scene, registration)
     }
 
     /// Registers a triangle mesh (vertices in metres, the shape's local frame; triangles as
@@ -624,7 +704,8 @@ impl<S: Service> Client<S> {
         vertices: &[[f64; 3]],
         triangles: &[[u32; 3]],
     ) -> Result<Registration, ControlError> {
-        self.register_geometry(scene, ShapeKindCode::Mesh, vertices, triangles)
+        let indices = triangles.as_flattened();
+        self.register_geometry(scene, ShapeKindCode::Mesh, [0.0; 4], vertices, indices)
     }
 
     /// Whether shape `shape` of scene `scene` is built.
@@ -797,23 +878,26 @@ impl<S: Service> Client<S> {
         }
     }
 
-    /// Registers a convex or mesh shape with its geometry payload.
+    /// Registers a shape with a geometry payload: `vertices`, then `indices` (a mesh's
+    /// vertex indices, a compound's part sizes).
     fn register_geometry(
         &self,
         scene: u32,
         kind: ShapeKindCode,
+        dimensions: [f64; 4],
         vertices: &[[f64; 3]],
-        triangles: &[[u32; 3]],
+        indices: &[u32],
     ) -> Result<Registration, ControlError> {
         let count = |n: usize| u32::try_from(n).map_err(|_| ControlError::TooLarge(n));
         let header = ControlRequest {
             shape_kind: kind as u32,
+            dimensions,
             vertex_count: count(vertices.len())?,
-            index_count: count(triangles.len() * 3)?,
+            index_count: count(indices.len())?,
             ..self.header(Command::RegisterShape, scene)
         };
-        let len = geometry_len(vertices.len(), triangles.len() * 3);
-        let fill = |out: &mut [u8]| encode_geometry(out, vertices, triangles);
+        let len = geometry_len(vertices.len(), indices.len());
+        let fill = |out: &mut [u8]| encode_geometry(out, vertices, indices);
         let (reply, _) =
             self.request_until(&header, len, fill, Instant::now() + self.reply_timeout)?;
         let (shape, flags) = accepted(&reply)?;
@@ -909,14 +993,14 @@ const fn geometry_len(vertices: usize, indices: usize) -> usize {
 
 /// Writes the geometry payload (see [`ControlRequest`]) into `out`, which is exactly
 /// [`geometry_len`] bytes long.
-fn encode_geometry(out: &mut [u8], vertices: &[[f64; 3]], triangles: &[[u32; 3]]) {
-    debug_assert_eq!(out.len(), geometry_len(vertices.len(), triangles.len() * 3));
-    let (points, indices) = out.split_at_mut(vertices.len() * 24);
+fn encode_geometry(out: &mut [u8], vertices: &[[f64; 3]], indices: &[u32]) {
+    debug_assert_eq!(out.len(), geometry_len(vertices.len(), indices.len()));
+    let (points, index_bytes) = out.split_at_mut(vertices.len() * 24);
     let coordinates = vertices.iter().flatten();
     for (dst, x) in points.chunks_exact_mut(8).zip(coordinates) {
         dst.copy_from_slice(&x.to_ne_bytes());
     }
-    for (dst, i) in indices.chunks_exact_mut(4).zip(triangles.iter().flatten()) {
+    for (dst, i) in index_bytes.chunks_exact_mut(4).zip(indices) {
         dst.copy_from_slice(&i.to_ne_bytes());
     }
 }

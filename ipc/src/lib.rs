@@ -41,7 +41,7 @@ use iceoryx2::service::service_name::{ServiceName, ServiceNameError};
 
 /// The protocol version. A client and a daemon whose versions differ refuse to talk; bump it
 /// on any change to a wire record's layout or meaning.
-pub const PROTOCOL_VERSION: u32 = 10;
+pub const PROTOCOL_VERSION: u32 = 11;
 
 /// The default root prefix of every service name (`<root>/control`, `<root>/scene-<token>/poses`…).
 pub const DEFAULT_ROOT: &str = "proxima";

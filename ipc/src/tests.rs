@@ -115,7 +115,7 @@ fn every_command_shape_kind_and_motion_survives_the_wire_and_unknown_values_are_
     );
     assert_eq!(
         count(&|v| wire::ShapeKindCode::from_u32(v).map(|c| c as u32)),
-        7
+        9
     );
     assert_eq!(
         count(&|v| wire::MotionCode::from_u32(v).map(|c| c as u32)),

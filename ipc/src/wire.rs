@@ -502,7 +502,23 @@ pub enum ShapeKindCode {
     /// A triangle mesh: `vertex_count` points, then `index_count` vertex indices (three per
     /// triangle) in the payload.
     Mesh = 6,
+    /// A solid made of convex parts: `vertex_count` points, then `index_count` part sizes
+    /// (points per part, each at least 1, summing to `vertex_count`; at most
+    /// [`MAX_COMPOUND_PARTS`] parts) in the payload; each part is the convex hull of its
+    /// points. Contacts report true penetration depth (since protocol version 11).
+    Compound = 7,
+    /// A closed triangle mesh (payload as [`Mesh`](Self::Mesh)) that the daemon decomposes
+    /// into convex parts and answers as their [`Compound`](Self::Compound):
+    /// `dimensions = [max_concavity, max_parts, method, 0]`, `max_concavity` relative to
+    /// the mesh's bounding-box diagonal (0: 0.02), `max_parts` a whole number up to
+    /// [`MAX_COMPOUND_PARTS`] (0: 64), `method` 0 for the concavity-driven cut search
+    /// (quality first) or 1 for relaxation (faster). A mesh that encloses no volume is
+    /// refused with `InvalidShape` (since protocol version 11).
+    DecomposedMesh = 8,
 }
+
+/// The most parts a [`ShapeKindCode::Compound`] or [`ShapeKindCode::DecomposedMesh`] has.
+pub const MAX_COMPOUND_PARTS: u32 = 1024;
 
 impl Command {
     /// The command for a wire value, `None` for values this version does not define.
@@ -535,6 +551,8 @@ impl ShapeKindCode {
             4 => Self::Cone,
             5 => Self::Convex,
             6 => Self::Mesh,
+            7 => Self::Compound,
+            8 => Self::DecomposedMesh,
             _ => return None,
         })
     }

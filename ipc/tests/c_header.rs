@@ -259,7 +259,7 @@ fn table() -> Table {
     codes!(t, Command, "PROXIMA_COMMAND_": Hello, CreateScene, DropScene, RegisterShape,
         AddBody, RemoveBody, UpdateBody, SetSceneParams, ShapeState);
     codes!(t, ShapeKindCode, "PROXIMA_SHAPE_KIND_": Sphere, Capsule, Cuboid, Cylinder, Cone,
-        Convex, Mesh);
+        Convex, Mesh, Compound, DecomposedMesh);
     codes!(t, MotionCode, "PROXIMA_MOTION_": Static, Kinematic, Dynamic);
     codes!(t, BroadPhaseCode, "PROXIMA_BROAD_PHASE_": Auto, SortAndSweep, IncrementalSap,
         HashGrid, ColumnGrid, SkinGrid);
@@ -286,6 +286,7 @@ fn table() -> Table {
     constant!(t, wire::stage::COUNT => "PROXIMA_STAGE_COUNT");
     constant!(t, wire::MAX_CONTACTS_PER_PAIR => "PROXIMA_MAX_CONTACTS_PER_PAIR");
     constant!(t, wire::REASON_BYTES => "PROXIMA_REASON_BYTES");
+    constant!(t, wire::MAX_COMPOUND_PARTS => "PROXIMA_MAX_COMPOUND_PARTS");
 
     constant!(t, ipc::PROTOCOL_VERSION => "PROXIMA_PROTOCOL_VERSION");
     constant!(t, ipc::CONTROL_MAX_CLIENTS => "PROXIMA_CONTROL_MAX_CLIENTS");
@@ -781,15 +782,18 @@ fn the_header_compiles_cleanly_as_c99_and_as_cxx98_to_cxx20() {
     // A C and C++ program that uses a record, a code and a flag, and checks them at run time.
     std::fs::write(
         &source,
-        "#include \"proxima_wire.h\"\n\
-         #include \"proxima_wire.h\" /* the include guard holds */\n\
-         int main(void) {\n\
-             proxima_PoseFrameHeader h;\n\
-             h.protocol_version = PROXIMA_PROTOCOL_VERSION;\n\
-             h.query_flags = PROXIMA_QUERY_CLOSE | PROXIMA_QUERY_CONTACTS;\n\
-             return (h.protocol_version == 10 && h.query_flags == 10\n\
-                     && PROXIMA_ERROR_SCENE_RELEASED == 15) ? 0 : 1;\n\
-         }\n",
+        format!(
+            "#include \"proxima_wire.h\"\n\
+             #include \"proxima_wire.h\" /* the include guard holds */\n\
+             int main(void) {{\n\
+                 proxima_PoseFrameHeader h;\n\
+                 h.protocol_version = PROXIMA_PROTOCOL_VERSION;\n\
+                 h.query_flags = PROXIMA_QUERY_CLOSE | PROXIMA_QUERY_CONTACTS;\n\
+                 return (h.protocol_version == {} && h.query_flags == 10\n\
+                         && PROXIMA_ERROR_SCENE_RELEASED == 15) ? 0 : 1;\n\
+             }}\n",
+            proxima_ipc::PROTOCOL_VERSION
+        ),
     )
     .unwrap();
     let strict = ["-Wall", "-Wextra", "-pedantic", "-Werror"];

@@ -579,6 +579,10 @@ fn port_settings_event_ids_and_constants_are_the_codes() {
             wire::MAX_CONTACTS_PER_PAIR.to_string(),
         ),
         ("REASON_BYTES".to_owned(), wire::REASON_BYTES.to_string()),
+        (
+            "MAX_COMPOUND_PARTS".to_owned(),
+            wire::MAX_COMPOUND_PARTS.to_string(),
+        ),
     ]);
     assert_eq!(constants, expected, "other constants");
 }

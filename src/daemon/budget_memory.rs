@@ -41,7 +41,7 @@ pub fn geometry_estimate(geometry: &GeometryRequest) -> u64 {
         u64::from(geometry.vertex_count),
         u64::from(geometry.index_count),
     );
-    if geometry.mesh {
+    if geometry.kind.is_mesh() {
         (indices / 3) * MESH_BYTES_PER_TRIANGLE + vertices * MESH_BYTES_PER_VERTEX
     } else {
         vertices * CONVEX_BYTES_PER_POINT

@@ -575,6 +575,93 @@ fn a_mesh_refuses_bodies_until_it_is_built_and_a_primitive_is_ready_at_once() {
     );
 }
 
+/// A compound of convex parts and a decomposed closed mesh build like meshes; part sizes
+/// that do not add up, an empty part, a mesh with no volume and undefined decomposition
+/// options are refused with their codes, the first two and the last at once.
+#[test]
+fn compounds_and_decomposed_meshes_build_or_say_why_not() {
+    let (mut state, jobs) = state_with(DaemonConfig::default(), 8);
+    let scene = state.handle(OWNER, &request(Command::CreateScene), &[]).id;
+    let shifted: Vec<[f64; 3]> = TETRA.iter().map(|p| [p[0] + 2.0, p[1], p[2]]).collect();
+    let points = [TETRA.to_vec(), shifted].concat();
+    let register = |state: &mut ControlState, kind: ShapeKindCode, dims, sizes: &[u32]| {
+        let header = ControlRequest {
+            shape_kind: kind as u32,
+            dimensions: dims,
+            ..mesh_request(scene, points.len(), sizes.len())
+        };
+        state.handle(OWNER, &header, &mesh_payload(&points, sizes))
+    };
+    let compound = register(&mut state, ShapeKindCode::Compound, [0.0; 4], &[4, 4]);
+    let uneven = register(&mut state, ShapeKindCode::Compound, [0.0; 4], &[3, 4]);
+    let empty_part = register(&mut state, ShapeKindCode::Compound, [0.0; 4], &[8, 0]);
+    let decompose = |state: &mut ControlState, dims: [f64; 4], indices: &[u32]| {
+        let header = ControlRequest {
+            shape_kind: ShapeKindCode::DecomposedMesh as u32,
+            dimensions: dims,
+            ..mesh_request(scene, 4, indices.len())
+        };
+        state.handle(OWNER, &header, &mesh_payload(&TETRA, indices))
+    };
+    let decomposed = decompose(&mut state, [0.05, 8.0, 1.0, 0.0], &TETRA_INDICES);
+    let flat = decompose(&mut state, [0.0; 4], &TETRA_INDICES[..3]);
+    for (reply, what) in [
+        (&compound, "compound"),
+        (&uneven, "uneven"),
+        (&empty_part, "empty part"),
+        (&decomposed, "decomposed"),
+        (&flat, "flat"),
+    ] {
+        assert_eq!(
+            (code(reply), reply.flags),
+            (ErrorCode::Ok, reply_flags::SHAPE_BUILDING),
+            "{what}: {}",
+            reply.reason()
+        );
+    }
+    for dims in [
+        [-0.1, 0.0, 0.0, 0.0],
+        [f64::NAN, 0.0, 0.0, 0.0],
+        [0.0, 2.5, 0.0, 0.0],
+        [0.0, 2000.0, 0.0, 0.0],
+        [0.0, 0.0, 2.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ] {
+        let refused = decompose(&mut state, dims, &TETRA_INDICES);
+        assert_eq!(code(&refused), ErrorCode::InvalidShape, "{dims:?}");
+    }
+    let too_many = register(
+        &mut state,
+        ShapeKindCode::Compound,
+        [0.0; 4],
+        &[1; 1025][..],
+    );
+    assert_eq!(
+        code(&too_many),
+        ErrorCode::LimitExceeded,
+        "{}",
+        too_many.reason()
+    );
+
+    assert_eq!(build_all(&jobs), 5);
+    for (reply, expected) in [
+        (&compound, ErrorCode::Ok),
+        (&uneven, ErrorCode::MalformedMessage),
+        (&empty_part, ErrorCode::MalformedMessage),
+        (&decomposed, ErrorCode::Ok),
+        (&flat, ErrorCode::InvalidShape),
+    ] {
+        let built = shape_state(&mut state, scene, reply.id);
+        assert_eq!(code(&built), expected, "{}", built.reason());
+    }
+    let cell = lock(state.scene(scene).unwrap());
+    let parts = |id: u32| match cell.scene.shape(cell.shapes.usable(id).unwrap()) {
+        Some(crate::narrow::Shape::Compound(c)) => c.parts().len(),
+        other => panic!("shape {id}: {other:?}"),
+    };
+    assert_eq!((parts(compound.id), parts(decomposed.id)), (2, 1));
+}
+
 /// Every command that names a scene, as a request on `scene` (shape or body 0).
 fn scene_commands(scene: u32) -> Vec<ControlRequest> {
     [

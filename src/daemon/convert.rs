@@ -2,12 +2,13 @@
 //! takes untrusted input and returns either a value the engine may trust or a
 //! [`Rejection`] naming the wire error code and the reason.
 
+use crate::geometry::decompose;
 use crate::geometry::{
     Capsule, Cone, ConvexHullError, ConvexPolyhedron, Cuboid, Cylinder, MeshError, MeshLimits,
     Sphere, TriMesh,
 };
 use crate::math::{DQuat, DVec3, Pose};
-use crate::narrow::{MeshShape, Shape};
+use crate::narrow::{CompoundShape, MeshShape, Shape};
 use crate::pipeline::Query;
 use crate::scene::{CollisionFilter, Motion};
 use proxima_ipc::wire::{self, ControlRequest, ErrorCode, MotionCode, ShapeKindCode, query};
@@ -100,15 +101,41 @@ pub enum ShapeRequest {
     Geometry(GeometryRequest),
 }
 
-/// A convex or mesh registration whose counts are within the limits and whose payload
-/// length matches them (see [`shape_request`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What a geometry registration builds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GeometryKind {
+    /// The convex hull of the points.
+    Convex,
+    /// A triangle mesh.
+    Mesh,
+    /// Convex parts: the indices are the number of points of each part.
+    Compound,
+    /// A closed triangle mesh, decomposed into convex parts with these options.
+    Decomposed(decompose::Options),
+}
+
+impl GeometryKind {
+    /// Whether the indices are triangles' vertex indices.
+    #[must_use]
+    pub fn is_mesh(self) -> bool {
+        matches!(self, Self::Mesh | Self::Decomposed(_))
+    }
+}
+
+/// The most triangles of a [`ShapeKindCode::DecomposedMesh`]: a decomposition of a
+/// 70,000-triangle mesh takes about a minute on the builder thread.
+pub const MAX_DECOMPOSED_TRIANGLES: usize = 200_000;
+
+/// A geometry registration whose counts are within the limits and whose payload length
+/// matches them (see [`shape_request`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeometryRequest {
-    /// Whether the points are a convex hull's or a mesh's.
-    pub mesh: bool,
+    /// What the points and indices make.
+    pub kind: GeometryKind,
     /// Points in the payload.
     pub vertex_count: u32,
-    /// Indices after the points (a multiple of 3; none for a convex shape).
+    /// `u32` entries after the points: vertex indices (a multiple of 3) of a mesh, part
+    /// sizes of a compound, none for a convex shape.
     pub index_count: u32,
 }
 
@@ -150,8 +177,100 @@ pub fn shape_request(
         ShapeKindCode::Cylinder => primitive(Cylinder::try_new(d1, d0).map(Shape::Cylinder)),
         ShapeKindCode::Cone => primitive(Cone::try_new(d1, d0).map(Shape::Cone)),
         ShapeKindCode::Convex => convex_request(request, payload_len, max_convex_points),
-        ShapeKindCode::Mesh => mesh_request(request, payload_len, mesh_limits),
+        ShapeKindCode::Mesh => mesh_request(request, payload_len, mesh_limits, GeometryKind::Mesh),
+        ShapeKindCode::Compound => compound_request(request, payload_len, max_convex_points),
+        ShapeKindCode::DecomposedMesh => {
+            let options = decompose_options(request.dimensions)?;
+            if request.index_count as usize / 3 > MAX_DECOMPOSED_TRIANGLES {
+                return Err(Rejection::new(
+                    ErrorCode::LimitExceeded,
+                    format!(
+                        "{} triangles; a decomposed mesh has at most {MAX_DECOMPOSED_TRIANGLES}",
+                        request.index_count / 3
+                    ),
+                ));
+            }
+            mesh_request(
+                request,
+                payload_len,
+                mesh_limits,
+                GeometryKind::Decomposed(options),
+            )
+        }
     }
+}
+
+/// The decomposition options of a [`ShapeKindCode::DecomposedMesh`]'s `dimensions`:
+/// `[max_concavity, max_parts, method, 0]`, zeros for the defaults.
+fn decompose_options(dimensions: [f64; 4]) -> Result<decompose::Options, Rejection> {
+    let [concavity, parts, method, unused] = dimensions;
+    let bad = |what: String| Err(Rejection::new(ErrorCode::InvalidShape, what));
+    let defaults = decompose::Options::default();
+    if !(concavity.is_finite() && concavity >= 0.0) {
+        return bad(format!(
+            "max_concavity {concavity} is not a finite number ≥ 0"
+        ));
+    }
+    let max_parts = f64::from(wire::MAX_COMPOUND_PARTS);
+    if !(parts >= 0.0 && parts <= max_parts && parts.fract() == 0.0) {
+        return bad(format!(
+            "max_parts {parts} is not a whole number in 0..={max_parts}"
+        ));
+    }
+    let method = match method {
+        0.0 => decompose::Method::CutSearch,
+        1.0 => decompose::Method::Relaxation,
+        _ => {
+            return bad(format!(
+                "method {method} is neither 0 (cut search) nor 1 (relaxation)"
+            ));
+        }
+    };
+    if unused != 0.0 {
+        return bad(format!("dimensions[3] is {unused}, not 0"));
+    }
+    Ok(decompose::Options {
+        method,
+        max_concavity: if concavity == 0.0 {
+            defaults.max_concavity
+        } else {
+            concavity
+        },
+        // A whole number in 0..=MAX_COMPOUND_PARTS, checked above.
+        max_parts: if parts == 0.0 {
+            defaults.max_parts
+        } else {
+            parts as usize
+        },
+        ..defaults
+    })
+}
+
+/// A compound registration: at most `max_points` points in all and
+/// [`MAX_COMPOUND_PARTS`](wire::MAX_COMPOUND_PARTS) parts, as many points as the part
+/// sizes say.
+fn compound_request(
+    request: &ControlRequest,
+    payload_len: usize,
+    max_points: u32,
+) -> Result<ShapeRequest, Rejection> {
+    if request.vertex_count > max_points || request.index_count > wire::MAX_COMPOUND_PARTS {
+        return Err(Rejection::new(
+            ErrorCode::LimitExceeded,
+            format!(
+                "{} points in {} parts, the limits are {max_points} and {}",
+                request.vertex_count,
+                request.index_count,
+                wire::MAX_COMPOUND_PARTS
+            ),
+        ));
+    }
+    check_payload_len(request.vertex_count, request.index_count, payload_len)?;
+    Ok(ShapeRequest::Geometry(GeometryRequest {
+        kind: GeometryKind::Compound,
+        vertex_count: request.vertex_count,
+        index_count: request.index_count,
+    }))
 }
 
 /// A convex registration: at most `max_points` points, no indices.
@@ -174,17 +293,19 @@ fn convex_request(
         ));
     }
     Ok(ShapeRequest::Geometry(GeometryRequest {
-        mesh: false,
+        kind: GeometryKind::Convex,
         vertex_count: request.vertex_count,
         index_count: 0,
     }))
 }
 
-/// A mesh registration: index triples, vertex and triangle counts within `limits`.
+/// A mesh registration (of `kind`, a mesh or a decomposed one): index triples, vertex and
+/// triangle counts within `limits`.
 fn mesh_request(
     request: &ControlRequest,
     payload_len: usize,
     limits: &MeshLimits,
+    kind: GeometryKind,
 ) -> Result<ShapeRequest, Rejection> {
     // The limits first, from the header alone: nothing sized by the client is touched.
     let (vertices, triangles) = (
@@ -208,7 +329,7 @@ fn mesh_request(
         ));
     }
     Ok(ShapeRequest::Geometry(GeometryRequest {
-        mesh: true,
+        kind,
         vertex_count: request.vertex_count,
         index_count: request.index_count,
     }))
@@ -237,56 +358,99 @@ fn check_payload_len(
 
 /// Decodes and builds the shape of a checked registration ([`shape_request`]) from its
 /// `payload`: the hull of a convex shape's points, a mesh (checked against `mesh_limits`)
-/// with its BVHs. O(n log n) and more: the builder thread's work.
+/// with its BVHs, a compound of its parts' hulls, or a closed mesh's decomposition. O(n log
+/// n) and more (a decomposition: seconds to a minute): the builder thread's work.
 pub fn geometry_shape(
     geometry: GeometryRequest,
     payload: &[u8],
     mesh_limits: &MeshLimits,
 ) -> Result<Shape, Rejection> {
     let (points, indices) = decode(geometry, payload)?;
-    if geometry.mesh {
-        mesh(points, &indices, mesh_limits)
-    } else {
-        convex(&points)
+    match geometry.kind {
+        GeometryKind::Convex => convex(&points).map(|hull| Shape::Convex(Arc::new(hull))),
+        GeometryKind::Mesh => {
+            trimesh(points, &indices, mesh_limits).map(|m| Shape::Mesh(Arc::new(MeshShape::new(m))))
+        }
+        GeometryKind::Compound => compound(&points, &indices),
+        GeometryKind::Decomposed(options) => decomposed(points, &indices, mesh_limits, &options),
     }
 }
 
-/// The convex hull of `points`.
-fn convex(points: &[DVec3]) -> Result<Shape, Rejection> {
-    ConvexPolyhedron::try_from_points(points)
-        .map(|hull| Shape::Convex(Arc::new(hull)))
-        .map_err(|e| {
-            // A coordinate beyond the limit is a bad shape, not a size limit (the number of
-            // points was checked against the limit before decoding).
-            let code = match e {
-                ConvexHullError::Empty => ErrorCode::EmptyGeometry,
-                ConvexHullError::NonFinite { .. } | ConvexHullError::TooLarge { .. } => {
-                    ErrorCode::InvalidShape
-                }
-            };
-            Rejection::new(code, e.to_string())
-        })
+/// The compound of the hulls of consecutive runs of `points`, `sizes[i]` points each.
+fn compound(points: &[DVec3], sizes: &[u32]) -> Result<Shape, Rejection> {
+    let total: u64 = sizes.iter().map(|&n| u64::from(n)).sum();
+    if total != points.len() as u64 || sizes.contains(&0) {
+        return Err(Rejection::new(
+            ErrorCode::MalformedMessage,
+            format!(
+                "the part sizes sum to {total} for {} points, or a part has none",
+                points.len()
+            ),
+        ));
+    }
+    let mut rest = points;
+    let mut hulls = Vec::with_capacity(sizes.len());
+    for &n in sizes {
+        let (part, after) = rest.split_at(n as usize);
+        rest = after;
+        hulls.push(convex(part)?);
+    }
+    CompoundShape::from_hulls(hulls)
+        .map(|c| Shape::Compound(Arc::new(c)))
+        .map_err(|e| Rejection::new(ErrorCode::EmptyGeometry, e.to_string()))
 }
 
-/// A triangle mesh of `vertices` and index triples `indices`, with its BVHs.
-fn mesh(vertices: Vec<DVec3>, indices: &[u32], limits: &MeshLimits) -> Result<Shape, Rejection> {
+/// The compound of the convex decomposition of a closed mesh.
+fn decomposed(
+    vertices: Vec<DVec3>,
+    indices: &[u32],
+    limits: &MeshLimits,
+    options: &decompose::Options,
+) -> Result<Shape, Rejection> {
+    let mesh = trimesh(vertices, indices, limits)?;
+    let parts = decompose::decompose(&mesh, options)
+        .map_err(|e| Rejection::new(ErrorCode::InvalidShape, e.to_string()))?;
+    CompoundShape::from_decomposition(&parts)
+        .map(|c| Shape::Compound(Arc::new(c)))
+        .map_err(|e| Rejection::new(ErrorCode::InvalidShape, e.to_string()))
+}
+
+/// The convex hull of `points`.
+fn convex(points: &[DVec3]) -> Result<ConvexPolyhedron, Rejection> {
+    ConvexPolyhedron::try_from_points(points).map_err(|e| {
+        // A coordinate beyond the limit is a bad shape, not a size limit (the number of
+        // points was checked against the limit before decoding).
+        let code = match e {
+            ConvexHullError::Empty => ErrorCode::EmptyGeometry,
+            ConvexHullError::NonFinite { .. } | ConvexHullError::TooLarge { .. } => {
+                ErrorCode::InvalidShape
+            }
+        };
+        Rejection::new(code, e.to_string())
+    })
+}
+
+/// A triangle mesh of `vertices` and index triples `indices`.
+fn trimesh(
+    vertices: Vec<DVec3>,
+    indices: &[u32],
+    limits: &MeshLimits,
+) -> Result<TriMesh, Rejection> {
     let triangles = indices
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])
         .collect();
-    TriMesh::try_new_with_limits(vertices, triangles, limits)
-        .map(|mesh| Shape::Mesh(Arc::new(MeshShape::new(mesh))))
-        .map_err(|e| {
-            let code = match e {
-                MeshError::Empty => ErrorCode::EmptyGeometry,
-                MeshError::IndexOutOfRange { .. } => ErrorCode::MeshIndexOutOfRange,
-                MeshError::TooManyVertices { .. } | MeshError::TooManyTriangles { .. } => {
-                    ErrorCode::LimitExceeded
-                }
-                _ => ErrorCode::InvalidShape,
-            };
-            Rejection::new(code, e.to_string())
-        })
+    TriMesh::try_new_with_limits(vertices, triangles, limits).map_err(|e| {
+        let code = match e {
+            MeshError::Empty => ErrorCode::EmptyGeometry,
+            MeshError::IndexOutOfRange { .. } => ErrorCode::MeshIndexOutOfRange,
+            MeshError::TooManyVertices { .. } | MeshError::TooManyTriangles { .. } => {
+                ErrorCode::LimitExceeded
+            }
+            _ => ErrorCode::InvalidShape,
+        };
+        Rejection::new(code, e.to_string())
+    })
 }
 
 /// Decodes the geometry payload: `vertex_count` points, then `index_count` indices.

@@ -480,7 +480,8 @@ class Client:
     def register_convex_no_wait(self, scene: int, points: Any) -> Registration:
         """Registers a convex hull like :meth:`register_convex`, returning once the daemon
         accepted the points; geometry refused while building is told by :meth:`shape_state`."""
-        return self._register_geometry(scene, ShapeKindCode.CONVEX, points, ())
+        v, t = _geometry(points, ())
+        return self._register_geometry(scene, ShapeKindCode.CONVEX, v, t.ravel())
 
     def register_mesh(self, scene: int, vertices: Any, triangles: Any) -> int:
         """Registers a triangle mesh (vertices ``(n, 3)`` metres, triangles ``(m, 3)``
@@ -495,7 +496,46 @@ class Client:
     def register_mesh_no_wait(self, scene: int, vertices: Any, triangles: Any) -> Registration:
         """Registers a mesh like :meth:`register_mesh`, returning once the daemon accepted
         the geometry, before its BVHs are built."""
-        return self._register_geometry(scene, ShapeKindCode.MESH, vertices, triangles)
+        v, t = _geometry(vertices, triangles)
+        return self._register_geometry(scene, ShapeKindCode.MESH, v, t.ravel())
+
+    def register_compound(self, scene: int, parts: Sequence[Any]) -> int:
+        """Registers a solid made of convex parts, each the hull of its points (``(n_i, 3)``
+        arrays, metres, local frame), and waits until it is built; returns the shape id.
+        Its contacts report true penetration depth, part pair by part pair.
+
+        Raises:
+            BuildTimeout: not built within the build timeout.
+            DaemonError: refused (e.g. :class:`LimitExceededError` beyond
+                :data:`~proxima_client.wire.MAX_COMPOUND_PARTS` parts).
+        """
+        arrays = [_geometry(p, ())[0] for p in parts]
+        v = np.concatenate(arrays) if arrays else np.zeros((0, 3))
+        sizes = np.array([len(a) for a in arrays], dtype=np.uint32)
+        registration = self._register_geometry(scene, ShapeKindCode.COMPOUND, v, sizes)
+        return self._wait_registered(scene, registration)
+
+    def register_decomposed_mesh(self, scene: int, vertices: Any, triangles: Any, *,
+                                 max_concavity: float = 0.0, max_parts: int = 0,
+                                 fast: bool = False) -> int:
+        """Registers a closed triangle mesh (as :meth:`register_mesh`) that the daemon
+        decomposes into convex parts, answered as that compound (true penetration depth);
+        waits until built (seconds to a minute: set the build timeout accordingly) and
+        returns the shape id. ``max_concavity`` is relative to the mesh's bounding-box
+        diagonal (0: the daemon's 0.02), ``max_parts`` at most
+        :data:`~proxima_client.wire.MAX_COMPOUND_PARTS` (0: 64); ``fast`` chooses
+        relaxation over the quality-first cut search.
+
+        Raises:
+            BuildTimeout: not built within the build timeout.
+            DaemonError: refused (:class:`InvalidShapeError` for a mesh enclosing no
+                volume or undefined options).
+        """
+        v, t = _geometry(vertices, triangles)
+        dimensions = (float(max_concavity), float(max_parts), 1.0 if fast else 0.0, 0.0)
+        registration = self._register_geometry(scene, ShapeKindCode.DECOMPOSED_MESH, v,
+                                               t.ravel(), dimensions)
+        return self._wait_registered(scene, registration)
 
     def shape_state(self, scene: int, shape: int) -> ShapeState:
         """Whether shape ``shape`` of scene ``scene`` is built.
@@ -603,12 +643,15 @@ class Client:
         """One request with an empty payload; the reply's id on success."""
         return check_reply(self.request(header))[0]
 
-    def _register_geometry(self, scene: int, kind: ShapeKindCode, vertices: Any,
-                           triangles: Any) -> Registration:
-        """Registers a convex or mesh shape with its geometry payload; the registration."""
-        v, t = _geometry(vertices, triangles)
+    def _register_geometry(self, scene: int, kind: ShapeKindCode, v: np.ndarray, t: np.ndarray,
+                           dimensions: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0),
+                           ) -> Registration:
+        """Registers a shape with its geometry payload: the points ``v`` (float64
+        ``(n, 3)``), then the u32 entries ``t`` (a mesh's indices, a compound's part sizes);
+        the registration."""
         header = self._header(Command.REGISTER_SHAPE, scene)
         header.shape_kind = int(kind)
+        header.dimensions[:] = list(dimensions)
         header.vertex_count = len(v)
         header.index_count = t.size
         v_bytes, t_bytes = v.nbytes, t.nbytes

@@ -33,13 +33,16 @@ from typing import Any
 import numpy as np
 
 #: The protocol version; a client and a daemon whose versions differ refuse to talk.
-PROTOCOL_VERSION: int = 10
+PROTOCOL_VERSION: int = 11
 
 #: Most contact records per pair (one manifold).
 MAX_CONTACTS_PER_PAIR: int = 4
 
 #: Bytes of :attr:`ControlReply.reason`.
 REASON_BYTES: int = 112
+
+#: Most parts of a ``COMPOUND`` or ``DECOMPOSED_MESH`` shape.
+MAX_COMPOUND_PARTS: int = 1024
 
 #: ``u32::MAX``: the ``id`` of a failure reply, the ``error_body`` of a frame without one.
 U32_MAX: int = 0xFFFF_FFFF
@@ -163,6 +166,13 @@ class ShapeKindCode(enum.IntEnum):
     CONVEX = 5
     #: ``vertex_count`` points, then ``index_count`` u32 indices, in the payload.
     MESH = 6
+    #: ``vertex_count`` points, then ``index_count`` u32 part sizes; each part is the
+    #: convex hull of its points.
+    COMPOUND = 7
+    #: A closed mesh (payload as ``MESH``) the daemon decomposes into a compound:
+    #: ``[max_concavity, max_parts, method, 0]`` (0 = defaults 0.02 and 64; method 0 cut
+    #: search, 1 relaxation).
+    DECOMPOSED_MESH = 8
 
 
 class MotionCode(enum.IntEnum):

@@ -212,6 +212,41 @@ def test_a_geometry_payload_that_disagrees_with_its_counts_is_malformed(client: 
         check_reply(client.request(header, CUBE[:4].tobytes()))
 
 
+#: The closed mesh of the cube ``CUBE`` (corner ``i`` has bit ``k`` set for ``+1`` on axis
+#: ``2 - k``), faces counter-clockwise from outside.
+CUBE_FACES = np.array([
+    [0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+    [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3],
+], dtype=np.uint32)
+
+
+def test_a_compound_and_a_decomposed_mesh_are_built_and_take_bodies(client: Client) -> None:
+    scene = client.create_scene()
+    compound = client.register_compound(scene, [CUBE * 0.5, CUBE * 0.5 + [3.0, 0.0, 0.0]])
+    decomposed = client.register_decomposed_mesh(scene, CUBE, CUBE_FACES, max_parts=4)
+    fast = client.register_decomposed_mesh(scene, CUBE, CUBE_FACES, max_concavity=0.05, fast=True)
+    for shape in (compound, decomposed, fast):
+        assert client.shape_state(scene, shape) is ShapeState.READY
+        client.add_body(scene, BodySpec(shape=shape))
+
+
+def test_bad_compounds_and_decompositions_get_their_codes(client: Client) -> None:
+    scene = client.create_scene()
+    with pytest.raises(EmptyGeometryError):
+        client.register_compound(scene, [])
+    with pytest.raises(MalformedMessageError):
+        client.register_compound(scene, [np.zeros((0, 3)), CUBE])
+    with pytest.raises(LimitExceededError):
+        client.register_compound(scene, [CUBE[:1]] * 1025)
+    with pytest.raises(InvalidShapeError):
+        client.register_decomposed_mesh(scene, CUBE, CUBE_FACES, max_concavity=-1.0)
+    with pytest.raises(InvalidShapeError):
+        client.register_decomposed_mesh(scene, CUBE, CUBE_FACES, max_parts=2000)
+    # One triangle encloses no volume.
+    with pytest.raises(InvalidShapeError):
+        client.register_decomposed_mesh(scene, CUBE, CUBE_FACES[:1])
+
+
 def test_a_mesh_still_building_refuses_add_body_with_shape_not_ready(client: Client) -> None:
     scene = client.create_scene()
     # AddBody follows the registration's reply within a millisecond or so; a mesh whose
