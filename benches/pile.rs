@@ -208,8 +208,10 @@ fn parry_shape(spec: &ShapeSpec) -> ParryShape {
             let points: Vec<ParryVector> = points.iter().map(|p| parry_vector(*p)).collect();
             plain(SharedShape::convex_hull(&points).expect("the pile's hulls are valid"))
         }
-        ShapeSpec::Primitive(Primitive::Cone { .. }) | ShapeSpec::Mesh(_) => {
-            unreachable!("the pile has no cones or meshes")
+        ShapeSpec::Primitive(Primitive::Cone { .. })
+        | ShapeSpec::Mesh(_)
+        | ShapeSpec::Compound(_) => {
+            unreachable!("the pile has no cones, meshes or compounds")
         }
     }
 }

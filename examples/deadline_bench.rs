@@ -9,13 +9,14 @@
 //! ```
 //!
 //! For each scene class (`--scene`, repeatable; all by default: `demo`, `falling`, `pile`,
-//! `robot-chain`, `coincident-meshes`, `sphere-swarm`) and budget (`--budgets-us`), a row
-//! builds the scene afresh in the daemon and in an in-process mirror, sends one frame
-//! without a budget (the daemon's exact answer must equal the mirror's), then `--frames`
-//! frames back to back (heavy scenes default to fewer; the output says so), each moving
-//! the bodies as the scene's client does (simulations bounce theirs with the returned
-//! contacts), publishing every moving body's pose and waiting for the answer; the oracle
-//! runs between frames, outside the timed round trip. Rows print as they finish:
+//! `compound-pile`, `robot-chain`, `coincident-meshes`, `sphere-swarm`) and budget
+//! (`--budgets-us`), a row builds the scene afresh in the daemon and in an in-process
+//! mirror, sends one frame without a budget (the daemon's exact answer must equal the
+//! mirror's), then `--frames` frames back to back (heavy scenes default to fewer; the
+//! output says so), each moving the bodies as the scene's client does (simulations bounce
+//! theirs with the returned contacts), publishing every moving body's pose and waiting for
+//! the answer; the oracle runs between frames, outside the timed round trip. Rows print as
+//! they finish:
 //! - `met %`: frames the daemon answered within the budget (header `elapsed_ns`, receipt
 //!   to publish, ≤ budget), of the frames sent (a lost frame, unanswered within
 //!   `--frame-timeout-ms`, counts as missed);
@@ -35,12 +36,15 @@
 //! header's `elapsed_ns` starts when the daemon takes the frame, so it cannot see the wait).
 //!
 //! Writes `DIR/deadlines.csv` (one line per frame) and `DIR/overrun.svg` (the overruns of
-//! each scene and budget), `DIR` from `--out`. `robot-chain` needs FCL's meshes from the
-//! data folder (`PROXIMA_DATA`, default `../shared/data`); without them it is skipped.
+//! each scene and budget), `DIR` from `--out`. `robot-chain` needs FCL's meshes and
+//! `compound-pile` Keenan Crane's spot from the data folder (`PROXIMA_DATA`, default
+//! `../shared/data`); without them they are skipped.
 //! The daemon defaults to `target/release/proximad` next to this example (`--daemon`).
 
 #[path = "scenes/coincident_meshes.rs"]
 mod coincident_meshes;
+#[path = "scenes/compound_pile.rs"]
+mod compound_pile;
 #[path = "../tests/support/data.rs"]
 #[allow(dead_code)]
 mod data;
@@ -87,7 +91,7 @@ use workloads::{Built, CLASSES, Class, Workload};
 #[derive(Debug, Parser)]
 #[command(about = "Deadline scorecard of proximad: every scene class, budget by budget")]
 struct Args {
-    /// Scene class to run (repeatable): demo, falling, pile, robot-chain,
+    /// Scene class to run (repeatable): demo, falling, pile, compound-pile, robot-chain,
     /// coincident-meshes, sphere-swarm; all when none is given.
     #[arg(long)]
     scene: Vec<String>,

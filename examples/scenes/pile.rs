@@ -51,23 +51,8 @@ pub fn pile_scene(seed: u64) -> SceneSpec {
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
     let mut spec = SceneSpec::default();
     add_box(&mut spec);
-    let spacing = 2.0 * BOX_HALF / LAYER_SIDE as f64;
     for i in 0..PILE_BODIES {
-        let (column, row, layer) = (
-            i % LAYER_SIDE,
-            i / LAYER_SIDE % LAYER_SIDE,
-            i / (LAYER_SIDE * LAYER_SIDE),
-        );
-        let jitter = DVec3::new(
-            rng.random_range(-0.01..0.01),
-            rng.random_range(-0.01..0.01),
-            0.0,
-        );
-        let position = DVec3::new(
-            -BOX_HALF + (column as f64 + 0.5) * spacing,
-            -BOX_HALF + (row as f64 + 0.5) * spacing,
-            0.1 + layer as f64 * LAYER_SPACING_M,
-        ) + jitter;
+        let position = layer_position(i, &mut rng);
         let size = rng.random_range(SIZE_M.0..SIZE_M.1);
         let shape = spec.add_shape(random_shape(&mut rng, i % 5, size));
         spec.add_body(BodyPlan {
@@ -79,6 +64,27 @@ pub fn pile_scene(seed: u64) -> SceneSpec {
         });
     }
     spec
+}
+
+/// Where body `i` of a pile starts: the layers of 16, the lowest 10 cm above the floor,
+/// each place jittered by up to a centimetre.
+pub fn layer_position(i: usize, rng: &mut Pcg64Mcg) -> DVec3 {
+    let spacing = 2.0 * BOX_HALF / LAYER_SIDE as f64;
+    let (column, row, layer) = (
+        i % LAYER_SIDE,
+        i / LAYER_SIDE % LAYER_SIDE,
+        i / (LAYER_SIDE * LAYER_SIDE),
+    );
+    let jitter = DVec3::new(
+        rng.random_range(-0.01..0.01),
+        rng.random_range(-0.01..0.01),
+        0.0,
+    );
+    DVec3::new(
+        -BOX_HALF + (column as f64 + 0.5) * spacing,
+        -BOX_HALF + (row as f64 + 0.5) * spacing,
+        0.1 + layer as f64 * LAYER_SPACING_M,
+    ) + jitter
 }
 
 /// The simulation of `spec` (from [`pile_scene`]) whose bodies got daemon ids `ids`: the
@@ -101,7 +107,7 @@ pub fn pile_world(spec: &SceneSpec, ids: &[u32], seed: u64) -> World {
 
 /// The floor and four walls around the box's inside, `[−BOX_HALF, BOX_HALF]²` from the
 /// floor at `z = 0` up to [`WALL_HEIGHT`].
-fn add_box(spec: &mut SceneSpec) {
+pub fn add_box(spec: &mut SceneSpec) {
     let (t, h) = (WALL_HALF_THICKNESS, WALL_HEIGHT / 2.0);
     let outer = BOX_HALF + 2.0 * t;
     let cuboid = |x, y, z| {
@@ -193,7 +199,7 @@ fn random_unit(rng: &mut Pcg64Mcg) -> DVec3 {
 }
 
 /// A rotation, uniform over all rotations.
-fn random_orientation(rng: &mut Pcg64Mcg) -> DQuat {
+pub fn random_orientation(rng: &mut Pcg64Mcg) -> DQuat {
     loop {
         let q = DQuat::from_xyzw(
             rng.random_range(-1.0..1.0),

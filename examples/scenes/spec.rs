@@ -13,7 +13,7 @@ use proxima::geometry::{
     Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, MeshError, Sphere, TriMesh,
 };
 use proxima::math::Pose;
-use proxima::narrow::{MeshShape, Shape};
+use proxima::narrow::{CompoundShape, MeshShape, Shape};
 use proxima::scene::{BodyDesc, CollisionFilter, Motion as LocalMotion, Scene, SceneLimits};
 use proxima_ipc::client::{BodySpec, Client, Motion, Primitive};
 use proxima_ipc::error::ControlError;
@@ -29,6 +29,8 @@ pub enum ShapeSpec {
     Convex(Vec<DVec3>),
     /// A triangle mesh, metres, the shape's local frame.
     Mesh(Arc<TriMesh>),
+    /// A solid of convex parts, each the hull of its points (metres, local frame).
+    Compound(Vec<Vec<DVec3>>),
 }
 
 impl ShapeSpec {
@@ -63,6 +65,13 @@ impl ShapeSpec {
                     TriMesh::try_new(mesh.vertices().to_vec(), mesh.triangles().to_vec());
                 Shape::Mesh(Arc::new(MeshShape::new(copy?)))
             }
+            Self::Compound(ref parts) => {
+                let hulls = parts
+                    .iter()
+                    .map(|p| ConvexPolyhedron::try_from_points(p))
+                    .collect::<Result<Vec<_>, _>>()?;
+                Shape::Compound(Arc::new(CompoundShape::from_hulls(hulls)?))
+            }
         })
     }
 
@@ -81,6 +90,14 @@ impl ShapeSpec {
                 let vertices: Vec<[f64; 3]> =
                     mesh.vertices().iter().map(|v| v.to_array()).collect();
                 client.register_mesh(scene, &vertices, mesh.triangles())
+            }
+            Self::Compound(parts) => {
+                let points: Vec<Vec<[f64; 3]>> = parts
+                    .iter()
+                    .map(|p| p.iter().map(|q| q.to_array()).collect())
+                    .collect();
+                let slices: Vec<&[[f64; 3]]> = points.iter().map(Vec::as_slice).collect();
+                client.register_compound(scene, &slices)
             }
         }
     }
