@@ -5,19 +5,22 @@
 //! queries answer part by part, through the dispatcher, over the part pairs that the small
 //! tree of part boxes ([`PartTree`]) cannot prove farther than what is already known:
 //!
-//! - the signed distance is the smallest over the part pairs: the gap when apart, and when
-//!   they overlap minus the deepest part pair's penetration depth (GJK/EPA, or the closed
-//!   form of a primitive pair). A decomposition's union is within its stated concavity of
-//!   the mesh, so that depth is within it of the mesh's own;
-//! - the manifold gathers every touching part pair's points and keeps at most four under
-//!   the deepest one's normal ([`reduce_under_deepest`](crate::narrow::manifold_reduction::reduce_under_deepest)).
+//! - apart, the signed distance is the smallest gap over the part pairs;
+//! - overlapping, it is minus the depth of the whole compound ([`union_depth`]): the
+//!   deepest part pair's (GJK/EPA, or a primitive pair's closed form) when moving B out of
+//!   that part frees it from every part, else the shortest move found that does, never
+//!   less deep. A decomposition's union is within its stated concavity of the mesh;
+//! - the manifold gathers every touching part pair's points and the distance's own
+//!   witnesses, and keeps at most four under the compound's normal
+//!   ([`reduce_under_deepest`](crate::narrow::manifold_reduction::reduce_under_deepest)).
 //!
 //! Like every query of the dispatcher the distance polls the frame's clock, here before
 //! each part pair after the first, and answers bounds when it stops: the best part pair
 //! found so far above, the smallest box bound left below. See [`query`].
 
-pub(crate) mod query;
+pub mod query;
 mod tree;
+pub mod union_depth;
 
 pub use tree::{PartNode, PartTree};
 

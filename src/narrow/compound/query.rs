@@ -6,22 +6,28 @@
 //! box bound; they are answered in order of that bound, each exact up to the best found so
 //! far (or the limit), until the next bound is positive and no smaller than the best (boxes
 //! that overlap may hold a deeper pair than any found, so all of them are answered). So:
-//! - within the limit the answer is exact: the smallest signed distance over the part
-//!   pairs, with that pair's witnesses and normal;
+//! - within the limit the answer is exact: apart, the smallest distance over the part
+//!   pairs, with that pair's witnesses and normal; overlapping, the depth of the whole
+//!   compound ([`union_depth`](super::union_depth)): the deepest part pair's when moving B
+//!   out of it frees it from every part, else the shortest freeing translation found along
+//!   the touching pairs' normals;
 //! - beyond it, only a lower bound (`distance > limit` holds): the best part pair's, or the
 //!   smallest box bound of the pairs left out when that is smaller;
 //! - when the frame's clock stops it (polled before each part pair after the first, and
 //!   inside each), [`Reached::Bounded`]: the best part pair found above, below the
-//!   smallest bound of the pairs not answered: their boxes' gap, or where the boxes overlap
-//!   minus the smaller part's box diagonal.
+//!   smallest bound of the pairs not answered: their boxes' gap, or where boxes overlap
+//!   minus the length of a move that frees B from the whole compound (for a mesh B, minus
+//!   the widest part's width).
 //!
 //! # Manifold
 //! Every part pair whose boxes overlap is answered (distance, then its manifold when it
-//! touches); their points are merged under the deepest one's normal
-//! ([`reduce_under_deepest`]).
+//! touches); their points and the distance's own witnesses (the deepest, with the
+//! compound's normal) are merged under that normal ([`reduce_under_deepest`]), the other
+//! points' depths measured along it.
 
 use super::CompoundShape;
 use super::tree::Candidate;
+use super::union_depth::{freeing_bound, union_depth};
 use crate::bounding::Obb;
 use crate::budget::WORK_PER_CLOCK_READ;
 use crate::math::{DMat3, DVec3, Pose};
@@ -35,7 +41,9 @@ use crate::narrow::manifold_reduction::reduce_under_deepest;
 pub(crate) struct CompoundScratch {
     stack: Vec<u32>,
     pair_stack: Vec<(u32, u32)>,
-    candidates: Vec<Candidate>,
+    pub(super) candidates: Vec<Candidate>,
+    /// The touching part pairs' depths and normals, for the union's depth.
+    pub(super) directions: Vec<(f64, DVec3)>,
     points: Vec<ManifoldPoint>,
     normals: Vec<DVec3>,
     positions: Vec<DVec3>,
@@ -46,7 +54,7 @@ pub(crate) struct CompoundScratch {
 /// The part pairs of `a` and `b` (B placed by `pose_ab`) whose boxes may be within
 /// `cutoff`, into `scratch.candidates` sorted by their bound; returns the smallest bound of
 /// the pairs left out.
-fn list_candidates(
+pub(super) fn list_candidates(
     a: &CompoundShape,
     b: &Shape,
     pose_ab: &Pose,
@@ -82,7 +90,11 @@ fn list_candidates(
 }
 
 /// The two shapes of candidate `c`: a part of `a`, and a part of `b` or `b` itself.
-fn pair_of<'s>(a: &'s CompoundShape, b: &'s Shape, c: &Candidate) -> (&'s Shape, &'s Shape) {
+pub(super) fn pair_of<'s>(
+    a: &'s CompoundShape,
+    b: &'s Shape,
+    c: &Candidate,
+) -> (&'s Shape, &'s Shape) {
     let part_a = &a.parts()[c.a as usize];
     match b {
         Shape::Compound(b) => (part_a, &b.parts()[c.b as usize]),
@@ -110,7 +122,7 @@ pub(crate) fn distance_within(
             break;
         }
         if k > 0 && !scratch.clock.allows(WORK_PER_CLOCK_READ) {
-            let left = lowest_left(a, b, &own.candidates[k..]);
+            let left = lowest_left(a, b, pose_ab, &own.candidates[k..]);
             stopped = Some(bounds(left, best.as_ref()));
             break;
         }
@@ -123,7 +135,9 @@ pub(crate) fn distance_within(
                 }
             }
             Reached::Bounded(bound) => {
-                let lower = bound.lower.min(lowest_left(a, b, &own.candidates[k + 1..]));
+                let lower = bound
+                    .lower
+                    .min(lowest_left(a, b, pose_ab, &own.candidates[k + 1..]));
                 stopped = Some(match best {
                     Some(d) if d.distance <= bound.upper => bounds(lower, Some(&d)),
                     _ => DistanceBound::new(lower, bound.upper, bound.normal, bound.point_b),
@@ -132,32 +146,51 @@ pub(crate) fn distance_within(
             }
         }
     }
-    scratch.compound = own;
-    if let Some(bound) = stopped {
-        return Reached::Bounded(bound);
-    }
-    Reached::Exact(match best {
-        Some(d) if d.distance <= limit || d.distance <= left_out => d,
+    let answer = match (stopped, best) {
+        (Some(bound), _) => Reached::Bounded(whole_compound_lower(a, b, pose_ab, bound)),
+        // Overlapping: the depth of the whole compound, not only of the deepest part.
+        (None, Some(d)) if d.distance < 0.0 => union_depth(a, b, pose_ab, d, scratch, &mut own),
+        (None, Some(d)) if d.distance <= limit || d.distance <= left_out => Reached::Exact(d),
         // Beyond the limit with pairs left out closer than the best: their bound.
-        Some(d) => DistanceBound::new(left_out, left_out, d.normal, d.point_b).at_lower(),
-        None => beyond_every_box(a, b, pose_ab, left_out),
-    })
+        (None, Some(d)) => {
+            Reached::Exact(DistanceBound::new(left_out, left_out, d.normal, d.point_b).at_lower())
+        }
+        (None, None) => Reached::Exact(beyond_every_box(a, b, pose_ab, left_out)),
+    };
+    scratch.compound = own;
+    answer
 }
 
-/// The smallest lower bound of the part pairs `left`: their box bound, or where the boxes
-/// overlap minus the smaller part's box diagonal, which no penetration depth exceeds (the
-/// smaller part pushed by its whole width along any direction is clear of the other).
-fn lowest_left(a: &CompoundShape, b: &Shape, left: &[Candidate]) -> f64 {
-    let width = |s: &Shape| (s.local_bounds().max - s.local_bounds().min).length();
-    left.iter()
-        .map(|c| {
-            if c.lower > 0.0 {
-                return c.lower;
-            }
-            let (part_a, part_b) = pair_of(a, b, c);
-            -width(part_a).min(width(part_b))
-        })
-        .fold(f64::INFINITY, f64::min)
+/// The smallest lower bound of the part pairs `left` (sorted by their box bound): the
+/// first one's box bound when positive, else minus [`freeing_bound`], which no depth of the
+/// whole compound exceeds.
+fn lowest_left(a: &CompoundShape, b: &Shape, pose_ab: &Pose, left: &[Candidate]) -> f64 {
+    match left.first() {
+        None => f64::INFINITY,
+        Some(c) if c.lower > 0.0 => c.lower,
+        Some(_) if matches!(b, Shape::Mesh(_)) => {
+            // A mesh is a surface: a part reaches through it by at most its own width.
+            let width = |s: &Shape| (s.local_bounds().max - s.local_bounds().min).length();
+            -a.parts().iter().map(width).fold(0.0, f64::max)
+        }
+        Some(_) => -freeing_bound(a, b, pose_ab),
+    }
+}
+
+/// `bound`, from part pairs, as bounds of the whole compound's signed distance: where it
+/// says they may overlap, the whole compound may be deeper than any part pair, down to
+/// minus [`freeing_bound`] (a mesh B, a surface, keeps the part pairs' bound).
+fn whole_compound_lower(
+    a: &CompoundShape,
+    b: &Shape,
+    pose_ab: &Pose,
+    bound: DistanceBound,
+) -> DistanceBound {
+    if bound.lower > 0.0 || matches!(b, Shape::Mesh(_)) {
+        return bound;
+    }
+    let lower = bound.lower.min(-freeing_bound(a, b, pose_ab));
+    DistanceBound::new(lower, bound.upper, bound.normal, bound.point_b)
 }
 
 /// Bounds from the best part pair found (the upper bound and its witnesses; `+∞` without
@@ -209,6 +242,14 @@ pub(crate) fn manifold(
         own.points.extend_from_slice(m.points());
         own.normals.extend(std::iter::repeat_n(m.normal, m.len()));
     }
+    // The compound's own depth and normal lead (the whole compound's, at least as deep as
+    // any part pair's).
+    own.points.push(ManifoldPoint {
+        point_a: d.point_a,
+        point_b: d.point_b,
+        distance: d.distance,
+    });
+    own.normals.push(d.normal);
     let CompoundScratch {
         points,
         normals,
