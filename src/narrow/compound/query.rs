@@ -20,8 +20,8 @@
 //!   the widest part's width).
 //!
 //! # Manifold
-//! Every part pair whose boxes overlap is answered (distance, then its manifold when it
-//! touches); their points and the distance's own witnesses (the deepest, with the
+//! Every touching part pair's manifold (their distances kept from the distance just
+//! asked of the same pair and pose, else answered again); their points and the distance's own witnesses (the deepest, with the
 //! compound's normal) are merged under that normal ([`reduce_under_deepest`]), the other
 //! points' depths measured along it.
 
@@ -44,11 +44,34 @@ pub(crate) struct CompoundScratch {
     pub(super) candidates: Vec<Candidate>,
     /// The touching part pairs' depths and normals, for the union's depth.
     pub(super) directions: Vec<(f64, DVec3)>,
+    /// The part pairs the last finished distance found touching, with their exact
+    /// distances, and which query that was: the manifold of the same pair and pose, asked
+    /// next, takes them instead of answering the part pairs again.
+    pub(super) touching: Vec<(Candidate, ShapeDistance)>,
+    touching_of: Option<QueryKey>,
     points: Vec<ManifoldPoint>,
     normals: Vec<DVec3>,
     positions: Vec<DVec3>,
     kept: Vec<usize>,
     part_manifold: Manifold,
+}
+
+/// A compound query: the two shapes (by address) and the pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct QueryKey {
+    a: usize,
+    b: usize,
+    pose_ab: Pose,
+}
+
+impl QueryKey {
+    fn new(a: &CompoundShape, b: &Shape, pose_ab: &Pose) -> Self {
+        Self {
+            a: std::ptr::from_ref(a) as usize,
+            b: std::ptr::from_ref(b) as usize,
+            pose_ab: *pose_ab,
+        }
+    }
 }
 
 /// The part pairs of `a` and `b` (B placed by `pose_ab`) whose boxes may be within
@@ -113,6 +136,8 @@ pub(crate) fn distance_within(
 ) -> Reached {
     let mut own = std::mem::take(&mut scratch.compound);
     let left_out = list_candidates(a, b, pose_ab, limit, &mut own);
+    own.touching.clear();
+    own.touching_of = None;
     let mut best: Option<ShapeDistance> = None;
     let mut stopped: Option<DistanceBound> = None;
     for (k, c) in own.candidates.iter().enumerate() {
@@ -127,9 +152,14 @@ pub(crate) fn distance_within(
             break;
         }
         let (part_a, part_b) = pair_of(a, b, c);
-        let enough = best.map_or(limit, |d| d.distance.min(limit));
+        // Exact up to the best gap found, and every touching pair exact once one touches
+        // (the whole compound's depth and the manifold want them all).
+        let enough = best.map_or(limit, |d| d.distance.max(0.0).min(limit));
         match dispatch::distance_within(part_a, part_b, pose_ab, enough, scratch) {
             Reached::Exact(d) => {
+                if d.distance <= 0.0 && limit >= 0.0 {
+                    own.touching.push((*c, d));
+                }
                 if best.is_none_or(|b| d.distance < b.distance) {
                     best = Some(d);
                 }
@@ -145,6 +175,9 @@ pub(crate) fn distance_within(
                 break;
             }
         }
+    }
+    if stopped.is_none() && limit >= 0.0 {
+        own.touching_of = Some(QueryKey::new(a, b, pose_ab));
     }
     let answer = match (stopped, best) {
         (Some(bound), _) => Reached::Bounded(whole_compound_lower(a, b, pose_ab, bound)),
@@ -228,17 +261,24 @@ pub(crate) fn manifold(
         return;
     }
     let mut own = std::mem::take(&mut scratch.compound);
-    list_candidates(a, b, pose_ab, 0.0, &mut own);
+    if own.touching_of != Some(QueryKey::new(a, b, pose_ab)) {
+        // Not right after this pair's distance: answer the part pairs again.
+        list_candidates(a, b, pose_ab, 0.0, &mut own);
+        own.touching.clear();
+        for c in &own.candidates {
+            let (part_a, part_b) = pair_of(a, b, c);
+            let part_d = dispatch::distance(part_a, part_b, pose_ab, 0.0, scratch);
+            if part_d.distance <= 0.0 {
+                own.touching.push((*c, part_d));
+            }
+        }
+    }
     own.points.clear();
     own.normals.clear();
-    for c in &own.candidates {
+    for (c, part_d) in &own.touching {
         let (part_a, part_b) = pair_of(a, b, c);
-        let part_d = dispatch::distance(part_a, part_b, pose_ab, 0.0, scratch);
-        if part_d.distance > 0.0 {
-            continue;
-        }
         let m = &mut own.part_manifold;
-        dispatch::manifold(part_a, part_b, pose_ab, &part_d, scratch, m);
+        dispatch::manifold(part_a, part_b, pose_ab, part_d, scratch, m);
         own.points.extend_from_slice(m.points());
         own.normals.extend(std::iter::repeat_n(m.normal, m.len()));
     }

@@ -8,9 +8,10 @@
 //! 1. **Certificate.** If moving B by `δ` along the deepest pair's normal frees it from
 //!    every part, that is the union's depth, exactly (the usual case: one part touched, or
 //!    a normal that leaves the others behind).
-//! 2. **Search.** Otherwise each touching part pair's normal is a candidate direction, and
-//!    so are the axes of A's frame and of B's (one of them carries B past A's extent, so
-//!    the answer never exceeds [`freeing_bound`]); along each, B is moved out of every part it still overlaps (conservative advancement from
+//! 2. **Search.** Otherwise each touching part pair's normal is a candidate direction; the
+//!    move past A's extent along an axis of either frame ([`freeing_bound`]) frees B too
+//!    and is the answer's ceiling. Along each direction, until it is no shorter than the
+//!    best, B is moved out of every part it still overlaps (conservative advancement from
 //!    the pair's separating plane inwards, which stops at the last exit), re-listing the
 //!    parts it may hit on the way. The shortest such translation is the answer: an upper
 //!    bound of the union's depth, at least `δ`, always one that frees B.
@@ -30,7 +31,7 @@ use crate::narrow::shape::core_of;
 /// Most candidate directions searched (the deepest touching pairs' normals).
 const MAX_DIRECTIONS: usize = 8;
 /// Most conservative-advancement steps per part pair and direction.
-const MAX_STEPS: usize = 32;
+const MAX_STEPS: usize = 16;
 /// Most times B is re-listed against the parts along one direction.
 const MAX_ROUNDS: usize = 16;
 
@@ -41,7 +42,8 @@ const OVERLAP_REL: f64 = 1e-9;
 /// The union's depth for `deepest`, the smallest signed distance over the part pairs of `a`
 /// and `b` (negative), under `scratch.clock` (see the [module docs](self)). Exact when the
 /// certificate holds; else the shortest freeing translation found; [`Reached::Bounded`]
-/// between the two when the clock stops the search.
+/// between the deepest pair's depth and the shortest freeing move known when the clock
+/// stops the search (polled before each part pair's query).
 pub(super) fn union_depth(
     a: &CompoundShape,
     b: &Shape,
@@ -56,121 +58,142 @@ pub(super) fn union_depth(
     let scale = a.local_bounds().half_extents().length()
         + b.local_bounds().half_extents().length()
         + pose_ab.position.length();
-    let tolerance = OVERLAP_REL * scale;
-    let depth = -deepest.distance;
-    let first = escape_along(
+    let search = Search {
         a,
         b,
         pose_ab,
-        deepest.normal,
-        depth,
-        tolerance,
-        scratch,
-        own,
-    );
-    if first <= depth + tolerance {
-        return Reached::Exact(deepest);
-    }
-    // The touching part pairs' normals, deepest first.
-    list_candidates(a, b, pose_ab, 0.0, own);
-    own.directions.clear();
-    for k in 0..own.candidates.len() {
-        let (part_a, part_b) = pair_of(a, b, &own.candidates[k]);
-        let d = dispatch::distance(part_a, part_b, pose_ab, 0.0, scratch);
-        if d.distance < -tolerance {
-            own.directions.push((d.distance, d.normal));
+        tolerance: OVERLAP_REL * scale,
+    };
+    let depth = -deepest.distance;
+    let answer = |length: f64, normal: DVec3, exact: bool| {
+        // B's deepest point against the push, and A's surface where the push leaves it.
+        let point_b = support_in(b, pose_ab, -normal);
+        if exact {
+            Reached::Exact(ShapeDistance {
+                distance: -length,
+                point_a: point_b + length * normal,
+                point_b,
+                normal,
+            })
+        } else {
+            Reached::Bounded(DistanceBound::new(-length, -depth, normal, point_b))
         }
-    }
+    };
+    // The move past A's extent along an axis of either frame frees B: never answer more.
+    let past_extent = freeing_move(a, b, pose_ab);
+    let first = match search.escape_along(deepest.normal, depth, past_extent.0, scratch, own) {
+        Some(length) if length <= depth + search.tolerance => return Reached::Exact(deepest),
+        Some(length) => length,
+        None if scratch.clock.stopped() => return answer(past_extent.0, past_extent.1, false),
+        // No shorter than the move past A's extent.
+        None => f64::INFINITY,
+    };
+    // The touching part pairs' normals (all found by the distance search), deepest first.
+    own.directions.clear();
+    own.directions.extend(
+        own.touching
+            .iter()
+            .filter(|(_, d)| d.distance < -search.tolerance)
+            .map(|(_, d)| (d.distance, d.normal)),
+    );
     own.directions.sort_by(|x, y| x.0.total_cmp(&y.0));
     own.directions.truncate(MAX_DIRECTIONS);
-    // The axes of both frames: the shortest move past A's extent along one frees B too,
-    // so the answer is never more than that.
-    own.directions
-        .extend(axis_directions(pose_ab).map(|n| (0.0, n)));
-    let mut best = (first, deepest.normal);
+    // That axis, refined: along it B may be free well before it clears A's extent.
+    own.directions.push((0.0, past_extent.1));
+    let mut best = if first < past_extent.0 {
+        (first, deepest.normal)
+    } else {
+        past_extent
+    };
     for k in 0..own.directions.len() {
         let normal = own.directions[k].1;
-        if !scratch.clock.allows(WORK_PER_CLOCK_READ) {
-            let (length, normal) = best;
-            let point_b = support_in(b, pose_ab, -normal);
-            return Reached::Bounded(DistanceBound::new(-length, -depth, normal, point_b));
-        }
-        let length = escape_along(a, b, pose_ab, normal, depth, tolerance, scratch, own);
-        if length < best.0 {
-            best = (length, normal);
+        // `None`: stopped by the clock, or no shorter than the best (then the loop goes on).
+        match search.escape_along(normal, depth, best.0, scratch, own) {
+            Some(length) => best = (length, normal),
+            None if scratch.clock.stopped() => return answer(best.0, best.1, false),
+            None => {}
         }
     }
-    let (length, normal) = best;
-    // B's deepest point against the push, and A's surface where the push leaves it.
-    let point_b = support_in(b, pose_ab, -normal);
-    Reached::Exact(ShapeDistance {
-        distance: -length,
-        point_a: point_b + length * normal,
-        point_b,
-        normal,
-    })
+    answer(best.0, best.1, true)
 }
 
-/// How far B (placed by `pose_ab`) must move along the unit `normal` (A's frame) to be free
-/// of every part of `a`, at least `start` metres: an upper bound within about `tolerance`
-/// of the exact length, and always a translation that frees it.
-#[allow(clippy::too_many_arguments)]
-fn escape_along(
-    a: &CompoundShape,
-    b: &Shape,
-    pose_ab: &Pose,
-    normal: DVec3,
-    start: f64,
+/// One search for the union's depth: B placed by `pose_ab` against compound `a`.
+struct Search<'s> {
+    a: &'s CompoundShape,
+    b: &'s Shape,
+    pose_ab: &'s Pose,
+    /// A part pair counts as overlapping below minus this, metres.
     tolerance: f64,
-    scratch: &mut NarrowScratch,
-    own: &mut CompoundScratch,
-) -> f64 {
-    let mut length = start;
-    for _ in 0..MAX_ROUNDS {
-        let moved = moved_by(pose_ab, normal * length);
-        list_candidates(a, b, &moved, 0.0, own);
-        let mut raised = false;
-        for k in 0..own.candidates.len() {
-            let c = own.candidates[k];
-            let (part_a, part_b) = pair_of(a, b, &c);
-            let d = dispatch::distance(part_a, part_b, &moved, 0.0, scratch);
-            if d.distance < -tolerance {
-                let exit = exit_along(part_a, part_b, pose_ab, normal, tolerance, scratch);
-                length = length.max(exit);
-                raised = true;
+}
+
+impl Search<'_> {
+    /// How far B must move along the unit `normal` (A's frame) to be free of every part of
+    /// A, at least `start` metres: an upper bound within about the tolerance of the exact
+    /// length, and always a translation that frees it. `None` once it is known to be at
+    /// least `shorter_than`, or when `scratch.clock` stopped it (polled before each part
+    /// pair's query).
+    fn escape_along(
+        &self,
+        normal: DVec3,
+        start: f64,
+        shorter_than: f64,
+        scratch: &mut NarrowScratch,
+        own: &mut CompoundScratch,
+    ) -> Option<f64> {
+        let mut length = start;
+        for _ in 0..MAX_ROUNDS {
+            if length >= shorter_than {
+                return None;
+            }
+            let moved = moved_by(self.pose_ab, normal * length);
+            list_candidates(self.a, self.b, &moved, 0.0, own);
+            let mut raised = false;
+            for k in 0..own.candidates.len() {
+                let (part_a, part_b) = pair_of(self.a, self.b, &own.candidates[k]);
+                if !scratch.clock.allows(WORK_PER_CLOCK_READ) {
+                    return None;
+                }
+                let d = dispatch::distance(part_a, part_b, &moved, 0.0, scratch);
+                if d.distance < -self.tolerance {
+                    length = length.max(self.exit_along(part_a, part_b, normal, scratch)?);
+                    raised = true;
+                }
+            }
+            if !raised {
+                return Some(length);
             }
         }
-        if !raised {
-            return length;
-        }
+        Some(length)
     }
-    length
-}
 
-/// The exit of B's part `part_b` (placed by `pose_ab`) from `part_a` along the unit
-/// `normal`: the smallest translation along it beyond which they stay apart, from above
-/// (conservative advancement from the separating plane of their projections on `normal`,
-/// each step the pair's distance, which no motion of that length can close).
-fn exit_along(
-    part_a: &Shape,
-    part_b: &Shape,
-    pose_ab: &Pose,
-    normal: DVec3,
-    tolerance: f64,
-    scratch: &mut NarrowScratch,
-) -> f64 {
-    let top_a = support_in(part_a, &Pose::IDENTITY, normal).dot(normal);
-    let bottom_b = support_in(part_b, pose_ab, -normal).dot(normal);
-    let mut length = (top_a - bottom_b).max(0.0);
-    for _ in 0..MAX_STEPS {
-        let moved = moved_by(pose_ab, normal * length);
-        let gap = dispatch::distance(part_a, part_b, &moved, f64::INFINITY, scratch).distance;
-        if gap <= tolerance {
-            break;
+    /// The exit of B's part `part_b` from `part_a` along the unit `normal`: the smallest
+    /// translation along it beyond which they stay apart, from above (conservative
+    /// advancement from the separating plane of their projections on `normal`, each step
+    /// the pair's distance, which no motion of that length can close). `None` when
+    /// `scratch.clock` stopped it (polled before each step).
+    fn exit_along(
+        &self,
+        part_a: &Shape,
+        part_b: &Shape,
+        normal: DVec3,
+        scratch: &mut NarrowScratch,
+    ) -> Option<f64> {
+        let top_a = support_in(part_a, &Pose::IDENTITY, normal).dot(normal);
+        let bottom_b = support_in(part_b, self.pose_ab, -normal).dot(normal);
+        let mut length = (top_a - bottom_b).max(0.0);
+        for _ in 0..MAX_STEPS {
+            if !scratch.clock.allows(WORK_PER_CLOCK_READ) {
+                return None;
+            }
+            let moved = moved_by(self.pose_ab, normal * length);
+            let gap = dispatch::distance(part_a, part_b, &moved, f64::INFINITY, scratch).distance;
+            if gap <= self.tolerance {
+                break;
+            }
+            length -= gap;
         }
-        length -= gap;
+        Some(length)
     }
-    length
 }
 
 /// A translation length that frees B from the whole of `a` (B placed by `pose_ab`): the
@@ -178,6 +201,11 @@ fn exit_along(
 /// past A's extent (their supports), metres. No penetration depth of the two exceeds it.
 /// Both frames' axes make it the same whichever shape is queried as A.
 pub(super) fn freeing_bound(a: &CompoundShape, b: &Shape, pose_ab: &Pose) -> f64 {
+    freeing_move(a, b, pose_ab).0
+}
+
+/// [`freeing_bound`] and the direction of its move.
+fn freeing_move(a: &CompoundShape, b: &Shape, pose_ab: &Pose) -> (f64, DVec3) {
     let whole_a = |n: DVec3| {
         a.parts()
             .iter()
@@ -185,8 +213,11 @@ pub(super) fn freeing_bound(a: &CompoundShape, b: &Shape, pose_ab: &Pose) -> f64
             .fold(f64::NEG_INFINITY, f64::max)
     };
     axis_directions(pose_ab)
-        .map(|n| (whole_a(n) - support_in(b, pose_ab, -n).dot(n)).max(0.0))
-        .fold(f64::INFINITY, f64::min)
+        .map(|n| ((whole_a(n) - support_in(b, pose_ab, -n).dot(n)).max(0.0), n))
+        .fold(
+            (f64::INFINITY, DVec3::X),
+            |x, y| if y.0 < x.0 { y } else { x },
+        )
 }
 
 /// The twelve axis directions of A's frame and of B's (placed by `pose_ab`), A's frame.
