@@ -630,6 +630,11 @@ fn compounds_and_decomposed_meshes_build_or_say_why_not() {
         let refused = decompose(&mut state, dims, &TETRA_INDICES);
         assert_eq!(code(&refused), ErrorCode::InvalidShape, "{dims:?}");
     }
+    // The wire's limit is the library's.
+    assert_eq!(
+        proxima_ipc::wire::MAX_COMPOUND_PARTS as usize,
+        crate::narrow::compound::MAX_PARTS
+    );
     let too_many = register(
         &mut state,
         ShapeKindCode::Compound,

@@ -12,7 +12,7 @@
 //!   less deep. A decomposition's union is within its stated concavity of the mesh;
 //! - the manifold gathers every touching part pair's points and the distance's own
 //!   witnesses, and keeps at most four under the compound's normal
-//!   ([`reduce_under_deepest`](crate::narrow::manifold_reduction::reduce_under_deepest)).
+//!   (`manifold_reduction::reduce_under_deepest`).
 //!
 //! Like every query of the dispatcher the distance polls the frame's clock, here before
 //! each part pair after the first, and answers bounds when it stops: the best part pair

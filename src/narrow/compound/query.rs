@@ -22,7 +22,7 @@
 //! # Manifold
 //! Every touching part pair's manifold (their distances kept from the distance just
 //! asked of the same pair and pose, else answered again); their points and the distance's own witnesses (the deepest, with the
-//! compound's normal) are merged under that normal ([`reduce_under_deepest`]), the other
+//! compound's normal) are merged under that normal (`reduce_under_deepest`), the other
 //! points' depths measured along it.
 
 use super::CompoundShape;

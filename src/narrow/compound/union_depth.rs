@@ -9,7 +9,7 @@
 //!    every part, that is the union's depth, exactly (the usual case: one part touched, or
 //!    a normal that leaves the others behind).
 //! 2. **Search.** Otherwise each touching part pair's normal is a candidate direction; the
-//!    move past A's extent along an axis of either frame ([`freeing_bound`]) frees B too
+//!    move past A's extent along an axis of either frame (`freeing_bound`) frees B too
 //!    and is the answer's ceiling. Along each direction, until it is no shorter than the
 //!    best, B is moved out of every part it still overlaps (conservative advancement from
 //!    the pair's separating plane inwards, which stops at the last exit), re-listing the
