@@ -140,10 +140,13 @@ pub(crate) fn distance_within(
     own.touching_of = None;
     let mut best: Option<ShapeDistance> = None;
     let mut stopped: Option<DistanceBound> = None;
+    // A lower bound of the distance of every part pair not touching.
+    let mut others_apart_by = left_out;
     for (k, c) in own.candidates.iter().enumerate() {
         // Boxes apart by `lower` hold parts at least that far apart; overlapping boxes may
         // hold a deeper pair than any found.
         if c.lower > 0.0 && best.is_some_and(|d| c.lower >= d.distance) {
+            others_apart_by = others_apart_by.min(c.lower);
             break;
         }
         if k > 0 && !scratch.clock.allows(WORK_PER_CLOCK_READ) {
@@ -157,7 +160,10 @@ pub(crate) fn distance_within(
         let enough = best.map_or(limit, |d| d.distance.max(0.0).min(limit));
         match dispatch::distance_within(part_a, part_b, pose_ab, enough, scratch) {
             Reached::Exact(d) => {
-                if d.distance <= 0.0 && limit >= 0.0 {
+                // Beyond `enough`, a convex pair's value is a lower bound.
+                if d.distance > 0.0 {
+                    others_apart_by = others_apart_by.min(d.distance);
+                } else if limit >= 0.0 {
                     own.touching.push((*c, d));
                 }
                 if best.is_none_or(|b| d.distance < b.distance) {
@@ -182,7 +188,9 @@ pub(crate) fn distance_within(
     let answer = match (stopped, best) {
         (Some(bound), _) => Reached::Bounded(whole_compound_lower(a, b, pose_ab, bound)),
         // Overlapping: the depth of the whole compound, not only of the deepest part.
-        (None, Some(d)) if d.distance < 0.0 => union_depth(a, b, pose_ab, d, scratch, &mut own),
+        (None, Some(d)) if d.distance < 0.0 => {
+            union_depth(a, b, pose_ab, d, others_apart_by, scratch, &mut own)
+        }
         (None, Some(d)) if d.distance <= limit || d.distance <= left_out => Reached::Exact(d),
         // Beyond the limit with pairs left out closer than the best: their bound.
         (None, Some(d)) => {

@@ -7,7 +7,8 @@
 //! pair's depth `δ`, so:
 //! 1. **Certificate.** If moving B by `δ` along the deepest pair's normal frees it from
 //!    every part, that is the union's depth, exactly (the usual case: one part touched, or
-//!    a normal that leaves the others behind).
+//!    a normal that leaves the others behind). With one part touched and every other
+//!    farther than `δ` (the distance search's bounds say so) it costs nothing more.
 //! 2. **Search.** Otherwise each touching part pair's normal is a candidate direction; the
 //!    move past A's extent along an axis of either frame (`freeing_bound`) frees B too
 //!    and is the answer's ceiling. Along each direction, until it is no shorter than the
@@ -40,7 +41,8 @@ const MAX_ROUNDS: usize = 16;
 const OVERLAP_REL: f64 = 1e-9;
 
 /// The union's depth for `deepest`, the smallest signed distance over the part pairs of `a`
-/// and `b` (negative), under `scratch.clock` (see the [module docs](self)). Exact when the
+/// and `b` (negative), under `scratch.clock` (see the [module docs](self)); the part pairs
+/// not in `own.touching` are at least `others_apart_by` metres apart. Exact when the
 /// certificate holds; else the shortest freeing translation found; [`Reached::Bounded`]
 /// between the deepest pair's depth and the shortest freeing move known when the clock
 /// stops the search (polled before each part pair's query).
@@ -49,6 +51,7 @@ pub(super) fn union_depth(
     b: &Shape,
     pose_ab: &Pose,
     deepest: ShapeDistance,
+    others_apart_by: f64,
     scratch: &mut NarrowScratch,
     own: &mut CompoundScratch,
 ) -> Reached {
@@ -65,6 +68,10 @@ pub(super) fn union_depth(
         tolerance: OVERLAP_REL * scale,
     };
     let depth = -deepest.distance;
+    // The certificate for free: one part touched, and every other farther than the move.
+    if own.touching.len() == 1 && others_apart_by > depth + search.tolerance {
+        return Reached::Exact(deepest);
+    }
     let answer = |length: f64, normal: DVec3, exact: bool| {
         // B's deepest point against the push, and A's surface where the push leaves it.
         let point_b = support_in(b, pose_ab, -normal);
