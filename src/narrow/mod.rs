@@ -39,6 +39,7 @@ pub mod gjk;
 pub mod manifold_reduction;
 pub mod mesh_hull;
 pub mod mesh_mesh;
+mod pair_key;
 pub mod pairs;
 pub mod polygon;
 pub mod shape;

@@ -35,6 +35,7 @@ use crate::narrow::Shape;
 use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, Reached, ShapeDistance};
 use crate::narrow::dispatch::{self, NarrowScratch};
 use crate::narrow::manifold_reduction::reduce_under_deepest;
+use crate::narrow::pair_key::PairKey;
 
 /// Scratch of the compound queries for one thread (no allocation once grown).
 #[derive(Debug, Default)]
@@ -48,30 +49,12 @@ pub(crate) struct CompoundScratch {
     /// distances, and which query that was: the manifold of the same pair and pose, asked
     /// next, takes them instead of answering the part pairs again.
     pub(super) touching: Vec<(Candidate, ShapeDistance)>,
-    touching_of: Option<QueryKey>,
+    touching_of: Option<PairKey>,
     points: Vec<ManifoldPoint>,
     normals: Vec<DVec3>,
     positions: Vec<DVec3>,
     kept: Vec<usize>,
     part_manifold: Manifold,
-}
-
-/// A compound query: the two shapes (by address) and the pose.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct QueryKey {
-    a: usize,
-    b: usize,
-    pose_ab: Pose,
-}
-
-impl QueryKey {
-    fn new(a: &CompoundShape, b: &Shape, pose_ab: &Pose) -> Self {
-        Self {
-            a: std::ptr::from_ref(a) as usize,
-            b: std::ptr::from_ref(b) as usize,
-            pose_ab: *pose_ab,
-        }
-    }
 }
 
 /// The part pairs of `a` and `b` (B placed by `pose_ab`) whose boxes may be within
@@ -183,7 +166,7 @@ pub(crate) fn distance_within(
         }
     }
     if stopped.is_none() && limit >= 0.0 {
-        own.touching_of = Some(QueryKey::new(a, b, pose_ab));
+        own.touching_of = Some(PairKey::new(a, b, pose_ab));
     }
     let answer = match (stopped, best) {
         (Some(bound), _) => Reached::Bounded(whole_compound_lower(a, b, pose_ab, bound)),
@@ -269,7 +252,7 @@ pub(crate) fn manifold(
         return;
     }
     let mut own = std::mem::take(&mut scratch.compound);
-    if own.touching_of != Some(QueryKey::new(a, b, pose_ab)) {
+    if own.touching_of != Some(PairKey::new(a, b, pose_ab)) {
         // Not right after this pair's distance: answer the part pairs again.
         list_candidates(a, b, pose_ab, 0.0, &mut own);
         own.touching.clear();

@@ -61,6 +61,7 @@ use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, Reached, Sh
 use crate::narrow::dispatch::{GJK, NarrowScratch};
 use crate::narrow::gjk::{EpaWorkspace, GjkCache, Rounded, signed_distance_convex};
 use crate::narrow::manifold_reduction::reduce_under_deepest;
+use crate::narrow::pair_key::PairKey;
 use crate::narrow::pairs;
 use crate::narrow::shape::core_of;
 use crate::narrow::{MeshShape, Shape};
@@ -77,7 +78,7 @@ const ON_EDGE: f64 = 1e-9;
 #[derive(Debug, Default)]
 pub(crate) struct MeshContactScratch {
     /// The pair the last distance walk answered, when it recorded every touching triangle.
-    walked: Option<WalkKey>,
+    walked: Option<PairKey>,
     /// The triangles the last distance walk found touching: id, A's frame, signed distance.
     touching: Vec<(u32, Triangle, ShapeDistance)>,
     /// A triangle's manifold, while a mesh manifold is gathered.
@@ -89,25 +90,6 @@ pub(crate) struct MeshContactScratch {
     kept: Vec<usize>,
     /// Per-triangle queries (distance or manifold) run so far, for tests and statistics.
     pub triangle_queries: u64,
-}
-
-/// Which pair a distance walk answered: the shape and mesh (by address; both live in the
-/// scene for the whole frame) and the relative pose, bit for bit.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct WalkKey {
-    shape: usize,
-    mesh: usize,
-    pose_ab: Pose,
-}
-
-impl WalkKey {
-    fn new(shape: &Shape, mesh: &MeshShape, pose_ab: &Pose) -> Self {
-        Self {
-            shape: std::ptr::from_ref(shape) as usize,
-            mesh: std::ptr::from_ref(mesh) as usize,
-            pose_ab: *pose_ab,
-        }
-    }
 }
 
 /// A convex shape against a mesh's triangles: the nearest (or deepest) triangle's signed
@@ -161,7 +143,7 @@ pub(crate) fn shape_mesh_distance(
     // With a negative limit the walk may skip touching triangles, and a stopped walk skips
     // some: no record then.
     let finished = walk.unvisited_lower.is_none();
-    *walked = (limit >= 0.0 && finished).then(|| WalkKey::new(shape, mesh, pose_ab));
+    *walked = (limit >= 0.0 && finished).then(|| PairKey::new(shape, mesh, pose_ab));
     let best = walk.best.map(|(_, d)| d);
     // The volumes' bounds are distances, 0 where they overlap; a triangle left there may
     // be reached through by up to the shape's width along its normal, at most the
@@ -264,7 +246,7 @@ pub(crate) fn shape_mesh_manifold(
         };
         contact.push_corrected(m, points, normals);
     };
-    if *walked == Some(WalkKey::new(shape, mesh, pose_ab)) {
+    if *walked == Some(PairKey::new(shape, mesh, pose_ab)) {
         let one_point = !matches!(shape, Shape::Capsule(_) | Shape::Cuboid(_));
         for (id, triangle, d_t) in touching.iter() {
             if one_point {
