@@ -97,6 +97,10 @@ pub struct NarrowScratch {
     manifold: Box<ManifoldScratch>,
     /// The compound queries' candidate part pairs and gathered points.
     pub(crate) compound: CompoundScratch,
+    /// Set by a [`manifold`] that `clock` stopped before it gathered every point (a
+    /// compound's part pairs; it keeps the deepest point and the normal): the caller marks
+    /// the pair's answer inexact. Never cleared here.
+    pub manifold_cut_short: bool,
 }
 
 /// Every convex kind, as a pattern (every kind but the mesh and the compound).

@@ -97,10 +97,13 @@ pub(super) fn direct(
         .max(d.point_b.abs().max_element())
         + a.pose.position.abs().max_element();
     let error_bound = 1e-10 * d.distance.abs() + 64.0 * f64::EPSILON * scale;
-    let result = in_world(pair, a, &d, error_bound, true);
+    let mut result = in_world(pair, a, &d, error_bound, true);
     let touching = d.distance <= 0.0;
     if query.contacts && touching {
+        scratch.manifold_cut_short = false;
         dispatch::manifold(sa, sb, &pose_ab, &d, scratch, manifold);
+        // The frame's clock stopped the manifold (a compound's): fewer points than exact.
+        result.exact = !scratch.manifold_cut_short;
         let normal = a.pose.transform_vector(manifold.normal);
         for p in manifold.points() {
             contacts.push(ContactPoint {

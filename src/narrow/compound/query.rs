@@ -21,7 +21,9 @@
 //!
 //! # Manifold
 //! Every touching part pair's manifold (their distances kept from the distance just
-//! asked of the same pair and pose, else answered again); their points and the distance's own witnesses (the deepest, with the
+//! asked of the same pair and pose, else answered again; the frame's clock polled before
+//! each after the first, and when it stops them `manifold_cut_short` is raised in the
+//! dispatcher's scratch); their points and the distance's own witnesses (the deepest, with the
 //! compound's normal) are merged under that normal (`reduce_under_deepest`), the other
 //! points' depths measured along it.
 
@@ -256,7 +258,11 @@ pub(crate) fn manifold(
         // Not right after this pair's distance: answer the part pairs again.
         list_candidates(a, b, pose_ab, 0.0, &mut own);
         own.touching.clear();
-        for c in &own.candidates {
+        for (k, c) in own.candidates.iter().enumerate() {
+            if k > 0 && !scratch.clock.allows(WORK_PER_CLOCK_READ) {
+                scratch.manifold_cut_short = true;
+                break;
+            }
             let (part_a, part_b) = pair_of(a, b, c);
             let part_d = dispatch::distance(part_a, part_b, pose_ab, 0.0, scratch);
             if part_d.distance <= 0.0 {
@@ -266,7 +272,11 @@ pub(crate) fn manifold(
     }
     own.points.clear();
     own.normals.clear();
-    for (c, part_d) in &own.touching {
+    for (k, (c, part_d)) in own.touching.iter().enumerate() {
+        if k > 0 && !scratch.clock.allows(WORK_PER_CLOCK_READ) {
+            scratch.manifold_cut_short = true;
+            break;
+        }
         let (part_a, part_b) = pair_of(a, b, c);
         let m = &mut own.part_manifold;
         dispatch::manifold(part_a, part_b, pose_ab, part_d, scratch, m);

@@ -400,3 +400,46 @@ fn a_compound_needs_one_to_max_parts_all_convex() {
     );
     assert!(CompoundShape::new(vec![ball(); MAX_PARTS]).is_ok());
 }
+
+/// A manifold the frame's clock stops keeps the deepest point and the normal, and says it
+/// was cut short; an unlimited clock gathers every part pair and says nothing.
+#[test]
+fn a_stopped_manifold_keeps_the_deepest_point_and_says_so() {
+    let mut r = rng(3306);
+    let mut s = NarrowScratch::default();
+    let mut cut = 0;
+    for case in 0..400 {
+        let a = Arc::new(random_compound(&mut r));
+        let b = Shape::Compound(Arc::new(random_compound(&mut r)));
+        let pose_ab = pose(&mut r, 0.4);
+        let Shape::Compound(parts_b) = &b else {
+            unreachable!()
+        };
+        let touching = a
+            .parts()
+            .iter()
+            .flat_map(|pa| parts_b.parts().iter().map(move |pb| (pa, pb)))
+            .filter(|(pa, pb)| dispatch::distance(pa, pb, &pose_ab, 0.0, &mut s).distance < 0.0)
+            .count();
+        if touching < 2 {
+            continue;
+        }
+        let shape_a = Shape::Compound(a);
+        let d = dispatch::distance(&shape_a, &b, &pose_ab, 0.0, &mut s);
+        let mut m = Manifold::new();
+        for (stop, expect_cut) in [(Stop::Never, false), (Stop::AfterWork(0), true)] {
+            s.clock = WorkClock::new(stop);
+            s.manifold_cut_short = false;
+            dispatch::manifold(&shape_a, &b, &pose_ab, &d, &mut s, &mut m);
+            assert_eq!(s.manifold_cut_short, expect_cut, "case {case}");
+            let deepest = m.points().iter().map(|p| p.distance).fold(0.0, f64::min);
+            assert!(
+                m.normal.distance(d.normal) < 1e-12 && (deepest - d.distance).abs() < 1e-12,
+                "case {case}: {m:?} against {d:?}"
+            );
+        }
+        cut += 1;
+    }
+    s.clock = WorkClock::default();
+    assert!(cut > 30, "{cut} pairs with two touching part pairs");
+}
