@@ -26,9 +26,7 @@
 //! `DIR/<mesh>-<method>.obj`, one object `part_N` per hull. A mesh that cannot be found or
 //! loaded ends the program before any work with exit code 2.
 
-#[path = "../tests/support/data.rs"]
-#[allow(dead_code)]
-mod data;
+// The data folder's rule and the procedural prisms (the rest is the tests').
 #[path = "decompose/meshes.rs"]
 mod meshes;
 #[path = "decompose/methods.rs"]
@@ -37,6 +35,8 @@ mod methods;
 mod metrics;
 #[path = "../benches/common/parry_convert.rs"]
 mod parry_convert;
+#[path = "../tests/support/mod.rs"]
+mod support;
 
 use clap::Parser;
 use methods::{Limits, Run};

@@ -264,12 +264,20 @@ fn build_pile(
     scene: u32,
     _: Option<&Path>,
 ) -> Result<Built, Box<dyn Error>> {
-    let spec = pile_scene(PILE_SEED);
-    let (ids, mirror) = register(client, scene, &spec)?;
+    settling_in_the_pile_box(client, scene, &pile_scene(PILE_SEED))
+}
+
+/// `spec` (a scene in the pile's box) registered, its bodies falling as the pile's do.
+fn settling_in_the_pile_box(
+    client: &Client<ipc::Service>,
+    scene: u32,
+    spec: &SceneSpec,
+) -> Result<Built, Box<dyn Error>> {
+    let (ids, mirror) = register(client, scene, spec)?;
     Ok(Built {
         mirror,
         workload: Box::new(Simulation {
-            world: pile_world(&spec, &ids, PILE_SEED),
+            world: pile_world(spec, &ids, PILE_SEED),
             dt_s: 1.0 / PILE_RATE_HZ,
         }),
     })
@@ -292,24 +300,16 @@ fn build_compound_pile(
         None => {
             let mesh = TriMesh::load(data.join("meshes").join("spot.obj"))?;
             let (decomposition, parts) = compound_parts(&mesh, SPOT_PARTS)?;
+            let diagonal = mesh_diagonal(&mesh);
             println!(
-                "compound-pile: spot in {} parts, concavity {:.4} of its {:.3} m diagonal",
+                "compound-pile: spot in {} parts, concavity {:.4} of its {diagonal:.3} m diagonal",
                 decomposition.parts.len(),
-                decomposition.concavity / mesh_diagonal(&mesh),
-                mesh_diagonal(&mesh)
+                decomposition.concavity / diagonal,
             );
             SPOT_PARTS_CACHE.get_or_init(|| parts).clone()
         }
     };
-    let spec = compound_pile_scene(parts, PILE_SEED);
-    let (ids, mirror) = register(client, scene, &spec)?;
-    Ok(Built {
-        mirror,
-        workload: Box::new(Simulation {
-            world: pile_world(&spec, &ids, PILE_SEED),
-            dt_s: 1.0 / PILE_RATE_HZ,
-        }),
-    })
+    settling_in_the_pile_box(client, scene, &compound_pile_scene(parts, PILE_SEED))
 }
 
 /// The diagonal of a mesh's bounding box, metres.

@@ -1,13 +1,12 @@
 //! The meshes `decompose` measures: files by path, the shared meshes by name (found in the
 //! data folder by `tests/support/data.rs`'s rule), and closed procedural solids made here.
 //!
-//! The procedural solids are prisms: a simple polygon in the xy plane, ear-clipped into the
-//! two caps, extruded along z. They are welded (every edge shared by exactly two triangles)
-//! and oriented counter-clockwise seen from outside, so their enclosed volume is exact.
+//! The procedural solids are the torus and prisms of `tests/support/meshes.rs` (welded,
+//! oriented outward, so their enclosed volume is exact).
 
-use crate::data;
+use crate::support::data;
+use crate::support::meshes::prism;
 use proxima::geometry::{MeshError, TriMesh};
-use proxima::math::DVec3;
 use std::path::{Path, PathBuf};
 
 /// The shared meshes of `--all`: short name and file under the data folder's `meshes/`.
@@ -135,64 +134,5 @@ pub fn u_block() -> TriMesh {
         [1.0, 2.0],
         [0.0, 2.0],
     ];
-    prism(&outline, 0.0, 1.0)
-}
-
-/// The closed prism over a simple counter-clockwise polygon `outline` (xy, metres) from
-/// `z = bottom` to `z = top > bottom`.
-///
-/// # Panics
-/// When the outline has fewer than 3 vertices or is not simple and counter-clockwise (the
-/// ear clipping finds no ear).
-#[must_use]
-pub fn prism(outline: &[[f64; 2]], bottom: f64, top: f64) -> TriMesh {
-    let n = outline.len() as u32;
-    let mut vertices: Vec<DVec3> = outline
-        .iter()
-        .map(|[x, y]| DVec3::new(*x, *y, bottom))
-        .collect();
-    vertices.extend(outline.iter().map(|[x, y]| DVec3::new(*x, *y, top)));
-    let mut triangles = Vec::new();
-    for [a, b, c] in ear_clip(outline) {
-        triangles.push([a, c, b]);
-        triangles.push([a + n, b + n, c + n]);
-    }
-    for i in 0..n {
-        let j = (i + 1) % n;
-        triangles.push([i, j, j + n]);
-        triangles.push([i, j + n, i + n]);
-    }
-    TriMesh::try_new(vertices, triangles).expect("a prism is a valid mesh")
-}
-
-/// Triangles (counter-clockwise, indices into `outline`) covering a simple counter-clockwise
-/// polygon, by ear clipping.
-///
-/// # Panics
-/// When no ear is found (fewer than 3 vertices, or not simple and counter-clockwise).
-fn ear_clip(outline: &[[f64; 2]]) -> Vec<[u32; 3]> {
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
-        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-    };
-    let mut left: Vec<u32> = (0..outline.len() as u32).collect();
-    let mut triangles = Vec::new();
-    while left.len() > 3 {
-        let m = left.len();
-        let ear = (0..m)
-            .find(|&k| {
-                let [a, b, c] = [left[(k + m - 1) % m], left[k], left[(k + 1) % m]];
-                let [pa, pb, pc] = [a, b, c].map(|i| outline[i as usize]);
-                cross(pa, pb, pc) > 0.0
-                    && left.iter().filter(|i| ![a, b, c].contains(i)).all(|&i| {
-                        let p = outline[i as usize];
-                        cross(pa, pb, p) < 0.0 || cross(pb, pc, p) < 0.0 || cross(pc, pa, p) < 0.0
-                    })
-            })
-            .expect("a simple counter-clockwise polygon has an ear");
-        triangles.push([left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]]);
-        left.remove(ear);
-    }
-    assert_eq!(left.len(), 3, "a polygon has at least 3 vertices");
-    triangles.push([left[0], left[1], left[2]]);
-    triangles
+    prism(&outline, 1.0)
 }

@@ -1,16 +1,13 @@
 //! The metrics against analytic answers.
 
 use super::*;
-use crate::meshes::{prism, u_block};
+use crate::meshes::u_block;
+use crate::support::meshes::{L_OUTLINE, cuboid, prism};
 use rand::Rng;
 
 /// The unit cube `[-0.5, 0.5]³` as a closed mesh (12 triangles).
 fn unit_cube() -> TriMesh {
-    prism(
-        &[[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]],
-        -0.5,
-        0.5,
-    )
+    cuboid(DVec3::splat(0.5))
 }
 
 /// The hull of the box `[lo, hi]`.
@@ -88,15 +85,7 @@ fn cube_under_a_hull_shrunk_by_ten_percent_scores_its_corner_gap() {
 
 /// The L-shaped prism: the square `[0, 2]²` without `[1, 2]²`, 2 m tall.
 fn l_block() -> TriMesh {
-    let outline = [
-        [0.0, 0.0],
-        [2.0, 0.0],
-        [2.0, 1.0],
-        [1.0, 1.0],
-        [1.0, 2.0],
-        [0.0, 2.0],
-    ];
-    prism(&outline, 0.0, 2.0)
+    prism(&L_OUTLINE, 2.0)
 }
 
 /// Sampling error allowed on the L-block, in units of its diagonal (about 3.5 m): both

@@ -24,10 +24,10 @@
 //! Rapid Interference Detection", SIGGRAPH 1996; Gottschalk's thesis (2000) §4 for the
 //! facet covariance.
 
-use super::BoundingVolume;
 use super::fit::{
     Moments, frame_about, point_moments, principal_axes, principal_frame, triangle_moments,
 };
+use super::{Aabb, BoundingVolume};
 use crate::geometry::{ConvexPolyhedron, Triangle};
 use crate::math::{DMat3, DVec3, Isometry, conservative_slack, tolerance};
 
@@ -66,6 +66,12 @@ impl Obb {
             axes,
             half_extents,
         }
+    }
+
+    /// The axis-aligned box `aabb` as an OBB of the same frame (no padding).
+    #[must_use]
+    pub fn from_aabb(aabb: &Aabb) -> Self {
+        Self::new(aabb.center(), DMat3::IDENTITY, aabb.half_extents())
     }
 
     /// The smallest box with the given `axes` containing `points` (non-empty), padded.

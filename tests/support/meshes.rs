@@ -82,17 +82,22 @@ pub fn torus(major: f64, minor: f64, around: u32, across: u32) -> TriMesh {
     TriMesh::torus(major, minor, around, across)
 }
 
-/// The closed prism over the counter-clockwise `outline` (x, y), from `z = 0` to `height`;
-/// `cap` triangulates the outline (indices into it, counter-clockwise). Welded, oriented
-/// outward.
-pub fn prism(outline: &[[f64; 2]], cap: &[[u32; 3]], height: f64) -> TriMesh {
+/// The closed prism over a simple counter-clockwise polygon `outline` (x, y, metres), from
+/// `z = 0` to `height`, its caps ear-clipped. Welded, oriented outward, so its enclosed
+/// volume is exact.
+///
+/// # Panics
+/// When the outline has fewer than 3 vertices or is not simple and counter-clockwise (the
+/// ear clipping finds no ear).
+pub fn prism(outline: &[[f64; 2]], height: f64) -> TriMesh {
     let n = outline.len() as u32;
     let mut vertices: Vec<DVec3> = Vec::with_capacity(2 * outline.len());
     for z in [0.0, height] {
         vertices.extend(outline.iter().map(|&[x, y]| DVec3::new(x, y, z)));
     }
+    let cap = ear_clip(outline);
     let mut triangles = Vec::with_capacity(2 * cap.len() + 2 * outline.len());
-    for &[a, b, c] in cap {
+    for [a, b, c] in cap {
         triangles.push([a, c, b]);
         triangles.push([n + a, n + b, n + c]);
     }
@@ -104,18 +109,51 @@ pub fn prism(outline: &[[f64; 2]], cap: &[[u32; 3]], height: f64) -> TriMesh {
     mesh(vertices, triangles)
 }
 
+/// Triangles (counter-clockwise, indices into `outline`) covering a simple counter-clockwise
+/// polygon, by ear clipping.
+///
+/// # Panics
+/// When no ear is found (fewer than 3 vertices, or not simple and counter-clockwise).
+fn ear_clip(outline: &[[f64; 2]]) -> Vec<[u32; 3]> {
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let mut left: Vec<u32> = (0..outline.len() as u32).collect();
+    let mut triangles = Vec::new();
+    while left.len() > 3 {
+        let m = left.len();
+        let ear = (0..m)
+            .find(|&k| {
+                let [a, b, c] = [left[(k + m - 1) % m], left[k], left[(k + 1) % m]];
+                let [pa, pb, pc] = [a, b, c].map(|i| outline[i as usize]);
+                cross(pa, pb, pc) > 0.0
+                    && left.iter().filter(|i| ![a, b, c].contains(i)).all(|&i| {
+                        let p = outline[i as usize];
+                        cross(pa, pb, p) < 0.0 || cross(pb, pc, p) < 0.0 || cross(pc, pa, p) < 0.0
+                    })
+            })
+            .expect("a simple counter-clockwise polygon has an ear");
+        triangles.push([left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]]);
+        left.remove(ear);
+    }
+    assert_eq!(left.len(), 3, "a polygon has at least 3 vertices");
+    triangles.push([left[0], left[1], left[2]]);
+    triangles
+}
+
+/// The L outline of [`l_prism`]: the square `[0, 2]²` without `[1, 2]²`.
+pub const L_OUTLINE: [[f64; 2]; 6] = [
+    [0.0, 0.0],
+    [2.0, 0.0],
+    [2.0, 1.0],
+    [1.0, 1.0],
+    [1.0, 2.0],
+    [0.0, 2.0],
+];
+
 /// An L-shaped prism: two unit squares' worth of arm on a unit corner, 1 high (volume 3).
 pub fn l_prism() -> TriMesh {
-    let outline = [
-        [0.0, 0.0],
-        [2.0, 0.0],
-        [2.0, 1.0],
-        [1.0, 1.0],
-        [1.0, 2.0],
-        [0.0, 2.0],
-    ];
-    // A fan about the bend (1, 1), which sees every corner.
-    prism(&outline, &[[3, 4, 5], [3, 5, 0], [3, 0, 1], [3, 1, 2]], 1.0)
+    prism(&L_OUTLINE, 1.0)
 }
 
 /// A U-shaped prism, 3 wide, 2 deep and 1 high, its notch 1 × 1 (volume 5).
@@ -130,15 +168,7 @@ pub fn u_prism() -> TriMesh {
         [1.0, 2.0],
         [0.0, 2.0],
     ];
-    let cap = [
-        [0, 1, 4],
-        [0, 4, 5],
-        [1, 2, 4],
-        [2, 3, 4],
-        [0, 5, 7],
-        [5, 6, 7],
-    ];
-    prism(&outline, &cap, 1.0)
+    prism(&outline, 1.0)
 }
 
 /// The box `[-half, half]` with 12 triangles (8 vertices).

@@ -115,10 +115,12 @@ fn merge_cheapest(
         if done(f64::from_bits(bits), pool.live()) {
             break;
         }
-        costs.retain(|&(_, a, b)| a != i && a != j && b != i && b != j);
         let Some(union) = pool.get(i).merged(pool.get(j)) else {
+            // This pair cannot merge; the others of `i` and `j` still may.
+            costs.remove(&(bits, i, j));
             continue;
         };
+        costs.retain(|&(_, a, b)| a != i && a != j && b != i && b != j);
         let k = pool.replace(i, j, union);
         for n in pool.neighbours[k].clone() {
             price(pool, &mut costs, n, k);

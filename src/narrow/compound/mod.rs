@@ -24,7 +24,7 @@ pub mod union_depth;
 
 pub use tree::{PartNode, PartTree};
 
-use crate::bounding::{Aabb, BoundingVolume, Obb};
+use crate::bounding::{Aabb, BoundingVolume};
 use crate::geometry::ConvexPolyhedron;
 use crate::geometry::decompose::Decomposition;
 use crate::math::DVec3;
@@ -152,12 +152,6 @@ impl CompoundShape {
     #[must_use]
     pub fn local_bounds(&self) -> Aabb {
         self.bounds
-    }
-
-    /// The box around the whole compound, the tree's root volume.
-    #[must_use]
-    pub fn root_bound(&self) -> &Obb {
-        &self.tree.nodes()[0].bv
     }
 }
 

@@ -32,7 +32,7 @@ use super::tree::Candidate;
 use super::union_depth::{freeing_bound, union_depth};
 use crate::bounding::Obb;
 use crate::budget::WORK_PER_CLOCK_READ;
-use crate::math::{DMat3, DVec3, Pose};
+use crate::math::{DVec3, Pose};
 use crate::narrow::Shape;
 use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, Reached, ShapeDistance};
 use crate::narrow::dispatch::{self, NarrowScratch};
@@ -87,8 +87,7 @@ pub(super) fn list_candidates(
                 .candidates_against(root, &iso, cutoff, stack, candidates)
         }
         _ => {
-            let local = b.local_bounds();
-            let bound = Obb::new(local.center(), DMat3::IDENTITY, local.half_extents());
+            let bound = Obb::from_aabb(&b.local_bounds());
             a.tree()
                 .candidates_against(&bound, &iso, cutoff, stack, candidates)
         }
@@ -298,9 +297,7 @@ pub(crate) fn manifold(
         kept,
         ..
     } = &mut own;
-    if !reduce_under_deepest(points, normals, positions, kept, out) {
-        // Touching at rounding level with no part pair's point: the distance's own.
-        out.set_from_distance(d);
-    }
+    // Never empty: the distance's own point is in.
+    reduce_under_deepest(points, normals, positions, kept, out);
     scratch.compound = own;
 }

@@ -352,7 +352,6 @@ fn the_part_tree_bounds_its_parts() {
         let c = CompoundShape::new(parts).expect("convex parts");
         let nodes = c.tree().nodes();
         let mut seen = vec![0; c.parts().len()];
-        let mut stack = vec![(0, Vec::<usize>::new())];
         let mut below: Vec<Vec<usize>> = vec![Vec::new(); nodes.len()];
         // Each node's parts, children first (they come after their parent).
         for i in (0..nodes.len()).rev() {
@@ -373,7 +372,6 @@ fn the_part_tree_bounds_its_parts() {
                 }
             }
         }
-        stack.clear();
         assert!(seen.iter().all(|&n| n == 1), "{seen:?}");
         assert_eq!(below[0].len(), c.parts().len());
     }

@@ -213,14 +213,9 @@ pub(super) fn freeing_bound(a: &CompoundShape, b: &Shape, pose_ab: &Pose) -> f64
 
 /// [`freeing_bound`] and the direction of its move.
 fn freeing_move(a: &CompoundShape, b: &Shape, pose_ab: &Pose) -> (f64, DVec3) {
-    let whole_a = |n: DVec3| {
-        a.parts()
-            .iter()
-            .map(|p| support_in(p, &Pose::IDENTITY, n).dot(n))
-            .fold(f64::NEG_INFINITY, f64::max)
-    };
+    let top_a = |n: DVec3| compound_support(a, &Pose::IDENTITY, n).dot(n);
     axis_directions(pose_ab)
-        .map(|n| ((whole_a(n) - support_in(b, pose_ab, -n).dot(n)).max(0.0), n))
+        .map(|n| ((top_a(n) - support_in(b, pose_ab, -n).dot(n)).max(0.0), n))
         .fold(
             (f64::INFINITY, DVec3::X),
             |x, y| if y.0 < x.0 { y } else { x },
@@ -235,6 +230,16 @@ fn axis_directions(pose_ab: &Pose) -> impl Iterator<Item = DVec3> + '_ {
         .flat_map(|axis| [axis, -axis])
 }
 
+/// [`support_in`] of a compound: the farthest of its parts'.
+fn compound_support(compound: &CompoundShape, pose: &Pose, direction: DVec3) -> DVec3 {
+    compound
+        .parts()
+        .iter()
+        .map(|p| support_in(p, pose, direction))
+        .max_by(|x, y| x.dot(direction).total_cmp(&y.dot(direction)))
+        .unwrap_or_else(|| unreachable!("a compound has parts"))
+}
+
 /// `pose_ab` with B moved by `offset`, A's frame.
 fn moved_by(pose_ab: &Pose, offset: DVec3) -> Pose {
     Pose::new(pose_ab.position + offset, pose_ab.rotation)
@@ -244,12 +249,7 @@ fn moved_by(pose_ab: &Pose, offset: DVec3) -> Pose {
 /// frame): a compound's over its parts. `shape` is convex or a compound.
 fn support_in(shape: &Shape, pose: &Pose, direction: DVec3) -> DVec3 {
     if let Shape::Compound(c) = shape {
-        return c
-            .parts()
-            .iter()
-            .map(|p| support_in(p, pose, direction))
-            .max_by(|x, y| x.dot(direction).total_cmp(&y.dot(direction)))
-            .unwrap_or_else(|| unreachable!("a compound has parts"));
+        return compound_support(c, pose, direction);
     }
     let Some((core, radius)) = core_of(shape) else {
         unreachable!("meshes keep the per-part answer");

@@ -645,8 +645,7 @@ impl ShapeBound for Rss {
 impl ShapeBound for Obb {
     /// The shape's local box.
     fn around(shape: &Shape) -> Self {
-        let local = shape.local_bounds();
-        Obb::new(local.center(), DMat3::IDENTITY, local.half_extents())
+        Obb::from_aabb(&shape.local_bounds())
     }
 }
 
