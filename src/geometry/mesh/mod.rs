@@ -1,18 +1,21 @@
 //! Indexed triangle meshes: validated construction, loading (OBJ, binary and ASCII STL),
 //! writing, a quality report, the transforms benchmarks use, and edge adjacency with the
-//! surface's bends ([`MeshEdges`], for ghost-normal removal in the narrow phase).
+//! surface's bends ([`MeshEdges`], for ghost-normal removal in the narrow phase), and an
+//! approximation of a closed surface's medial axis ([`medial_balls`], for sphere trees).
 //!
 //! A mesh is not assumed closed, manifold or free of degenerate triangles: [`TriMesh::report`]
 //! tells which of these hold, and later stages (BVH fitting, narrow phase) handle them all.
 
 mod edges;
 mod error;
+mod medial;
 mod obj;
 mod procedural;
 mod stl;
 
 pub use edges::{EdgeKind, FLAT_EDGE_ANGLE, MeshEdges, NO_NEIGHBOUR, TriangleEdges};
 pub use error::{MeshError, ParseReason};
+pub use medial::{MAX_BALLS, MedialBall, medial_balls};
 
 use super::Triangle;
 use crate::math::{DVec3, tolerance};
