@@ -26,11 +26,13 @@ use support::meshes::{self, grid, torus, triangle_soup, uv_sphere, zero_area_tri
 use support::{CENTERS, SCALES, rng};
 
 /// Every preset; each is built with leaf sizes 1 and 4.
-const PRESETS: [BuildParams; 4] = [
+const PRESETS: [BuildParams; 6] = [
     BuildParams::MEDIAN,
     BuildParams::MEAN_VARIANCE,
     BuildParams::BINNED_SAH,
     BuildParams::AGGLOMERATIVE,
+    BuildParams::OCTREE,
+    BuildParams::MEDIAL_AXIS,
 ];
 
 /// Leaf sizes every preset is built with.

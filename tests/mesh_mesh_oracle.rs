@@ -50,8 +50,9 @@ const MAIN_POSES_PER_PAIR: usize = 100;
 const MAIN_PAIRS: usize = 6;
 /// Random poses per procedural mesh pair in the tolerance test.
 const TOLERANCE_POSES_PER_PAIR: usize = 50;
-/// Tree configurations: 8 volume types × 4 builds (see [`all_configs`]).
-const CONFIG_COUNT: usize = 32;
+/// Tree configurations: 8 volume types × 4 builds, and the octree and medial-axis sphere
+/// trees (see [`all_configs`]).
+const CONFIG_COUNT: usize = 34;
 /// Configurations each pose of the main tests is checked with.
 const CONFIGS_PER_POSE: usize = CONFIG_COUNT;
 /// Procedural pairs of the offset and scale stress tests (see [`stress_pairs`]).
@@ -297,7 +298,8 @@ const BUILDS: [BuildParams; 4] = [
     BuildParams::BINNED_SAH.with_leaf_size(4),
 ];
 
-/// Every volume type under every build of [`BUILDS`]: [`CONFIG_COUNT`] configurations.
+/// Every volume type under every build of [`BUILDS`], and the two sphere-tree builds:
+/// [`CONFIG_COUNT`] configurations.
 fn all_configs(a: &TriMesh, b: &TriMesh) -> Vec<Box<dyn PairQueries>> {
     let mut out = Vec::new();
     for params in BUILDS {
@@ -309,6 +311,10 @@ fn all_configs(a: &TriMesh, b: &TriMesh) -> Vec<Box<dyn PairQueries>> {
         out.push(trees::<Kdop14>(a, b, params));
         out.push(trees::<Kdop26>(a, b, params));
         out.push(trees::<Lss>(a, b, params));
+    }
+    // The two sphere-tree constructions (issue #33), whose trees differ in shape only.
+    for params in [BuildParams::OCTREE, BuildParams::MEDIAL_AXIS] {
+        out.push(trees::<BoundingSphere>(a, b, params));
     }
     assert_eq!(out.len(), CONFIG_COUNT);
     out

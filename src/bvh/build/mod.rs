@@ -1,7 +1,8 @@
 //! BVH construction: split or cluster the triangles into a tree, then fit every node.
 //!
 //! Building is two steps. A *builder* decides the tree's shape only, as a `Topology`
-//! (top-down splits in `top_down`, agglomerative clustering in `bottom_up`); then
+//! (top-down splits in `top_down`, octree cells in `octree`, medial-axis cuts in
+//! `medial_axis`, agglomerative clustering in `bottom_up`); then
 //! `fit_topology` copies the triangles into leaf order and fits each node's volume to all
 //! triangles of its subtree with [`BoundingVolume::fit_triangles`] (tighter than merging the
 //! children's volumes, which is what refit does).
@@ -9,7 +10,11 @@
 //! Building is offline work (once per shape) and allocates freely.
 
 mod bottom_up;
+mod medial_axis;
+mod octree;
 mod top_down;
+
+pub use medial_axis::MEDIAL_SPREAD;
 
 use super::{Bvh, BvhNode};
 use crate::bounding::BoundingVolume;
@@ -34,6 +39,13 @@ pub enum BuildStrategy {
     /// volume type the tree is then fitted with (faster and tighter than clustering on
     /// OBB/RSS merges, measured in `bottom_up.rs`).
     Agglomerative,
+    /// Top-down: the cells of a regular octree over the centroids (Hubbard's octree sphere
+    /// tree, `octree.rs`), each cell written as three binary levels.
+    Octree,
+    /// Top-down: cuts across the surface's medial axis, approximated by one inscribed ball
+    /// per triangle, then into surface patches where the balls bunch up (the medial-axis
+    /// sphere tree, `medial_axis.rs`). Meant for closed surfaces; valid for any.
+    MedialAxis,
 }
 
 /// Number of bins per axis of [`BuildStrategy::BinnedSah`].
@@ -57,6 +69,10 @@ impl BuildParams {
     pub const BINNED_SAH: Self = Self::new(BuildStrategy::BinnedSah, 1);
     /// Agglomerative clustering, one triangle per leaf.
     pub const AGGLOMERATIVE: Self = Self::new(BuildStrategy::Agglomerative, 1);
+    /// Octree cells, one triangle per leaf.
+    pub const OCTREE: Self = Self::new(BuildStrategy::Octree, 1);
+    /// Medial-axis cuts, one triangle per leaf.
+    pub const MEDIAL_AXIS: Self = Self::new(BuildStrategy::MedialAxis, 1);
 
     /// Parameters from parts; a `leaf_size` of 0 is taken as 1.
     #[must_use]
@@ -133,6 +149,8 @@ pub(super) fn build<B: BoundingVolume>(triangles: &[Triangle], params: &BuildPar
             top_down::build(&primitives, params.strategy, leaf_size)
         }
         BuildStrategy::Agglomerative => bottom_up::build(triangles, &primitives, leaf_size),
+        BuildStrategy::Octree => octree::build(&primitives, leaf_size),
+        BuildStrategy::MedialAxis => medial_axis::build(triangles, &primitives, leaf_size),
     };
     fit_topology(&topology, triangles, leaf_size)
 }

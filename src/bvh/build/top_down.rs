@@ -17,7 +17,31 @@ pub(super) fn build(
     strategy: BuildStrategy,
     leaf_size: u32,
 ) -> Topology {
-    let n = primitives.len() as u32;
+    let mut scratch = Vec::new();
+    split_recursively(primitives.len(), leaf_size, (), |order, ()| {
+        let mid = match strategy {
+            BuildStrategy::Median => split_median(primitives, order),
+            BuildStrategy::MeanVariance => split_mean(primitives, order, &mut scratch),
+            BuildStrategy::BinnedSah => split_sah(primitives, order),
+            BuildStrategy::Agglomerative | BuildStrategy::Octree | BuildStrategy::MedialAxis => {
+                unreachable!("not a split rule of this builder")
+            }
+        };
+        (mid, [(), ()])
+    })
+}
+
+/// The topology made by splitting `0..n` recursively until parts hold at most `leaf_size`:
+/// `split` reorders a node's indices and returns where to cut them (`0 < mid < len`), and
+/// the state each side carries into its own split (a cell, for the octree); `root` is the
+/// root's state.
+pub(super) fn split_recursively<S>(
+    n: usize,
+    leaf_size: u32,
+    root: S,
+    mut split: impl FnMut(&mut [u32], &S) -> (usize, [S; 2]),
+) -> Topology {
+    let n = n as u32;
     let mut topology = Topology {
         nodes: vec![TopologyNode {
             first: 0,
@@ -26,9 +50,8 @@ pub(super) fn build(
         }],
         order: (0..n).collect(),
     };
-    let mut pending = vec![0usize];
-    let mut scratch = Vec::new();
-    while let Some(index) = pending.pop() {
+    let mut pending = vec![(0usize, root)];
+    while let Some((index, state)) = pending.pop() {
         let [start, end] = topology.nodes[index].span;
         let len = end - start;
         if len <= leaf_size {
@@ -37,12 +60,8 @@ pub(super) fn build(
             continue;
         }
         let order = &mut topology.order[start as usize..end as usize];
-        let mid = match strategy {
-            BuildStrategy::Median => split_median(primitives, order),
-            BuildStrategy::MeanVariance => split_mean(primitives, order, &mut scratch),
-            BuildStrategy::BinnedSah => split_sah(primitives, order),
-            BuildStrategy::Agglomerative => unreachable!("bottom-up strategy in top-down builder"),
-        } as u32;
+        let (mid, [left, right]) = split(order, &state);
+        let mid = mid as u32;
         debug_assert!(mid > 0 && mid < len);
         let first = topology.nodes.len();
         topology.nodes[index].first = first as u32;
@@ -56,8 +75,8 @@ pub(super) fn build(
             count: 0,
             span: [start + mid, end],
         });
-        pending.push(first + 1);
-        pending.push(first);
+        pending.push((first + 1, right));
+        pending.push((first, left));
     }
     topology
 }
@@ -76,19 +95,14 @@ fn centroid_bounds(primitives: &[BuildPrimitive], order: &[u32]) -> (DVec3, DVec
 fn split_median(primitives: &[BuildPrimitive], order: &mut [u32]) -> usize {
     let (lo, hi) = centroid_bounds(primitives, order);
     let axis = (hi - lo).max_position();
-    split_at_median_along(primitives, order, |c| c[axis])
+    split_at_median_by(order, |i| primitives[i as usize].centroid[axis])
 }
 
-/// Reorders `order` so its first half has the smaller `key`s; returns the split index.
-fn split_at_median_along(
-    primitives: &[BuildPrimitive],
-    order: &mut [u32],
-    key: impl Fn(DVec3) -> f64,
-) -> usize {
+/// Reorders `order` so its first half has the smaller `key`s (of the indices); returns the
+/// split index.
+pub(super) fn split_at_median_by(order: &mut [u32], key: impl Fn(u32) -> f64) -> usize {
     let mid = order.len() / 2;
-    order.select_nth_unstable_by(mid, |&i, &j| {
-        key(primitives[i as usize].centroid).total_cmp(&key(primitives[j as usize].centroid))
-    });
+    order.select_nth_unstable_by(mid, |&i, &j| key(i).total_cmp(&key(j)));
     mid
 }
 
@@ -102,14 +116,14 @@ fn split_mean(primitives: &[BuildPrimitive], order: &mut [u32], scratch: &mut Ve
     let mean = axis.dot(moments.mean);
     let below = partition(order, |i| axis.dot(primitives[i as usize].centroid) < mean);
     if below == 0 || below == order.len() {
-        split_at_median_along(primitives, order, |c| axis.dot(c))
+        split_at_median_by(order, |i| axis.dot(primitives[i as usize].centroid))
     } else {
         below
     }
 }
 
 /// Moves the indices satisfying `goes_left` to the front; returns how many there are.
-fn partition(order: &mut [u32], goes_left: impl Fn(u32) -> bool) -> usize {
+pub(super) fn partition(order: &mut [u32], goes_left: impl Fn(u32) -> bool) -> usize {
     let mut left = 0;
     for k in 0..order.len() {
         if goes_left(order[k]) {
@@ -195,7 +209,7 @@ fn split_sah(primitives: &[BuildPrimitive], order: &mut [u32]) -> usize {
         }
     }
     let Some((_, axis, planes)) = best else {
-        return split_at_median_along(primitives, order, |c| c.x);
+        return split_at_median_by(order, |i| primitives[i as usize].centroid.x);
     };
     let scale = SAH_BINS as f64 / extent[axis];
     partition(order, |i| {
