@@ -35,6 +35,9 @@
 //! - `broad_us_mean`, `frontier_us_mean`, `narrow_us_mean`: the frame's stage times
 //!   ([`StepReport`]'s `broad_ns`, `mid_ns`, `narrow_ns`), mean µs.
 //!
+//! `--volume obb|rss|sphere|sphere-medial|sphere-octree` refines every mesh pair with that tree instead
+//! of each mesh's measured choice (`auto`), to compare the trees on one scene.
+//!
 //! `--speed F` moves the bodies along the same paths at `F` times the scene's motion per
 //! frame (a faster control loop sees less motion per frame, and kept separations last
 //! longer). `--workers N` gives the stepping workspace a pool of `N` worker threads, which
@@ -52,10 +55,11 @@ mod data;
 
 use clap::Parser;
 use plotters::prelude::*;
+use proxima::bvh::BuildParams;
 use proxima::geometry::{Capsule, Cuboid, Sphere, TriMesh};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::narrow::mesh_mesh::frontier::RoundOrder;
-use proxima::narrow::{MeshShape, Shape};
+use proxima::narrow::{MeshShape, QueryVolume, Shape};
 use proxima::pipeline::{
     Budget, Deadline, FrameResults, PairResult, PipelineWorkspace, Query, StepReport, Unlimited,
     VisitBudget, WorkerPool, step, step_within,
@@ -115,6 +119,58 @@ struct Args {
     /// Second mesh of a two-mesh scene.
     #[arg(long)]
     mesh2: Option<PathBuf>,
+    /// The trees mesh pairs are refined with: `auto` (each mesh's measured choice,
+    /// `QueryVolume::measure`), `obb`, `rss`, `sphere` (the tighter of each mesh's two
+    /// sphere trees), `sphere-medial` or `sphere-octree`, forced for every mesh.
+    #[arg(long, default_value = "auto")]
+    volume: String,
+}
+
+/// The trees every mesh of the scene is refined with (`--volume`).
+#[derive(Debug, Clone, Copy)]
+enum VolumeChoice {
+    Auto,
+    Forced(QueryVolume),
+    /// Sphere trees of one construction (`None`: the tighter, as the mesh would keep).
+    Spheres(Option<BuildParams>),
+}
+
+impl VolumeChoice {
+    fn parse(name: &str) -> Result<Self, Box<dyn Error>> {
+        Ok(match name {
+            "auto" => Self::Auto,
+            "obb" => Self::Forced(QueryVolume::Obb),
+            "rss" => Self::Forced(QueryVolume::Rss),
+            "sphere" => Self::Spheres(None),
+            "sphere-medial" => Self::Spheres(Some(BuildParams::MEDIAL_AXIS)),
+            "sphere-octree" => Self::Spheres(Some(BuildParams::OCTREE)),
+            other => {
+                return Err(format!(
+                    "--volume {other:?}: auto, obb, rss, sphere, sphere-medial or sphere-octree"
+                )
+                .into());
+            }
+        })
+    }
+
+    /// The mesh with its trees, refined as chosen; prints the mesh's own measured choice.
+    fn shape(self, name: &str, mesh: TriMesh) -> Arc<MeshShape> {
+        let mut shape = MeshShape::new(mesh);
+        println!(
+            "mesh {name}: {} triangles, measured choice {:?}",
+            shape.mesh.triangle_count(),
+            shape.query_volume
+        );
+        match self {
+            Self::Auto => {}
+            Self::Forced(volume) => shape.query_volume = volume,
+            Self::Spheres(params) => {
+                shape = shape.with_sphere_tree(params.as_ref());
+                shape.query_volume = QueryVolume::Sphere;
+            }
+        }
+        Arc::new(shape)
+    }
 }
 
 /// The built-in scenes.
@@ -231,11 +287,11 @@ impl Lcg {
     }
 }
 
-fn mesh_pile() -> Workload {
+fn mesh_pile(volume: VolumeChoice) -> Workload {
     let mut w = new_workload("mesh-pile");
     let mut rng = Lcg(7);
-    let torus = Arc::new(MeshShape::new(TriMesh::torus(0.4, 0.12, 32, 16)));
-    let ball = Arc::new(MeshShape::new(TriMesh::uv_sphere(0.35, 24, 20)));
+    let torus = volume.shape("torus", TriMesh::torus(0.4, 0.12, 32, 16));
+    let ball = volume.shape("ball", TriMesh::uv_sphere(0.35, 24, 20));
     for i in 0..16 {
         let shape = if i < 12 {
             Shape::Mesh(Arc::clone(&torus))
@@ -266,7 +322,7 @@ fn meshes_dir() -> Result<PathBuf, Box<dyn Error>> {
     Ok(dir.join("meshes"))
 }
 
-fn robot_chain() -> Result<Workload, Box<dyn Error>> {
+fn robot_chain(volume: VolumeChoice) -> Result<Workload, Box<dyn Error>> {
     let mut w = new_workload("robot-chain");
     let meshes = meshes_dir()?;
     let env = TriMesh::load(meshes.join("env.obj"))?
@@ -275,9 +331,9 @@ fn robot_chain() -> Result<Workload, Box<dyn Error>> {
     let rob = TriMesh::load(meshes.join("rob.obj"))?
         .scaled(0.001)
         .centered_on_bounds();
-    let link = Arc::new(MeshShape::new(rob));
+    let link = volume.shape("rob", rob);
     w.add(
-        Shape::Mesh(Arc::new(MeshShape::new(env))),
+        Shape::Mesh(volume.shape("env", env)),
         Pose::IDENTITY,
         Motion::Static,
         0.02,
@@ -327,7 +383,7 @@ fn primitives() -> Workload {
     w
 }
 
-fn two_meshes(a: &Path, b: &Path) -> Result<Workload, Box<dyn Error>> {
+fn two_meshes(a: &Path, b: &Path, volume: VolumeChoice) -> Result<Workload, Box<dyn Error>> {
     let mut w = new_workload("two-meshes");
     let (ma, mb) = (
         TriMesh::load(a)?.centered_on_bounds(),
@@ -340,13 +396,13 @@ fn two_meshes(a: &Path, b: &Path) -> Result<Workload, Box<dyn Error>> {
     let reach = 0.5 * (size(&ma) + size(&mb));
     let margin = 0.01 * reach;
     w.add(
-        Shape::Mesh(Arc::new(MeshShape::new(ma))),
+        Shape::Mesh(volume.shape("mesh1", ma)),
         Pose::IDENTITY,
         Motion::Static,
         margin,
     );
     let id = w.add(
-        Shape::Mesh(Arc::new(MeshShape::new(mb))),
+        Shape::Mesh(volume.shape("mesh2", mb)),
         Pose::from_translation(DVec3::X * reach),
         Motion::Dynamic,
         margin,
@@ -783,11 +839,12 @@ fn main() -> Result<(), Box<dyn Error>> {
             return Err(format!("--order {other:?}: stages, bound, pair or largest").into());
         }
     };
+    let volume = VolumeChoice::parse(&args.volume)?;
     let mut workload = match (&args.mesh1, &args.mesh2) {
-        (Some(a), Some(b)) => two_meshes(a, b)?,
+        (Some(a), Some(b)) => two_meshes(a, b, volume)?,
         (None, None) => match args.scene.as_str() {
-            "mesh-pile" => mesh_pile(),
-            "robot-chain" => robot_chain()?,
+            "mesh-pile" => mesh_pile(volume),
+            "robot-chain" => robot_chain(volume)?,
             "primitives" => primitives(),
             other => return Err(format!("unknown scene {other:?}: see --list-scenes").into()),
         },

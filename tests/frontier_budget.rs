@@ -770,26 +770,22 @@ fn alone<P: PairTrees>(pair: &P) -> FrontierAnswer {
 }
 
 #[test]
-fn a_frontier_mixing_obb_and_rss_pairs_is_conservative_monotone_and_exact_per_pair() {
+fn a_frontier_mixing_obb_rss_and_sphere_pairs_is_conservative_monotone_and_exact_per_pair() {
     let mut tally = Tally::default();
     for seed in PILE_SEEDS {
         let scene = tori_pile(seed);
         let meshes: Vec<Arc<MeshShape>> = scene
             .meshes
             .iter()
-            .map(|m| Arc::new(MeshShape::new(m.clone())))
+            .map(|m| Arc::new(MeshShape::new(m.clone()).with_sphere_tree(None)))
             .collect();
-        // Alternate the volume type from pair to pair, whatever the meshes chose.
+        // Rotate the volume type from pair to pair, whatever the meshes chose.
         let pairs: Vec<MeshPairTrees> = scene
             .pairs
             .iter()
             .enumerate()
             .map(|(i, p)| MeshPairTrees {
-                volume: if i % 2 == 0 {
-                    QueryVolume::Obb
-                } else {
-                    QueryVolume::Rss
-                },
+                volume: [QueryVolume::Obb, QueryVolume::Rss, QueryVolume::Sphere][i % 3],
                 ..MeshPairTrees::new(
                     &meshes[p.a],
                     &meshes[p.b],
@@ -814,6 +810,10 @@ fn a_frontier_mixing_obb_and_rss_pairs_is_conservative_monotone_and_exact_per_pa
             let own = match pair.volume {
                 QueryVolume::Obb => alone(&typed(&a.overlap_tree, &b.overlap_tree, pair)),
                 QueryVolume::Rss => alone(&typed(&a.distance_tree, &b.distance_tree, pair)),
+                QueryVolume::Sphere => {
+                    let (ta, tb) = a.sphere_trees(b);
+                    alone(&typed(ta, tb, pair))
+                }
             };
             assert!(same_bits(&[*answer], &[own]), "seed {seed}, pair {i}");
         }

@@ -6,17 +6,22 @@
 //!
 //! The estimates are measured upper bounds (release build, resident memory, temporaries
 //! included):
-//! - a mesh took 884–1,082 bytes per triangle (grids of 20,000 to 980,000 triangles, its
-//!   two BVHs, edges and hull included), a convex hull 668–1,024 bytes per input point
-//!   (4,096 to 65,536 points on a sphere, every one a hull vertex);
+//! - a mesh took at most 1,264–1,416 bytes per triangle at the peak of its build, its
+//!   vertices, trees, edges and hull included (grids of 20,000 and 200,000 triangles,
+//!   UV spheres of 39,800 and 359,400; 2026-11-28, with the sphere trees, which add about
+//!   250 bytes a triangle to the grids' peak and nothing to the spheres'), and a cloud of
+//!   200,000 loose triangles, which keeps its sphere tree, 1,499 with its 600,000
+//!   vertices; a convex hull 668–1,024 bytes per input point (4,096 to 65,536 points on a
+//!   sphere, every one a hull vertex);
 //! - a body took 2.1–3.3 KB once stepped (its record, broad phase, pair memory and the
 //!   frame's workspace: 10,000 to 100,000 spheres in a grid, three `CLOSE` frames). Fewer
 //!   bodies take more each (9.4 KB at 1,000) but less in all than the charge of 1,000.
 
 use super::convert::GeometryRequest;
 
-/// Bytes charged per mesh triangle (measured at most 1,082).
-pub const MESH_BYTES_PER_TRIANGLE: u64 = 1_200;
+/// Bytes charged per mesh triangle (measured at most 1,416 with the vertices of a welded
+/// mesh, which add about 32 of their own charge a triangle).
+pub const MESH_BYTES_PER_TRIANGLE: u64 = 1_500;
 /// Bytes charged per mesh vertex, besides its triangles'.
 pub const MESH_BYTES_PER_VERTEX: u64 = 64;
 /// Bytes charged per convex input point (measured at most 1,024).

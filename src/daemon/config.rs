@@ -30,7 +30,7 @@ pub struct DaemonConfig {
     /// a copy of its geometry payload.
     pub max_queued_builds: usize,
     /// Memory the shapes and bodies of all scenes may take, bytes, as estimated before
-    /// anything is copied, built or added (1,200 B per mesh triangle plus 64 B per mesh
+    /// anything is copied, built or added (1,500 B per mesh triangle plus 64 B per mesh
     /// vertex, 1,100 B per convex point, 4,096 B per body: measured upper bounds, see
     /// `budget_memory`); a registration or body beyond is refused with `LimitExceeded`. A
     /// removed body or dropped scene gives its share back.

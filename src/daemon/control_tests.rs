@@ -802,11 +802,12 @@ fn a_quarantined_scene_tells_its_owner_why_until_dropped_and_frees_its_slot() {
 #[test]
 fn shapes_are_charged_against_the_memory_budget_before_anything_is_copied_and_scenes_give_it_back()
 {
-    use super::super::budget_memory::MESH_BYTES_PER_TRIANGLE;
+    use super::super::budget_memory::{MESH_BYTES_PER_TRIANGLE, readable};
     // Room for one 4-triangle tetrahedron mesh, not two.
     let one_mesh = 4 * MESH_BYTES_PER_TRIANGLE + 4 * 64;
+    let config_limit = one_mesh + one_mesh / 2;
     let config = DaemonConfig {
-        max_memory_bytes: one_mesh + one_mesh / 2,
+        max_memory_bytes: config_limit,
         ..DaemonConfig::default()
     };
     let (mut state, jobs) = state_with(config, 4);
@@ -819,10 +820,11 @@ fn shapes_are_charged_against_the_memory_budget_before_anything_is_copied_and_sc
     );
     let refused = state.handle(OWNER, &mesh_request(second, 4, 12), &payload);
     assert_eq!(code(&refused), ErrorCode::LimitExceeded);
+    let (limit, left) = (readable(config_limit), readable(config_limit - one_mesh));
     assert!(
-        refused
-            .reason()
-            .contains("the daemon's 8 KiB for shapes and bodies has 3 KiB left"),
+        refused.reason().contains(&format!(
+            "the daemon's {limit} for shapes and bodies has {left} left"
+        )),
         "{}",
         refused.reason()
     );

@@ -3,7 +3,7 @@
 //! cone < convex < mesh < compound), and [`MeshShape`], a triangle mesh with everything its queries
 //! need, built once when it is registered.
 
-use crate::bounding::{Aabb, BoundingVolume, Obb, Rss};
+use crate::bounding::{Aabb, BoundingSphere, BoundingVolume, Obb, Rss};
 use crate::budget::WorkClock;
 use crate::bvh::{BuildParams, Bvh};
 use crate::geometry::mesh::MeshEdges;
@@ -20,8 +20,9 @@ use crate::narrow::mesh_mesh::{
 };
 use std::sync::Arc;
 
-/// A triangle mesh ready for queries: the mesh and its two BVHs (OBB trees answer overlap
-/// and contacts fastest, RSS trees distance; measured in `benches/mesh_pair.rs`).
+/// A triangle mesh ready for queries: the mesh and its three BVHs (OBB trees answer overlap
+/// and contacts fastest, RSS trees distance, measured in `benches/mesh_pair.rs`; the sphere
+/// tree is the third choice for distance, [`QueryVolume`]).
 #[derive(Debug)]
 pub struct MeshShape {
     /// The mesh, local frame.
@@ -30,6 +31,12 @@ pub struct MeshShape {
     pub overlap_tree: Bvh<Obb>,
     /// Binned-SAH tree of RSSs.
     pub distance_tree: Bvh<Rss>,
+    /// Tree of spheres: the medial-axis or the octree construction, whichever holds less
+    /// volume at the top levels ([`BuildParams::MEDIAL_AXIS`], [`BuildParams::OCTREE`]),
+    /// kept only when the mesh chose it (a third tree costs about 200 bytes a triangle,
+    /// and the closed surfaces measured never choose it). Pair queries told to refine
+    /// spheres refine RSSs when either mesh kept none ([`MeshShape::pair_volume`]).
+    pub sphere_tree: Option<Bvh<BoundingSphere>>,
     /// Edge adjacency and bends, for convex–mesh contacts without ghost normals.
     pub edges: MeshEdges,
     /// The tree distance queries on this mesh refine, the budgeted frontier's and the
@@ -42,19 +49,65 @@ pub struct MeshShape {
 }
 
 impl MeshShape {
-    /// Builds both trees over `mesh` (offline work: about 1 s for 70,000 triangles), its
-    /// edge adjacency and its query volume choice.
+    /// Builds the three trees over `mesh` (offline work: about 1 s for 70,000 triangles),
+    /// its edge adjacency and its query volume choice.
     #[must_use]
     pub fn new(mesh: TriMesh) -> Self {
         let overlap_tree = Bvh::from_mesh(&mesh, &BuildParams::BINNED_SAH);
         let distance_tree = Bvh::from_mesh(&mesh, &BuildParams::BINNED_SAH);
+        let (obb, rss) = (measured(&overlap_tree), measured(&distance_tree));
+        let chosen = |sphere| QueryVolume::choose(obb, rss, Some(sphere)) == QueryVolume::Sphere;
+        let sphere_tree = tighter_sphere_tree(&mesh, chosen);
+        let query_volume = QueryVolume::choose(obb, rss, sphere_tree.as_ref().map(measured));
         Self {
             edges: MeshEdges::new(&mesh),
-            query_volume: QueryVolume::measure(&overlap_tree, &distance_tree),
             hull: MeshHull::of(&mesh),
+            sphere_tree,
+            query_volume,
             overlap_tree,
             distance_tree,
             mesh,
+        }
+    }
+
+    /// The same mesh with a sphere tree built by `params` (`None`: the tighter of the
+    /// medial-axis and octree trees) and kept whatever the choice, for measurements of one
+    /// tree against another, which then set [`query_volume`](Self::query_volume); the
+    /// query volume is measured again.
+    #[must_use]
+    pub fn with_sphere_tree(mut self, params: Option<&BuildParams>) -> Self {
+        let tree = match params {
+            Some(params) => Bvh::from_mesh(&self.mesh, params),
+            None => tighter_sphere_tree(&self.mesh, |_| true).expect("every tree is kept"),
+        };
+        self.query_volume = QueryVolume::measure(&self.overlap_tree, &self.distance_tree, &tree);
+        self.sphere_tree = Some(tree);
+        self
+    }
+
+    /// The volume type this mesh and `other` are refined with: [`QueryVolume::for_pair`] of
+    /// their choices, or `volume` when given, and RSSs in place of spheres when either
+    /// mesh kept no sphere tree.
+    #[must_use]
+    pub fn pair_volume(&self, other: &Self, volume: Option<QueryVolume>) -> QueryVolume {
+        match volume.unwrap_or(QueryVolume::for_pair(self.query_volume, other.query_volume)) {
+            QueryVolume::Sphere if self.sphere_tree.is_none() || other.sphere_tree.is_none() => {
+                QueryVolume::Rss
+            }
+            chosen => chosen,
+        }
+    }
+
+    /// Both meshes' sphere trees; call only where [`pair_volume`](Self::pair_volume) said
+    /// [`QueryVolume::Sphere`], which it says only when both are kept.
+    #[must_use]
+    pub fn sphere_trees<'a>(
+        &'a self,
+        other: &'a Self,
+    ) -> (&'a Bvh<BoundingSphere>, &'a Bvh<BoundingSphere>) {
+        match (&self.sphere_tree, &other.sphere_tree) {
+            (Some(a), Some(b)) => (a, b),
+            _ => unreachable!("pair_volume chooses spheres only when both meshes kept theirs"),
         }
     }
 
@@ -96,22 +149,29 @@ impl MeshShape {
         clock: &mut WorkClock,
     ) -> MeshDistance {
         let exact = &DistanceParams::EXACT;
-        match QueryVolume::for_pair(self.query_volume, other.query_volume) {
+        let iso = pose_ab.to_isometry();
+        // The RSS trees' rounding, whichever trees were searched, plus what the search left
+        // unsearched (the other trees' own rounding is replaced), so a record does not
+        // depend on the choice.
+        let restated = |d: MeshDistance, searched_rounding: f64| MeshDistance {
+            error_bound: self.rounding_with(other, &iso)
+                + (d.error_bound - searched_rounding).max(0.0),
+            ..d
+        };
+        match self.pair_volume(other, None) {
             QueryVolume::Obb => {
                 let (a, b) = (&self.overlap_tree, &other.overlap_tree);
                 let d = distance_mesh_mesh_within(a, b, pose_ab, exact, cache, workspace, clock);
-                // The RSS trees' rounding, whichever trees were searched, plus what the
-                // search left unsearched (the OBB trees' own rounding is replaced).
-                let unsearched = d.error_bound - rounding_bound(a, b, &pose_ab.to_isometry());
-                MeshDistance {
-                    error_bound: self.rounding_with(other, &pose_ab.to_isometry())
-                        + unsearched.max(0.0),
-                    ..d
-                }
+                restated(d, rounding_bound(a, b, &iso))
             }
             QueryVolume::Rss => {
                 let (a, b) = (&self.distance_tree, &other.distance_tree);
                 distance_mesh_mesh_within(a, b, pose_ab, exact, cache, workspace, clock)
+            }
+            QueryVolume::Sphere => {
+                let (a, b) = self.sphere_trees(other);
+                let d = distance_mesh_mesh_within(a, b, pose_ab, exact, cache, workspace, clock);
+                restated(d, rounding_bound(a, b, &iso))
             }
         }
     }
@@ -127,7 +187,7 @@ impl MeshShape {
         max_distance: f64,
         workspace: &mut MeshMeshWorkspace,
     ) -> Proximity {
-        match QueryVolume::for_pair(self.query_volume, other.query_volume) {
+        match self.pair_volume(other, None) {
             QueryVolume::Obb => {
                 let (a, b) = (&self.overlap_tree, &other.overlap_tree);
                 proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
@@ -136,11 +196,15 @@ impl MeshShape {
                 let (a, b) = (&self.distance_tree, &other.distance_tree);
                 proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
             }
+            QueryVolume::Sphere => {
+                let (a, b) = self.sphere_trees(other);
+                proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
+            }
         }
     }
 }
 
-/// Which of a mesh's two trees distance queries refine it with: the budgeted frontier
+/// Which of a mesh's three trees distance queries refine it with: the budgeted frontier
 /// ([`MeshPairTrees`](crate::narrow::mesh_mesh::frontier::MeshPairTrees)) and the exact queries
 /// ([`MeshShape::distance_to`], [`MeshShape::proximity`]).
 ///
@@ -148,8 +212,13 @@ impl MeshShape {
 /// tighter per visit. The OBB's separating-axis gap costs a fraction of the RSS's exact
 /// rectangle distance, so box-like CAD parts, whose RSSs hold clearly more volume than
 /// their boxes, choose OBBs; curved meshes (tori, spheres), whose RSSs are as small as
-/// their boxes and bound distance more tightly, choose RSSs. `examples/time_vs_error`
-/// (`--scene robot-chain` and `--scene mesh-pile`) measures both.
+/// their boxes and bound distance more tightly, choose RSSs. A sphere's bound costs least
+/// of all (one centre distance, no rotation) but bounds a surface patch by its diameter
+/// rather than its thickness, so only meshes whose sphere tree is nearly as tight as the
+/// others choose it: clouds of loose triangles (debris, foliage, scanned fragments), never
+/// the closed surfaces measured.
+/// `examples/time_vs_error` (`--scene robot-chain` and `--scene mesh-pile`, `--volume`)
+/// measures all three.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum QueryVolume {
     /// The OBB tree: clearly the tighter of the two on this mesh.
@@ -157,6 +226,9 @@ pub enum QueryVolume {
     /// The RSS tree: about as tight as the boxes, and its distance bound is exact for
     /// rounded rectangles.
     Rss,
+    /// The sphere tree: nearly as tight as the others at the top levels (clouds of loose
+    /// pieces, not surfaces of solids), where its cheaper bound pays.
+    Sphere,
 }
 
 impl QueryVolume {
@@ -165,32 +237,77 @@ impl QueryVolume {
     const MEASURED_DEPTH: u32 = 5;
     /// RSS volume over OBB volume above which the boxes are taken.
     const OBB_TIGHTER: f64 = 1.15;
+    /// Sphere volume over the smaller of the box and RSS volumes up to which the spheres are
+    /// taken. Measured (`examples/time_vs_error --volume`, exact frames, two alternating
+    /// runs): two clouds of loose triangles, at 1.28 and 1.43, ran 1.6× and 1.2× faster at
+    /// the median on (octree) spheres than on boxes, though 1.2–1.3× slower at p99, and
+    /// 1.8–2.5× faster at the median and 1.2× at p99 than on RSSs, which the box/RSS rule
+    /// alone gives them. Closed meshes are at 2.0–2.4 (spot, fandisk, bunny, and the tori
+    /// and balls of the mesh pile, which ran 2.5× slower on spheres than on RSSs) and CAD
+    /// parts at 6–12 (robot-chain: 140× slower). Spheres bound a surface patch by its
+    /// diameter, not its thickness.
+    const SPHERE_TIGHT_ENOUGH: f64 = 1.6;
 
     /// The choice for a mesh with these trees: OBBs when the RSSs of the nodes down to
     /// depth 5 (`MEASURED_DEPTH`) hold more than 1.15 (`OBB_TIGHTER`) times the boxes'
-    /// volume, else RSSs.
+    /// volume, else RSSs; spheres instead when theirs hold at most 1.6
+    /// (`SPHERE_TIGHT_ENOUGH`) times the smaller of the two.
     #[must_use]
-    pub fn measure(overlap_tree: &Bvh<Obb>, distance_tree: &Bvh<Rss>) -> Self {
-        let (obb, rss) = (
-            top_volume(overlap_tree, Self::MEASURED_DEPTH),
-            top_volume(distance_tree, Self::MEASURED_DEPTH),
-        );
-        if rss > Self::OBB_TIGHTER * obb {
+    pub fn measure(
+        overlap_tree: &Bvh<Obb>,
+        distance_tree: &Bvh<Rss>,
+        sphere_tree: &Bvh<BoundingSphere>,
+    ) -> Self {
+        Self::choose(
+            measured(overlap_tree),
+            measured(distance_tree),
+            Some(measured(sphere_tree)),
+        )
+    }
+
+    /// [`measure`](Self::measure) from the trees' measured volumes, cubic metres (`sphere`:
+    /// `None` when there is no sphere tree to choose).
+    fn choose(obb: f64, rss: f64, sphere: Option<f64>) -> Self {
+        if sphere.is_some_and(|sphere| sphere <= Self::SPHERE_TIGHT_ENOUGH * obb.min(rss)) {
+            Self::Sphere
+        } else if rss > Self::OBB_TIGHTER * obb {
             Self::Obb
         } else {
             Self::Rss
         }
     }
 
-    /// The volume type a pair of meshes is refined with: OBBs when both meshes chose them.
+    /// The volume type a pair of meshes is refined with: the one both meshes chose, else
+    /// RSSs (every mesh has its box and RSS trees).
     #[must_use]
     pub fn for_pair(a: Self, b: Self) -> Self {
-        if a == Self::Obb && b == Self::Obb {
-            Self::Obb
-        } else {
-            Self::Rss
+        if a == b { a } else { Self::Rss }
+    }
+}
+
+/// The medial-axis sphere tree of `mesh` or its octree sphere tree, whichever holds less
+/// volume down to [`QueryVolume`]'s measured depth, if `keep` takes its volume. The medial
+/// axis groups the triangles of a closed solid's tubes and plates into slices, but a surface
+/// with no inside (a cloud of pieces, an open sheet) has no medial axis worth the name, and
+/// there the octree's cells are tighter (measured in `examples/sphere_trees.rs`).
+///
+/// Built one after the other, and a tree `keep` refuses is dropped at once: a third tree
+/// costs about 200 bytes a triangle, and most meshes keep none.
+fn tighter_sphere_tree(mesh: &TriMesh, keep: impl Fn(f64) -> bool) -> Option<Bvh<BoundingSphere>> {
+    let mut kept: Option<(Bvh<BoundingSphere>, f64)> = None;
+    for params in [BuildParams::MEDIAL_AXIS, BuildParams::OCTREE] {
+        let tree = Bvh::from_mesh(mesh, &params);
+        let volume = measured(&tree);
+        if keep(volume) && kept.as_ref().is_none_or(|(_, best)| volume < *best) {
+            kept = Some((tree, volume));
         }
     }
+    kept.map(|(tree, _)| tree)
+}
+
+/// The volume [`QueryVolume`] measures a tree by: its nodes' down to the measured depth.
+fn measured<B: BoundingVolume>(tree: &Bvh<B>) -> f64 {
+    top_volume(tree, QueryVolume::MEASURED_DEPTH)
 }
 
 /// Total volume, cubic metres, of the nodes of `tree` down to `depth` (the root at 0).
@@ -359,16 +476,44 @@ mod tests {
         assert_eq!(pair(QueryVolume::Obb, QueryVolume::Obb), QueryVolume::Obb);
         assert_eq!(pair(QueryVolume::Obb, QueryVolume::Rss), QueryVolume::Rss);
         assert_eq!(pair(QueryVolume::Rss, QueryVolume::Obb), QueryVolume::Rss);
+        assert_eq!(
+            pair(QueryVolume::Sphere, QueryVolume::Obb),
+            QueryVolume::Rss
+        );
+        assert_eq!(
+            pair(QueryVolume::Sphere, QueryVolume::Sphere),
+            QueryVolume::Sphere
+        );
+    }
+
+    /// A cloud of loose triangles in a ball takes its sphere tree and keeps it; a closed
+    /// surface keeps none, and a pair told to refine spheres then refines RSSs.
+    #[test]
+    fn clouds_of_loose_pieces_take_spheres_and_surfaces_keep_none() {
+        let dust = MeshShape::new(meshes::dust_ball(&mut rng(5), 2_000, 0.5, 0.02));
+        assert_eq!(dust.query_volume, QueryVolume::Sphere);
+        assert!(dust.sphere_tree.is_some());
+        let torus = MeshShape::new(meshes::torus(0.4, 0.12, 32, 16));
+        assert!(torus.sphere_tree.is_none());
+        assert_eq!(dust.pair_volume(&dust, None), QueryVolume::Sphere);
+        assert_eq!(dust.pair_volume(&torus, None), QueryVolume::Rss);
+        let told = Some(QueryVolume::Sphere);
+        assert_eq!(torus.pair_volume(&torus, told), QueryVolume::Rss);
+        assert_eq!(dust.pair_volume(&dust, told), QueryVolume::Sphere);
+        // Forced for a measurement: the torus then has one, and refines it when told.
+        let forced = MeshShape::new(meshes::torus(0.4, 0.12, 32, 16)).with_sphere_tree(None);
+        assert_eq!(forced.pair_volume(&forced, told), QueryVolume::Sphere);
     }
 
     /// The exact queries refine the trees the pair's volume names (OBBs for two slabs, RSSs
-    /// when a ball is in the pair) and answer as the brute force over every triangle pair
+    /// when a ball is in the pair, spheres for two dust clouds) and answer as the brute force over every triangle pair
     /// does, with the RSS trees' rounding bound on either path; `proximity` agrees with the
     /// distance on both sides of the limit, and its lower bound when apart is one.
     #[test]
-    fn exact_queries_on_either_volume_match_the_brute_force() {
+    fn exact_queries_on_every_volume_match_the_brute_force() {
         let slab = MeshShape::new(meshes::subdivided_cuboid(DVec3::new(0.5, 0.3, 0.15), 3));
         let ball = MeshShape::new(meshes::uv_sphere(0.35, 12, 8));
+        let dust = MeshShape::new(meshes::dust_ball(&mut rng(6), 300, 0.4, 0.03));
         let mut r = rng(91);
         let mut workspace = MeshMeshWorkspace::new();
         let (mut within, mut beyond) = (0, 0);
@@ -376,6 +521,7 @@ mod tests {
             (&slab, &slab, QueryVolume::Obb),
             (&slab, &ball, QueryVolume::Rss),
             (&ball, &ball, QueryVolume::Rss),
+            (&dust, &dust, QueryVolume::Sphere),
         ] {
             assert_eq!(
                 QueryVolume::for_pair(a.query_volume, b.query_volume),

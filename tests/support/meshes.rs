@@ -265,6 +265,28 @@ pub fn triangle_soup(rng: &mut TestRng, count: usize, half: f64, size: f64) -> T
     mesh(vertices, tris)
 }
 
+/// `count` random unwelded triangles with centres uniform in the ball of `radius` about the
+/// origin and vertices within `size` of their centre: a cloud of loose pieces (debris,
+/// foliage), the class of mesh whose sphere tree is nearly as tight as its boxes.
+pub fn dust_ball(rng: &mut TestRng, count: usize, radius: f64, size: f64) -> TriMesh {
+    let mut vertices = Vec::with_capacity(3 * count);
+    let mut tris = Vec::with_capacity(count);
+    for t in 0..count {
+        let centre = loop {
+            let p = point_in_cube(rng, radius);
+            if p.length() <= radius {
+                break p;
+            }
+        };
+        for _ in 0..3 {
+            vertices.push(centre + point_in_cube(rng, size));
+        }
+        let first = 3 * t as u32;
+        tris.push([first, first + 1, first + 2]);
+    }
+    mesh(vertices, tris)
+}
+
 /// `count` zero-area triangles in the cube `[-half, half]³` and nothing else, unwelded, in
 /// turn: a point (one vertex, index repeated three times); three collinear points `p`,
 /// `p + d`, `p + 2.5 d` (collinear up to the rounding of the sums); a segment with a

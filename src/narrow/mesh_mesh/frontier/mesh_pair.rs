@@ -12,8 +12,8 @@ use std::sync::Arc;
 pub struct MeshPairTrees {
     /// Mesh of body A, mesh of body B (held while the frontier refers to their trees).
     pub meshes: [Arc<MeshShape>; 2],
-    /// Which of the meshes' trees the pair is refined with
-    /// ([`QueryVolume::for_pair`]).
+    /// Which of the meshes' trees the pair is refined with ([`MeshShape::pair_volume`];
+    /// spheres are refined as RSSs when either mesh kept no sphere tree).
     pub volume: QueryVolume,
     /// B's frame expressed in A's frame.
     pub pose_ab: Isometry,
@@ -35,7 +35,7 @@ impl MeshPairTrees {
         seed: Option<[u32; 2]>,
     ) -> Self {
         Self {
-            volume: QueryVolume::for_pair(a.query_volume, b.query_volume),
+            volume: a.pair_volume(b, None),
             meshes: [Arc::clone(a), Arc::clone(b)],
             pose_ab,
             threshold,
@@ -48,7 +48,7 @@ impl MeshPairTrees {
 macro_rules! on_trees {
     ($pair:ident, $trees:ident => $call:expr) => {{
         let [a, b] = &$pair.meshes;
-        match $pair.volume {
+        match a.pair_volume(b, Some($pair.volume)) {
             QueryVolume::Obb => {
                 let $trees = TreesAt {
                     a: &a.overlap_tree,
@@ -61,6 +61,15 @@ macro_rules! on_trees {
                 let $trees = TreesAt {
                     a: &a.distance_tree,
                     b: &b.distance_tree,
+                    pose_ab: &$pair.pose_ab,
+                };
+                $call
+            }
+            QueryVolume::Sphere => {
+                let (a, b) = a.sphere_trees(b);
+                let $trees = TreesAt {
+                    a,
+                    b,
                     pose_ab: &$pair.pose_ab,
                 };
                 $call
