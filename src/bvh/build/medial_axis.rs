@@ -60,3 +60,59 @@ fn widest(order: &[u32], point: impl Fn(u32) -> DVec3) -> (f64, usize) {
     let extent = hi - lo;
     (extent.max_element(), extent.max_position())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::TriMesh;
+
+    /// Whether every node down to `depth` holds triangles of both the outer and the inner
+    /// half of a torus's tube (a slice across the core circle) rather than a patch of one.
+    fn slices_across_the_tube(
+        topology: &Topology,
+        triangles: &[Triangle],
+        depth: u32,
+        major: f64,
+    ) -> bool {
+        let outer = |i: u32| {
+            let c = triangles[i as usize].centroid();
+            c.truncate().length() > major
+        };
+        let mut stack = vec![(0usize, 0u32)];
+        while let Some((i, d)) = stack.pop() {
+            let node = topology.nodes[i];
+            let [start, end] = node.span;
+            let members = &topology.order[start as usize..end as usize];
+            if !(members.iter().any(|&t| outer(t)) && members.iter().any(|&t| !outer(t))) {
+                return false;
+            }
+            if d < depth && node.count == 0 {
+                stack.extend([
+                    (node.first as usize, d + 1),
+                    (node.first as usize + 1, d + 1),
+                ]);
+            }
+        }
+        true
+    }
+
+    /// On a fat torus the medial rule cuts across the core circle (every node of the top
+    /// five levels holds inner and outer triangles: 16 rings), where splitting the
+    /// centroids at their median has cut the tube into inner and outer patches by then.
+    /// Below, a ring is shorter along the circle than half its width, and the rule turns to
+    /// patches (`MEDIAL_SPREAD`).
+    #[test]
+    fn a_torus_is_sliced_across_its_core_circle() {
+        let (major, minor) = (1.0, 0.6);
+        let mesh = TriMesh::torus(major, minor, 64, 32);
+        let triangles: Vec<Triangle> = (0..mesh.triangle_count())
+            .map(|i| mesh.triangle(i))
+            .collect();
+        let primitives: Vec<BuildPrimitive> = triangles.iter().map(BuildPrimitive::of).collect();
+        let medial = build(&triangles, &primitives, 1);
+        assert!(slices_across_the_tube(&medial, &triangles, 4, major));
+        let median =
+            super::super::top_down::build(&primitives, super::super::BuildStrategy::Median, 1);
+        assert!(!slices_across_the_tube(&median, &triangles, 4, major));
+    }
+}

@@ -82,3 +82,53 @@ pub(super) fn build(primitives: &[BuildPrimitive], leaf_size: u32) -> Topology {
         (order.len() / 2, [cell, cell])
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Triangle;
+
+    /// Tiny triangles centred at `centres`.
+    fn primitives(centres: &[DVec3]) -> Vec<BuildPrimitive> {
+        centres
+            .iter()
+            .map(|&c| {
+                BuildPrimitive::of(&Triangle::new(c, c + DVec3::X * 1e-3, c + DVec3::Y * 1e-3))
+            })
+            .collect()
+    }
+
+    /// The sorted triangle indices of node `i`.
+    fn members(topology: &Topology, i: usize) -> Vec<u32> {
+        let [start, end] = topology.nodes[i].span;
+        let mut m = topology.order[start as usize..end as usize].to_vec();
+        m.sort_unstable();
+        m
+    }
+
+    /// Cells, not medians: the root's cube (side 100 m) is cut at its middle, so the four
+    /// centroids near the origin go one way and the far one the other (a median would cut
+    /// 2 | 3); the near four are cut where their shrunken cell's middle falls, 1.5625 m.
+    #[test]
+    fn splits_fall_at_cell_middles_not_medians() {
+        let centres = [0.0, 1.0, 2.0, 3.0, 100.0].map(|x| DVec3::new(x, 0.0, 0.0));
+        let topology = build(&primitives(&centres), 1);
+        let root = topology.nodes[0];
+        let [near, far] = [root.first as usize, root.first as usize + 1];
+        assert_eq!(members(&topology, near), [0, 1, 2, 3]);
+        assert_eq!(members(&topology, far), [4]);
+        let first = topology.nodes[near].first as usize;
+        assert_eq!(members(&topology, first), [0, 1]);
+        assert_eq!(members(&topology, first + 1), [2, 3]);
+    }
+
+    /// Coincident centroids cannot be told apart by any cell: they are split by index, and
+    /// every leaf holds one triangle.
+    #[test]
+    fn coincident_centroids_end_in_single_leaves() {
+        let topology = build(&primitives(&[DVec3::splat(0.5); 5]), 1);
+        let leaves = topology.nodes.iter().filter(|n| n.count > 0).count();
+        assert_eq!(leaves, 5);
+        assert!(topology.nodes.iter().all(|n| n.count <= 1));
+    }
+}
