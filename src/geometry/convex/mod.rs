@@ -17,7 +17,7 @@ mod validate;
 use build::{bounds, build_with_corners};
 use scan::VertexLanes;
 
-use super::SupportMap;
+use super::{PointTree, SupportMap};
 use crate::math::{DVec3, tolerance};
 use std::collections::HashSet;
 use std::fmt;
@@ -239,8 +239,19 @@ impl ConvexPolyhedron {
     }
 
     /// Whether every point is within tolerance of the hull (the construction contract).
+    /// Whether every point passes [`contains_point`](Self::contains_point). Solid and flat
+    /// hulls ask, per plane, for the point farthest along its normal (the same dot products,
+    /// `O(F log n)` rather than `O(F n)`).
     fn contains_all(&self, points: &[DVec3]) -> bool {
-        points.iter().all(|p| self.contains_point(*p))
+        if self.dimension < 2 {
+            return points.iter().all(|p| self.contains_point(*p));
+        }
+        let tol = self.tolerance();
+        let local: Vec<DVec3> = points.iter().map(|p| *p - self.origin).collect();
+        let tree = PointTree::new(&local);
+        self.planes
+            .iter()
+            .all(|(n, d)| tree.max_dot(*n).is_none_or(|(_, top)| top - d <= tol))
     }
 
     /// Hull vertices (local frame): a subset of the input points, without duplicates.

@@ -1,6 +1,7 @@
 //! [`ConvexPolyhedron::validate`]: the invariants listed on the type, checked from scratch.
 
 use super::{ConvexPolyhedron, quickhull};
+use crate::geometry::PointTree;
 use crate::math::DVec3;
 use std::collections::{HashMap, HashSet};
 
@@ -41,9 +42,16 @@ impl ConvexPolyhedron {
                 Err("triangles or faces below dimension 2".into())
             };
         }
-        for (i, v) in self.vertices.iter().enumerate() {
-            let worst = self.max_plane_distance(*v).unwrap_or(0.0);
-            if worst > tol {
+        // Every vertex behind every plane: per plane, the vertex farthest along its normal
+        // (branch and bound: `O(F log V)`, where vertex by plane was `O(F V)` and took 19 s
+        // for the 80,000 vertices of a round cloud).
+        let local: Vec<DVec3> = self.vertices.iter().map(|v| *v - self.origin).collect();
+        let tree = PointTree::new(&local);
+        for (n, d) in &self.planes {
+            if let Some((i, top)) = tree.max_dot(*n)
+                && top - d > tol
+            {
+                let worst = top - d;
                 return Err(format!("vertex {i} is {worst:e} m outside a face plane"));
             }
         }
@@ -63,13 +71,19 @@ impl ConvexPolyhedron {
                 return Err(format!("vertex {i} has a missing or one-sided neighbour"));
             }
         }
-        self.validate_triangles(tol)?;
+        self.validate_triangles(&local, &tree, tol)?;
         self.validate_faces(tol)?;
         validate_closed(&self.triangles, self.vertices.len(), self.dimension == 3)
     }
 
-    fn validate_triangles(&self, tol: f64) -> Result<(), String> {
-        let local: Vec<DVec3> = self.vertices.iter().map(|v| *v - self.origin).collect();
+    /// The triangles' own checks; `local` are the vertices less the origin, `tree` over
+    /// them.
+    fn validate_triangles(
+        &self,
+        local: &[DVec3],
+        tree: &PointTree,
+        tol: f64,
+    ) -> Result<(), String> {
         for (ti, t) in self.triangles.iter().enumerate() {
             if t.iter().any(|&i| i as usize >= local.len()) {
                 return Err(format!("triangle {ti} indexes past the vertices"));
@@ -90,14 +104,14 @@ impl ConvexPolyhedron {
                 }
                 continue;
             }
-            let (n, d) = quickhull::triangle_plane(&local, t.map(|i| i as usize));
-            for (vi, v) in local.iter().enumerate() {
-                let dist = n.dot(*v) - d;
-                if dist > tol {
-                    return Err(format!(
-                        "vertex {vi} is {dist:e} m in front of triangle {ti}: not outward"
-                    ));
-                }
+            let (n, d) = quickhull::triangle_plane(local, t.map(|i| i as usize));
+            if let Some((vi, top)) = tree.max_dot(n)
+                && top - d > tol
+            {
+                let dist = top - d;
+                return Err(format!(
+                    "vertex {vi} is {dist:e} m in front of triangle {ti}: not outward"
+                ));
             }
         }
         if self.dimension == 3 && self.volume() <= 0.0 {
@@ -153,4 +167,47 @@ fn validate_closed(tris: &[[u32; 3]], vertex_count: usize, solid: bool) -> Resul
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A hull of 200 points on a unit sphere about (3, −2, 1), which validates.
+    fn round_hull() -> ConvexPolyhedron {
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        let points: Vec<DVec3> = (0..200)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (f64::from(i) + 0.5) / 200.0;
+                let (s, c) = (golden * f64::from(i)).sin_cos();
+                let r = (1.0 - z * z).sqrt();
+                DVec3::new(3.0 + r * c, -2.0 + r * s, 1.0 + z)
+            })
+            .collect();
+        let hull = ConvexPolyhedron::try_from_points(&points).expect("a solid");
+        assert_eq!(hull.validate(), Ok(()));
+        hull
+    }
+
+    /// The per-plane searches still find the one vertex that breaks convexity.
+    #[test]
+    fn a_vertex_pushed_out_of_its_hull_is_caught() {
+        let mut hull = round_hull();
+        let centre = DVec3::new(3.0, -2.0, 1.0);
+        hull.vertices[17] = centre + (hull.vertices[17] - centre) * 1.2;
+        let error = hull.validate().expect_err("a vertex outside the planes");
+        assert!(
+            error.contains("vertex 17") && error.contains("outside a face plane"),
+            "{error}"
+        );
+    }
+
+    /// A triangle wound inward sees every other vertex in front of it.
+    #[test]
+    fn a_triangle_wound_inward_is_caught() {
+        let mut hull = round_hull();
+        hull.triangles[5].swap(1, 2);
+        let error = hull.validate().expect_err("an inward triangle");
+        assert!(error.contains("in front of triangle 5"), "{error}");
+    }
 }
