@@ -45,6 +45,17 @@ pub mod tolerance {
     pub const MAX_COORDINATE: f64 = 1e9;
 }
 
+/// The smallest axis-aligned box `(min, max)` holding `points`, metres; `(+∞, −∞)` when
+/// there are none.
+#[must_use]
+pub fn bounds_of(points: impl IntoIterator<Item = DVec3>) -> (DVec3, DVec3) {
+    points
+        .into_iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        })
+}
+
 /// Slack that keeps a floating-point comparison of quantities of magnitude `scale`
 /// conservative: `BV_RELATIVE * scale`, plus a tiny absolute floor for `scale == 0`.
 #[must_use]

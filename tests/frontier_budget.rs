@@ -784,17 +784,22 @@ fn a_frontier_mixing_obb_rss_and_sphere_pairs_is_conservative_monotone_and_exact
             .pairs
             .iter()
             .enumerate()
-            .map(|(i, p)| MeshPairTrees {
-                volume: [QueryVolume::Obb, QueryVolume::Rss, QueryVolume::Sphere][i % 3],
-                ..MeshPairTrees::new(
+            .map(|(i, p)| {
+                MeshPairTrees::new(
                     &meshes[p.a],
                     &meshes[p.b],
                     p.pose_ab.to_isometry(),
                     p.threshold,
                     None,
                 )
+                .with_volume([QueryVolume::Obb, QueryVolume::Rss, QueryVolume::Sphere][i % 3])
             })
             .collect();
+        // Every mesh kept a sphere tree, so no pair was moved off the type it was given.
+        for (i, pair) in pairs.iter().enumerate() {
+            let given = [QueryVolume::Obb, QueryVolume::Rss, QueryVolume::Sphere][i % 3];
+            assert_eq!(pair.volume(), given, "seed {seed}, pair {i}");
+        }
         for (&t, p) in scene.truth.iter().zip(&scene.pairs) {
             match t {
                 0.0 => tally.touching += 1,
@@ -807,7 +812,7 @@ fn a_frontier_mixing_obb_rss_and_sphere_pairs_is_conservative_monotone_and_exact
         assert!(query_frontier(&pairs, &mut Unlimited, &mut ws, &mut exact));
         for (i, (pair, answer)) in pairs.iter().zip(&exact).enumerate() {
             let [a, b] = &pair.meshes;
-            let own = match pair.volume {
+            let own = match pair.volume() {
                 QueryVolume::Obb => alone(&typed(&a.overlap_tree, &b.overlap_tree, pair)),
                 QueryVolume::Rss => alone(&typed(&a.distance_tree, &b.distance_tree, pair)),
                 QueryVolume::Sphere => {

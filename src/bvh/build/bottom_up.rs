@@ -40,7 +40,7 @@
 use super::{BuildPrimitive, Topology, TopologyNode};
 use crate::bounding::{Aabb, BoundingVolume};
 use crate::geometry::Triangle;
-use crate::math::DVec3;
+use crate::math::{DVec3, bounds_of};
 
 /// How many clusters before and after its own position in curve order a cluster searches
 /// for its nearest neighbour (PLOC's `r`; the paper finds 8–16 about as good as exact).
@@ -65,11 +65,7 @@ pub(super) fn build(
 
 /// Triangle indices sorted by the Morton code of their centroid (ties by index).
 fn morton_order(primitives: &[BuildPrimitive]) -> Vec<u32> {
-    let (lo, hi) = primitives
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p.centroid), hi.max(p.centroid))
-        });
+    let (lo, hi) = bounds_of(primitives.iter().map(|p| p.centroid));
     let side = (hi - lo).max_element();
     let cells = f64::from((1u32 << MORTON_BITS) - 1);
     let scale = if side > 0.0 { cells / side } else { 0.0 };

@@ -22,7 +22,7 @@ use super::top_down::{split_at_median_by, split_recursively};
 use super::{BuildPrimitive, Topology};
 use crate::geometry::Triangle;
 use crate::geometry::mesh::medial_balls;
-use crate::math::DVec3;
+use crate::math::{DVec3, bounds_of};
 
 /// Extent of a node's ball centres, over the extent of its centroids, from which the node is
 /// cut across the medial axis (below it, into surface patches).
@@ -52,11 +52,7 @@ pub(super) fn build(
 
 /// The largest extent of the points `point` gives the indices, metres, and its axis.
 fn widest(order: &[u32], point: impl Fn(u32) -> DVec3) -> (f64, usize) {
-    let (lo, hi) = order
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
-            (lo.min(point(i)), hi.max(point(i)))
-        });
+    let (lo, hi) = bounds_of(order.iter().map(|&i| point(i)));
     let extent = hi - lo;
     (extent.max_element(), extent.max_position())
 }

@@ -16,7 +16,7 @@
 
 use super::top_down::{partition, split_recursively};
 use super::{BuildPrimitive, Topology};
-use crate::math::DVec3;
+use crate::math::{DVec3, bounds_of};
 
 /// Halvings in a row that may leave a side empty before a node is split by index.
 const MAX_EMPTY_HALVINGS: u32 = 3 * 64;
@@ -54,11 +54,7 @@ impl Cell {
 
 /// Builds the topology by octree subdivision of the centroids (see the [module docs](self)).
 pub(super) fn build(primitives: &[BuildPrimitive], leaf_size: u32) -> Topology {
-    let (lo, hi) = primitives
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p.centroid), hi.max(p.centroid))
-        });
+    let (lo, hi) = bounds_of(primitives.iter().map(|p| p.centroid));
     let side = (hi - lo).max_element();
     let root = Cell {
         lo,

@@ -9,7 +9,7 @@
 
 use super::{BuildPrimitive, BuildStrategy, SAH_BINS, Topology, TopologyNode};
 use crate::bounding::fit::{point_moments, principal_axes};
-use crate::math::DVec3;
+use crate::math::{DVec3, bounds_of};
 
 /// Builds the topology by recursive splitting with `strategy` (not `Agglomerative`).
 pub(super) fn build(
@@ -83,12 +83,7 @@ pub(super) fn split_recursively<S>(
 
 /// Centroid bounds of the triangles in `order`.
 fn centroid_bounds(primitives: &[BuildPrimitive], order: &[u32]) -> (DVec3, DVec3) {
-    order
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
-            let c = primitives[i as usize].centroid;
-            (lo.min(c), hi.max(c))
-        })
+    bounds_of(order.iter().map(|&i| primitives[i as usize].centroid))
 }
 
 /// Median of the centroids along the longest axis of their box; returns `order.len() / 2`.

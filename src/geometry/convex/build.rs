@@ -20,13 +20,6 @@ impl ConvexPolyhedron {
     }
 }
 
-pub(super) fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
-    points.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    )
-}
-
 /// Index of the point maximising `score` (the first on ties).
 fn argmax(local: &[DVec3], score: impl Fn(DVec3) -> f64) -> (usize, f64) {
     let mut best = (0, f64::NEG_INFINITY);

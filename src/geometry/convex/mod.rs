@@ -14,11 +14,11 @@ mod quickhull;
 mod scan;
 mod validate;
 
-use build::{bounds, build_with_corners};
+use build::build_with_corners;
 use scan::VertexLanes;
 
 use super::{PointTree, SupportMap};
-use crate::math::{DVec3, tolerance};
+use crate::math::{DVec3, bounds_of, tolerance};
 use std::collections::HashSet;
 use std::fmt;
 
@@ -184,7 +184,7 @@ impl ConvexPolyhedron {
                 unique.push(*p);
             }
         }
-        let (lo, hi) = bounds(&unique);
+        let (lo, hi) = bounds_of(unique.iter().copied());
         let origin = (lo + hi) * 0.5;
         let local: Vec<DVec3> = unique.iter().map(|p| *p - origin).collect();
         let mut eps = plane_tolerance(lo, hi);
@@ -215,7 +215,7 @@ impl ConvexPolyhedron {
         if points.is_empty() || !points.iter().all(|p| p.is_finite()) {
             return None;
         }
-        let (lo, hi) = bounds(points);
+        let (lo, hi) = bounds_of(points.iter().copied());
         let origin = (lo + hi) * 0.5;
         let local: Vec<DVec3> = points.iter().map(|p| *p - origin).collect();
         let eps = plane_tolerance(lo, hi);

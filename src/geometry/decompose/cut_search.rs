@@ -18,12 +18,12 @@
 //! with Collision-Aware Concavity and Tree Search", SIGGRAPH 2022 (CoACD).
 
 use super::concavity::{Surface, concavity};
-use super::fitted::{Fitted, bounds_of};
+use super::fitted::Fitted;
 use super::nearest::SampleGrid;
 use super::piece::{Piece, Plane};
 use crate::geometry::ConvexPolyhedron;
 use crate::geometry::pca::{point_moments, principal_axes};
-use crate::math::DVec3;
+use crate::math::{DVec3, bounds_of};
 
 /// Most surface samples a candidate is scored on.
 const SCORE_SAMPLES: usize = 1200;
@@ -215,7 +215,7 @@ struct Scorer<'a> {
 
 impl<'a> Scorer<'a> {
     fn new(piece: &'a Fitted, samples: &'a [DVec3]) -> Self {
-        let (lo, hi) = bounds_of(samples);
+        let (lo, hi) = bounds_of(samples.iter().copied());
         Self {
             samples,
             grid: SampleGrid::new(samples),

@@ -4,7 +4,7 @@ use super::concavity::{Surface, concavity};
 use super::nearest::SampleGrid;
 use super::piece::Piece;
 use crate::geometry::ConvexPolyhedron;
-use crate::math::DVec3;
+use crate::math::{DVec3, bounds_of};
 
 /// A piece of the solid, measured.
 #[derive(Debug, Clone)]
@@ -34,7 +34,7 @@ impl Fitted {
         let volume = piece.volume();
         let concavity = hull_concavity(&hull, &samples, &piece, spacing);
         Some(Self {
-            bounds: bounds_of(hull.vertices()),
+            bounds: bounds_of(hull.vertices().iter().copied()),
             piece,
             hull,
             samples,
@@ -52,7 +52,7 @@ impl Fitted {
         let piece = self.piece.merged(&other.piece);
         let concavity = hull_concavity(&hull, &samples, &piece, self.spacing);
         Some(Self {
-            bounds: bounds_of(hull.vertices()),
+            bounds: bounds_of(hull.vertices().iter().copied()),
             piece,
             hull,
             samples,
@@ -103,12 +103,4 @@ fn hull_concavity(hull: &ConvexPolyhedron, samples: &[DVec3], piece: &Piece, spa
         spacing,
     };
     concavity(&triangles, samples, &surface)
-}
-
-/// Axis-aligned bounds of `points` (non-empty), metres.
-pub(super) fn bounds_of(points: &[DVec3]) -> (DVec3, DVec3) {
-    points.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    )
 }

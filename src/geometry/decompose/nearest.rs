@@ -22,7 +22,7 @@ const MAX_DIM: usize = 32;
 impl<'a> SampleGrid<'a> {
     /// Buckets `points` (finite).
     pub fn new(points: &'a [DVec3]) -> Self {
-        let (lo, hi) = super::fitted::bounds_of(points);
+        let (lo, hi) = crate::math::bounds_of(points.iter().copied());
         let extent = (hi - lo).max(DVec3::splat(f64::MIN_POSITIVE));
         let volume = extent.x * extent.y * extent.z;
         let by_count = (volume * PER_CELL / points.len().max(1) as f64).cbrt();

@@ -27,7 +27,7 @@
 
 use super::super::Triangle;
 use super::super::point_tree::PointTree;
-use crate::math::DVec3;
+use crate::math::{DVec3, bounds_of};
 
 /// Most shrinking steps per ball (Ma et al. report convergence in under 10 on scans).
 const MAX_STEPS: usize = 48;
@@ -69,11 +69,7 @@ pub fn medial_balls(triangles: &[Triangle]) -> Vec<MedialBall> {
         .step_by(every)
         .flat_map(|t| [t.a, t.b, t.c, t.centroid()])
         .collect();
-    let (lo, hi) = samples
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
+    let (lo, hi) = bounds_of(samples.iter().copied());
     let start_radius = (hi - lo).length();
     let tree = PointTree::new(&samples);
     let inward = if signed_volume(triangles) < 0.0 {

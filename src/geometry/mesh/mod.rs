@@ -18,7 +18,7 @@ pub use error::{MeshError, ParseReason};
 pub use medial::{MAX_BALLS, MedialBall, medial_balls};
 
 use super::Triangle;
-use crate::math::{DVec3, tolerance};
+use crate::math::{DVec3, bounds_of, tolerance};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -237,12 +237,11 @@ impl TriMesh {
     /// Bounding box `(min, max)` of the referenced vertices, metres.
     #[must_use]
     pub fn bounds(&self) -> (DVec3, DVec3) {
-        self.triangles.iter().flatten().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), &i| {
-                let p = self.vertices[i as usize];
-                (lo.min(p), hi.max(p))
-            },
+        bounds_of(
+            self.triangles
+                .iter()
+                .flatten()
+                .map(|&i| self.vertices[i as usize]),
         )
     }
 

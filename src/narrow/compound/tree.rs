@@ -6,7 +6,7 @@
 //! compounds are near each other at one place only.
 
 use crate::bounding::{BoundingVolume, Obb};
-use crate::math::{DVec3, Isometry};
+use crate::math::{DVec3, Isometry, bounds_of};
 
 /// One node of a [`PartTree`]: its box and either two children or one part.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,11 +94,7 @@ impl PartTree {
         if ids.len() < 2 {
             return;
         }
-        let (lo, hi) = ids
-            .iter()
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
-                (lo.min(centres[i as usize]), hi.max(centres[i as usize]))
-            });
+        let (lo, hi) = bounds_of(ids.iter().map(|&i| centres[i as usize]));
         let axis = (hi - lo).max_position();
         ids.sort_unstable_by(|&i, &j| {
             centres[i as usize][axis].total_cmp(&centres[j as usize][axis])

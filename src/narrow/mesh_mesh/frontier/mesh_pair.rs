@@ -12,9 +12,10 @@ use std::sync::Arc;
 pub struct MeshPairTrees {
     /// Mesh of body A, mesh of body B (held while the frontier refers to their trees).
     pub meshes: [Arc<MeshShape>; 2],
-    /// Which of the meshes' trees the pair is refined with ([`MeshShape::pair_volume`];
-    /// spheres are refined as RSSs when either mesh kept no sphere tree).
-    pub volume: QueryVolume,
+    /// Which of the meshes' trees the pair is refined with ([`MeshShape::pair_volume`]):
+    /// set once, so that every visit matches on it alone, and never spheres unless both
+    /// meshes kept theirs.
+    volume: QueryVolume,
     /// B's frame expressed in A's frame.
     pub pose_ab: Isometry,
     /// The pair's threshold, metres ([`crate::narrow::mesh_mesh::frontier::FrontierPair::threshold`]).
@@ -42,13 +43,28 @@ impl MeshPairTrees {
             seed,
         }
     }
+
+    /// The same pair refined with `volume`'s trees instead of the ones its meshes chose
+    /// (RSSs in place of spheres a mesh did not keep), for measurements and tests.
+    #[must_use]
+    pub fn with_volume(mut self, volume: QueryVolume) -> Self {
+        let [a, b] = &self.meshes;
+        self.volume = a.pair_volume(b, Some(volume));
+        self
+    }
+
+    /// The volume type the pair is refined with.
+    #[must_use]
+    pub fn volume(&self) -> QueryVolume {
+        self.volume
+    }
 }
 
 /// Evaluates `$call` with `$trees` bound to the pair's [`TreesAt`] of its volume type.
 macro_rules! on_trees {
     ($pair:ident, $trees:ident => $call:expr) => {{
         let [a, b] = &$pair.meshes;
-        match a.pair_volume(b, Some($pair.volume)) {
+        match $pair.volume {
             QueryVolume::Obb => {
                 let $trees = TreesAt {
                     a: &a.overlap_tree,
