@@ -183,6 +183,7 @@ impl<S: Service> SceneFrames<S> {
             parked: None,
             lateness: Lateness::default(),
             workspace: PipelineWorkspace::with_workers(Arc::clone(workers))
+                .publishing()
                 .abandon_on(keys.signals.abandon().clone()),
             output: FrameResults::default(),
             validated: Vec::new(),

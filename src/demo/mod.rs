@@ -105,7 +105,8 @@ pub fn run(args: &DemoArgs) -> Result<(), Box<dyn Error>> {
         let line = FrameLine::new(seq, frame.header(), round_trip, bounced);
         drop(frame);
         summary.add(&line);
-        if seq % args.print_every.max(1) == 0 || seq == 1 {
+        // Every late frame is printed, with its stage times.
+        if seq % args.print_every.max(1) == 0 || seq == 1 || line.budget_missed() {
             println!("{line}");
         }
     }

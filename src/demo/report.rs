@@ -1,7 +1,7 @@
 //! What the demo prints: one line per sampled frame, and a summary of the run.
 
 use proxima_ipc::tools::latency::LatencyRecorder;
-use proxima_ipc::wire::{Completeness, ErrorCode, ResultFrameHeader};
+use proxima_ipc::wire::{Completeness, ErrorCode, ResultFrameHeader, stage};
 use std::fmt;
 use std::time::Duration;
 
@@ -17,6 +17,7 @@ pub struct FrameLine {
     budget_met: bool,
     round_trip: Duration,
     in_daemon_ns: u64,
+    stage_ns: [u64; stage::COUNT],
 }
 
 impl FrameLine {
@@ -34,7 +35,16 @@ impl FrameLine {
             budget_met: header.budget_met != 0,
             round_trip,
             in_daemon_ns: header.elapsed_ns,
+            stage_ns: header.stage_ns,
         }
+    }
+}
+
+impl FrameLine {
+    /// Whether the daemon published the frame after its budget.
+    #[must_use]
+    pub fn budget_missed(&self) -> bool {
+        self.status == ErrorCode::Ok as u32 && !self.budget_met
     }
 }
 
@@ -60,7 +70,23 @@ impl fmt::Display for FrameLine {
                 "BUDGET MISSED"
             },
             if self.exact { "exact" } else { "truncated" },
-        )
+        )?;
+        if !self.budget_met {
+            // Where the time went, so a late frame can be told from an OS descheduling.
+            let us = |i: usize| self.stage_ns[i] as f64 / 1e3;
+            write!(
+                f,
+                "  (µs: ingest {:.1}, plan {:.1}, broad {:.1}, mid {:.1}, narrow {:.1}, \
+                 publish {:.1})",
+                us(stage::INGEST),
+                us(stage::PLAN),
+                us(stage::BROAD),
+                us(stage::MID),
+                us(stage::NARROW),
+                us(stage::PUBLISH),
+            )?;
+        }
+        Ok(())
     }
 }
 

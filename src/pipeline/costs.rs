@@ -26,9 +26,12 @@
 use std::time::Instant;
 
 /// The cost of one pair in a frame's tail until the scene's own is measured, picoseconds:
-/// a conservative answer from separating axes or world boxes and its record (tens to
-/// hundreds of nanoseconds on the 2-core VM, `benches/narrow_phase.rs`'s `proxima-bound`).
-pub const DEFAULT_TAIL_PS_PER_PAIR: u64 = 250_000;
+/// a conservative answer from separating axes or world boxes and its record. Warm, tens to
+/// hundreds of nanoseconds on the 2-core VM (`benches/narrow_phase.rs`'s `proxima-bound`);
+/// but the first tails of a scene run cold (a tail runs only when a clock stops, so its
+/// code, its pairs' memory records and the result lists are not in cache, and lists grow):
+/// 0.6–1.1 µs a pair on the demo's first frame, which a 250 ns prior made 35–240 µs late.
+pub const DEFAULT_TAIL_PS_PER_PAIR: u64 = 1_500_000;
 
 /// The cost of one entry left waiting on the frontier until the scene's own is measured,
 /// picoseconds: its share of the answer pass and of at most one round's sort (tens of
@@ -43,6 +46,12 @@ const PENDING_ENTRY_PER_ANSWER: u64 = 2;
 /// The cost of publishing one record until the scene's own is measured, picoseconds: a
 /// 120-byte record written into shared memory (tens of nanoseconds), with room to spare.
 pub const DEFAULT_PUBLISH_PS_PER_RECORD: u64 = 100_000;
+
+/// The time a caller that publishes ([`FrameCosts::publishing`]) is taken to need for its
+/// first result frame, beyond its records, until one is timed, nanoseconds: the daemon's
+/// first results of a scene are written to shared memory not touched yet, 18–48 µs for
+/// 116–280 records on the demo's first frame (2-core VM).
+pub const COLD_PUBLISH_NS: u64 = 30_000;
 
 /// The least a further record is taken to cost, picoseconds, whatever the fit says: writing
 /// 120 bytes to memory another process maps.
@@ -83,9 +92,26 @@ pub struct FrameCosts {
     answer_ps_per_entry: Spread,
     /// Body count of the scene when the estimates were taken (0: none yet).
     bodies: usize,
+    /// Whether the caller publishes its results (and so tells their time): until it has,
+    /// each frame reserves a cold publish ([`COLD_PUBLISH_NS`]).
+    publishes: bool,
 }
 
 impl FrameCosts {
+    /// Costs of a caller that publishes each frame's results (the daemon), and tells how
+    /// long that took ([`note_publish`](Self::note_publish)): until it has, a frame
+    /// reserves a cold publish for it, 30 µs (`COLD_PUBLISH_NS`) and 100 ns a record
+    /// (`DEFAULT_PUBLISH_PS_PER_RECORD`).
+    /// Without it, nothing is reserved before a publish is told (a library caller
+    /// publishes nothing).
+    #[must_use]
+    pub fn publishing() -> Self {
+        Self {
+            publishes: true,
+            ..Self::default()
+        }
+    }
+
     /// Records a frame's broad phase on a scene of `bodies` bodies.
     pub fn note_broad(&mut self, bodies: usize, ns: u64) {
         self.forget_if_changed(bodies);
@@ -156,7 +182,8 @@ impl FrameCosts {
     /// plus, for each record beyond the typical count, the cost of a further record: the
     /// slope of publishing time against records over recent frames (at least 10 ns), or
     /// 100 ns (`DEFAULT_PUBLISH_PS_PER_RECORD`) until frames of different sizes were
-    /// published; 0 before any publish was told.
+    /// published. Before any publish was told: a cold publish for a caller that
+    /// [publishes](Self::publishing), else 0.
     ///
     /// Not the typical time scaled in proportion: a scene whose frames published no
     /// records (bodies still apart) would then price its first frame of a thousand
@@ -166,7 +193,12 @@ impl FrameCosts {
     pub fn publish_estimate_ns(&self, records: u64) -> u64 {
         if self.publish_ns == 0 {
             // Nothing published yet, or a caller that publishes nothing (a library user).
-            return 0;
+            return if self.publishes {
+                COLD_PUBLISH_NS
+                    .saturating_add(records.saturating_mul(DEFAULT_PUBLISH_PS_PER_RECORD) / 1000)
+            } else {
+                0
+            };
         }
         let per_record = self
             .publish_fit
@@ -247,6 +279,7 @@ impl FrameCosts {
                 visit_ps_per_pair: self.visit_ps_per_pair,
                 answer_ps_per_entry: self.answer_ps_per_entry,
                 publish_fit: self.publish_fit,
+                publishes: self.publishes,
                 ..Self::default()
             };
         }
@@ -493,6 +526,34 @@ mod tests {
         assert!(cost(fits) <= left && cost(fits + 1) > left, "{fits}");
         assert_eq!(costs.pairs_that_fit(10, left), 10, "all of few pairs");
         assert_eq!(costs.pairs_that_fit(10, 0), 0);
+    }
+
+    #[test]
+    fn a_publishing_caller_reserves_a_cold_publish_until_one_is_timed() {
+        let library = FrameCosts::default();
+        assert_eq!(library.publish_estimate_ns(1_000), 0, "publishes nothing");
+        let mut daemon = FrameCosts::publishing();
+        assert_eq!(
+            daemon.publish_estimate_ns(1_000),
+            COLD_PUBLISH_NS + 1_000 * DEFAULT_PUBLISH_PS_PER_RECORD / 1000
+        );
+        assert_eq!(
+            daemon.tail_ns(10, 0),
+            10 * DEFAULT_TAIL_PS_PER_PAIR / 1000
+                + daemon.publish_estimate_ns(10 * RECORDS_PER_TAIL_PAIR),
+            "the tail reserves the cold publish of its records"
+        );
+        daemon.note_publish(5_000, 1_000);
+        assert_eq!(
+            daemon.publish_estimate_ns(1_000),
+            5_000,
+            "timed: the measure"
+        );
+        // A scene that changed size is measured afresh, and is still a publisher's.
+        daemon.note_broad(100, 1_000);
+        daemon.note_broad(1_000, 1_000);
+        assert_eq!(daemon.publish_ns, 0);
+        assert!(daemon.publish_estimate_ns(0) >= COLD_PUBLISH_NS);
     }
 
     #[test]

@@ -85,8 +85,8 @@ pub use crate::narrow::dispatch::PathCounts;
 pub use costs::FrameCosts;
 use pair_loop::answer_candidates;
 pub use plan::{
-    Deadline, FRONTIER_RESERVE, FrontierClock, MIN_ANSWERED_PAIRS, Unlimited, VisitBudget,
-    frontier_deadline,
+    COLD_RESERVE, Deadline, FRONTIER_RESERVE, FrontierClock, MIN_ANSWERED_PAIRS, Unlimited,
+    VisitBudget, frontier_deadline,
 };
 use plan::{FramePlan, mandatory_work_fits};
 pub use toi::{PairToi, TOI_TOLERANCE};
@@ -426,6 +426,15 @@ impl PipelineWorkspace {
         self.costs.note_publish(ns, records);
     }
 
+    /// This workspace for a caller that publishes every frame's results and tells how long
+    /// that took ([`note_publish`](Self::note_publish)), as the daemon does: until it
+    /// has, each budgeted frame reserves a cold publish ([`FrameCosts::publishing`]).
+    #[must_use]
+    pub fn publishing(mut self) -> Self {
+        self.costs = FrameCosts::publishing();
+        self
+    }
+
     /// A workspace that answers mesh–mesh pairs on `workers` too (when a frame has at least
     /// [`MIN_PARALLEL_MESH_PAIRS`] of them). Results are identical with or without.
     #[must_use]
@@ -572,7 +581,9 @@ pub fn step_sliced(
 /// are, and so do the exact contacts of touching mesh pairs. Counted budgets leave them
 /// exact. A frame with more candidates than even their conservative answers fit in the
 /// time left after the broad phase ([`FrameCosts::pairs_that_fit`]) answers the first
-/// that fit, counted in [`StepReport::dropped_candidates`]. Not yet budgeted: the broad
+/// that fit, counted in [`StepReport::dropped_candidates`]. A frame of a scene whose costs
+/// are not measured yet (its first) runs cold and keeps [`COLD_RESERVE`] of its time
+/// left in reserve. Not yet budgeted: the broad
 /// phase and time of impact's single distance queries run to completion whatever the
 /// budget. The worker pool is not used for a budgeted frontier (one thread).
 ///
@@ -613,7 +624,8 @@ pub fn step_within(
         workspace.costs.note_broad(bodies, broad_ns);
     }
     let started = Instant::now();
-    let mut plan = FramePlan::new(&*budget, query, workspace.slice);
+    let cold = workspace.costs.mandatory_ns(bodies).is_none();
+    let mut plan = FramePlan::new(&*budget, query, workspace.slice, cold);
     let over_time = plan.cap_to_time(
         &workspace.costs,
         &mut workspace.candidates,
@@ -680,7 +692,7 @@ fn mid_phase(
     let pairs = workspace.candidates.len() + workspace.toi_candidates.len();
     let tail = Duration::from_nanos(workspace.costs.typical_tail_ns(pairs, 0));
     let ps_per_pending_entry = workspace.costs.pending_entry_ps();
-    let mut reserved = budget.deadline().map(|d| FrontierClock {
+    let mut reserved = plan.deadline().map(|d| FrontierClock {
         deadline: frontier_deadline(started, d, tail),
         ps_per_pending_entry,
         abandon: workspace.abandon.clone(),
