@@ -1,7 +1,9 @@
-//! The narrow routes a frame's clock can stop (`dispatch::distance_within`): a convex
-//! shape's walk of a mesh and EPA. Each is stopped after every count of work units from 0
-//! to what its whole run takes (a counted clock, `Stop::AfterWork`, never wall time), and
-//! every stopped answer must be conservative against the same query run to the end:
+//! The narrow routes a frame's clock can stop: a convex shape's walk of a mesh and EPA
+//! (`dispatch::distance_within`), and the mesh–mesh searches (overlap, proximity,
+//! distance, contacts). Each is stopped after every count of work units from 0 (or a
+//! growing sample of them) to what its whole run takes (a counted clock, `Stop::AfterWork`,
+//! never wall time), and every stopped answer must be conservative against the same query
+//! run to the end:
 //!
 //! - `Bounded { lower, upper }` holds the exact signed distance (`lower ≤ exact ≤ upper`,
 //!   to rounding), so a pair that touches is never reported apart;
@@ -164,6 +166,71 @@ fn a_stopped_epa_holds_the_exact_depth_and_tightens_with_work() {
     println!("{seen:?}");
     assert!(seen.touching > 30 && seen.apart > 30, "{seen:?}");
     assert!(seen.stopped > 100 && seen.finished == 300, "{seen:?}");
+}
+
+/// The mesh–mesh overlap and proximity tests stopped after a growing count of work units
+/// (each an eighth more than the last, from 0): each says it stopped (`None`) or gives the
+/// unlimited run's answer, bit for bit; once a count finishes, every larger one does; every
+/// run finishes with enough work.
+#[test]
+fn stopped_mesh_overlap_and_proximity_tests_say_so_or_answer_exactly() {
+    use proxima::narrow::mesh_mesh::{MeshMeshWorkspace, intersects_mesh_mesh_within};
+    let a = MeshShape::new(meshes::torus(0.5, 0.15, 32, 12));
+    let b = MeshShape::new(meshes::uv_sphere(0.3, 16, 10));
+    let mut r = rng(2905);
+    let workspace = &mut MeshMeshWorkspace::default();
+    let (mut intersecting, mut within, mut apart, mut stopped) = (0, 0, 0, 0);
+    for case in 0..200 {
+        let pose = Pose::new(point_in_cube(&mut r, 0.8), rotation(&mut r));
+        let margin = 0.05;
+        let overlap = |work, workspace: &mut MeshMeshWorkspace| {
+            let (ta, tb) = (&a.overlap_tree, &b.overlap_tree);
+            intersects_mesh_mesh_within(ta, tb, &pose, workspace, &mut WorkClock::new(work))
+        };
+        let proximity = |work, workspace: &mut MeshMeshWorkspace| {
+            a.proximity_within(&b, &pose, margin, workspace, &mut WorkClock::new(work))
+        };
+        let truth = (
+            overlap(Stop::Never, workspace).expect("an unlimited clock never stops"),
+            proximity(Stop::Never, workspace).expect("an unlimited clock never stops"),
+        );
+        intersecting += usize::from(truth.0);
+        match truth.1 {
+            proxima::narrow::mesh_mesh::Proximity::Within => within += 1,
+            proxima::narrow::mesh_mesh::Proximity::Apart { .. } => apart += 1,
+        }
+        let (mut overlap_done, mut proximity_done) = (false, false);
+        let mut work = 0;
+        loop {
+            match overlap(Stop::AfterWork(work), workspace) {
+                Some(found) => {
+                    assert_eq!(found, truth.0, "case {case}, {work} units: overlap");
+                    overlap_done = true;
+                }
+                None => {
+                    assert!(!overlap_done, "case {case}: stopped with more work");
+                    stopped += 1;
+                }
+            }
+            match proximity(Stop::AfterWork(work), workspace) {
+                Some(found) => {
+                    assert_eq!(found, truth.1, "case {case}, {work} units: proximity");
+                    proximity_done = true;
+                }
+                None => {
+                    assert!(!proximity_done, "case {case}: stopped with more work");
+                    stopped += 1;
+                }
+            }
+            if overlap_done && proximity_done {
+                break;
+            }
+            assert!(work < 10_000_000, "case {case}: never finished");
+            work = (work + work / 8).max(work + 1);
+        }
+    }
+    println!("{intersecting} intersecting, {within} within, {apart} apart, {stopped} stopped");
+    assert!(intersecting > 30 && apart > 30 && within > intersecting && stopped > 400);
 }
 
 #[test]

@@ -16,7 +16,7 @@ use crate::narrow::gjk::POINT;
 use crate::narrow::mesh_hull::MeshHull;
 use crate::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity,
-    distance_mesh_mesh_within, proximity_mesh_mesh, rounding_bound,
+    distance_mesh_mesh_within, proximity_mesh_mesh_within, rounding_bound,
 };
 use std::sync::Arc;
 
@@ -187,18 +187,34 @@ impl MeshShape {
         max_distance: f64,
         workspace: &mut MeshMeshWorkspace,
     ) -> Proximity {
+        let unlimited = &mut WorkClock::default();
+        let found = self.proximity_within(other, pose_ab, max_distance, workspace, unlimited);
+        found.expect("an unlimited clock never stops")
+    }
+
+    /// [`proximity`](Self::proximity), polling `clock` before each pair of leaves
+    /// ([`proximity_mesh_mesh_within`]): `None` when the clock stopped it first.
+    #[must_use]
+    pub fn proximity_within(
+        &self,
+        other: &Self,
+        pose_ab: &Pose,
+        max_distance: f64,
+        workspace: &mut MeshMeshWorkspace,
+        clock: &mut WorkClock,
+    ) -> Option<Proximity> {
         match self.pair_volume(other, None) {
             QueryVolume::Obb => {
                 let (a, b) = (&self.overlap_tree, &other.overlap_tree);
-                proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
+                proximity_mesh_mesh_within(a, b, pose_ab, max_distance, workspace, clock)
             }
             QueryVolume::Rss => {
                 let (a, b) = (&self.distance_tree, &other.distance_tree);
-                proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
+                proximity_mesh_mesh_within(a, b, pose_ab, max_distance, workspace, clock)
             }
             QueryVolume::Sphere => {
                 let (a, b) = self.sphere_trees(other);
-                proximity_mesh_mesh(a, b, pose_ab, max_distance, workspace)
+                proximity_mesh_mesh_within(a, b, pose_ab, max_distance, workspace, clock)
             }
         }
     }

@@ -19,7 +19,7 @@ use crate::narrow::dispatch::{self, NarrowScratch};
 use crate::narrow::mesh_mesh::frontier::FrontierAnswer;
 use crate::narrow::mesh_mesh::{
     DistanceCache, MeshDistance, MeshMeshWorkspace, Proximity, contacts_mesh_mesh_within,
-    intersects_mesh_mesh,
+    intersects_mesh_mesh_within,
 };
 use crate::narrow::{MANIFOLD_POINTS, reduce_manifold};
 use crate::narrow::{MeshShape, Shape};
@@ -171,7 +171,9 @@ fn witness_contact(result: &PairResult, distance: f64) -> ContactPoint {
 
 /// Mesh–mesh (meshes are surfaces): the exact distance when the query needs one (`CLOSE`
 /// for pairs within their margins, `DISTANCE` for all; warm-started from the pair's `cache`), the reduced intersection set when it asks `CONTACTS`,
-/// else (`OVERLAP` alone) [`intersects_mesh_mesh`], which stops at the first proof.
+/// else (`OVERLAP` alone) an intersection test, which stops at the first proof. Every
+/// step polls `clock` (leaf pair by leaf pair); a pair it stopped is answered
+/// conservatively, from what it found so far or from its world boxes.
 ///
 /// A `CLOSE` pair beyond its margins (and no `DISTANCE` asked) says distance `+∞`: it is
 /// not reported, and it touches nothing; its [`Answer::apart_by`] is the lower bound the
@@ -195,19 +197,24 @@ pub(super) fn mesh_mesh(
     // could call a grazing contact apart, so when touching matters (`OVERLAP`,
     // `CONTACTS`) the exact predicates confirm before the pair is dismissed.
     let margins = a.margin + b.margin;
-    if query.close
-        && !query.distance
-        && let Proximity::Apart { lower_bound } =
-            ma.proximity(mb, &pose_ab, margins, &mut scratch.traversal)
-        && !((query.overlap || query.contacts)
-            && intersects_mesh_mesh(
-                &ma.overlap_tree,
-                &mb.overlap_tree,
-                &pose_ab,
-                &mut scratch.traversal,
-            ))
-    {
-        return apart(pair, Some(lower_bound));
+    if query.close && !query.distance {
+        let traversal = &mut scratch.traversal;
+        let Some(proximity) = ma.proximity_within(mb, &pose_ab, margins, traversal, clock) else {
+            return mesh_unsearched(pair, (a, b), query, contacts);
+        };
+        if let Proximity::Apart { lower_bound } = proximity {
+            let touching = if query.overlap || query.contacts {
+                let (ta, tb) = (&ma.overlap_tree, &mb.overlap_tree);
+                intersects_mesh_mesh_within(ta, tb, &pose_ab, traversal, clock)
+            } else {
+                Some(false)
+            };
+            match touching {
+                Some(false) => return apart(pair, Some(lower_bound)),
+                Some(true) => {}
+                None => return mesh_unsearched(pair, (a, b), query, contacts),
+            }
+        }
     }
     let mut known = None;
     if query.close || query.distance {
@@ -248,6 +255,19 @@ fn mesh_distance_stopped(
     let bounds = (d.distance - d.error_bound, d.error_bound);
     let witnesses = Some((d.point_a, d.point_b));
     mesh_bounded(pair, (a, b), query, bounds, witnesses, contacts)
+}
+
+/// A mesh pair whose first test the clock stopped (the frame's slice ended, or its client
+/// is gone): known only by its world boxes ([`mesh_bounded`] between their bounds).
+fn mesh_unsearched(
+    pair: &CandidatePair,
+    (a, b): (&Body, &Body),
+    query: Query,
+    contacts: &mut Vec<ContactPoint>,
+) -> Answer {
+    let boxes = world_boxes(pair, a, b);
+    let bounds = (boxes.distance, boxes.error_bound);
+    mesh_bounded(pair, (a, b), query, bounds, None, contacts)
 }
 
 /// The exact distance of a mesh pair, witnesses in A's frame.
@@ -310,14 +330,16 @@ fn mesh_mesh_tail(
         // Stopped, the contacts found are real but perhaps not all of them.
         result.exact &= finished;
     }
-    let touching = touching.unwrap_or_else(|| {
-        intersects_mesh_mesh(
-            &ma.overlap_tree,
-            &mb.overlap_tree,
-            pose_ab,
-            &mut scratch.traversal,
-        )
-    });
+    let touching = match touching {
+        Some(known) => known,
+        None => {
+            let (ta, tb) = (&ma.overlap_tree, &mb.overlap_tree);
+            let found = intersects_mesh_mesh_within(ta, tb, pose_ab, &mut scratch.traversal, clock);
+            // Stopped before it found an intersection: the pair may touch.
+            result.exact &= found.is_some();
+            found.unwrap_or(true)
+        }
+    };
     Answer {
         result,
         touching,
@@ -364,13 +386,15 @@ pub(super) fn mesh_mesh_finished(
         // touching matters and the exact predicates find an intersection (a grazing
         // contact the float distances miss, or an upper bound under `DISTANCE` that
         // rounding undercut), where it computes the exact distance: so does this.
-        let grazing = (query.overlap || query.contacts)
-            && intersects_mesh_mesh(
-                &ma.overlap_tree,
-                &mb.overlap_tree,
-                &pose_ab,
-                &mut scratch.traversal,
-            );
+        let grazing = if query.overlap || query.contacts {
+            let (ta, tb) = (&ma.overlap_tree, &mb.overlap_tree);
+            match intersects_mesh_mesh_within(ta, tb, &pose_ab, &mut scratch.traversal, clock) {
+                Some(found) => found,
+                None => return mesh_unsearched(pair, (a, b), query, contacts),
+            }
+        } else {
+            false
+        };
         if query.distance || grazing {
             let mesh = (scratch, clock);
             return mesh_mesh(pair, (a, ma), (b, mb), query, cache, mesh, contacts);

@@ -449,8 +449,8 @@ impl PipelineWorkspace {
     /// raised (the daemon raises a scene's when its owner is gone): the frontier, the pair
     /// loop, the narrow routes' long steps, the pool's mesh pairs and time of impact, as if
     /// the deadline had come, with conservative answers marked `Truncated`; an unlimited
-    /// frame then is not exact. What no poll interrupts (the broad phase, one mesh pair's
-    /// distance search) runs to its end.
+    /// frame then is not exact. What no poll interrupts (the broad phase, the work between
+    /// two polls) runs to its end.
     #[must_use]
     pub fn abandon_on(mut self, abandon: Abandon) -> Self {
         self.abandon = abandon;
@@ -498,7 +498,8 @@ pub fn step(
 /// are then incomplete and must not be used; the scene is untouched and `workspace` still
 /// valid, so [`step`] run next over the same scene gives the exact answers (faster, by
 /// what the slice kept). Otherwise exactly [`step`]'s report and results. The worker pool
-/// is not used, and a mesh pair's exact search, once started, ends before the slice does.
+/// is not used; a mesh pair's exact search stops at the slice's end too (it polls the
+/// frame's clock leaf pair by leaf pair).
 pub fn step_sliced(
     scene: &Scene,
     query: Query,

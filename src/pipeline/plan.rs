@@ -283,8 +283,8 @@ impl FramePlan {
             Route::MeshMesh(ma, mb) if self.limited => PairPlan::Frontier(ma, mb),
             Route::MeshMesh(..) if self.pool => PairPlan::Pooled,
             // An exact mesh search starts only while the frame is not abandoned and its
-            // slice, if any, lasts (its distance search and contacts poll the clock inside,
-            // its proximity and overlap tests do not).
+            // slice, if any, lasts (then its proximity, overlap and distance searches and
+            // its contacts poll the clock leaf pair by leaf pair).
             Route::MeshMesh(..) if !clock.allows(WORK_PER_CLOCK_READ) => PairPlan::Conservative,
             Route::MeshMesh(ma, mb) => PairPlan::MeshMesh(ma, mb),
         }

@@ -21,13 +21,39 @@ pub fn intersects_mesh_mesh<B: BoundingVolume>(
     pose_ab: &Pose,
     workspace: &mut MeshMeshWorkspace,
 ) -> bool {
+    let unlimited = &mut WorkClock::default();
+    let found = intersects_mesh_mesh_within(a, b, pose_ab, workspace, unlimited);
+    found.expect("an unlimited clock never stops")
+}
+
+/// [`intersects_mesh_mesh`], polling `clock` before each pair of leaves
+/// ([`TRIANGLE_PAIR_WORK`] units per triangle pair): `None` when the clock stopped it
+/// before it found an intersecting pair (the meshes may then intersect or not).
+///
+/// # Allocation
+/// None once `workspace` has grown to the deepest descent.
+#[must_use]
+pub fn intersects_mesh_mesh_within<B: BoundingVolume>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    workspace: &mut MeshMeshWorkspace,
+    clock: &mut WorkClock,
+) -> Option<bool> {
     let iso = pose_ab.to_isometry();
+    let (na, nb) = (a.nodes(), b.nodes());
+    let mut stopped = false;
     let flow = for_each_leaf_pair(
         a,
         b,
         &mut workspace.pairs,
         |x, y| x.overlaps(y, &iso),
         |la, lb| {
+            let tests = na[la].slots().len() * nb[lb].slots().len();
+            if !clock.allows(TRIANGLE_PAIR_WORK * tests as u64) {
+                stopped = true;
+                return ControlFlow::Break(());
+            }
             for_each_triangle_pair(a, b, [la, lb], &iso, |_, tri_a, _, tri_b| {
                 if intersects_triangle_triangle(tri_a, tri_b) {
                     ControlFlow::Break(())
@@ -37,7 +63,7 @@ pub fn intersects_mesh_mesh<B: BoundingVolume>(
             })
         },
     );
-    flow.is_break()
+    (!stopped).then_some(flow.is_break())
 }
 
 /// Reports every intersecting triangle pair of `a` and `b` placed at `pose_ab` to `sink`, in

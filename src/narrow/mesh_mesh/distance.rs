@@ -176,8 +176,34 @@ pub fn proximity_mesh_mesh<B: BoundingVolume>(
     max_distance: f64,
     workspace: &mut MeshMeshWorkspace,
 ) -> Proximity {
+    let unlimited = &mut WorkClock::default();
+    let found = proximity_mesh_mesh_within(a, b, pose_ab, max_distance, workspace, unlimited);
+    found.expect("an unlimited clock never stops")
+}
+
+/// Units of [`WorkClock`] work one triangle pair's distance counts for (a few closed-form
+/// pairs' worth).
+pub const TRIANGLE_DISTANCE_WORK: u64 = 4;
+
+/// [`proximity_mesh_mesh`], polling `clock` before each pair of leaves
+/// ([`TRIANGLE_DISTANCE_WORK`] units per triangle pair): `None` when the clock stopped it
+/// before it found a pair within `max_distance` or ruled them all out.
+///
+/// # Allocation
+/// None once `workspace` has grown to the deepest descent.
+#[must_use]
+pub fn proximity_mesh_mesh_within<B: BoundingVolume>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    max_distance: f64,
+    workspace: &mut MeshMeshWorkspace,
+    clock: &mut WorkClock,
+) -> Option<Proximity> {
     let iso = pose_ab.to_isometry();
     let rounding = rounding_bound(a, b, &iso);
+    let (na, nb) = (a.nodes(), b.nodes());
+    let mut stopped = false;
     // The smallest bound of everything ruled out so far (a `Cell`: both closures lower it).
     let floor = std::cell::Cell::new(f64::INFINITY);
     let flow = for_each_leaf_pair(
@@ -193,6 +219,11 @@ pub fn proximity_mesh_mesh<B: BoundingVolume>(
             true
         },
         |la, lb| {
+            let tests = na[la].slots().len() * nb[lb].slots().len();
+            if !clock.allows(TRIANGLE_DISTANCE_WORK * tests as u64) {
+                stopped = true;
+                return ControlFlow::Break(());
+            }
             for_each_triangle_pair(a, b, [la, lb], &iso, |_, tri_a, _, tri_b| {
                 let distance = distance_triangle_triangle(tri_a, tri_b).distance;
                 if distance <= max_distance {
@@ -204,12 +235,14 @@ pub fn proximity_mesh_mesh<B: BoundingVolume>(
             })
         },
     );
-    if flow.is_break() {
-        Proximity::Within
+    if stopped {
+        None
+    } else if flow.is_break() {
+        Some(Proximity::Within)
     } else {
-        Proximity::Apart {
+        Some(Proximity::Apart {
             lower_bound: floor.get(),
-        }
+        })
     }
 }
 

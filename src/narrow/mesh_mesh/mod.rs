@@ -18,6 +18,11 @@
 //! | [`within_distance_mesh_mesh`] | is the distance at most `d`? | at the first pair within `d` |
 //! | [`proximity_mesh_mesh`] | the same, and a lower bound of the distance when not | at the first pair within `d` |
 //!
+//! The four the pipeline runs (all but `within_distance_mesh_mesh`) have a `_within` form
+//! that polls a [`WorkClock`](crate::budget::WorkClock) before each pair of leaves (each
+//! step of the distance search) and says when it stopped unfinished; the plain forms run
+//! it with an unlimited clock.
+//!
 //! Meshes are surfaces here: a mesh wholly inside a closed mesh does not intersect it, and
 //! the distance of intersecting meshes is `0.0`, not a penetration depth.
 //!
@@ -34,10 +39,12 @@ pub mod frontier;
 
 pub use collide::{
     TRIANGLE_PAIR_WORK, contacts_mesh_mesh, contacts_mesh_mesh_within, intersects_mesh_mesh,
+    intersects_mesh_mesh_within,
 };
 pub use distance::{
-    Proximity, distance_mesh_mesh, distance_mesh_mesh_within, precedes_in_ties,
-    proximity_mesh_mesh, rounding_bound, within_distance_mesh_mesh,
+    Proximity, TRIANGLE_DISTANCE_WORK, distance_mesh_mesh, distance_mesh_mesh_within,
+    precedes_in_ties, proximity_mesh_mesh, proximity_mesh_mesh_within, rounding_bound,
+    within_distance_mesh_mesh,
 };
 
 use crate::bvh::Bvh;
