@@ -125,6 +125,9 @@ pub struct SceneFrames<S: Service> {
     workspace: PipelineWorkspace,
     output: FrameResults,
     validated: Vec<(BodyId, Pose)>,
+    /// Records a result sample of the publisher's data segment holds now (it grows by
+    /// powers of two, [`grow_results_ahead`](Self::grow_results_ahead)).
+    results_room: usize,
 }
 
 impl<S: Service> SceneFrames<S> {
@@ -187,6 +190,7 @@ impl<S: Service> SceneFrames<S> {
                 .abandon_on(keys.signals.abandon().clone()),
             output: FrameResults::default(),
             validated: Vec::new(),
+            results_room: INITIAL_RESULT_RECORDS,
             keys,
         })
     }
@@ -364,7 +368,41 @@ impl<S: Service> SceneFrames<S> {
         if let Some(late) = self.lateness.note(budget_ns, published.elapsed_ns, cpu_ns) {
             log_late(log, scene_id, frame.header.frame_seq, late);
         }
+        self.grow_results_ahead(records, scene_id, log);
         Ok(())
+    }
+
+    /// Doubles the results' data segment, after a frame is published, once a frame used
+    /// more than half of it: the growth then happens between frames, not inside the next
+    /// frame that needs it. A loan larger than the segment makes the publisher allocate and
+    /// map a new one (`AllocationStrategy::PowerOfTwo`): 230 µs of one frame's publish in
+    /// `falling_bodies` (1,058 records, 1,024 held), counted in that frame's time. Here the
+    /// larger sample is loaned, written (its pages touched) and dropped unsent.
+    fn grow_results_ahead(&mut self, records: u64, scene_id: u32, log: &mut Logger) {
+        let records = usize::try_from(records).unwrap_or(usize::MAX);
+        // A frame that outgrew the segment has grown it already.
+        self.results_room = self.results_room.max(records.next_power_of_two());
+        if records <= self.results_room / 2 {
+            return;
+        }
+        let room = self.results_room.saturating_mul(2);
+        match self.results.loan_slice_uninit(room) {
+            Ok(sample) => {
+                drop(sample.write_from_fn(|_| ResultRecord::default()));
+                self.results_room = room;
+            }
+            // No chunk free (subscribers hold them all), or no memory: the frame that needs
+            // the room grows the segment itself, as before.
+            Err(e) => {
+                let cause = Cause {
+                    what: "results segment not grown ahead",
+                    code: 0,
+                };
+                log.once(Level::Debug, Subject::Scene(scene_id), cause, || {
+                    format!("results segment not grown ahead of need: {e:?}")
+                });
+            }
+        }
     }
 
     /// Its budgeted frames that were late, and why.
