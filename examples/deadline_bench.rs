@@ -6,6 +6,7 @@
 //! cargo build --release && cargo run --release --example deadline_bench
 //! cargo run --release --example deadline_bench -- --scene pile --scene demo --budgets-us 200,1000 --frames 100
 //! cargo run --release --example deadline_bench -- --scene falling --hostile-registration --out target/db
+//! cargo run --release --example deadline_bench -- --scene falling --realtime-priority 10
 //! ```
 //!
 //! For each scene class (`--scene`, repeatable; all by default: `demo`, `falling`, `pile`,
@@ -118,6 +119,9 @@ struct Args {
     /// The `proximad` executable (default: `proximad` next to this example's directory).
     #[arg(long)]
     daemon: Option<PathBuf>,
+    /// Start the daemon with `--realtime-priority N`: its frame thread under SCHED_FIFO.
+    #[arg(long)]
+    realtime_priority: Option<u8>,
 }
 
 /// How long the unbudgeted first frame of a row may take (the exact answer of a heavy
@@ -133,10 +137,11 @@ struct Session {
 }
 
 impl Session {
-    /// Starts `exe` under a root and prefix of its own and connects.
-    fn start(exe: &Path) -> Result<Self, Box<dyn Error>> {
+    /// Starts `exe` under a root and prefix of its own, with `extra` arguments, and
+    /// connects.
+    fn start(exe: &Path, extra: &[&str]) -> Result<Self, Box<dyn Error>> {
         let isolation = Isolation::unique("dlb");
-        let daemon = ChildProcess::spawn_quiet_daemon(exe, &isolation)?;
+        let daemon = ChildProcess::spawn_quiet_daemon_with(exe, &isolation, extra)?;
         let Isolation { root, prefix } = &isolation;
         let client = ClientBuilder::new()
             .root(root)
@@ -171,9 +176,14 @@ fn main() -> Result<(), Box<dyn Error>> {
         None => sibling_daemon()?,
     };
     std::fs::create_dir_all(&args.out)?;
+    let daemon_args: Vec<String> = args
+        .realtime_priority
+        .map(|p| vec!["--realtime-priority".to_owned(), p.to_string()])
+        .unwrap_or_default();
     let mut bench = Bench {
-        session: Session::start(&exe)?,
+        session: Session::start(&exe, &strs(&daemon_args))?,
         exe,
+        daemon_args,
         data: data::data_dir(),
         rows: Vec::new(),
     };
@@ -192,6 +202,8 @@ fn main() -> Result<(), Box<dyn Error>> {
 struct Bench {
     session: Session,
     exe: PathBuf,
+    /// Arguments the daemon is started with besides its isolation.
+    daemon_args: Vec<String>,
     data: Option<PathBuf>,
     rows: Vec<Row>,
 }
@@ -252,7 +264,7 @@ impl Bench {
                 println!("{} at {} µs: FAILED: {e}", plan.class.name, plan.budget_us);
                 if self.session.daemon.has_exited() {
                     println!("  the daemon died; starting a new one");
-                    self.session = Session::start(&self.exe)?;
+                    self.session = Session::start(&self.exe, &strs(&self.daemon_args))?;
                 }
             }
         }
@@ -471,6 +483,11 @@ fn print_hostile(h: &HostileReport) {
         times(h.convex),
         times(h.mesh)
     );
+}
+
+/// The strings of `args`, borrowed.
+fn strs(args: &[String]) -> Vec<&str> {
+    args.iter().map(String::as_str).collect()
 }
 
 fn write_outputs(out: &Path, rows: &[Row]) -> Result<(), Box<dyn Error>> {

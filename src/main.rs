@@ -52,6 +52,11 @@ struct Cli {
     /// Worker threads answering mesh pairs beside the frame thread [default: cores − 1].
     #[arg(long)]
     workers: Option<usize>,
+    /// Run the frame thread under SCHED_FIFO at this priority (1–99), so no other thread
+    /// takes its CPU mid-frame; needs CAP_SYS_NICE, else a warning and normal priority
+    /// [default: off].
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=99))]
+    realtime_priority: Option<u8>,
     /// Write this run's instance id (hex, one line) to FILE, readable by the owner only,
     /// once the daemon serves: clients that read it connect only to this daemon.
     #[arg(long, value_name = "FILE")]
@@ -93,6 +98,9 @@ impl Cli {
         }
         if let Some(workers) = self.workers {
             config.workers = workers;
+        }
+        if let Some(priority) = self.realtime_priority {
+            config.realtime_priority = Some(priority);
         }
         Ok(config)
     }

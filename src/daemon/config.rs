@@ -55,6 +55,10 @@ pub struct DaemonConfig {
     /// Worker threads answering mesh–mesh pairs beside the frame thread (0: the frame
     /// thread answers everything itself). Default: one fewer than the cores, at least one.
     pub workers: usize,
+    /// `SCHED_FIFO` priority (1–99) of the frame thread, so that no thread under the fair
+    /// scheduler takes its CPU mid-frame ([`realtime`](super::realtime)); `None` (the
+    /// default): normal priority.
+    pub realtime_priority: Option<u8>,
 }
 
 impl Default for DaemonConfig {
@@ -79,6 +83,7 @@ impl Default for DaemonConfig {
             log_level: Level::Info,
             workers: std::thread::available_parallelism()
                 .map_or(1, |n| n.get().saturating_sub(1).max(1)),
+            realtime_priority: None,
         }
     }
 }

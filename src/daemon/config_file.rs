@@ -32,6 +32,7 @@
 //! sweep_interval_ms = 100         # dead-client and signal checks, longest blocking wait
 //! dead_client_grace_ms = 2000     # a dead client's scenes live this long
 //! workers = 1                     # threads answering mesh pairs (default: cores − 1)
+//! realtime_priority = 10          # frame thread under SCHED_FIFO at this priority (default: off)
 //! ```
 
 use super::config::DaemonConfig;
@@ -73,6 +74,8 @@ pub struct ServiceLoopSection {
     pub dead_client_grace_ms: Option<u64>,
     /// Worker threads answering mesh–mesh pairs beside the loop (0: none).
     pub workers: Option<usize>,
+    /// `SCHED_FIFO` priority of the frame thread, 1–99.
+    pub realtime_priority: Option<u8>,
 }
 
 /// `[limits]`: what one client may ask of the daemon.
@@ -185,6 +188,15 @@ impl ConfigFile {
         let l = &self.service_loop;
         if let Some(us) = l.spin_us {
             out.spin = Duration::from_micros(us);
+        }
+        if let Some(priority) = l.realtime_priority {
+            if !crate::daemon::realtime::PRIORITIES.contains(&priority) {
+                return Err(ConfigFileError::Invalid {
+                    key: "service_loop.realtime_priority",
+                    reason: format!("{priority} is not a SCHED_FIFO priority (1–99)"),
+                });
+            }
+            out.realtime_priority = Some(priority);
         }
         let mut sweep_ms = out.sweep_interval.as_millis() as u64;
         set_positive(
@@ -352,6 +364,7 @@ mod tests {
             sweep_interval_ms = 9
             dead_client_grace_ms = 11
             workers = 13
+            realtime_priority = 17
             "#,
         )
         .unwrap();
@@ -376,8 +389,8 @@ mod tests {
             (80, 81, 82, 83 << 20)
         );
         assert_eq!(
-            (c.log_level, c.workers),
-            (super::super::log::Level::Debug, 13)
+            (c.log_level, c.workers, c.realtime_priority),
+            (super::super::log::Level::Debug, 13, Some(17))
         );
         assert_eq!(
             (c.spin, c.sweep_interval, c.dead_client_grace),
@@ -424,6 +437,10 @@ mod tests {
             (
                 "[service_loop]\nsweep_interval_ms = 0",
                 "service_loop.sweep_interval_ms",
+            ),
+            (
+                "[service_loop]\nrealtime_priority = 0",
+                "service_loop.realtime_priority",
             ),
         ] {
             assert!(

@@ -37,6 +37,7 @@ use super::error::DaemonRunError;
 use super::frame_loop::{Answer, SceneFrames};
 use super::lane::{Answered, Lane};
 use super::log::{Level, Logger, Subject};
+use super::realtime;
 use super::schedule::most_urgent;
 use super::shared_scene::{SharedScene, lock};
 use super::stop::StopHandle;
@@ -112,7 +113,7 @@ impl LiveScene {
 
 /// How long a frame without a deadline is worked on here before it is parked and handed to
 /// the lane: most such frames take less and are answered at once; a longer one holds up
-/// frames with a deadline by at most this (plus the one exact mesh search it may be in).
+/// frames with a deadline by at most this (plus the step it is in when the slice ends).
 const INLINE_SLICE: Duration = Duration::from_micros(250);
 
 /// The frame thread's state (see the module docs).
@@ -125,6 +126,8 @@ pub struct FrameThread {
     level: Level,
     spin: Duration,
     max_block: Duration,
+    /// `SCHED_FIFO` priority to serve at, once the lane has started.
+    realtime_priority: Option<u8>,
 }
 
 impl FrameThread {
@@ -139,6 +142,7 @@ impl FrameThread {
             level: config.log_level,
             spin: config.spin,
             max_block: config.sweep_interval,
+            realtime_priority: config.realtime_priority,
         }
     }
 
@@ -158,8 +162,22 @@ impl FrameThread {
         std::thread::scope(|scope| {
             let lane = Lane::spawn(scope, lane_wake, self.level)
                 .map_err(|e| DaemonRunError::Ipc(format!("starting the lane: {e}")))?;
+            // Raised only now: the lane, started above, keeps the fair scheduler.
+            if let Some(priority) = self.realtime_priority {
+                match realtime::raise_current_thread(priority) {
+                    Ok(()) => self.log.info(format_args!(
+                        "frame thread under SCHED_FIFO, priority {priority}"
+                    )),
+                    Err(e) => self
+                        .log
+                        .warn(format_args!("{e}; the frame thread keeps normal priority")),
+                }
+            }
             let mut running = Running { thread: self, lane };
             let served = running.serve(stop, &waitset);
+            if running.thread.realtime_priority.is_some() {
+                realtime::lower_current_thread();
+            }
             if let Some(back) = running.lane.stop() {
                 running.take_back(back);
             }

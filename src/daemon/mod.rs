@@ -5,7 +5,7 @@
 //!
 //! | thread | owns | does |
 //! |---|---|---|
-//! | frame (the caller of [`Daemon::run`]) | every scene's pose, result and event ports | pose frames only, earliest deadline first across scenes |
+//! | frame (the caller of [`Daemon::run`]; `SCHED_FIFO` with `--realtime-priority`) | every scene's pose, result and event ports | pose frames only, earliest deadline first across scenes |
 //! | control (`proximad-control`) | the node, the control server, the scenes by id | control requests, opening and closing scenes' ports, dead-client sweeps, signals |
 //! | builder (`proximad-builder`, nice +10) | the queue of shapes to build | decoding and building convex and mesh shapes |
 //! | workers (`proxima-worker-*`) | nothing between frames | a frame's mesh–mesh pairs, beside the frame thread |
@@ -29,7 +29,8 @@
 //! - `shared_scene`: a scene as the threads share it;
 //! - `frame_thread`, `schedule`: which scene's frame is answered next; `frame_loop`: one
 //!   scene's frame path through `ingest`, the pipeline and publication;
-//! - `wait`, `stop`: how the threads block, and stop together;
+//! - `wait`, `stop`: how the threads block, and stop together; [`realtime`]: the frame
+//!   thread under `SCHED_FIFO`, on request;
 //! - [`liveness`]: which client owns each scene, and which scenes outlived their owner;
 //! - [`quota`]: what each client process holds, and the most it may;
 //! - [`log`]: leveled stderr lines, once per (scene or client, cause);
@@ -55,6 +56,7 @@ pub mod liveness;
 pub mod log;
 pub mod node_counter;
 pub mod quota;
+pub mod realtime;
 pub mod records;
 mod schedule;
 mod secrets;

@@ -78,6 +78,19 @@ impl ChildProcess {
         program: impl AsRef<OsStr>,
         isolation: &Isolation,
     ) -> std::io::Result<Self> {
+        Self::spawn_quiet_daemon_with(program, isolation, &[])
+    }
+
+    /// [`spawn_quiet_daemon`](Self::spawn_quiet_daemon) with `extra` arguments after the
+    /// isolation's.
+    ///
+    /// # Errors
+    /// The program could not be started.
+    pub fn spawn_quiet_daemon_with(
+        program: impl AsRef<OsStr>,
+        isolation: &Isolation,
+        extra: &[&str],
+    ) -> std::io::Result<Self> {
         let Isolation { root, prefix } = isolation;
         let args = [
             "--root",
@@ -87,7 +100,7 @@ impl ChildProcess {
             "--log-level",
             "warn",
         ];
-        Self::spawn(program, args, prefix)
+        Self::spawn(program, args.iter().chain(extra), prefix)
     }
 
     /// The child's process id.
