@@ -177,8 +177,9 @@ impl MeshShape {
     }
 
     /// Whether some triangle of this mesh and one of `other` placed at `pose_ab` are within
-    /// `max_distance`, with a lower bound of the distance when not ([`proximity_mesh_mesh`]
-    /// on the trees [`QueryVolume::for_pair`] chooses).
+    /// `max_distance`, with a lower bound of the distance when not
+    /// ([`proximity_mesh_mesh`](crate::narrow::mesh_mesh::proximity_mesh_mesh) on the
+    /// trees [`QueryVolume::for_pair`] chooses).
     #[must_use]
     pub fn proximity(
         &self,
