@@ -168,6 +168,89 @@ fn a_stopped_epa_holds_the_exact_depth_and_tightens_with_work() {
     assert!(seen.stopped > 100 && seen.finished == 300, "{seen:?}");
 }
 
+/// A convex shape's manifold against a mesh, stopped after every count of work units from
+/// 0: either it finished (not cut short), and is the unlimited manifold exactly, or it says
+/// it was cut short and is the distance's one point (the deepest, with its normal), never
+/// a partial set that could miss the deepest point. Boxes and capsules (whose triangle
+/// manifolds are queried, and so polled) deep in a finely tessellated torus, both orders.
+#[test]
+fn a_stopped_manifold_against_a_mesh_is_the_deepest_point_or_the_whole_manifold() {
+    use proxima::narrow::Manifold;
+    let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.5, 0.15, 64, 24))));
+    let mut r = rng(2906);
+    let (mut cut, mut whole, mut cases) = (0, 0, 0);
+    while cases < 120 {
+        let size = r.random_range(0.05..0.3);
+        let shape = if r.random_bool(0.5) {
+            Shape::Cuboid(Cuboid::new(DVec3::new(size / 2.0, size / 3.0, size / 4.0)))
+        } else {
+            Shape::Capsule(Capsule::new(size / 2.0, size / 4.0))
+        };
+        // On the tube's surface (0.15 from the core circle), so that it touches.
+        let angle = r.random_range(0.0..std::f64::consts::TAU);
+        let around = r.random_range(0.0..std::f64::consts::TAU);
+        let rho = 0.5 + 0.15 * around.cos();
+        let position = DVec3::new(rho * angle.cos(), rho * angle.sin(), 0.15 * around.sin());
+        let pose = Pose::new(position, rotation(&mut r));
+        let (a, b, pose) = if cases % 2 == 0 {
+            (&shape, &torus, pose)
+        } else {
+            (&torus, &shape, pose.inverse())
+        };
+        let scratch = &mut NarrowScratch::default();
+        let d = dispatch::distance(a, b, &pose, f64::INFINITY, scratch);
+        if d.distance > 0.0 {
+            continue;
+        }
+        cases += 1;
+        let mut full = Manifold::default();
+        dispatch::manifold(a, b, &pose, &d, scratch, &mut full);
+        assert!(
+            !scratch.manifold_cut_short,
+            "an unlimited clock cut it short"
+        );
+        let mut deepest = Manifold::default();
+        deepest.set_from_distance(&d);
+        for work in 0.. {
+            // As the pipeline does: the distance walk first, then the manifold under the clock.
+            let d_again = dispatch::distance(a, b, &pose, f64::INFINITY, scratch);
+            assert_eq!(d_again, d);
+            scratch.clock = WorkClock::new(Stop::AfterWork(work));
+            scratch.manifold_cut_short = false;
+            let mut found = Manifold::default();
+            dispatch::manifold(a, b, &pose, &d, scratch, &mut found);
+            scratch.clock = WorkClock::default();
+            if scratch.manifold_cut_short {
+                cut += 1;
+                // The flipped order rebuilds the point through two pose changes: to rounding.
+                assert!(
+                    same_to_rounding(&found, &deepest),
+                    "case {cases}, {work} units: {found:?}, not the deepest point {deepest:?}"
+                );
+            } else {
+                whole += 1;
+                assert_eq!(found, full, "case {cases}, {work} units: another manifold");
+                break;
+            }
+            assert!(work < 1_000_000, "case {cases}: never finished");
+        }
+    }
+    println!("{cut} cut short, {whole} whole");
+    assert!(cut > 100 && whole == 120, "{cut} cut short, {whole} whole");
+}
+
+/// Whether two manifolds have the same points and normal to 1e-12 m.
+fn same_to_rounding(x: &proxima::narrow::Manifold, y: &proxima::narrow::Manifold) -> bool {
+    let near = |p: DVec3, q: DVec3| (p - q).abs().max_element() <= 1e-12;
+    x.points().len() == y.points().len()
+        && near(x.normal, y.normal)
+        && x.points().iter().zip(y.points()).all(|(p, q)| {
+            near(p.point_a, q.point_a)
+                && near(p.point_b, q.point_b)
+                && (p.distance - q.distance).abs() <= 1e-12
+        })
+}
+
 /// The mesh–mesh overlap and proximity tests stopped after a growing count of work units
 /// (each an eighth more than the last, from 0): each says it stopped (`None`) or gives the
 /// unlimited run's answer, bit for bit; once a count finishes, every larger one does; every

@@ -98,8 +98,9 @@ pub struct NarrowScratch {
     /// The compound queries' candidate part pairs and gathered points.
     pub(crate) compound: CompoundScratch,
     /// Set by a [`manifold`] that `clock` stopped before it gathered every point (a
-    /// compound's part pairs; it keeps the deepest point and the normal): the caller marks
-    /// the pair's answer inexact. Never cleared here.
+    /// compound's part pairs, a convex shape's triangles of a mesh; it keeps the deepest
+    /// point and the normal): the caller marks the pair's answer inexact. Never cleared
+    /// here.
     pub manifold_cut_short: bool,
 }
 

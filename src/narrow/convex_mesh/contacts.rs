@@ -49,7 +49,7 @@
 //! shapes whose triangle manifold is one point (spheres and the GJK shapes). A pair beyond
 //! contact (distance `> 0`) gets an empty manifold with no walk at all.
 
-use super::walk::{for_each_overlapping_triangle, nearest_triangle_within};
+use super::walk::{TRIANGLE_WORK, for_each_overlapping_triangle, nearest_triangle_within};
 use crate::bounding::BoundingVolume;
 use crate::bounding::{Obb, Rss};
 use crate::geometry::SupportMap;
@@ -203,6 +203,11 @@ fn plane_separation(core: &dyn SupportMap, radius: f64, triangle: &Triangle) -> 
 /// right after that distance walk of the same pair its record of touching triangles is used
 /// instead of walking the tree again. Falls back to `d`'s one point when the shape touches
 /// but no corrected point does (a graze at rounding level).
+///
+/// Polls `scratch.clock` before each triangle's manifold ([`TRIANGLE_WORK`] units; a
+/// one-point triangle costs nothing to poll for): once it stops, the manifold is `d`'s one
+/// point (the deepest, with its normal) and `scratch.manifold_cut_short` is set, so the
+/// caller marks the answer inexact.
 pub(crate) fn shape_mesh_manifold(
     shape: &Shape,
     mesh: &MeshShape,
@@ -220,6 +225,8 @@ pub(crate) fn shape_mesh_manifold(
         epa,
         convex_mesh,
         mesh_contacts,
+        clock,
+        manifold_cut_short,
         ..
     } = scratch;
     let MeshContactScratch {
@@ -246,12 +253,17 @@ pub(crate) fn shape_mesh_manifold(
         };
         contact.push_corrected(m, points, normals);
     };
+    let mut stopped = false;
     if *walked == Some(PairKey::new(shape, mesh, pose_ab)) {
         let one_point = !matches!(shape, Shape::Capsule(_) | Shape::Cuboid(_));
         for (id, triangle, d_t) in touching.iter() {
             if one_point {
                 triangle_manifold.set_from_distance(d_t);
             } else {
+                if !clock.allows(TRIANGLE_WORK) {
+                    stopped = true;
+                    break;
+                }
                 *triangle_queries += 1;
                 shape_triangle_manifold(shape, triangle, epa, triangle_manifold);
             }
@@ -264,12 +276,22 @@ pub(crate) fn shape_mesh_manifold(
             pose_ab,
             convex_mesh,
             |id, triangle| {
+                if !clock.allows(TRIANGLE_WORK) {
+                    stopped = true;
+                    return ControlFlow::Break(());
+                }
                 *triangle_queries += 1;
                 shape_triangle_manifold(shape, triangle, epa, triangle_manifold);
                 gather(id, triangle, triangle_manifold);
                 ControlFlow::Continue(())
             },
         );
+    }
+    if stopped {
+        // The points gathered so far may miss the deepest: the distance's one point does not.
+        *manifold_cut_short = true;
+        out.set_from_distance(d);
+        return;
     }
     // A ridge's or a valley's points of another face get their depth along the deepest
     // point's normal.
