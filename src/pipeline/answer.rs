@@ -257,8 +257,9 @@ fn mesh_distance_stopped(
     mesh_bounded(pair, (a, b), query, bounds, witnesses, contacts)
 }
 
-/// A mesh pair whose first test the clock stopped (the frame's slice ended, or its client
-/// is gone): known only by its world boxes ([`mesh_bounded`] between their bounds).
+/// A mesh pair whose first test the clock stopped (the frame's deadline came near or its
+/// slice ended, or its client is gone): known only by its world boxes ([`mesh_bounded`]
+/// between their bounds).
 fn mesh_unsearched(
     pair: &CandidatePair,
     (a, b): (&Body, &Body),
