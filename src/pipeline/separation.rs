@@ -97,6 +97,11 @@ pub(super) fn mark_separated(
         return 0;
     }
     separated.extend(candidates.iter().map(|pair| {
+        // Only mesh pairs have separations and hulls: any other pair is done without a
+        // look-up of its memory (a pile of primitives pays nothing here).
+        let Some((ma, mb)) = mesh_pair(scene, pair) else {
+            return false;
+        };
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         if memory.kept_answer(scene, pair, query).is_some() {
             return false;
@@ -109,9 +114,6 @@ pub(super) fn mark_separated(
         {
             return true;
         }
-        let Some((ma, mb)) = mesh_pair(scene, pair) else {
-            return false;
-        };
         let (Some(ha), Some(hb)) = (&ma.hull, &mb.hull) else {
             return false;
         };
