@@ -10,6 +10,12 @@
 //! (nor in two with the whole daemon under `chrt -f 10`). The frames late by the daemon's
 //! own work (its tail estimates; 1–17 a run either way) are not this module's to fix.
 //!
+//! It is not a default, as it can lose too. On the README demo (1 ms budget, 304 bodies at
+//! 200 Hz, its client on the same two cores) it measured worse: three runs of
+//! `proximad demo --realtime-priority 10` met 997, 993 and 996 of 1,000 frames, against
+//! 999–1,000 without it. Every stage was slower: ingest 16–27 µs against 9, the broad phase
+//! 66–91 µs against 29.
+//!
 //! # What
 //! Only the frame thread is raised, to `SCHED_FIFO` at the priority asked: it blocks on its
 //! listeners between frames (after a spin of [`DaemonConfig::spin`](super::config::DaemonConfig::spin)),

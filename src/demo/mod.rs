@@ -41,6 +41,10 @@ pub struct DemoArgs {
     /// Print one frame line every this many frames.
     #[arg(long, default_value_t = 50)]
     print_every: u64,
+    /// Start the demo's daemon with `--realtime-priority N` (its frame thread under
+    /// SCHED_FIFO; needs CAP_SYS_NICE).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=99))]
+    realtime_priority: Option<u8>,
 }
 
 /// Runs the demo: daemon process, scene, frames, summary.
@@ -50,7 +54,12 @@ pub struct DemoArgs {
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn Error>> {
     let isolation = Isolation::unique("demo");
     let exe = std::env::current_exe()?;
-    let mut daemon = ChildProcess::spawn_quiet_daemon(&exe, &isolation)?;
+    let priority = args.realtime_priority.map(|p| p.to_string());
+    let extra: Vec<&str> = match &priority {
+        Some(p) => vec!["--realtime-priority", p],
+        None => Vec::new(),
+    };
+    let mut daemon = ChildProcess::spawn_quiet_daemon_with(&exe, &isolation, &extra)?;
     let Isolation { root, prefix } = isolation;
     let client = ClientBuilder::new()
         .root(&root)
