@@ -172,13 +172,16 @@ fn a_stopped_epa_holds_the_exact_depth_and_tightens_with_work() {
 /// 0: either it finished (not cut short), and is the unlimited manifold exactly, or it says
 /// it was cut short and is the distance's one point (the deepest, with its normal), never
 /// a partial set that could miss the deepest point. Boxes and capsules (whose triangle
-/// manifolds are queried, and so polled) deep in a finely tessellated torus, both orders.
+/// manifolds are queried, and so polled) deep in a finely tessellated torus, both orders;
+/// each manifold both from the distance walk's record of touching triangles (as the
+/// pipeline asks it) and from a walk of its own (a scratch without that record).
 #[test]
 fn a_stopped_manifold_against_a_mesh_is_the_deepest_point_or_the_whole_manifold() {
     use proxima::narrow::Manifold;
     let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.5, 0.15, 64, 24))));
     let mut r = rng(2906);
-    let (mut cut, mut whole, mut cases) = (0, 0, 0);
+    // Stopped runs without and with the walk's record.
+    let (mut cut, mut whole, mut cases) = ([0; 2], 0, 0);
     while cases < 120 {
         let size = r.random_range(0.05..0.3);
         let shape = if r.random_bool(0.5) {
@@ -203,40 +206,50 @@ fn a_stopped_manifold_against_a_mesh_is_the_deepest_point_or_the_whole_manifold(
             continue;
         }
         cases += 1;
-        let mut full = Manifold::default();
-        dispatch::manifold(a, b, &pose, &d, scratch, &mut full);
+        // The unlimited manifold, from the walk's record and from a walk of its own (the
+        // same points, perhaps in another order).
+        let mut full = [Manifold::default(); 2];
+        dispatch::manifold(a, b, &pose, &d, scratch, &mut full[1]);
+        dispatch::manifold(a, b, &pose, &d, &mut NarrowScratch::default(), &mut full[0]);
         assert!(
             !scratch.manifold_cut_short,
             "an unlimited clock cut it short"
         );
         let mut deepest = Manifold::default();
         deepest.set_from_distance(&d);
-        for work in 0.. {
-            // As the pipeline does: the distance walk first, then the manifold under the clock.
-            let d_again = dispatch::distance(a, b, &pose, f64::INFINITY, scratch);
-            assert_eq!(d_again, d);
-            scratch.clock = WorkClock::new(Stop::AfterWork(work));
-            scratch.manifold_cut_short = false;
-            let mut found = Manifold::default();
-            dispatch::manifold(a, b, &pose, &d, scratch, &mut found);
-            scratch.clock = WorkClock::default();
-            if scratch.manifold_cut_short {
-                cut += 1;
-                // The flipped order rebuilds the point through two pose changes: to rounding.
-                assert!(
-                    same_to_rounding(&found, &deepest),
-                    "case {cases}, {work} units: {found:?}, not the deepest point {deepest:?}"
-                );
-            } else {
-                whole += 1;
-                assert_eq!(found, full, "case {cases}, {work} units: another manifold");
-                break;
+        for walked in [true, false] {
+            let full = &full[usize::from(walked)];
+            for work in 0.. {
+                let scratch = &mut NarrowScratch::default();
+                if walked {
+                    // As the pipeline does: the distance walk, then the manifold.
+                    let d_again = dispatch::distance(a, b, &pose, f64::INFINITY, scratch);
+                    assert_eq!(d_again, d);
+                }
+                scratch.clock = WorkClock::new(Stop::AfterWork(work));
+                let mut found = Manifold::default();
+                dispatch::manifold(a, b, &pose, &d, scratch, &mut found);
+                if scratch.manifold_cut_short {
+                    cut[usize::from(walked)] += 1;
+                    // The flipped order rebuilds the point through two pose changes.
+                    assert!(
+                        same_to_rounding(&found, &deepest),
+                        "case {cases}, {work} units: {found:?}, not the deepest {deepest:?}"
+                    );
+                } else {
+                    whole += 1;
+                    assert_eq!(&found, full, "case {cases}, {work} units: another manifold");
+                    break;
+                }
+                assert!(work < 1_000_000, "case {cases}: never finished");
             }
-            assert!(work < 1_000_000, "case {cases}: never finished");
         }
     }
-    println!("{cut} cut short, {whole} whole");
-    assert!(cut > 100 && whole == 120, "{cut} cut short, {whole} whole");
+    println!("{cut:?} cut short (own walk, walk's record), {whole} whole");
+    assert!(
+        cut.iter().all(|&n| n > 100) && whole == 240,
+        "{cut:?} cut short, {whole} whole"
+    );
 }
 
 /// Whether two manifolds have the same points and normal to 1e-12 m.
@@ -285,26 +298,10 @@ fn stopped_mesh_overlap_and_proximity_tests_say_so_or_answer_exactly() {
         let (mut overlap_done, mut proximity_done) = (false, false);
         let mut work = 0;
         loop {
-            match overlap(Stop::AfterWork(work), workspace) {
-                Some(found) => {
-                    assert_eq!(found, truth.0, "case {case}, {work} units: overlap");
-                    overlap_done = true;
-                }
-                None => {
-                    assert!(!overlap_done, "case {case}: stopped with more work");
-                    stopped += 1;
-                }
-            }
-            match proximity(Stop::AfterWork(work), workspace) {
-                Some(found) => {
-                    assert_eq!(found, truth.1, "case {case}, {work} units: proximity");
-                    proximity_done = true;
-                }
-                None => {
-                    assert!(!proximity_done, "case {case}: stopped with more work");
-                    stopped += 1;
-                }
-            }
+            let found = overlap(Stop::AfterWork(work), workspace);
+            stopped += check_stop(found, &truth.0, &mut overlap_done, (case, work));
+            let found = proximity(Stop::AfterWork(work), workspace);
+            stopped += check_stop(found, &truth.1, &mut proximity_done, (case, work));
             if overlap_done && proximity_done {
                 break;
             }
@@ -314,6 +311,31 @@ fn stopped_mesh_overlap_and_proximity_tests_say_so_or_answer_exactly() {
     }
     println!("{intersecting} intersecting, {within} within, {apart} apart, {stopped} stopped");
     assert!(intersecting > 30 && apart > 30 && within > intersecting && stopped > 400);
+}
+
+/// Checks a run stopped after `work` units: finished (`Some`), it is `truth` and `done`
+/// becomes true; stopped (`None`), no run with less work may have finished. Returns 1 for a
+/// stopped run.
+fn check_stop<T: PartialEq + std::fmt::Debug>(
+    found: Option<T>,
+    truth: &T,
+    done: &mut bool,
+    (case, work): (usize, u64),
+) -> usize {
+    match found {
+        Some(found) => {
+            assert_eq!(&found, truth, "case {case}, {work} units");
+            *done = true;
+            0
+        }
+        None => {
+            assert!(
+                !*done,
+                "case {case}: stopped after {work} units, with more work"
+            );
+            1
+        }
+    }
 }
 
 #[test]
