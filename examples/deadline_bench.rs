@@ -120,7 +120,7 @@ struct Args {
     #[arg(long)]
     daemon: Option<PathBuf>,
     /// Start the daemon with `--realtime-priority N`: its frame thread under SCHED_FIFO.
-    #[arg(long)]
+    #[arg(long, value_parser = proxima::daemon::realtime::parse_priority)]
     realtime_priority: Option<u8>,
 }
 
@@ -137,11 +137,12 @@ struct Session {
 }
 
 impl Session {
-    /// Starts `exe` under a root and prefix of its own, with `extra` arguments, and
-    /// connects.
-    fn start(exe: &Path, extra: &[&str]) -> Result<Self, Box<dyn Error>> {
+    /// Starts `exe` under a root and prefix of its own, its frame thread at
+    /// `realtime_priority` when given, and connects.
+    fn start(exe: &Path, realtime_priority: Option<u8>) -> Result<Self, Box<dyn Error>> {
         let isolation = Isolation::unique("dlb");
-        let daemon = ChildProcess::spawn_quiet_daemon_with(exe, &isolation, extra)?;
+        let daemon =
+            ChildProcess::spawn_quiet_daemon_at_priority(exe, &isolation, realtime_priority)?;
         let Isolation { root, prefix } = &isolation;
         let client = ClientBuilder::new()
             .root(root)
@@ -176,14 +177,10 @@ fn main() -> Result<(), Box<dyn Error>> {
         None => sibling_daemon()?,
     };
     std::fs::create_dir_all(&args.out)?;
-    let daemon_args: Vec<String> = args
-        .realtime_priority
-        .map(|p| vec!["--realtime-priority".to_owned(), p.to_string()])
-        .unwrap_or_default();
     let mut bench = Bench {
-        session: Session::start(&exe, &strs(&daemon_args))?,
+        session: Session::start(&exe, args.realtime_priority)?,
         exe,
-        daemon_args,
+        realtime_priority: args.realtime_priority,
         data: data::data_dir(),
         rows: Vec::new(),
     };
@@ -202,8 +199,8 @@ fn main() -> Result<(), Box<dyn Error>> {
 struct Bench {
     session: Session,
     exe: PathBuf,
-    /// Arguments the daemon is started with besides its isolation.
-    daemon_args: Vec<String>,
+    /// The daemon's `--realtime-priority`, if any.
+    realtime_priority: Option<u8>,
     data: Option<PathBuf>,
     rows: Vec<Row>,
 }
@@ -264,7 +261,7 @@ impl Bench {
                 println!("{} at {} µs: FAILED: {e}", plan.class.name, plan.budget_us);
                 if self.session.daemon.has_exited() {
                     println!("  the daemon died; starting a new one");
-                    self.session = Session::start(&self.exe, &strs(&self.daemon_args))?;
+                    self.session = Session::start(&self.exe, self.realtime_priority)?;
                 }
             }
         }
@@ -483,11 +480,6 @@ fn print_hostile(h: &HostileReport) {
         times(h.convex),
         times(h.mesh)
     );
-}
-
-/// The strings of `args`, borrowed.
-fn strs(args: &[String]) -> Vec<&str> {
-    args.iter().map(String::as_str).collect()
 }
 
 fn write_outputs(out: &Path, rows: &[Row]) -> Result<(), Box<dyn Error>> {

@@ -55,7 +55,7 @@ struct Cli {
     /// Run the frame thread under SCHED_FIFO at this priority (1–99), so no other thread
     /// takes its CPU mid-frame; needs CAP_SYS_NICE, else a warning and normal priority
     /// [default: off].
-    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=99))]
+    #[arg(long, value_parser = proxima::daemon::realtime::parse_priority)]
     realtime_priority: Option<u8>,
     /// Write this run's instance id (hex, one line) to FILE, readable by the owner only,
     /// once the daemon serves: clients that read it connect only to this daemon.

@@ -36,6 +36,7 @@
 //! ```
 
 use super::config::DaemonConfig;
+use super::realtime;
 use serde::Deserialize;
 use std::fmt;
 use std::path::Path;
@@ -190,12 +191,12 @@ impl ConfigFile {
             out.spin = Duration::from_micros(us);
         }
         if let Some(priority) = l.realtime_priority {
-            if !crate::daemon::realtime::PRIORITIES.contains(&priority) {
-                return Err(ConfigFileError::Invalid {
+            let priority = realtime::checked_priority(priority).map_err(|reason| {
+                ConfigFileError::Invalid {
                     key: "service_loop.realtime_priority",
-                    reason: format!("{priority} is not a SCHED_FIFO priority (1–99)"),
-                });
-            }
+                    reason,
+                }
+            })?;
             out.realtime_priority = Some(priority);
         }
         let mut sweep_ms = out.sweep_interval.as_millis() as u64;

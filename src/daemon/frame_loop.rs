@@ -362,8 +362,9 @@ impl<S: Service> SceneFrames<S> {
     ) -> Result<(), String> {
         let budget_ns = frame.header.budget_ns;
         let published = self.publish(result, frame.key.received, budget_ns)?;
-        let records = self.output.record_count() as u64;
-        self.workspace.note_publish(published.publish_ns, records);
+        let records = self.output.record_count();
+        self.workspace
+            .note_publish(published.publish_ns, records as u64);
         let cpu_ns = published.cpu_ns.saturating_sub(frame.cpu_at_receipt);
         if let Some(late) = self.lateness.note(budget_ns, published.elapsed_ns, cpu_ns) {
             log_late(log, scene_id, frame.header.frame_seq, late);
@@ -378,8 +379,7 @@ impl<S: Service> SceneFrames<S> {
     /// map a new one (`AllocationStrategy::PowerOfTwo`): 230 µs of one frame's publish in
     /// `falling_bodies` (1,058 records, 1,024 held), counted in that frame's time. Here the
     /// larger sample is loaned, written (its pages touched) and dropped unsent.
-    fn grow_results_ahead(&mut self, records: u64, scene_id: u32, log: &mut Logger) {
-        let records = usize::try_from(records).unwrap_or(usize::MAX);
+    fn grow_results_ahead(&mut self, records: usize, scene_id: u32, log: &mut Logger) {
         // A frame that outgrew the segment has grown it already.
         self.results_room = self.results_room.max(records.next_power_of_two());
         if records <= self.results_room / 2 {

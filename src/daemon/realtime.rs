@@ -45,6 +45,35 @@ impl fmt::Display for NotRaised {
 /// Lowest and highest `SCHED_FIFO` priorities Linux accepts.
 pub const PRIORITIES: std::ops::RangeInclusive<u8> = 1..=99;
 
+/// `priority` when it is one of [`PRIORITIES`], else why not: the one check of the flags
+/// ([`parse_priority`]) and the configuration file.
+///
+/// # Errors
+/// The reason, for a priority outside [`PRIORITIES`].
+pub fn checked_priority(priority: u8) -> Result<u8, String> {
+    if PRIORITIES.contains(&priority) {
+        Ok(priority)
+    } else {
+        Err(format!(
+            "{priority} is not a SCHED_FIFO priority ({}..={})",
+            PRIORITIES.start(),
+            PRIORITIES.end()
+        ))
+    }
+}
+
+/// Parses a `--realtime-priority` value (the value parser of the daemon's and the demo's
+/// flag): a number in [`PRIORITIES`].
+///
+/// # Errors
+/// The reason, when `text` is not such a number.
+pub fn parse_priority(text: &str) -> Result<u8, String> {
+    let priority = text
+        .parse::<u8>()
+        .map_err(|e| format!("{text:?} is not a SCHED_FIFO priority: {e}"))?;
+    checked_priority(priority)
+}
+
 /// Moves the calling thread to `SCHED_FIFO` at `priority` (in [`PRIORITIES`]).
 ///
 /// # Errors
@@ -112,6 +141,16 @@ pub fn current_thread_is_realtime() -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_flag_takes_the_priorities_linux_accepts_and_nothing_else() {
+        assert_eq!(parse_priority("1"), Ok(1));
+        assert_eq!(parse_priority("99"), Ok(99));
+        for text in ["0", "100", "-1", "ten", ""] {
+            let e = parse_priority(text).expect_err(text);
+            assert!(e.contains("not a SCHED_FIFO priority"), "{e}");
+        }
+    }
 
     #[test]
     fn a_priority_out_of_range_is_refused_before_asking() {

@@ -43,7 +43,7 @@ pub struct DemoArgs {
     print_every: u64,
     /// Start the demo's daemon with `--realtime-priority N` (its frame thread under
     /// SCHED_FIFO; needs CAP_SYS_NICE).
-    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=99))]
+    #[arg(long, value_parser = proxima::daemon::realtime::parse_priority)]
     realtime_priority: Option<u8>,
 }
 
@@ -54,12 +54,8 @@ pub struct DemoArgs {
 pub fn run(args: &DemoArgs) -> Result<(), Box<dyn Error>> {
     let isolation = Isolation::unique("demo");
     let exe = std::env::current_exe()?;
-    let priority = args.realtime_priority.map(|p| p.to_string());
-    let extra: Vec<&str> = match &priority {
-        Some(p) => vec!["--realtime-priority", p],
-        None => Vec::new(),
-    };
-    let mut daemon = ChildProcess::spawn_quiet_daemon_with(&exe, &isolation, &extra)?;
+    let mut daemon =
+        ChildProcess::spawn_quiet_daemon_at_priority(&exe, &isolation, args.realtime_priority)?;
     let Isolation { root, prefix } = isolation;
     let client = ClientBuilder::new()
         .root(&root)

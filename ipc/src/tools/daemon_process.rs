@@ -78,29 +78,33 @@ impl ChildProcess {
         program: impl AsRef<OsStr>,
         isolation: &Isolation,
     ) -> std::io::Result<Self> {
-        Self::spawn_quiet_daemon_with(program, isolation, &[])
+        Self::spawn_quiet_daemon_at_priority(program, isolation, None)
     }
 
-    /// [`spawn_quiet_daemon`](Self::spawn_quiet_daemon) with `extra` arguments after the
-    /// isolation's.
+    /// [`spawn_quiet_daemon`](Self::spawn_quiet_daemon), with the daemon's frame thread
+    /// under `SCHED_FIFO` at `realtime_priority` when one is given
+    /// (`--realtime-priority`).
     ///
     /// # Errors
     /// The program could not be started.
-    pub fn spawn_quiet_daemon_with(
+    pub fn spawn_quiet_daemon_at_priority(
         program: impl AsRef<OsStr>,
         isolation: &Isolation,
-        extra: &[&str],
+        realtime_priority: Option<u8>,
     ) -> std::io::Result<Self> {
         let Isolation { root, prefix } = isolation;
-        let args = [
-            "--root",
-            root,
-            "--iceoryx-prefix",
-            prefix,
-            "--log-level",
-            "warn",
+        let mut args = vec![
+            "--root".to_owned(),
+            root.clone(),
+            "--iceoryx-prefix".to_owned(),
+            prefix.clone(),
+            "--log-level".to_owned(),
+            "warn".to_owned(),
         ];
-        Self::spawn(program, args.iter().chain(extra), prefix)
+        if let Some(priority) = realtime_priority {
+            args.extend(["--realtime-priority".to_owned(), priority.to_string()]);
+        }
+        Self::spawn(program, args, prefix)
     }
 
     /// The child's process id.

@@ -1,6 +1,9 @@
 //! Collision queries: does any triangle pair intersect, and which ones do.
 
-use super::{FALLBACK_NORMAL, MeshMeshWorkspace, TriangleContact, for_each_triangle_pair};
+use super::{
+    FALLBACK_NORMAL, MeshMeshWorkspace, TriangleContact, clock_allows_leaf_pair,
+    for_each_triangle_pair,
+};
 use crate::bounding::BoundingVolume;
 use crate::budget::WorkClock;
 use crate::bvh::Bvh;
@@ -41,7 +44,6 @@ pub fn intersects_mesh_mesh_within<B: BoundingVolume>(
     clock: &mut WorkClock,
 ) -> Option<bool> {
     let iso = pose_ab.to_isometry();
-    let (na, nb) = (a.nodes(), b.nodes());
     let mut stopped = false;
     let flow = for_each_leaf_pair(
         a,
@@ -49,8 +51,7 @@ pub fn intersects_mesh_mesh_within<B: BoundingVolume>(
         &mut workspace.pairs,
         |x, y| x.overlaps(y, &iso),
         |la, lb| {
-            let tests = na[la].slots().len() * nb[lb].slots().len();
-            if !clock.allows(TRIANGLE_PAIR_WORK * tests as u64) {
+            if !clock_allows_leaf_pair(clock, (a, b), [la, lb], TRIANGLE_PAIR_WORK) {
                 stopped = true;
                 return ControlFlow::Break(());
             }
@@ -106,7 +107,6 @@ where
     S: FnMut(TriangleContact) -> ControlFlow<()>,
 {
     let iso = pose_ab.to_isometry();
-    let (na, nb) = (a.nodes(), b.nodes());
     let mut stopped = false;
     let _ = for_each_leaf_pair(
         a,
@@ -114,8 +114,7 @@ where
         &mut workspace.pairs,
         |x, y| x.overlaps(y, &iso),
         |la, lb| {
-            let tests = na[la].slots().len() * nb[lb].slots().len();
-            if !clock.allows(TRIANGLE_PAIR_WORK * tests as u64) {
+            if !clock_allows_leaf_pair(clock, (a, b), [la, lb], TRIANGLE_PAIR_WORK) {
                 stopped = true;
                 return ControlFlow::Break(());
             }

@@ -1,7 +1,8 @@
 //! Distance queries: the smallest triangle–triangle distance, and "within distance d?".
 
 use super::{
-    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, for_each_triangle_pair,
+    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, clock_allows_leaf_pair,
+    for_each_triangle_pair,
 };
 use crate::bounding::BoundingVolume;
 use crate::budget::WorkClock;
@@ -202,7 +203,6 @@ pub fn proximity_mesh_mesh_within<B: BoundingVolume>(
 ) -> Option<Proximity> {
     let iso = pose_ab.to_isometry();
     let rounding = rounding_bound(a, b, &iso);
-    let (na, nb) = (a.nodes(), b.nodes());
     let mut stopped = false;
     // The smallest bound of everything ruled out so far (a `Cell`: both closures lower it).
     let floor = std::cell::Cell::new(f64::INFINITY);
@@ -219,8 +219,7 @@ pub fn proximity_mesh_mesh_within<B: BoundingVolume>(
             true
         },
         |la, lb| {
-            let tests = na[la].slots().len() * nb[lb].slots().len();
-            if !clock.allows(TRIANGLE_DISTANCE_WORK * tests as u64) {
+            if !clock_allows_leaf_pair(clock, (a, b), [la, lb], TRIANGLE_DISTANCE_WORK) {
                 stopped = true;
                 return ControlFlow::Break(());
             }

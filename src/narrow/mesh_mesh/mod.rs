@@ -19,7 +19,7 @@
 //! | [`proximity_mesh_mesh`] | the same, and a lower bound of the distance when not | at the first pair within `d` |
 //!
 //! The four the pipeline runs (all but `within_distance_mesh_mesh`) have a `_within` form
-//! that polls a [`WorkClock`](crate::budget::WorkClock) before each pair of leaves (each
+//! that polls a [`WorkClock`] before each pair of leaves (each
 //! step of the distance search) and says when it stopped unfinished; the plain forms run
 //! it with an unlimited clock.
 //!
@@ -47,6 +47,7 @@ pub use distance::{
     within_distance_mesh_mesh,
 };
 
+use crate::budget::WorkClock;
 use crate::bvh::Bvh;
 use crate::bvh::tandem::RankedPair;
 use crate::geometry::Triangle;
@@ -155,6 +156,18 @@ impl DistanceCache {
     pub fn new() -> Self {
         Self::default()
     }
+}
+
+/// Whether `clock` allows the triangle pairs of leaf `leaf_a` of `a` and leaf `leaf_b` of
+/// `b`, `per_pair` units each: the one poll of the `_within` searches before a leaf pair.
+fn clock_allows_leaf_pair<B>(
+    clock: &mut WorkClock,
+    (a, b): (&Bvh<B>, &Bvh<B>),
+    [leaf_a, leaf_b]: [usize; 2],
+    per_pair: u64,
+) -> bool {
+    let tests = a.nodes()[leaf_a].slots().len() * b.nodes()[leaf_b].slots().len();
+    clock.allows(per_pair * tests as u64)
 }
 
 /// Calls `visit(slot_a, triangle_a, slot_b, triangle_b)` for every triangle pair of leaf
