@@ -238,9 +238,9 @@ impl ConvexPolyhedron {
         )
     }
 
-    /// Whether every point is within tolerance of the hull (the construction contract).
-    /// Whether every point passes [`contains_point`](Self::contains_point). Solid and flat
-    /// hulls ask, per plane, for the point farthest along its normal (the same dot products,
+    /// Whether every point is within tolerance of the hull (the construction contract):
+    /// passes [`contains_point`](Self::contains_point). Solid and flat hulls ask, per
+    /// plane, for the point farthest along its normal (the same dot products,
     /// `O(F log n)` rather than `O(F n)`).
     fn contains_all(&self, points: &[DVec3]) -> bool {
         if self.dimension < 2 {
