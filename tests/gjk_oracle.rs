@@ -989,6 +989,73 @@ fn large_hull_depths_separate_and_are_no_deeper_than_any_sampled_direction() {
     }
 }
 
+/// What a certificate answered, once [`check_certificate`] has checked it.
+enum Certified {
+    Overlapping,
+    Apart(ShapeDistance),
+    Beyond,
+    Unknown,
+}
+
+/// Checks a certificate's answer for `a` and `b` placed by `pose` against GJK/EPA in f64 on
+/// the same pair: an exact answer has the same signed distance (1e-9 relative) and
+/// consistent witnesses, and when overlapping B moved by `depth + ε` along its normal is
+/// apart, by `depth − ε` still overlapping; a lower bound beyond `limit` holds GJK's
+/// distance.
+fn check_certificate<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    certified: proxima::narrow::pairs::FaceCertificate,
+    a: &A,
+    b: &B,
+    pose: &Isometry,
+    limit: f64,
+    label: &str,
+) -> Certified {
+    use proxima::narrow::pairs::FaceCertificate;
+    let (g, _) = plain(a, b, pose);
+    match certified {
+        FaceCertificate::Exact(d) => {
+            check_contract(&d, 1e-12);
+            let tol = 1e-9 * d.distance.abs() + 1e-12;
+            assert!(
+                (d.distance - g.distance).abs() <= tol,
+                "{label}: certified {} vs GJK/EPA {}",
+                d.distance,
+                g.distance
+            );
+            if d.distance >= 0.0 {
+                return Certified::Apart(d);
+            }
+            let depth = -d.distance;
+            let eps = 1e-9 * (1.0 + depth);
+            for (shift, apart) in [(depth + eps, true), (depth - eps, false)] {
+                let moved = Isometry {
+                    translation: pose.translation + d.normal * shift,
+                    ..*pose
+                };
+                let (m, _) = plain(a, b, &moved);
+                assert_eq!(
+                    m.distance > 0.0,
+                    apart,
+                    "{label}: moved by {shift} of depth {depth}: {}",
+                    m.distance
+                );
+            }
+            Certified::Overlapping
+        }
+        FaceCertificate::Beyond(d) => {
+            assert!(d.distance > limit, "{label}: {d:?}");
+            assert!(
+                d.distance <= g.distance + 1e-12,
+                "{label}: bound {} above GJK's {}",
+                d.distance,
+                g.distance
+            );
+            Certified::Beyond
+        }
+        FaceCertificate::Unknown => Certified::Unknown,
+    }
+}
+
 /// The box face certificate (`pairs::face_distance_cuboid_convex`, the dispatcher's route
 /// for a box against a cylinder, cone or hull) against GJK/EPA in f64 on the same pair
 /// (depths, and distances over a face), and the metamorphic check: B moved by `depth + ε`
@@ -997,7 +1064,7 @@ fn large_hull_depths_separate_and_are_no_deeper_than_any_sampled_direction() {
 /// every outcome occurs often.
 #[test]
 fn the_box_face_certificate_matches_epa_and_moves_apart_by_its_depth() {
-    use proxima::narrow::pairs::{FaceCertificate, face_distance_cuboid_convex};
+    use proxima::narrow::pairs::face_distance_cuboid_convex;
     let mut r = rng(31);
     let limit = 0.02;
     let (mut exact, mut exact_apart, mut beyond, mut unknown) = ([0_usize; 3], 0, 0, 0);
@@ -1030,49 +1097,12 @@ fn the_box_face_certificate_matches_epa_and_moves_apart_by_its_depth() {
             rotation: proxima::math::DMat3::from_quat(q),
             translation: t,
         };
-        let (g, _) = plain(&a, b, &pose);
-        match face_distance_cuboid_convex(&a, b, &pose, limit) {
-            FaceCertificate::Exact(d) => {
-                check_contract(&d, 1e-12);
-                let tol = 1e-9 * d.distance.abs() + 1e-12;
-                assert!(
-                    (d.distance - g.distance).abs() <= tol,
-                    "case {case}: certified {} vs GJK/EPA {}",
-                    d.distance,
-                    g.distance
-                );
-                if d.distance >= 0.0 {
-                    exact_apart += 1;
-                    continue;
-                }
-                exact[kind] += 1;
-                let depth = -d.distance;
-                let eps = 1e-9 * (1.0 + depth);
-                for (shift, apart) in [(depth + eps, true), (depth - eps, false)] {
-                    let moved = Isometry {
-                        translation: pose.translation + d.normal * shift,
-                        ..pose
-                    };
-                    let (m, _) = plain(&a, b, &moved);
-                    assert_eq!(
-                        m.distance > 0.0,
-                        apart,
-                        "case {case}: moved by {shift} of depth {depth}: {}",
-                        m.distance
-                    );
-                }
-            }
-            FaceCertificate::Beyond(d) => {
-                beyond += 1;
-                assert!(d.distance > limit, "case {case}: {d:?}");
-                assert!(
-                    d.distance <= g.distance + 1e-12,
-                    "case {case}: bound {} above GJK's {}",
-                    d.distance,
-                    g.distance
-                );
-            }
-            FaceCertificate::Unknown => unknown += 1,
+        let certified = face_distance_cuboid_convex(&a, b, &pose, limit);
+        match check_certificate(certified, &a, b, &pose, limit, &format!("case {case}")) {
+            Certified::Overlapping => exact[kind] += 1,
+            Certified::Apart(_) => exact_apart += 1,
+            Certified::Beyond => beyond += 1,
+            Certified::Unknown => unknown += 1,
         }
     }
     println!(
@@ -1082,6 +1112,87 @@ fn the_box_face_certificate_matches_epa_and_moves_apart_by_its_depth() {
     assert!(
         exact.iter().all(|&n| n > 200) && exact_apart > 500 && beyond > 300 && unknown > 500,
         "{exact:?} {exact_apart} {beyond} {unknown}"
+    );
+}
+
+/// The cylinder's certificate (`pairs::certified_distance_cylinder_convex`, the
+/// dispatcher's route for a cylinder against a box, hull, cylinder or capsule before GJK)
+/// against GJK/EPA in f64 on the same pair, with the metamorphic check of the box
+/// certificate's test: B moved by `depth + ε` along the certified normal is apart, by
+/// `depth − ε` it still overlaps. Apart answers have their witnesses on the cylinder, and
+/// lower bounds beyond the limit hold GJK's distance. B is placed across a cap or beside
+/// the side, half the time turned by quarter turns only (faces, edges and axes parallel to
+/// the cylinder's, as bodies resting in a pile are) and else at random, so every outcome
+/// occurs for every kind of B.
+#[test]
+fn the_cylinder_certificate_matches_epa_and_moves_apart_by_its_depth() {
+    use proxima::narrow::pairs::certified_distance_cylinder_convex;
+    let mut r = rng(37);
+    let limit = 0.02;
+    let kinds = ["box", "hull", "cylinder", "segment"];
+    let (mut exact, mut exact_apart, mut beyond, mut unknown) = ([0_usize; 4], [0_usize; 4], 0, 0);
+    for case in 0..8000 {
+        let a = Cylinder::new(r.random_range(0.01..0.2), r.random_range(0.01..0.2));
+        let kind = case % 4;
+        let cuboid = random_box(&mut r, 0.01, 0.15);
+        let cloud: Vec<DVec3> = (0..20 + case % 40)
+            .map(|_| point_in_cube(&mut r, 0.1) * DVec3::new(1.0, 0.7, 0.4))
+            .collect();
+        let hull = ConvexPolyhedron::try_from_points(&cloud).expect("finite cloud");
+        let cylinder = Cylinder::new(r.random_range(0.01..0.2), r.random_range(0.01..0.2));
+        let half = r.random_range(0.01..0.2);
+        let segment = Segment::new(DVec3::new(0.0, 0.0, -half), DVec3::new(0.0, 0.0, half));
+        let b: &dyn SupportMap = match kind {
+            0 => &cuboid,
+            1 => &hull,
+            2 => &cylinder,
+            _ => &segment,
+        };
+        let q = if r.random() {
+            let quarter = |k: u32| f64::from(k) * std::f64::consts::FRAC_PI_2;
+            DQuat::from_rotation_z(r.random_range(0.0..std::f64::consts::TAU))
+                * DQuat::from_rotation_x(quarter(r.random_range(0..4)))
+                * DQuat::from_rotation_y(quarter(r.random_range(0..4)))
+        } else {
+            rotation(&mut r)
+        };
+        let (along, across) = if r.random() {
+            (DVec3::Z, DVec3::X)
+        } else {
+            let angle = r.random_range(0.0..std::f64::consts::TAU);
+            (DVec3::new(angle.cos(), angle.sin(), 0.0), DVec3::Z)
+        };
+        let reach = if along.z == 0.0 {
+            a.radius
+        } else {
+            a.half_height
+        };
+        let size = b.support(q.inverse() * -along).dot(-along);
+        let t = along * (reach + size * r.random_range(-0.3..1.3))
+            + across * a.radius.max(a.half_height) * r.random_range(-1.2..1.2);
+        let pose = Isometry {
+            rotation: proxima::math::DMat3::from_quat(q),
+            translation: t,
+        };
+        let certified = certified_distance_cylinder_convex(&a, b, &pose, 1e-10, limit);
+        let label = format!("case {case} ({})", kinds[kind]);
+        match check_certificate(certified, &a, b, &pose, limit, &label) {
+            Certified::Overlapping => exact[kind] += 1,
+            Certified::Apart(d) => {
+                assert!(in_cylinder(&a, d.point_a, 1e-12), "{label}: {d:?}");
+                exact_apart[kind] += 1;
+            }
+            Certified::Beyond => beyond += 1,
+            Certified::Unknown => unknown += 1,
+        }
+    }
+    println!(
+        "certified overlapping {exact:?}, apart {exact_apart:?} ({kinds:?}), beyond {beyond}, \
+         unknown {unknown}"
+    );
+    assert!(
+        exact.iter().chain(&exact_apart).all(|&n| n > 50) && beyond > 200 && unknown > 500,
+        "{exact:?} {exact_apart:?} {beyond} {unknown}"
     );
 }
 

@@ -6,6 +6,7 @@
 //! |---|---|---|
 //! | sphere, capsule, cuboid among themselves; sphere–cylinder | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
 //! | a box with a cylinder, cone or convex hull | the box's face certificate when B overlaps under one face, lies over one, or lies beyond a face's plane by more than the limit ([`pairs::face_distance_cuboid_convex`]), else as the next row | as the next row |
+//! | a cylinder with a capsule, box, cylinder, cone or hull | the cylinder's certificate when the depth under a cap or the side, or the distance over one, is proved by support points ([`pairs::certified_distance_cylinder_convex`]; either cylinder of a pair), after the box's; else as the next row | as the next row |
 //! | a cylinder, cone or convex hull with any convex shape | GJK on the cores (stopped once a support plane proves the pair beyond the limit), EPA when they overlap ([`crate::narrow::gjk`]) | one point, the distance's witnesses, against a sphere; else reference-face clipping of the shapes' contact features from the distance's normal, ≤ 4 points ([`crate::narrow::convex_manifold`]) |
 //! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`crate::narrow::convex_mesh`]) |
 //! | mesh–mesh | [`Route::MeshMesh`]: the BVH tandem queries with warm starts and the worker pool | intersection segments, reduced |
@@ -51,16 +52,16 @@ pub const GJK: GjkParams = GjkParams {
 /// entered. Time-of-impact searches count each of their distance steps.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct PathCounts {
-    /// Closed forms: sphere, capsule and cuboid among themselves, and a box's face
-    /// certificate against a cylinder, cone or hull.
+    /// Closed forms: sphere, capsule and cuboid among themselves, a box's face certificate
+    /// against a cylinder, cone or hull, and a cylinder's certificate.
     pub closed_form: u32,
     /// GJK runs: convex pairs without a closed form.
     pub gjk: u32,
     /// Distance bounds ([`DistanceBound`]): the early-outs that prove pairs beyond the
     /// reporting limit (cuboid–cuboid pairs by their separating axes, a box and a cylinder,
-    /// cone or hull by a face plane of the box, GJK pairs by a support plane, these counted
-    /// in `gjk` too), and the conservative answer of capsule
-    /// and cuboid pairs once the frame's deadline is near.
+    /// cone or hull by a face plane of the box, a cylinder by a plane of its caps or side,
+    /// GJK pairs by a support plane, these counted in `gjk` too), and the conservative
+    /// answer of capsule and cuboid pairs once the frame's deadline is near.
     pub separating_axes: u32,
     /// EPA runs: GJK found the cores overlapping.
     pub epa: u32,
@@ -300,19 +301,13 @@ fn convex_reach(
             let Some((core_b, _)) = core_of(b) else {
                 unreachable!("the arm holds convex shapes only");
             };
-            match pairs::face_distance_cuboid_convex(x, &core_b, pose_ab, limit) {
-                FaceCertificate::Exact(d) => closed(paths, d),
-                FaceCertificate::Beyond(d) => {
-                    paths.separating_axes += 1;
-                    Reached::Exact(d)
-                }
-                FaceCertificate::Unknown => convex_distance(a, b, pose_ab, limit, scratch),
-            }
+            let face = pairs::face_distance_cuboid_convex(x, &core_b, pose_ab, limit);
+            certified_or_gjk(a, b, pose_ab, limit, scratch, face)
         }
         (S(_), Shape::Cone(_) | Shape::Convex(_))
         | (C(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
-            convex_distance(a, b, pose_ab, limit, scratch)
+            certified_or_gjk(a, b, pose_ab, limit, scratch, FaceCertificate::Unknown)
         }
         (M(_) | K(_), _) | (_, M(_) | K(_)) => {
             distance_within(a, b, &pose_ab.to_pose(), limit, scratch)
@@ -388,6 +383,63 @@ pub fn manifold_convex(
         (M(_) | K(_), _) | (_, M(_) | K(_)) => {
             manifold(a, b, &pose_ab.to_pose(), d, scratch, out);
         }
+    }
+}
+
+/// A convex pair's answer from `certificate` when it has one, else from a cylinder's
+/// certificate when either shape is a cylinder ([`cylinder_certificate`]), else from GJK
+/// and EPA.
+fn certified_or_gjk(
+    a: &Shape,
+    b: &Shape,
+    pose_ab: &Isometry,
+    limit: f64,
+    scratch: &mut NarrowScratch,
+    certificate: FaceCertificate,
+) -> Reached {
+    let certificate = match certificate {
+        FaceCertificate::Unknown => cylinder_certificate(a, b, pose_ab, limit),
+        known => known,
+    };
+    match certificate {
+        FaceCertificate::Exact(d) => {
+            scratch.paths.closed_form += 1;
+            Reached::Exact(d)
+        }
+        FaceCertificate::Beyond(d) => {
+            scratch.paths.separating_axes += 1;
+            Reached::Exact(d)
+        }
+        FaceCertificate::Unknown => convex_distance(a, b, pose_ab, limit, scratch),
+    }
+}
+
+/// [`pairs::certified_distance_cylinder_convex`] for a cylinder on either side of a convex
+/// pair, the other shape's core rounded by its radius (a capsule's segment); `Unknown`
+/// when neither is a cylinder or the bounds do not meet.
+fn cylinder_certificate(a: &Shape, b: &Shape, pose_ab: &Isometry, limit: f64) -> FaceCertificate {
+    let certify = |cylinder, other: &Shape, pose: &Isometry| {
+        let Some((core, radius)) = core_of(other) else {
+            unreachable!("the dispatcher sends only convex pairs here");
+        };
+        let rel_tol = GJK.rel_tol.max(GJK.epa_rel_tol);
+        pairs::certified_distance_cylinder_convex(cylinder, &core, pose, rel_tol, limit + radius)
+            .map(|d| ShapeDistance {
+                distance: d.distance - radius,
+                point_b: d.point_b - d.normal * radius,
+                ..d
+            })
+    };
+    let as_a = match a {
+        Shape::Cylinder(x) => certify(x, b, pose_ab),
+        _ => FaceCertificate::Unknown,
+    };
+    match (as_a, b) {
+        (FaceCertificate::Unknown, Shape::Cylinder(y)) => {
+            let pose_ba = pose_ab.inverse();
+            certify(y, a, &pose_ba).map(|d| d.flipped(pose_ab))
+        }
+        (known, _) => known,
     }
 }
 

@@ -46,6 +46,18 @@ pub enum FaceCertificate {
     Unknown,
 }
 
+impl FaceCertificate {
+    /// The same answer with `f` applied to its distance (an exact answer or a bound).
+    #[must_use]
+    pub fn map(self, f: impl FnOnce(ShapeDistance) -> ShapeDistance) -> Self {
+        match self {
+            Self::Exact(d) => Self::Exact(f(d)),
+            Self::Beyond(d) => Self::Beyond(f(d)),
+            Self::Unknown => Self::Unknown,
+        }
+    }
+}
+
 /// The signed distance from box `a` to the convex shape `b` (its support map, B's frame)
 /// placed by `pose_ab`, A's frame, when B overlaps A under one face of A or lies over one
 /// face (module docs); a lower bound when B is otherwise beyond a face's plane by more than

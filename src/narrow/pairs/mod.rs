@@ -33,6 +33,7 @@ mod capsule_cuboid;
 mod capsule_triangle;
 mod cuboid_cuboid;
 mod cuboid_triangle;
+mod cylinder_certificate;
 mod face_certificate;
 mod sphere_capsule;
 mod sphere_cuboid;
@@ -53,6 +54,7 @@ pub use cuboid_cuboid::{
     distance_bound_cuboid_cuboid, distance_cuboid_cuboid, manifold_cuboid_cuboid,
 };
 pub use cuboid_triangle::{distance_cuboid_triangle, manifold_cuboid_triangle};
+pub use cylinder_certificate::certified_distance_cylinder_convex;
 pub use face_certificate::{FaceCertificate, face_distance_cuboid_convex};
 pub use sphere_capsule::{distance_sphere_capsule, manifold_sphere_capsule};
 pub use sphere_cuboid::{distance_sphere_cuboid, manifold_sphere_cuboid};
