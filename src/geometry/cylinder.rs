@@ -24,6 +24,25 @@ impl Cylinder {
         }
     }
 
+    /// The point of the solid cylinder nearest to `p` (local frame): `p` itself when inside,
+    /// else `p` with its radial part pulled in to the radius and its height clamped to the
+    /// caps.
+    #[must_use]
+    #[inline]
+    pub fn closest_point(&self, p: DVec3) -> DVec3 {
+        let rho = DVec3::new(p.x, p.y, 0.0).length();
+        let pulled_in = if rho > self.radius {
+            self.radius / rho
+        } else {
+            1.0
+        };
+        DVec3::new(
+            p.x * pulled_in,
+            p.y * pulled_in,
+            p.z.clamp(-self.half_height, self.half_height),
+        )
+    }
+
     /// From untrusted sizes.
     pub fn try_new(half_height: f64, radius: f64) -> Result<Self, ShapeError> {
         Ok(Self {

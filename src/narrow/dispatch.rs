@@ -6,7 +6,7 @@
 //! |---|---|---|
 //! | sphere, capsule, cuboid among themselves; sphere–cylinder | closed forms ([`crate::narrow::pairs`]) | closed forms (≤ 4 points, box faces clipped) |
 //! | a box with a cylinder, cone or convex hull | the box's face certificate when B overlaps under one face, lies over one, or lies beyond a face's plane by more than the limit ([`pairs::face_distance_cuboid_convex`]), else as the next row | as the next row |
-//! | a cylinder with a capsule, box, cylinder, cone or hull | the cylinder's certificate when the depth under a cap or the side, or the distance over one, is proved by support points ([`pairs::certified_distance_cylinder_convex`]; either cylinder of a pair), after the box's; else as the next row | as the next row |
+//! | a cylinder with a capsule, box, cylinder, cone or hull | for a capsule whose core is out of the cylinder, the certified search along the core ([`pairs::distance_capsule_cylinder`]); else the cylinder's certificate when the depth under a cap or the side, or the distance over one, is proved by support points ([`pairs::certified_distance_cylinder_convex`]; either cylinder of a pair), after the box's; else as the next row | as the next row |
 //! | a cylinder, cone or convex hull with any convex shape | GJK on the cores (stopped once a support plane proves the pair beyond the limit), EPA when they overlap ([`crate::narrow::gjk`]) | one point, the distance's witnesses, against a sphere; else reference-face clipping of the shapes' contact features from the distance's normal, ≤ 4 points ([`crate::narrow::convex_manifold`]) |
 //! | a convex shape and a mesh | the nearest triangle through the mesh's RSS tree ([`crate::narrow::convex_mesh`]), each triangle by its closed form or GJK | the manifolds of the triangles the shape reaches, ghost normals removed, reduced to 4 points ([`crate::narrow::convex_mesh`]) |
 //! | mesh–mesh | [`Route::MeshMesh`]: the BVH tandem queries with warm starts and the worker pool | intersection segments, reduced |
@@ -294,7 +294,13 @@ fn convex_reach(
             }
             Reached::Exact(d)
         }
-        (C(_) | Shape::Cylinder(_), S(_)) | (B(_), S(_) | C(_)) => {
+        (C(x), Shape::Cylinder(y)) => {
+            match pairs::distance_capsule_cylinder(x, y, pose_ab, GJK.rel_tol) {
+                Some(d) => closed(paths, d),
+                None => certified_or_gjk(a, b, pose_ab, limit, scratch, FaceCertificate::Unknown),
+            }
+        }
+        (C(_) | Shape::Cylinder(_), S(_)) | (B(_), S(_) | C(_)) | (Shape::Cylinder(_), C(_)) => {
             convex_reach(b, a, &pose_ab.inverse(), limit, scratch).flipped(pose_ab)
         }
         (B(x), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_)) => {
@@ -305,7 +311,7 @@ fn convex_reach(
             certified_or_gjk(a, b, pose_ab, limit, scratch, face)
         }
         (S(_), Shape::Cone(_) | Shape::Convex(_))
-        | (C(_), Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_))
+        | (C(_), Shape::Cone(_) | Shape::Convex(_))
         | (Shape::Cylinder(_) | Shape::Cone(_) | Shape::Convex(_), convex!()) => {
             certified_or_gjk(a, b, pose_ab, limit, scratch, FaceCertificate::Unknown)
         }

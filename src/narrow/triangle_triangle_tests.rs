@@ -157,17 +157,7 @@ fn segment_triangle_distance_by_search(p: DVec3, q: DVec3, t: &Triangle) -> f64 
             x, t.a, t.b, t.c,
         ))
     };
-    let ratio = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut lo, mut hi) = (0.0, 1.0);
-    for _ in 0..120 {
-        let (m1, m2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
-        if f(m1) <= f(m2) {
-            hi = m2;
-        } else {
-            lo = m1;
-        }
-    }
-    f(0.0).min(f(1.0)).min(f((lo + hi) / 2.0))
+    crate::test_support::convex_minimum_on_unit_interval(f)
 }
 
 #[test]

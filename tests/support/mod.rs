@@ -15,6 +15,23 @@ pub mod meshes;
 pub mod pair_queries;
 pub mod triangle_pairs;
 
+/// The minimum of a convex function on `[0, 1]` by golden-section search (120 steps, to
+/// rounding), the ends included: the brute-force oracle of a distance along a segment to a
+/// convex set, which needs only the set's point closest-point function.
+pub fn convex_minimum_on_unit_interval(f: impl Fn(f64) -> f64) -> f64 {
+    let ratio = (5f64.sqrt() - 1.0) / 2.0;
+    let (mut lo, mut hi) = (0.0, 1.0);
+    for _ in 0..120 {
+        let (m1, m2) = (hi - ratio * (hi - lo), lo + ratio * (hi - lo));
+        if f(m1) <= f(m2) {
+            hi = m2;
+        } else {
+            lo = m1;
+        }
+    }
+    f(0.0).min(f(1.0)).min(f((lo + hi) / 2.0))
+}
+
 /// The PRNG every test uses, always seeded explicitly.
 pub type TestRng = Pcg64Mcg;
 

@@ -106,7 +106,7 @@ pub fn certified_distance_cylinder_convex<S: SupportMap + ?Sized>(
     if gap > limit && least.p.is_finite() {
         return FaceCertificate::Beyond(ShapeDistance {
             distance: gap,
-            point_a: closest_point(a, least.p),
+            point_a: a.closest_point(least.p),
             point_b: least.p,
             normal: least.n,
         });
@@ -140,7 +140,7 @@ fn settled(a: &Cylinder, least: &Probe, points: &[DVec3], rel_tol: f64) -> Optio
     let gap = -least.overlap;
     let (p, on_a) = points
         .iter()
-        .map(|&p| (p, closest_point(a, p)))
+        .map(|&p| (p, a.closest_point(p)))
         .min_by(|x, y| {
             (x.0 - x.1)
                 .length_squared()
@@ -237,15 +237,4 @@ fn in_triangle(a: DVec3, b: DVec3, c: DVec3) -> bool {
 fn room(a: &Cylinder, p: DVec3) -> f64 {
     let rho = DVec3::new(p.x, p.y, 0.0).length();
     (a.half_height - p.z.abs()).min(a.radius - rho)
-}
-
-/// The cylinder's point nearest to `p` (A's frame), `p` itself when inside.
-fn closest_point(a: &Cylinder, p: DVec3) -> DVec3 {
-    let rho = DVec3::new(p.x, p.y, 0.0).length();
-    let pulled_in = if rho > a.radius { a.radius / rho } else { 1.0 };
-    DVec3::new(
-        p.x * pulled_in,
-        p.y * pulled_in,
-        p.z.clamp(-a.half_height, a.half_height),
-    )
 }

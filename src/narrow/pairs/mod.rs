@@ -30,6 +30,7 @@ mod query;
 
 mod capsule_capsule;
 mod capsule_cuboid;
+mod capsule_cylinder;
 mod capsule_triangle;
 mod cuboid_cuboid;
 mod cuboid_triangle;
@@ -48,6 +49,7 @@ pub use capsule_capsule::{
 pub use capsule_cuboid::{
     distance_bound_capsule_cuboid, distance_capsule_cuboid, manifold_capsule_cuboid,
 };
+pub use capsule_cylinder::distance_capsule_cylinder;
 pub use capsule_triangle::{distance_capsule_triangle, manifold_capsule_triangle};
 pub(crate) use cuboid_cuboid::distance_cuboid_cuboid_within;
 pub use cuboid_cuboid::{
