@@ -11,8 +11,9 @@
 //! sampled `f` is a real distance, an upper bound; by convexity the two tangents at the
 //! bracket's ends lie under `f`, and where they cross is a lower bound. The search stops
 //! when the bounds meet to the caller's relative tolerance (the one GJK stops at), so the
-//! answer is certified the way GJK's is, in about a tenth of GJK's time on this pair (whose
-//! curved rims and side cost GJK 8–14 iterations in the settling pile).
+//! answer is certified the way GJK's is. On the settling pile (`benches/pile.rs`, frame
+//! `k`) it takes 0.13 µs a pair against 0.53 µs for the cylinder's certificate and GJK it
+//! replaces (the curved side and rims cost GJK 8–14 iterations).
 //!
 //! # Not answered
 //! A core that touches or enters the cylinder (some `f` within rounding of 0), a search that

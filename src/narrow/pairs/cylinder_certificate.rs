@@ -62,8 +62,9 @@ struct Probe {
 /// The signed distance from cylinder `a` to the convex shape `b` (its support map in B's
 /// frame) placed by `pose_ab`, A's frame, when the bounds of the module docs meet to
 /// `rel_tol` (relative) plus rounding; a lower bound when B is apart beyond a plane of A by
-/// more than `limit` metres; else [`FaceCertificate::Unknown`]. Three to eight support
-/// calls of `b`; never NaN (non-finite input gives `Unknown`).
+/// more than `limit` metres; else [`FaceCertificate::Unknown`]. Two support calls of `b`
+/// for the caps, and up to `SHADOW_STEPS` + 2 more when the side is tried; never NaN
+/// (non-finite input gives `Unknown`).
 #[must_use]
 pub fn certified_distance_cylinder_convex<S: SupportMap + ?Sized>(
     a: &Cylinder,
