@@ -45,6 +45,8 @@
 #[path = "common/cycle.rs"]
 mod cycle;
 #[path = "../examples/scenes/pile.rs"]
+// The primitive pile is `deadline_bench`'s only.
+#[allow(dead_code)]
 mod pile;
 #[path = "../examples/scenes/point_mass.rs"]
 mod point_mass;

@@ -10,7 +10,8 @@
 //! ```
 //!
 //! For each scene class (`--scene`, repeatable; all by default: `demo`, `falling`, `pile`,
-//! `compound-pile`, `robot-chain`, `coincident-meshes`, `sphere-swarm`) and budget
+//! `pile-primitives`, `compound-pile`, `robot-chain`, `coincident-meshes`, `sphere-swarm`)
+//! and budget
 //! (`--budgets-us`), a row builds the scene afresh in the daemon and in an in-process
 //! mirror, sends one frame without a budget (the daemon's exact answer must equal the
 //! mirror's), then `--frames` frames back to back (heavy scenes default to fewer; the
@@ -92,8 +93,8 @@ use workloads::{Built, CLASSES, Class, Workload};
 #[derive(Debug, Parser)]
 #[command(about = "Deadline scorecard of proximad: every scene class, budget by budget")]
 struct Args {
-    /// Scene class to run (repeatable): demo, falling, pile, compound-pile, robot-chain,
-    /// coincident-meshes, sphere-swarm; all when none is given.
+    /// Scene class to run (repeatable): demo, falling, pile, pile-primitives, compound-pile,
+    /// robot-chain, coincident-meshes, sphere-swarm; all when none is given.
     #[arg(long)]
     scene: Vec<String>,
     /// Frame budgets, microseconds, comma-separated.

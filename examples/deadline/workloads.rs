@@ -6,7 +6,7 @@ use crate::coincident_meshes::CoincidentMeshes;
 use crate::compound_pile::{compound_parts, compound_pile_scene};
 use crate::demo_scene::DemoScene;
 use crate::falling::{falling_scene, falling_world};
-use crate::pile::{PILE_RATE_HZ, pile_scene, pile_world};
+use crate::pile::{PILE_RATE_HZ, pile_scene, pile_world, primitive_pile_scene};
 use crate::point_mass::World;
 use crate::robot_chain::RobotChain;
 use crate::spec::{BodyPlan, SceneSpec, ShapeSpec};
@@ -69,7 +69,7 @@ pub struct Class {
 }
 
 /// Every class, in the order they run.
-pub const CLASSES: [Class; 7] = [
+pub const CLASSES: [Class; 8] = [
     Class {
         name: "demo",
         about: "proximad demo's scene: 300 bouncing spheres, 4 tumbling tori (768 triangles each), 200 Hz",
@@ -95,6 +95,15 @@ pub const CLASSES: [Class; 7] = [
         default_frames: 500,
         check_every: 1,
         build: build_pile,
+        needs_data: false,
+    },
+    Class {
+        name: "pile-primitives",
+        about: "the pile with spheres, capsules and boxes only (100 bodies, 2-7 cm), 240 Hz",
+        query_flags: query::CLOSE | query::CONTACTS,
+        default_frames: 500,
+        check_every: 1,
+        build: build_primitive_pile,
         needs_data: false,
     },
     Class {
@@ -265,6 +274,14 @@ fn build_pile(
     _: Option<&Path>,
 ) -> Result<Built, Box<dyn Error>> {
     settling_in_the_pile_box(client, scene, &pile_scene(PILE_SEED))
+}
+
+fn build_primitive_pile(
+    client: &Client<ipc::Service>,
+    scene: u32,
+    _: Option<&Path>,
+) -> Result<Built, Box<dyn Error>> {
+    settling_in_the_pile_box(client, scene, &primitive_pile_scene(PILE_SEED))
 }
 
 /// `spec` (a scene in the pile's box) registered, its bodies falling as the pile's do.

@@ -48,13 +48,25 @@ pub const PILE_SOLVER: SolverParams = SolverParams {
 /// shape of its own, at random orientations.
 #[must_use]
 pub fn pile_scene(seed: u64) -> SceneSpec {
+    pile_of_kinds(seed, 5)
+}
+
+/// [`pile_scene`] with spheres, capsules and boxes only (a third each), the same sizes: the
+/// primitive pile that #30's second target is set on.
+#[must_use]
+pub fn primitive_pile_scene(seed: u64) -> SceneSpec {
+    pile_of_kinds(seed, 3)
+}
+
+/// The pile with body `i` of kind `i % kinds` ([`random_shape`]'s numbering).
+fn pile_of_kinds(seed: u64, kinds: usize) -> SceneSpec {
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
     let mut spec = SceneSpec::default();
     add_box(&mut spec);
     for i in 0..PILE_BODIES {
         let position = layer_position(i, &mut rng);
         let size = rng.random_range(SIZE_M.0..SIZE_M.1);
-        let shape = spec.add_shape(random_shape(&mut rng, i % 5, size));
+        let shape = spec.add_shape(random_shape(&mut rng, i % kinds, size));
         spec.add_body(BodyPlan {
             shape,
             position,
