@@ -363,8 +363,8 @@ pub fn manifold_convex(
     use Shape::{Capsule as C, Compound as K, Cuboid as B, Mesh as M, Sphere as S};
     out.reset(DVec3::ZERO);
     match (a, b) {
-        (C(x), C(y)) => pairs::manifold_capsule_capsule(x, y, pose_ab, out),
-        (C(x), B(y)) => pairs::manifold_capsule_cuboid(x, y, pose_ab, out),
+        (C(x), C(y)) => pairs::manifold_capsule_capsule_from(x, y, pose_ab, d, out),
+        (C(x), B(y)) => pairs::manifold_capsule_cuboid_from(x, y, pose_ab, d, out),
         (B(x), B(y)) => pairs::manifold_cuboid_cuboid(x, y, pose_ab, out),
         (B(_), C(_)) => {
             let pose_ba = pose_ab.inverse();

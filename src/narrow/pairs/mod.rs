@@ -45,9 +45,11 @@ mod sphere_triangle;
 
 pub use capsule_capsule::{
     distance_bound_capsule_capsule, distance_capsule_capsule, manifold_capsule_capsule,
+    manifold_capsule_capsule_from,
 };
 pub use capsule_cuboid::{
     distance_bound_capsule_cuboid, distance_capsule_cuboid, manifold_capsule_cuboid,
+    manifold_capsule_cuboid_from,
 };
 pub use capsule_cylinder::distance_capsule_cylinder;
 pub use capsule_triangle::{distance_capsule_triangle, manifold_capsule_triangle};
