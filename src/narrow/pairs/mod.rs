@@ -15,6 +15,15 @@
 //! against a reference face (`clip`). Exact to rounding, except the documented skip of
 //! near-parallel cross axes (`≤ 1e-12` × extent).
 //!
+//! Cylinders and hulls are not polytope cores; for them this module holds the proofs the
+//! dispatcher tries before GJK/EPA, each answering exactly (to GJK's tolerance) or not at
+//! all:
+//! - `sphere_cylinder`: a closed form;
+//! - `capsule_cylinder`: a certified search along the capsule's core while it stays out of
+//!   the cylinder;
+//! - `face_certificate`: a box's faces against any convex shape;
+//! - `cylinder_certificate`: a cylinder's caps and side against any convex shape.
+//!
 //! # Degenerate input, documented choices
 //! - Coincident sphere centres (and any pair whose cores touch in a point, segment or
 //!   flat set with no defined direction): the normal is the first of `+X, +Y, +Z` of A's
