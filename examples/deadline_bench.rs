@@ -11,14 +11,13 @@
 //!
 //! For each scene class (`--scene`, repeatable; all by default: `demo`, `falling`, `pile`,
 //! `pile-primitives`, `compound-pile`, `robot-chain`, `coincident-meshes`, `sphere-swarm`)
-//! and budget
-//! (`--budgets-us`), a row builds the scene afresh in the daemon and in an in-process
-//! mirror, sends one frame without a budget (the daemon's exact answer must equal the
-//! mirror's), then `--frames` frames back to back (heavy scenes default to fewer; the
-//! output says so), each moving the bodies as the scene's client does (simulations bounce
-//! theirs with the returned contacts), publishing every moving body's pose and waiting for
-//! the answer; the oracle runs between frames, outside the timed round trip. Rows print as
-//! they finish:
+//! and budget (`--budgets-us`), a row builds the scene afresh in the daemon and in an
+//! in-process mirror, sends one frame without a budget (the daemon's exact answer must
+//! equal the mirror's), then `--frames` frames back to back (heavy scenes default to fewer;
+//! the output says so), each moving the bodies as the scene's client does (simulations
+//! bounce theirs with the returned contacts), publishing every moving body's pose and
+//! waiting for the answer; the oracle runs between frames, outside the timed round trip.
+//! Rows print as they finish:
 //! - `met %`: frames the daemon answered within the budget (header `elapsed_ns`, receipt
 //!   to publish, ≤ budget), of the frames sent (a lost frame, unanswered within
 //!   `--frame-timeout-ms`, counts as missed);

@@ -194,6 +194,16 @@ impl WorkClock {
         self
     }
 
+    /// The answer of interruptible `work` run under a clock that never stops (the plain
+    /// form of a `_within` search, whose `None` means "stopped first").
+    ///
+    /// # Panics
+    /// When `work` answers `None` under it: a bug of `work`, which may stop only when its
+    /// clock does.
+    pub fn run_to_end<T>(work: impl FnOnce(&mut WorkClock) -> Option<T>) -> T {
+        work(&mut WorkClock::default()).expect("an unlimited clock never stops")
+    }
+
     /// Counts `units` more units of work about to be done; whether they may be. The first
     /// call reads the clock, so work never starts past the instant.
     pub fn allows(&mut self, units: u64) -> bool {

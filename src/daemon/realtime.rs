@@ -80,13 +80,7 @@ pub fn parse_priority(text: &str) -> Result<u8, String> {
 /// [`NotRaised`] with the reason: a priority out of range, the operating system's refusal
 /// (most often: no `CAP_SYS_NICE`), or a platform without it.
 pub fn raise_current_thread(priority: u8) -> Result<(), NotRaised> {
-    if !PRIORITIES.contains(&priority) {
-        return Err(NotRaised(format!(
-            "real-time priority {priority} is outside {}..={}",
-            PRIORITIES.start(),
-            PRIORITIES.end()
-        )));
-    }
+    checked_priority(priority).map_err(NotRaised)?;
     #[cfg(target_os = "linux")]
     {
         let param = libc::sched_param {
@@ -156,7 +150,10 @@ mod tests {
     fn a_priority_out_of_range_is_refused_before_asking() {
         for p in [0, 100, 255] {
             let e = raise_current_thread(p).expect_err("out of range");
-            assert!(e.to_string().contains("outside 1..=99"), "{e}");
+            assert!(
+                e.to_string().contains("not a SCHED_FIFO priority (1..=99)"),
+                "{e}"
+            );
         }
     }
 

@@ -188,9 +188,9 @@ impl MeshShape {
         max_distance: f64,
         workspace: &mut MeshMeshWorkspace,
     ) -> Proximity {
-        let unlimited = &mut WorkClock::default();
-        let found = self.proximity_within(other, pose_ab, max_distance, workspace, unlimited);
-        found.expect("an unlimited clock never stops")
+        WorkClock::run_to_end(|clock| {
+            self.proximity_within(other, pose_ab, max_distance, workspace, clock)
+        })
     }
 
     /// [`proximity`](Self::proximity), polling `clock` before each pair of leaves

@@ -24,9 +24,7 @@ pub fn intersects_mesh_mesh<B: BoundingVolume>(
     pose_ab: &Pose,
     workspace: &mut MeshMeshWorkspace,
 ) -> bool {
-    let unlimited = &mut WorkClock::default();
-    let found = intersects_mesh_mesh_within(a, b, pose_ab, workspace, unlimited);
-    found.expect("an unlimited clock never stops")
+    WorkClock::run_to_end(|clock| intersects_mesh_mesh_within(a, b, pose_ab, workspace, clock))
 }
 
 /// [`intersects_mesh_mesh`], polling `clock` before each pair of leaves

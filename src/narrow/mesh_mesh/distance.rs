@@ -177,9 +177,9 @@ pub fn proximity_mesh_mesh<B: BoundingVolume>(
     max_distance: f64,
     workspace: &mut MeshMeshWorkspace,
 ) -> Proximity {
-    let unlimited = &mut WorkClock::default();
-    let found = proximity_mesh_mesh_within(a, b, pose_ab, max_distance, workspace, unlimited);
-    found.expect("an unlimited clock never stops")
+    WorkClock::run_to_end(|clock| {
+        proximity_mesh_mesh_within(a, b, pose_ab, max_distance, workspace, clock)
+    })
 }
 
 /// Units of [`WorkClock`] work one triangle pair's distance counts for (a few closed-form

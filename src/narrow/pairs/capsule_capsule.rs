@@ -105,9 +105,9 @@ pub fn manifold_capsule_capsule(a: &Capsule, b: &Capsule, pose_ab: &Isometry, ou
     );
 }
 
-/// [`manifold_capsule_capsule`] from the pair's signed distance `d` (this file's `distance_…`, A's
-/// frame), which the dispatcher has already: the manifold is clipped along `d`'s normal
-/// without the separating axes and closest points again. PERF: the settling pile's
+/// [`manifold_capsule_capsule`] from the pair's signed distance `d` (this file's `distance_…`,
+/// A's frame), which the dispatcher has already: the manifold is clipped along `d`'s
+/// normal without the separating axes and closest points again. PERF: the settling pile's
 /// touching pairs (`benches/pile.rs`) spent 7× their distance's time in the manifold.
 pub fn manifold_capsule_capsule_from(
     a: &Capsule,

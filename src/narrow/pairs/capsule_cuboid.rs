@@ -266,9 +266,9 @@ pub fn manifold_capsule_cuboid(a: &Capsule, b: &Cuboid, pose_ab: &Isometry, out:
     );
 }
 
-/// [`manifold_capsule_cuboid`] from the pair's signed distance `d` (this file's `distance_…`, A's
-/// frame), which the dispatcher has already: the manifold is clipped along `d`'s normal
-/// without the separating axes and closest points again. PERF: the settling pile's
+/// [`manifold_capsule_cuboid`] from the pair's signed distance `d` (this file's `distance_…`,
+/// A's frame), which the dispatcher has already: the manifold is clipped along `d`'s
+/// normal without the separating axes and closest points again. PERF: the settling pile's
 /// touching pairs (`benches/pile.rs`) spent 7× their distance's time in the manifold.
 pub fn manifold_capsule_cuboid_from(
     a: &Capsule,

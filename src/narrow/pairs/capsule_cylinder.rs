@@ -76,7 +76,7 @@ pub fn distance_capsule_cylinder(
             slope: d.dot(x - c) / f,
         }
     };
-    let (mut lo, mut hi) = (sample(0.0), sample(1.0));
+    let (lo, hi) = (sample(0.0), sample(1.0));
     let touches = |s: &Sample| !(s.f > floor && s.slope.is_finite() && s.x.is_finite());
     if touches(&lo) || touches(&hi) {
         return None;
@@ -86,7 +86,7 @@ pub fn distance_capsule_cylinder(
     } else if hi.slope <= 0.0 {
         hi
     } else {
-        narrow_bracket(&mut lo, &mut hi, &sample, rel_tol, floor, touches)?
+        narrow_bracket(lo, hi, &sample, rel_tol, floor, touches)?
     };
     let normal = (best.c - best.x) / best.f;
     Some(ShapeDistance {
@@ -101,8 +101,8 @@ pub fn distance_capsule_cylinder(
 /// `[lo, hi]` (`lo.slope < 0 < hi.slope`); `None` when a sample touches the cylinder or the
 /// search does not settle.
 fn narrow_bracket(
-    lo: &mut Sample,
-    hi: &mut Sample,
+    mut lo: Sample,
+    mut hi: Sample,
     sample: &impl Fn(f64) -> Sample,
     rel_tol: f64,
     floor: f64,
@@ -113,7 +113,7 @@ fn narrow_bracket(
     let mut last_side = 0_i8;
     let (mut lo_weight, mut hi_weight) = (1.0, 1.0);
     for _ in 0..MAX_STEPS {
-        let best = if lo.f <= hi.f { *lo } else { *hi };
+        let best = if lo.f <= hi.f { lo } else { hi };
         // The tangents at both ends cross under `f`: a lower bound of its minimum.
         let crossing = (hi.f - lo.f + lo.slope * lo.t - hi.slope * hi.t) / (lo.slope - hi.slope);
         let lower = lo.f + lo.slope * (crossing - lo.t);
@@ -133,7 +133,7 @@ fn narrow_bracket(
             return Some(m);
         }
         if m.slope < 0.0 {
-            *lo = m;
+            lo = m;
             lo_weight = 1.0;
             hi_weight = if last_side == -1 {
                 hi_weight * 0.5
@@ -142,7 +142,7 @@ fn narrow_bracket(
             };
             last_side = -1;
         } else {
-            *hi = m;
+            hi = m;
             hi_weight = 1.0;
             lo_weight = if last_side == 1 { lo_weight * 0.5 } else { 1.0 };
             last_side = 1;

@@ -160,42 +160,33 @@ fn settled(a: &Cylinder, least: &Probe, points: &[DVec3], rel_tol: f64) -> Optio
     })
 }
 
-/// The side's probe: `n` the radial direction from A's axis to the point of B's shadow on
-/// A's cross-section plane nearest the axis (2D GJK, [`nearest_in_shadow`]), and B's point
-/// `q` over it, whose room is the side's lower bound; `None` when the shadow covers the
-/// axis (then the side is not the way out).
+/// The side's probe: `n` the radial direction from A's axis to the point of B's shadow
+/// (B projected along Z onto A's cross-section plane) nearest the axis, and `q`, B's point
+/// over that nearest point (the same convex combination of B's support points), whose room
+/// is the side's lower bound. Found by GJK in the plane from the origin, starting towards
+/// B's centre `centre` (A's frame). `None` when the origin lies in the shadow (to
+/// rounding; the side is then not the way out) or the input is not finite.
 fn side_probe(probe: &impl Fn(DVec3) -> Probe, centre: DVec3) -> Option<(Probe, DVec3)> {
-    let (v, q) = nearest_in_shadow(|n| probe(n).p, centre)?;
-    let n = DVec3::new(v.x, v.y, 0.0).try_normalize()?;
-    Some((probe(n), q))
-}
-
-/// GJK in A's XY plane from the axis (the origin) to B's shadow, the projection of B along
-/// Z: the shadow's point nearest the origin (its Z zeroed) and a point of B over it, the
-/// same convex combination of B's support points. `deepest(n)` is B's support point along
-/// `−n` (A's frame); the search starts towards B's centre `centre`. `None` when the origin
-/// lies in the shadow (to rounding) or the input is not finite.
-fn nearest_in_shadow(deepest: impl Fn(DVec3) -> DVec3, centre: DVec3) -> Option<(DVec3, DVec3)> {
     let flat = |p: DVec3| DVec3::new(p.x, p.y, 0.0);
-    let start = flat(centre).try_normalize().unwrap_or(DVec3::X);
-    let first = deepest(start);
-    // The simplex: up to two points of B (3D) whose shadows bound the nearest point.
-    let mut simplex: [DVec3; 2] = [first, first];
+    let mut q = probe(flat(centre).try_normalize().unwrap_or(DVec3::X)).p;
+    // The simplex: up to two points of B whose shadows bound the nearest point.
+    let mut simplex: [DVec3; 2] = [q, q];
     let mut count = 1;
-    let mut v = flat(first);
-    let mut q = first;
     for _ in 0..SHADOW_STEPS {
+        // The nearest point so far; B's support point along it is the side's probe.
+        let v = flat(q);
         let vv = v.length_squared();
         if !vv.is_finite() || vv <= f64::MIN_POSITIVE {
             return None;
         }
-        let w = deepest(v / vv.sqrt());
+        let along = probe(v / vv.sqrt());
+        let w = along.p;
         if !w.is_finite() {
             return None;
         }
         // Converged: no support point is nearer the origin along `v` than `v` itself.
         if vv - v.dot(flat(w)) <= SHADOW_REL_TOL * vv {
-            return Some((v, q));
+            return Some((along, q));
         }
         // The nearest point of the segments from `w` to the simplex's points (2D); the
         // origin inside the triangle they span means the shadow covers the axis.
@@ -218,13 +209,12 @@ fn nearest_in_shadow(deepest: impl Fn(DVec3) -> DVec3, centre: DVec3) -> Option<
         let (d2, a, b, t) = best;
         if d2 >= vv {
             // No progress: rounding.
-            return Some((v, q));
+            return Some((along, q));
         }
         q = a * t + b * (1.0 - t);
-        v = flat(q);
         (simplex, count) = if t < 1.0 { ([a, b], 2) } else { ([a, a], 1) };
     }
-    Some((v, q))
+    Some((probe(flat(q).try_normalize()?), q))
 }
 
 /// Whether the origin lies in the triangle `a b c` of the XY plane (inclusive).

@@ -23,18 +23,12 @@ pub fn distance_sphere_cylinder(a: &Sphere, b: &Cylinder, pose_ab: &Isometry) ->
     let (h, r) = (b.half_height, b.radius);
     // The sphere's centre (A's origin) in B's frame, and its closest point on the cylinder.
     let centre = pose_ab.inverse_transform_point(DVec3::ZERO);
-    let radial = DVec3::new(centre.x, centre.y, 0.0);
-    let rho = radial.length();
-    let pulled_in = if rho > r { r / rho } else { 1.0 };
-    let clamped = DVec3::new(
-        centre.x * pulled_in,
-        centre.y * pulled_in,
-        centre.z.clamp(-h, h),
-    );
-    if let Some(d) = sphere_outside(a.radius, pose_ab, centre, clamped) {
+    if let Some(d) = sphere_outside(a.radius, pose_ab, centre, b.closest_point(centre)) {
         return d;
     }
     // Inside (or on the surface): out through the nearer of a cap and the side.
+    let radial = DVec3::new(centre.x, centre.y, 0.0);
+    let rho = radial.length();
     let (room_cap, room_side) = (h - centre.z.abs(), r - rho);
     if room_cap <= room_side {
         let side = if centre.z < 0.0 { -1.0 } else { 1.0 };
