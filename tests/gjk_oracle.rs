@@ -1115,6 +1115,15 @@ fn the_box_face_certificate_matches_epa_and_moves_apart_by_its_depth() {
     );
 }
 
+/// A rotation of quarter turns about X and Y, then any turn about Z: a body's faces, edges
+/// and axes parallel or square to the cylinder's, as bodies resting in a pile are.
+fn resting_rotation(r: &mut TestRng) -> DQuat {
+    let quarter = |k: u32| f64::from(k) * std::f64::consts::FRAC_PI_2;
+    DQuat::from_rotation_z(r.random_range(0.0..std::f64::consts::TAU))
+        * DQuat::from_rotation_x(quarter(r.random_range(0..4)))
+        * DQuat::from_rotation_y(quarter(r.random_range(0..4)))
+}
+
 /// The cylinder's certificate (`pairs::certified_distance_cylinder_convex`, the
 /// dispatcher's route for a cylinder against a box, hull, cylinder or capsule before GJK)
 /// against GJK/EPA in f64 on the same pair, with the metamorphic check of the box
@@ -1149,10 +1158,7 @@ fn the_cylinder_certificate_matches_epa_and_moves_apart_by_its_depth() {
             _ => &segment,
         };
         let q = if r.random() {
-            let quarter = |k: u32| f64::from(k) * std::f64::consts::FRAC_PI_2;
-            DQuat::from_rotation_z(r.random_range(0.0..std::f64::consts::TAU))
-                * DQuat::from_rotation_x(quarter(r.random_range(0..4)))
-                * DQuat::from_rotation_y(quarter(r.random_range(0..4)))
+            resting_rotation(&mut r)
         } else {
             rotation(&mut r)
         };
@@ -1206,8 +1212,9 @@ fn the_cylinder_certificate_matches_epa_and_moves_apart_by_its_depth() {
 ///   the core's distance plus 1e-11 m (GJK's own stopping test).
 ///
 /// Answered pairs have consistent witnesses, `point_b` in the cylinder and `point_a` on the
-/// capsule (to the search's tolerance: its core point's slope is 0 only to it); the cases left to the caller are exactly those whose core reaches the
-/// cylinder (to 1e-9 m). Apart, overlapping and left cases all occur.
+/// capsule (to the search's tolerance: its core point's slope is 0 only to it); the cases
+/// left to the caller are exactly those whose core reaches the cylinder (to 1e-9 m).
+/// Apart, overlapping and left cases all occur.
 #[test]
 fn the_capsule_cylinder_search_matches_brute_force_and_gjk() {
     use proxima::narrow::pairs::distance_capsule_cylinder;
@@ -1217,9 +1224,7 @@ fn the_capsule_cylinder_search_matches_brute_force_and_gjk() {
         let cylinder = Cylinder::new(r.random_range(0.01..0.2), r.random_range(0.01..0.2));
         let capsule = Capsule::new(r.random_range(0.0..0.2), r.random_range(0.001..0.05));
         let q = if case % 2 == 0 {
-            let quarter = |k: u32| f64::from(k) * std::f64::consts::FRAC_PI_2;
-            DQuat::from_rotation_z(r.random_range(0.0..std::f64::consts::TAU))
-                * DQuat::from_rotation_x(quarter(r.random_range(0..4)))
+            resting_rotation(&mut r)
         } else {
             rotation(&mut r)
         };
