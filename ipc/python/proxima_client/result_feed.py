@@ -61,11 +61,27 @@ def records_view(address: int, count: int, owner: Any = None) -> np.ndarray:
     """
     if count == 0:
         return _NO_RECORDS
-    buffer = (ctypes.c_char * (count * _RECORD_BYTES)).from_address(address)
+    buffer = _byte_array(count * _RECORD_BYTES).from_address(address)
     buffer._owner = owner  # type: ignore[attr-defined]
     array = np.frombuffer(buffer, RESULT_DTYPE)  # type: ignore[call-overload]  # ctypes arrays are buffers
-    array.flags.writeable = False
+    array.setflags(write=False)
     return array
+
+
+#: ``ctypes.c_char * size`` by size, for the sizes frames have had (at most
+#: :data:`_BYTE_ARRAY_TYPES_KEPT` of them): a look-up here costs half of ctypes' own.
+_BYTE_ARRAY_TYPES: dict[int, Any] = {}
+_BYTE_ARRAY_TYPES_KEPT = 1024
+
+
+def _byte_array(size: int) -> Any:
+    """The ctypes array type of ``size`` bytes."""
+    kind = _BYTE_ARRAY_TYPES.get(size)
+    if kind is None:
+        kind = ctypes.c_char * size
+        if len(_BYTE_ARRAY_TYPES) < _BYTE_ARRAY_TYPES_KEPT:
+            _BYTE_ARRAY_TYPES[size] = kind
+    return kind
 
 
 def _clamp(count: int, length: int) -> int:
@@ -176,9 +192,8 @@ class ResultFrame(_Frame):
     def __init__(self, sample: Any) -> None:
         """Wraps a received sample (or a copied header and records)."""
         self._sample: Any = sample
-        header = ResultFrameHeader()
-        ctypes.memmove(ctypes.addressof(header), sample.user_header_ptr, _HEADER_BYTES)
-        self.header = header
+        header_bytes = _byte_array(_HEADER_BYTES).from_address(sample.user_header_ptr)
+        self.header = ResultFrameHeader.from_buffer_copy(header_bytes)
         # NOTE: not `sample.payload().len()`: the 0.10.0 bindings report bytes there.
         count = sample.header.number_of_elements
         self.records = records_view(sample.payload_ptr, count, sample)

@@ -22,6 +22,7 @@ scene's frame key, and a frame with another key is not answered.
 from __future__ import annotations
 
 import ctypes
+import struct
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
@@ -32,8 +33,8 @@ from . import services
 from .errors import TransportError
 from .result_feed import OwnedResultFrame, ResultFeed, ResultFrame, open_scene_service
 from .services import SceneToken
-from .transport import release_ports
-from .wire import POSE_DTYPE, PROTOCOL_VERSION, U32_MAX, PoseFrameHeader
+from .transport import assume_init, loan_slice_uninit, release_ports
+from .wire import POSE_DTYPE, POSE_FRAME_HEADER_LAYOUT, PROTOCOL_VERSION, U32_MAX, PoseFrameHeader
 
 #: Pose records the publisher's first shared-memory segment holds; a larger frame makes it
 #: allocate a segment of the next power of two (a one-off cost, for the daemon too).
@@ -64,7 +65,12 @@ class SceneAccess:
 
 _POSE_BYTES = POSE_DTYPE.itemsize
 _HEADER_BYTES = ctypes.sizeof(PoseFrameHeader)
+#: The bytes of a loaned sample's header, to pack it in place.
+_HEADER_BUFFER = ctypes.c_char * _HEADER_BYTES
 _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
+#: Whether an array's data pointer is fixed while it is referenced (numpy ≥ 2 forbids
+#: assigning ``ndarray.data``).
+_DATA_FIXED = int(np.__version__.split(".")[0]) >= 2
 
 
 def poses_view(address: int, count: int) -> np.ndarray:
@@ -182,12 +188,9 @@ class SceneLink:
         self.feed = ResultFeed(node, root, access.token)
         self.feed.expect_instance(access.instance)
         self._event_id = iox.EventId.new(services.EVENT_POSES_SENT)
-        # The header is written from this buffer with one memmove per frame.
-        self._header = PoseFrameHeader()
-        self._header.protocol_version = PROTOCOL_VERSION
-        self._header.scene = access.scene
-        self._header.frame_key = access.frame_key
-        self._header_address = ctypes.addressof(self._header)
+        # The array `publish_poses` sent last and its data's address (`_address_of`).
+        self._last_poses: Optional[np.ndarray] = None
+        self._last_address = 0
 
     @property
     def scene(self) -> int:
@@ -233,7 +236,7 @@ class SceneLink:
         if poses.dtype == POSE_DTYPE and poses.flags.c_contiguous:
             sample, _ = self._loan(frame_seq, budget_ns, query_flags, n, view=False)
             if n:
-                ctypes.memmove(sample.payload_ptr, poses.ctypes.data, n * _POSE_BYTES)
+                ctypes.memmove(sample.payload_ptr, self._address_of(poses), n * _POSE_BYTES)
         else:
             names = poses.dtype.names or ()
             if not {"body", "position", "orientation"} <= set(names):
@@ -260,10 +263,23 @@ class SceneLink:
             ctypes.memmove(sample.payload_ptr, poses.ctypes.data, poses.nbytes)
         self._send(sample)
 
+    def _address_of(self, poses: np.ndarray) -> int:
+        """The address of ``poses``' data: ``poses.ctypes.data`` (1–2 µs), remembered for
+        the array last published, which a client publishing one array updated in place
+        sends every frame. Safe because this link holds that array: numpy refuses to
+        ``resize`` an array others reference, and from numpy 2 an array's ``data`` cannot
+        be reassigned (before 2 it can, so nothing is remembered)."""
+        if poses is self._last_poses:
+            return self._last_address
+        address: int = poses.ctypes.data
+        if _DATA_FIXED:
+            self._last_poses, self._last_address = poses, address
+        return address
+
     def _loan_sample(self, count: int) -> Any:
         """A loaned, uninitialised sample of ``count`` pose records."""
         try:
-            return self._publisher.loan_slice_uninit(count)
+            return loan_slice_uninit(self._publisher, count)
         except Exception as e:
             raise TransportError(f"loaning {count} pose records", e) from e
 
@@ -272,19 +288,20 @@ class SceneLink:
         """A loaned sample with the frame header written; with ``view``, a numpy view of its records."""
         if count > U32_MAX:
             raise ValueError(f"{count} poses do not fit a frame")
-        header = self._header
-        header.frame_seq = frame_seq
-        header.budget_ns = budget_ns
-        header.query_flags = query_flags
-        header.count = count
         sample = self._loan_sample(count)
-        ctypes.memmove(sample.user_header_ptr, self._header_address, _HEADER_BYTES)
+        access = self._access
+        try:
+            POSE_FRAME_HEADER_LAYOUT.pack_into(
+                _HEADER_BUFFER.from_address(sample.user_header_ptr), 0, PROTOCOL_VERSION, access.scene,
+                frame_seq, budget_ns, query_flags, count, access.frame_key)
+        except struct.error as e:  # the sample, unsent, goes back when dropped
+            raise ValueError(f"frame_seq, budget_ns and query_flags must fit u64, u64, u32: {e}") from e
         return sample, (poses_view(sample.payload_ptr, count) if view else _EMPTY_POSES)
 
     def _send(self, sample: Any) -> None:
         """Sends ``sample`` and notifies the poses-ready service (event id 1)."""
         try:
-            sample.assume_init().send()
+            assume_init(sample).send()
         except Exception as e:
             raise TransportError("sending the pose frame", e) from e
         try:

@@ -13,6 +13,8 @@ from __future__ import annotations
 import time
 from typing import Any, Callable, Optional, TypeVar
 
+import iceoryx2 as iox
+
 #: How long a control reply is awaited by spinning before the wait starts sleeping, s.
 CONTROL_REPLY_SPIN_S: float = 20e-6
 #: One sleep of the control reply wait after the spin, s.
@@ -56,3 +58,20 @@ def release_ports(owner: Any, *names: str) -> None:
         if port is not None:
             port.delete()
             setattr(owner, name, None)
+
+
+# The 0.10.0 bindings wrap `Publisher.loan_slice_uninit` and `SampleMutUninit.assume_init`
+# in Python functions that check the payload type on every call (`typing.get_origin`,
+# asserts): 0.25 and 0.15 µs of a pose frame's ~3 µs of client work. The native methods
+# they call are used directly when the bindings have them (the pinned 0.10.0 does;
+# tests/test_binding_bug.py checks it), else the public ones. Both serve only the pose
+# service, a slice service, whose checks these are.
+_NATIVE_LOAN_SLICE: Optional[Callable[[Any, int], Any]] = getattr(iox.Publisher, "__loan_slice_uninit", None)
+_NATIVE_ASSUME_INIT: Optional[Callable[[Any], Any]] = getattr(iox.SampleMutUninit, "__assume_init", None)
+
+#: ``loan_slice_uninit(publisher, count)``: ``publisher.loan_slice_uninit(count)`` for a
+#: slice service, without the bindings' per-call checks.
+loan_slice_uninit: Callable[[Any, int], Any] = _NATIVE_LOAN_SLICE or iox.Publisher.loan_slice_uninit
+#: ``assume_init(sample)``: ``sample.assume_init()`` for a slice sample, without the
+#: bindings' per-call checks.
+assume_init: Callable[[Any], Any] = _NATIVE_ASSUME_INIT or iox.SampleMutUninit.assume_init

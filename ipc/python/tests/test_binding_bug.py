@@ -94,3 +94,13 @@ def test_an_empty_slice_reads_as_no_records(node: object) -> None:
         assert len(frame.records) == 0
         assert frame.records.dtype == RESULT_DTYPE
 
+
+
+def test_the_native_loan_and_assume_init_the_client_calls_exist() -> None:
+    # transport.py calls these past the bindings' Python wrappers (their per-call type
+    # checks cost a tenth of a frame's client work); when a binding release renames them,
+    # the client falls back to the public methods, and this test says so.
+    from proxima_client import transport
+
+    assert transport._NATIVE_LOAN_SLICE is not None, "Publisher.__loan_slice_uninit is gone"
+    assert transport._NATIVE_ASSUME_INIT is not None, "SampleMutUninit.__assume_init is gone"

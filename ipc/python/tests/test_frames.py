@@ -214,6 +214,35 @@ def test_every_way_of_publishing_writes_the_same_frame(client: Client) -> None:
         assert other_records.tobytes() == results[0].tobytes()
 
 
+def test_one_array_updated_in_place_and_two_arrays_in_turn_each_send_their_current_poses(client: Client) -> None:
+    # The link remembers the address of the array it sent last: every frame must still
+    # carry what the array holds now, and another array's frame that array's poses.
+    s = spheres(client, [0.5, 0.5], [(0.0, 0.0, 0.0), (5.0, 0.0, 0.0)], margin=5.0)
+    ids = np.array(s.bodies, dtype=np.uint32)
+    moving = pose_array(ids, [[0.0, 0.0, 0.0], [3.0, 0.0, 0.0]])
+    parked = pose_array(ids, [[0.0, 0.0, 0.0], [0.0, 0.0, 0.8]])
+    seen = []
+    for seq, (poses, x) in enumerate([(moving, 3.0), (moving, 2.0), (parked, None), (moving, 0.9),
+                                      (parked, None), (moving, 4.0)], start=1):
+        if x is not None:
+            poses["position"][1, 0] = x
+        s.link.publish_poses(seq, 0, query.CLOSE, poses)
+        copy = s.link.receive_copy_for(seq, FRAME_TIMEOUT)
+        assert copy is not None and copy.ok and len(copy.pairs) == 1
+        seen.append(float(copy.pairs[0]["distance"]))
+    np.testing.assert_allclose(seen, [2.0, 1.0, -0.2, -0.1, -0.2, 3.0], atol=1e-12)
+
+
+def test_a_frame_number_budget_or_flags_out_of_range_is_refused_before_sending(client: Client) -> None:
+    s = spheres(client, [0.5], [(0.0, 0.0, 0.0)])
+    poses = pose_array(np.array(s.bodies, dtype=np.uint32), [[0.0, 0.0, 0.0]])
+    for seq, budget, flags in [(-1, 0, query.CLOSE), (1, 1 << 64, query.CLOSE), (1, 0, 1 << 32)]:
+        with pytest.raises(ValueError):
+            s.link.publish_poses(seq, budget, flags, poses)
+    s.link.publish_poses(1, 0, query.CLOSE, poses)
+    assert s.link.receive_results_for(1, FRAME_TIMEOUT) is not None
+
+
 def test_pose_arrays_are_checked_before_anything_is_loaned(client: Client) -> None:
     s = spheres(client, [0.5], [(0.0, 0.0, 0.0)])
     with pytest.raises(ValueError):
