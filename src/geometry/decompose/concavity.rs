@@ -14,7 +14,7 @@
 //! piece measures up to about that, never 0 (the options' limit is twice the spacing).
 
 use super::nearest::SampleGrid;
-use super::piece::{Piece, Plane, lattice_samples};
+use super::piece::{CapOutline, Piece, Plane, lattice_samples};
 use crate::geometry::HullTriangle;
 use crate::math::DVec3;
 
@@ -39,24 +39,35 @@ pub(super) struct Surface<'a> {
 /// `samples` (module docs), metres.
 pub(super) fn concavity(hull: &[HullTriangle], samples: &[DVec3], surface: &Surface) -> f64 {
     let mut deepest: f64 = 0.0;
-    for &p in samples {
+    // The plane that last showed a sample no deeper than `deepest`: samples come triangle
+    // by triangle, so the next one is most often shown by the same plane, in one test.
+    let mut last_shown = 0;
+    'samples: for &p in samples {
         // The sample's depth is its least height below a plane: once one plane shows it no
         // deeper than the deepest so far, the rest cannot raise the maximum.
-        let depth =
-            hull.iter()
-                .map(|t| t.offset - t.normal.dot(p))
-                .try_fold(f64::INFINITY, |least, d| {
-                    let least = least.min(d);
-                    if least <= deepest { None } else { Some(least) }
-                });
-        if let Some(depth) = depth {
-            deepest = depth;
+        let height = |t: &HullTriangle| t.offset - t.normal.dot(p);
+        if hull.get(last_shown).is_some_and(|t| height(t) <= deepest) {
+            continue;
         }
+        let mut least = f64::INFINITY;
+        for (i, t) in hull.iter().enumerate() {
+            least = least.min(height(t));
+            if least <= deepest {
+                last_shown = i;
+                continue 'samples;
+            }
+        }
+        deepest = least;
     }
     deepest.max(bridge_height(hull, surface))
 }
 
 /// The greatest distance from the hull's boundary (off the cut planes) to the surface.
+///
+/// A maximum of nearest distances: a point with a sample within the greatest so far cannot
+/// raise it, so each point is first dismissed by the cheapest test that can (the section
+/// outline, the samples next to it), then by whether it lies on a cap, and only then pays
+/// for a whole nearest-sample search.
 fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
     let reach = hull
         .iter()
@@ -66,6 +77,9 @@ fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
     let on_plane = ON_CUT_RELATIVE * reach.max(f64::MIN_POSITIVE);
     let mut lattice = Vec::new();
     let mut highest: f64 = 0.0;
+    let mut hint = 0;
+    // The cap outlines met so far, by their cuts.
+    let mut outlines: Vec<(Vec<usize>, CapOutline)> = Vec::new();
     for t in hull {
         let on = |c: &Plane| {
             c.normal.dot(t.normal) > 0.0
@@ -80,6 +94,16 @@ fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
         let caps: Vec<usize> = (0..surface.piece.cuts.len())
             .filter(|&k| on(&surface.piece.cuts[k]))
             .collect();
+        let outline = if caps.is_empty() {
+            None
+        } else {
+            let known = outlines.iter().position(|(cuts, _)| *cuts == caps);
+            let at = known.unwrap_or_else(|| {
+                outlines.push((caps.clone(), surface.piece.cap_outline(&caps)));
+                outlines.len() - 1
+            });
+            Some(&outlines[at].1)
+        };
         lattice.clear();
         lattice.extend_from_slice(&t.corners);
         let [a, b, c] = t.corners;
@@ -90,16 +114,23 @@ fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
                 .iter()
                 .map(|&q| (q - p).length())
                 .fold(f64::INFINITY, f64::min);
-            if near_extra <= highest {
+            if near_extra <= highest
+                || surface
+                    .grid
+                    .near_within(p, highest, surface.member, &mut hint)
+            {
+                continue;
+            }
+            // Caps are sampled along their outlines only: the nearest sample to a point
+            // inside one is far, and its search the dearest of all.
+            if outline.is_some_and(|o| o.contains(p)) {
                 continue;
             }
             let Some(near) = surface.grid.nearest_above(p, highest, surface.member) else {
                 continue;
             };
             let near = near.min(near_extra);
-            // Last, as the dearest test: a point on a cut's cap is on the piece.
-            let on_cap = !caps.is_empty() && surface.piece.on_caps(p, &caps);
-            if near.is_finite() && !on_cap {
+            if near.is_finite() {
                 highest = highest.max(near);
             }
         }

@@ -52,6 +52,36 @@ struct Loop {
     cut: u32,
 }
 
+/// The outlines of a piece's caps on one cut plane, in the plane's coordinates
+/// ([`Piece::cap_outline`]).
+pub(super) struct CapOutline {
+    /// The plane's axes.
+    u: DVec3,
+    v: DVec3,
+    /// Every directed outline edge.
+    edges: Vec<[DVec3; 2]>,
+}
+
+impl CapOutline {
+    /// Whether `p`, a point on the plane, lies on the caps: the winding number of their
+    /// outlines about it, seen along the plane's normal, is not zero (Sunday's crossings
+    /// of the ray from `p` along `+u`).
+    pub fn contains(&self, p: DVec3) -> bool {
+        let flat = |q: DVec3| ((q - p).dot(self.u), (q - p).dot(self.v));
+        let mut winding = 0i32;
+        for &[a, b] in &self.edges {
+            let (a, b) = (flat(a), flat(b));
+            let left = (b.0 - a.0) * (0.0 - a.1) - (0.0 - a.0) * (b.1 - a.1);
+            if a.1 <= 0.0 && b.1 > 0.0 && left > 0.0 {
+                winding += 1;
+            } else if a.1 > 0.0 && b.1 <= 0.0 && left < 0.0 {
+                winding -= 1;
+            }
+        }
+        winding != 0
+    }
+}
+
 /// A piece of a closed solid, bounded by polygon loops (see the module docs).
 #[derive(Debug, Clone, Default)]
 pub(super) struct Piece {
@@ -210,15 +240,14 @@ impl Piece {
         Some((below, above))
     }
 
-    /// Whether `p`, a point on the plane of the cuts `cuts` (one plane, named once or more
-    /// by a merged piece), lies on their caps: the winding number of the caps' outlines
-    /// about it, seen along the plane's normal, is not zero.
-    pub fn on_caps(&self, p: DVec3, cuts: &[usize]) -> bool {
+    /// The outlines of the caps of the cuts `cuts` (one plane, named once or more by a
+    /// merged piece), flattened into that plane, to test points against
+    /// ([`CapOutline::contains`]).
+    pub fn cap_outline(&self, cuts: &[usize]) -> CapOutline {
         let normal = self.cuts[cuts[0]].normal;
         let u = normal.any_orthonormal_vector();
         let v = normal.cross(u);
-        let flat = |q: DVec3| ((q - p).dot(u), (q - p).dot(v));
-        let mut winding = 0i32;
+        let mut edges = Vec::new();
         for l in self
             .loops
             .iter()
@@ -227,17 +256,10 @@ impl Piece {
             let corners = self.loop_corners(*l);
             for (k, &a) in corners.iter().enumerate() {
                 let b = corners[(k + 1) % corners.len()];
-                let (a, b) = (flat(self.points[a as usize]), flat(self.points[b as usize]));
-                // Crossings of the ray from p along +u (Sunday's winding number).
-                let left = (b.0 - a.0) * (0.0 - a.1) - (0.0 - a.0) * (b.1 - a.1);
-                if a.1 <= 0.0 && b.1 > 0.0 && left > 0.0 {
-                    winding += 1;
-                } else if a.1 > 0.0 && b.1 <= 0.0 && left < 0.0 {
-                    winding -= 1;
-                }
+                edges.push([self.points[a as usize], self.points[b as usize]]);
             }
         }
-        winding != 0
+        CapOutline { u, v, edges }
     }
 
     /// The union of two pieces that touch along a cut: their loops together (the shared caps
