@@ -205,6 +205,8 @@ fn next_uid() -> u64 {
 #[derive(Debug)]
 pub struct Scene {
     shapes: Vec<Shape>,
+    /// How many of `shapes` are triangle meshes ([`Scene::has_mesh_shapes`]).
+    mesh_shapes: u32,
     /// `shape_boxes[i]` is shape `i`'s local box, computed once at registration.
     shape_boxes: Vec<LocalBox>,
     /// Slot `i` holds body `i` while it lives; removed bodies leave `None` until a new body
@@ -235,6 +237,7 @@ impl Clone for Scene {
     fn clone(&self) -> Self {
         Self {
             shapes: self.shapes.clone(),
+            mesh_shapes: self.mesh_shapes,
             shape_boxes: self.shape_boxes.clone(),
             bodies: self.bodies.clone(),
             free: self.free.clone(),
@@ -260,6 +263,7 @@ impl Scene {
         check_margin(default_margin)?;
         Ok(Self {
             shapes: Vec::new(),
+            mesh_shapes: 0,
             shape_boxes: Vec::new(),
             bodies: Vec::new(),
             free: Vec::new(),
@@ -299,8 +303,16 @@ impl Scene {
             return Err(SceneError::TooManyShapes(self.limits.max_shapes));
         }
         self.shape_boxes.push(prepared.local);
+        self.mesh_shapes += u32::from(matches!(prepared.shape, Shape::Mesh(_)));
         self.shapes.push(prepared.shape);
         Ok(ShapeId(self.shapes.len() as u32 - 1))
+    }
+
+    /// Whether any registered shape is a triangle mesh: without one the scene has no
+    /// mesh–mesh pairs, and a frame skips looking for them (shapes are never removed).
+    #[must_use]
+    pub fn has_mesh_shapes(&self) -> bool {
+        self.mesh_shapes > 0
     }
 
     /// The shape with id `id`, if registered.
@@ -764,6 +776,20 @@ mod tests {
             filter: CollisionFilter::ALL,
             margin: None,
         }
+    }
+
+    #[test]
+    fn a_scene_knows_whether_it_holds_a_mesh_shape_and_its_clone_too() {
+        let mut s = scene();
+        assert!(!s.has_mesh_shapes());
+        s.register_shape(Shape::Sphere(Sphere::new(0.5))).unwrap();
+        s.register_shape(Shape::Cuboid(Cuboid::new(DVec3::splat(0.5))))
+            .unwrap();
+        assert!(!s.has_mesh_shapes(), "primitives are not meshes");
+        let mesh = MeshShape::new(meshes::torus(1.0, 0.25, 12, 6));
+        s.register_shape(Shape::Mesh(Arc::new(mesh))).unwrap();
+        assert!(s.has_mesh_shapes());
+        assert!(s.clone().has_mesh_shapes());
     }
 
     #[test]

@@ -50,7 +50,7 @@ pub(super) fn run_frontier(
             })
             .map(|(pair, _)| pair)
     };
-    if needed().next().is_none() {
+    if !scene.has_mesh_shapes() || needed().next().is_none() {
         // Nothing to answer: no run (and nothing left to resume later).
         frontier_pairs.clear();
         frontier_answers.clear();

@@ -92,7 +92,7 @@ pub(super) fn mark_separated(
     } = workspace;
     let (mut tests, mut refused) = (0u64, false);
     separated.clear();
-    if query.distance {
+    if query.distance || !scene.has_mesh_shapes() {
         separated.resize(candidates.len(), false);
         return 0;
     }
