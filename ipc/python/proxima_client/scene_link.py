@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import ctypes
 import struct
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Optional
 
@@ -68,9 +69,24 @@ _HEADER_BYTES = ctypes.sizeof(PoseFrameHeader)
 #: The bytes of a loaned sample's header, to pack it in place.
 _HEADER_BUFFER = ctypes.c_char * _HEADER_BYTES
 _IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
-#: Whether an array's data pointer is fixed while it is referenced (numpy ≥ 2 forbids
-#: assigning ``ndarray.data``).
-_DATA_FIXED = int(np.__version__.split(".")[0]) >= 2
+
+
+def _data_pointer_is_fixed() -> bool:
+    """Whether this numpy refuses to re-point an array (assigning ``ndarray.data``, which
+    older releases allow with a deprecation warning): then an array's data address stays
+    what it was while it is referenced (``resize`` refuses a referenced array)."""
+    probe = np.zeros(1)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            probe.data = np.ones(1).data  # type: ignore[misc]
+    except (AttributeError, TypeError):
+        return True
+    return False
+
+
+#: See :func:`_data_pointer_is_fixed`.
+_DATA_FIXED = _data_pointer_is_fixed()
 
 
 def poses_view(address: int, count: int) -> np.ndarray:
@@ -279,8 +295,8 @@ class SceneLink:
         """The address of ``poses``' data: ``poses.ctypes.data`` (1–2 µs), remembered for
         the array last published, which a client publishing one array updated in place
         sends every frame. Safe because this link holds that array: numpy refuses to
-        ``resize`` an array others reference, and from numpy 2 an array's ``data`` cannot
-        be reassigned (before 2 it can, so nothing is remembered)."""
+        ``resize`` an array others reference, and a numpy that refuses to reassign an
+        array's ``data`` (2.x; older ones allow it, and then nothing is remembered)."""
         if poses is self._last_poses:
             return self._last_address
         address: int = poses.ctypes.data
@@ -359,9 +375,10 @@ class SceneLink:
             return frame.copy()
 
     def close(self) -> None:
-        """Releases the link's ports (idempotent)."""
+        """Releases the link's ports (idempotent) and the array it last published."""
         self.feed.close()
         release_ports(self, "_publisher", "_notifier")
+        self._last_poses = None
 
     def __enter__(self) -> "SceneLink":
         return self

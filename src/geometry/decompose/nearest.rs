@@ -66,7 +66,8 @@ impl<'a> SampleGrid<'a> {
 
     /// Whether an accepted point lies within `floor` of `p`, found cheaply: the point
     /// `hint`, then the eight cells nearest to `p` (which hold every point within half a
-    /// cell of it). `false` says nothing: such a point may lie farther out. A point found
+    /// cell of a `p` inside the grid). `false` says nothing: such a point may lie farther
+    /// out. A point found
     /// becomes the `hint` (any value is valid): neighbouring queries are mostly answered by
     /// the same point, in one test.
     pub fn near_within(
@@ -214,7 +215,7 @@ mod tests {
     /// decomposition's samples are) and in a slab, with queries on, inside and outside
     /// them, some points refused, floors below and above the true distance.
     #[test]
-    fn both_searches_agree_with_brute_force_and_the_hint_changes_nothing() {
+    fn both_searches_agree_with_brute_force_whatever_the_hint() {
         let mut r = rng(4401);
         let (mut dismissed, mut measured, mut near_found) = (0, 0, 0);
         for cloud in 0..40 {

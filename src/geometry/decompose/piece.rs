@@ -52,8 +52,8 @@ struct Loop {
     cut: u32,
 }
 
-/// The outlines of a piece's caps on one cut plane, in the plane's coordinates
-/// ([`Piece::cap_outline`]).
+/// The outlines of a piece's caps on one cut plane, gathered once from its loops to test
+/// many points against ([`Piece::cap_outline`]).
 pub(super) struct CapOutline {
     /// The plane's axes.
     u: DVec3,
@@ -241,8 +241,7 @@ impl Piece {
     }
 
     /// The outlines of the caps of the cuts `cuts` (one plane, named once or more by a
-    /// merged piece), flattened into that plane, to test points against
-    /// ([`CapOutline::contains`]).
+    /// merged piece), to test points against ([`CapOutline::contains`]).
     pub fn cap_outline(&self, cuts: &[usize]) -> CapOutline {
         let normal = self.cuts[cuts[0]].normal;
         let u = normal.any_orthonormal_vector();
