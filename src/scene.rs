@@ -205,8 +205,8 @@ fn next_uid() -> u64 {
 #[derive(Debug)]
 pub struct Scene {
     shapes: Vec<Shape>,
-    /// How many of `shapes` are triangle meshes ([`Scene::has_mesh_shapes`]).
-    mesh_shapes: u32,
+    /// Whether any of `shapes` is a triangle mesh ([`Scene::has_mesh_shapes`]).
+    any_mesh_shape: bool,
     /// `shape_boxes[i]` is shape `i`'s local box, computed once at registration.
     shape_boxes: Vec<LocalBox>,
     /// Slot `i` holds body `i` while it lives; removed bodies leave `None` until a new body
@@ -237,7 +237,7 @@ impl Clone for Scene {
     fn clone(&self) -> Self {
         Self {
             shapes: self.shapes.clone(),
-            mesh_shapes: self.mesh_shapes,
+            any_mesh_shape: self.any_mesh_shape,
             shape_boxes: self.shape_boxes.clone(),
             bodies: self.bodies.clone(),
             free: self.free.clone(),
@@ -263,7 +263,7 @@ impl Scene {
         check_margin(default_margin)?;
         Ok(Self {
             shapes: Vec::new(),
-            mesh_shapes: 0,
+            any_mesh_shape: false,
             shape_boxes: Vec::new(),
             bodies: Vec::new(),
             free: Vec::new(),
@@ -303,7 +303,7 @@ impl Scene {
             return Err(SceneError::TooManyShapes(self.limits.max_shapes));
         }
         self.shape_boxes.push(prepared.local);
-        self.mesh_shapes += u32::from(matches!(prepared.shape, Shape::Mesh(_)));
+        self.any_mesh_shape |= matches!(prepared.shape, Shape::Mesh(_));
         self.shapes.push(prepared.shape);
         Ok(ShapeId(self.shapes.len() as u32 - 1))
     }
@@ -312,7 +312,7 @@ impl Scene {
     /// mesh–mesh pairs, and a frame skips looking for them (shapes are never removed).
     #[must_use]
     pub fn has_mesh_shapes(&self) -> bool {
-        self.mesh_shapes > 0
+        self.any_mesh_shape
     }
 
     /// The shape with id `id`, if registered.

@@ -742,7 +742,9 @@ fn answer_on_pool(
                 && memory.kept_answer(scene, pair, query).is_none()
         })
     };
-    let Some(pool) = workers.as_ref().filter(|_| plan.wants_pool(needed())) else {
+    // A scene without a mesh shape has no mesh pair to look for.
+    let wanted = |_: &_| scene.has_mesh_shapes() && plan.wants_pool(needed());
+    let Some(pool) = workers.as_ref().filter(wanted) else {
         return false;
     };
     let jobs = needed().map(|(slot, pair)| {

@@ -48,6 +48,8 @@ from .wire import RESULT_DTYPE, Completeness, ErrorCode, ResultFrameHeader, fram
 
 _RECORD_BYTES = RESULT_DTYPE.itemsize
 _HEADER_BYTES = ctypes.sizeof(ResultFrameHeader)
+#: The bytes of a received sample's header, to copy it out.
+_HEADER_BUFFER = ctypes.c_char * _HEADER_BYTES
 #: The records of an empty or released frame (read-only, shared).
 _NO_RECORDS = np.empty(0, dtype=RESULT_DTYPE)
 _NO_RECORDS.flags.writeable = False
@@ -192,7 +194,7 @@ class ResultFrame(_Frame):
     def __init__(self, sample: Any) -> None:
         """Wraps a received sample (or a copied header and records)."""
         self._sample: Any = sample
-        header_bytes = _byte_array(_HEADER_BYTES).from_address(sample.user_header_ptr)
+        header_bytes = _HEADER_BUFFER.from_address(sample.user_header_ptr)
         self.header = ResultFrameHeader.from_buffer_copy(header_bytes)
         # NOTE: not `sample.payload().len()`: the 0.10.0 bindings report bytes there.
         count = sample.header.number_of_elements

@@ -154,14 +154,11 @@ fn narrow_bracket(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::{DMat3, DQuat};
+    use crate::math::{DQuat, Pose};
     use crate::narrow::pairs::check;
 
     fn iso(rotation: DQuat, translation: DVec3) -> Isometry {
-        Isometry {
-            rotation: DMat3::from_quat(rotation),
-            translation,
-        }
+        Pose::new(translation, rotation).to_isometry()
     }
 
     #[test]
