@@ -154,11 +154,12 @@ fn narrow_bracket(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::{DQuat, Pose};
+    use crate::math::{DMat3, DQuat};
     use crate::narrow::pairs::check;
 
+    // `Isometry::new`, not `Pose::new`: the NaN case below must reach the search.
     fn iso(rotation: DQuat, translation: DVec3) -> Isometry {
-        Pose::new(translation, rotation).to_isometry()
+        Isometry::new(DMat3::from_quat(rotation), translation)
     }
 
     #[test]
