@@ -135,6 +135,46 @@ def _write_fields(out: np.ndarray, ids: np.ndarray, positions: np.ndarray, orien
     out["orientation"] = _IDENTITY if orientations is None else orientations
 
 
+#: Largest frame :meth:`SceneLink.publish` gathers in a :class:`_PoseStaging` first; a
+#: larger one is written straight into the sample (its copies cost more than numpy's
+#: per-call overhead saved).
+_STAGED_MAX_POSES = 4096
+
+
+class _PoseStaging:
+    """A :data:`POSE_DTYPE` array of ``count`` records that :meth:`SceneLink.publish`
+    gathers separate fields in, then copies into the loaned sample with one ``memmove``.
+
+    For small frames this costs less than writing the fields into the sample: the field
+    views and the data address are made once, not per frame (numpy views on a fresh
+    sample cost about 1 µs a frame), ``reserved`` stays zero, and an identity orientation
+    is written only when the last frame had another (measured, 100 poses: 1.6 µs against
+    2.9 µs). The link holds the array, so its address stays valid.
+    """
+
+    def __init__(self, count: int) -> None:
+        self.count = count
+        self._poses = np.zeros(count, dtype=POSE_DTYPE)
+        self._body = self._poses["body"]
+        self._position = self._poses["position"]
+        self._orientation = self._poses["orientation"]
+        self._orientation[...] = _IDENTITY
+        # Whether every orientation holds the identity.
+        self._identity = True
+        self.address: int = self._poses.ctypes.data
+
+    def gather(self, ids: np.ndarray, positions: np.ndarray, orientations: Optional[np.ndarray]) -> None:
+        """Writes the fields (shapes checked by :func:`_check_fields`), one numpy copy each."""
+        self._body[...] = ids
+        self._position[...] = positions
+        if orientations is not None:
+            self._identity = False
+            self._orientation[...] = orientations
+        elif not self._identity:
+            self._orientation[...] = _IDENTITY
+            self._identity = True
+
+
 class PoseFrame:
     """A loaned pose frame being written in place (see :meth:`SceneLink.loan_frame`).
 
@@ -143,11 +183,11 @@ class PoseFrame:
     the memory back.
     """
 
-    def __init__(self, link: "SceneLink", sample: Any, count: int) -> None:
-        """Wraps a loaned sample of ``count`` records (see :meth:`SceneLink.loan_frame`)."""
+    def __init__(self, link: "SceneLink", sample: Any, poses: np.ndarray) -> None:
+        """Wraps a loaned sample and the view of its records (see :meth:`SceneLink.loan_frame`)."""
         self._link = link
         self._sample: Any = sample
-        self.poses: np.ndarray = poses_view(sample.payload_ptr, count)
+        self.poses: np.ndarray = poses
 
     def send(self) -> None:
         """Publishes the frame and notifies the daemon (once; later calls fail)."""
@@ -207,6 +247,8 @@ class SceneLink:
         # The array `publish_poses` sent last and its data's address (`_address_of`).
         self._last_poses: Optional[np.ndarray] = None
         self._last_address = 0
+        # Where `publish` gathers a small frame's fields (`_PoseStaging`).
+        self._staging: Optional[_PoseStaging] = None
 
     @property
     def scene(self) -> int:
@@ -224,17 +266,27 @@ class SceneLink:
                 orientations: Any = None) -> None:
         """Publishes pose frame ``frame_seq`` from arrays: body ``ids`` (``(n,)``
         integers), ``positions`` (``(n, 3)`` metres, world frame) and ``orientations``
-        (``(n, 4)`` unit quaternions ``[x, y, z, w]``; ``None``: identity), each copied once
-        into the loaned sample. ``budget_ns`` 0 = no deadline; ``query_flags`` a set of
+        (``(n, 4)`` unit quaternions ``[x, y, z, w]``; ``None``: identity), one numpy copy
+        per field: into a staging array the link keeps, then one ``memmove`` into the loaned
+        sample, or straight into the sample for frames over :data:`_STAGED_MAX_POSES` poses.
+        ``budget_ns`` 0 = no deadline; ``query_flags`` a set of
         :class:`~proxima_client.wire.query` bits.
 
         Raises:
             ValueError: mismatched shapes; TransportError: iceoryx2 failed.
         """
         ids, positions, orientations = _check_fields(ids, positions, orientations)
-        sample, view = self._loan(frame_seq, budget_ns, query_flags, len(ids))
-        _write_fields(view, ids, positions, orientations)
-        self._send(sample)
+        n = len(ids)
+        if n > _STAGED_MAX_POSES:
+            sample, view = self._loan(frame_seq, budget_ns, query_flags, n)
+            _write_fields(view, ids, positions, orientations)
+            self._send(sample)
+            return
+        staging = self._staging
+        if staging is None or staging.count != n:
+            staging = self._staging = _PoseStaging(n)
+        staging.gather(ids, positions, orientations)
+        self._publish_copy(frame_seq, budget_ns, query_flags, staging.address, n)
 
     def publish_poses(self, frame_seq: int, budget_ns: int, query_flags: int, poses: np.ndarray) -> None:
         """Publishes pose frame ``frame_seq`` from a structured array. With
@@ -250,35 +302,28 @@ class SceneLink:
             # The hot path, one array updated in place and sent every frame: its address is
             # known (`_address_of`), and what could change since it was first sent is
             # checked again above.
-            n = poses.shape[0]
-            sample = self._loan_sample(n)
-            self._write_header(sample, frame_seq, budget_ns, query_flags, n)
-            if n:
-                ctypes.memmove(sample.payload_ptr, self._last_address, n * _POSE_BYTES)
-            self._send(sample)
+            self._publish_copy(frame_seq, budget_ns, query_flags, self._last_address, poses.shape[0])
             return
         poses = np.asarray(poses)
         if poses.ndim != 1:
             raise ValueError(f"poses must be one-dimensional, not {poses.shape}")
         n = poses.shape[0]
         if poses.dtype == POSE_DTYPE and poses.flags.c_contiguous:
-            sample, _ = self._loan(frame_seq, budget_ns, query_flags, n, view=False)
-            if n:
-                ctypes.memmove(sample.payload_ptr, self._address_of(poses), n * _POSE_BYTES)
-        else:
-            names = poses.dtype.names or ()
-            if not {"body", "position", "orientation"} <= set(names):
-                raise ValueError(f"poses need fields body, position, orientation; got {names}")
-            sample, view = self._loan(frame_seq, budget_ns, query_flags, n)
-            _write_fields(view, poses["body"], poses["position"], poses["orientation"])
+            self._publish_copy(frame_seq, budget_ns, query_flags, self._address_of(poses), n)
+            return
+        names = poses.dtype.names or ()
+        if not {"body", "position", "orientation"} <= set(names):
+            raise ValueError(f"poses need fields body, position, orientation; got {names}")
+        sample, view = self._loan(frame_seq, budget_ns, query_flags, n)
+        _write_fields(view, poses["body"], poses["position"], poses["orientation"])
         self._send(sample)
 
     def loan_frame(self, frame_seq: int, budget_ns: int, query_flags: int, count: int) -> PoseFrame:
         """Loans pose frame ``frame_seq`` of ``count`` records to be written in place
         (:attr:`PoseFrame.poses`), then sent with :meth:`PoseFrame.send` or by leaving its
         ``with`` block; the analogue of the Rust ``publish_poses_with``."""
-        sample, _ = self._loan(frame_seq, budget_ns, query_flags, count, view=False)
-        return PoseFrame(self, sample, count)
+        sample, poses = self._loan(frame_seq, budget_ns, query_flags, count)
+        return PoseFrame(self, sample, poses)
 
     def publish_raw(self, header: PoseFrameHeader, poses: np.ndarray) -> None:
         """Publishes ``poses`` (:data:`POSE_DTYPE`) under ``header`` exactly as given (its
@@ -304,21 +349,33 @@ class SceneLink:
             self._last_poses, self._last_address = poses, address
         return address
 
+    def _publish_copy(self, frame_seq: int, budget_ns: int, query_flags: int, address: int, count: int) -> None:
+        """Publishes the ``count`` :data:`POSE_DTYPE` records at ``address`` (at most
+        :data:`~proxima_client.wire.U32_MAX`), copied into a loaned sample with one ``memmove``."""
+        sample = self._loan_sample(count)
+        self._write_header(sample, frame_seq, budget_ns, query_flags, count)
+        if count:
+            ctypes.memmove(sample.payload_ptr, address, count * _POSE_BYTES)
+        self._send(sample)
+
     def _loan_sample(self, count: int) -> Any:
-        """A loaned, uninitialised sample of ``count`` pose records."""
+        """A loaned, uninitialised sample of ``count`` pose records.
+
+        Raises:
+            ValueError: more records than a frame holds; TransportError: iceoryx2 failed.
+        """
+        if count > U32_MAX:
+            raise ValueError(f"{count} poses do not fit a frame")
         try:
             return loan_slice_uninit(self._publisher, count)
         except Exception as e:
             raise TransportError(f"loaning {count} pose records", e) from e
 
-    def _loan(self, frame_seq: int, budget_ns: int, query_flags: int, count: int,
-              view: bool = True) -> tuple[Any, np.ndarray]:
-        """A loaned sample with the frame header written; with ``view``, a numpy view of its records."""
-        if count > U32_MAX:
-            raise ValueError(f"{count} poses do not fit a frame")
+    def _loan(self, frame_seq: int, budget_ns: int, query_flags: int, count: int) -> tuple[Any, np.ndarray]:
+        """A loaned sample with the frame header written, and a numpy view of its records."""
         sample = self._loan_sample(count)
         self._write_header(sample, frame_seq, budget_ns, query_flags, count)
-        return sample, (poses_view(sample.payload_ptr, count) if view else _EMPTY_POSES)
+        return sample, poses_view(sample.payload_ptr, count)
 
     def _write_header(self, sample: Any, frame_seq: int, budget_ns: int, query_flags: int, count: int) -> None:
         """Writes the frame header into loaned ``sample``, in place.
@@ -386,5 +443,3 @@ class SceneLink:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-
-_EMPTY_POSES = np.empty(0, dtype=POSE_DTYPE)

@@ -17,6 +17,7 @@ from proxima_client import (
     BodySpec,
     Client,
     Completeness,
+    Cuboid,
     ErrorCode,
     InvalidPoseError,
     MalformedMessageError,
@@ -40,6 +41,7 @@ from proxima_client import (
     pose_array,
     query,
 )
+from proxima_client import scene_link
 from proxima_client.daemon_process import DaemonProcess
 from proxima_client.transport import now
 from proxima_client.wire import PROTOCOL_VERSION, U32_MAX
@@ -231,6 +233,37 @@ def test_one_array_updated_in_place_and_two_arrays_in_turn_each_send_their_curre
         assert copy is not None and copy.ok and len(copy.pairs) == 1
         seen.append(float(copy.pairs[0]["distance"]))
     np.testing.assert_allclose(seen, [2.0, 1.0, -0.2, -0.1, -0.2, 3.0], atol=1e-12)
+
+
+@pytest.mark.parametrize("staged_max", [4096, 0])
+def test_field_frames_carry_each_frames_orientations_and_sizes(client: Client, staged_max: int,
+                                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    # `publish` gathers small frames in a staging array it keeps (identity orientations
+    # written only when the last frame had others): each frame must still carry its own
+    # orientations, identity when none are given, and its own bodies. With a staging
+    # limit of 0 every frame is written straight into the sample instead.
+    monkeypatch.setattr(scene_link, "_STAGED_MAX_POSES", staged_max)
+    scene = client.create_scene()
+    small = client.register_primitive(scene, Cuboid((0.1, 0.1, 0.1)))
+    long = client.register_primitive(scene, Cuboid((1.0, 0.1, 0.1)))
+    a = client.add_body(scene, BodySpec(shape=small, position=(0.0, 0.0, 0.0), margin=5.0))
+    b = client.add_body(scene, BodySpec(shape=long, position=(2.0, 0.0, 0.0), margin=5.0))
+    link = client.open_scene(scene)
+    quarter_turn = [0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)]
+    both = np.array([a, b], dtype=np.uint32)
+    centres = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    frames = [
+        (both, centres, np.array([IDENTITY, quarter_turn]), 1.8),  # B turned: 0.1 deep in x
+        (both, centres, None, 0.9),  # identity again: B reaches to x = 1
+        (both, centres, np.array([IDENTITY, quarter_turn]), 1.8),
+        (both[1:], centres[1:] + [0.5, 0.0, 0.0], None, 1.4),  # one body, B moved, A kept
+        (both, centres, None, 0.9),
+    ]
+    for seq, (ids, positions, orientations, distance) in enumerate(frames, start=1):
+        link.publish(seq, 0, query.CLOSE, ids, positions, orientations)
+        copy = link.receive_copy_for(seq, FRAME_TIMEOUT)
+        assert copy is not None and copy.ok and len(copy.pairs) == 1, f"frame {seq}"
+        assert float(copy.pairs[0]["distance"]) == pytest.approx(distance, abs=1e-9), f"frame {seq}"
 
 
 def test_a_frame_number_budget_or_flags_out_of_range_is_refused_before_sending(client: Client) -> None:
