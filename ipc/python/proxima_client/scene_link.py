@@ -350,8 +350,13 @@ class SceneLink:
         return address
 
     def _publish_copy(self, frame_seq: int, budget_ns: int, query_flags: int, address: int, count: int) -> None:
-        """Publishes the ``count`` :data:`POSE_DTYPE` records at ``address`` (at most
-        :data:`~proxima_client.wire.U32_MAX`), copied into a loaned sample with one ``memmove``."""
+        """Publishes the ``count`` :data:`POSE_DTYPE` records at ``address``, copied into a
+        loaned sample with one ``memmove``.
+
+        Raises:
+            ValueError: more records than a frame holds, or a header field out of range;
+            TransportError: iceoryx2 failed.
+        """
         sample = self._loan_sample(count)
         self._write_header(sample, frame_seq, budget_ns, query_flags, count)
         if count:
