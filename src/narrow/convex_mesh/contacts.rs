@@ -51,7 +51,7 @@
 
 use super::walk::{TRIANGLE_WORK, for_each_overlapping_triangle, nearest_triangle_within};
 use crate::bounding::BoundingVolume;
-use crate::bounding::{Obb, Rss};
+use crate::bounding::{Aabb, Obb, Rss};
 use crate::geometry::SupportMap;
 use crate::geometry::Triangle;
 use crate::geometry::mesh::{EdgeKind, NO_NEIGHBOUR};
@@ -120,6 +120,7 @@ pub(crate) fn shape_mesh_distance(
     let Some((core, radius)) = core_of(shape) else {
         unreachable!("the dispatcher sends only convex shapes here");
     };
+    let local = shape.local_bounds();
     let walk = nearest_triangle_within(
         &Rss::around(shape),
         &mesh.distance_tree,
@@ -128,8 +129,11 @@ pub(crate) fn shape_mesh_distance(
         clock,
         convex_mesh,
         |id, triangle, threshold| {
-            if plane_separation(core.support_map(), radius, triangle) > threshold {
-                // PERF: the triangle's plane keeps it beyond anything that could matter.
+            if box_separation(&local, triangle) > threshold
+                || plane_separation(core.support_map(), radius, triangle) > threshold
+            {
+                // PERF: the shape's box or the triangle's plane keeps the triangle beyond
+                // anything that could matter.
                 return None;
             }
             *triangle_queries += 1;
@@ -178,6 +182,16 @@ pub(crate) fn shape_mesh_distance(
             DVec3::ZERO,
         )),
     }
+}
+
+/// How far apart the shape's local box `local` (A's frame) and `triangle`'s box (A's
+/// frame) are along the axis that separates them most, metres: a lower bound on the
+/// distance between the shape and the triangle, as each lies in its box. Negative when the
+/// boxes overlap.
+fn box_separation(local: &Aabb, triangle: &Triangle) -> f64 {
+    let (a, b, c) = (triangle.a, triangle.b, triangle.c);
+    let (low, high) = (a.min(b).min(c), a.max(b).max(c));
+    (low - local.max).max(local.min - high).max_element()
 }
 
 /// How far apart the shape (a core swept by `radius`, at the origin of A's frame) and the
