@@ -182,7 +182,7 @@ fn check_distance_bound_and_outcomes<B: BoundingVolume>(seed: u64) {
         let within = bv_a.distance_lower_bound_within(&bv_b, &pose_ab, limit);
         assert!(
             within <= truth && (within == bound || (within >= limit && bound >= limit)),
-            "{} case {case}: bound within {limit} is {within} (full {bound}, true {truth})",
+            "{} case {case}: bound within {limit} is {within} (full {bound}, true {truth}) {bv_a:?} {bv_b:?}",
             B::NAME
         );
         // The two-volume form (a node's two children against one node) is the single form

@@ -532,13 +532,29 @@ pub fn rectangle_distance(a: [f64; 2], c: DVec3, u: DVec3, v: DVec3, b: [f64; 2]
     // A point (a sphere's core) against a rectangle: its closest point in closed form,
     // certified like the general case.
     // PERF: a sphere against a mesh's RSS tree (`benches/convex_mesh.rs`).
+    // The normal of the closest pair is taken orthogonal to the rectangle's axes along which
+    // the closest point is inside it, as the general path snaps it ([`Closest::normal`]): on
+    // a large rectangle an unsnapped normal loses the half-lengths times its rounding.
     if b == [0.0, 0.0] {
-        let closest = DVec3::new(clamp_symmetric(c.x, a[0]), clamp_symmetric(c.y, a[1]), 0.0);
-        return certified_gap(c - closest, a, c, [u, v], b);
+        let (x, y) = (clamp_symmetric(c.x, a[0]), clamp_symmetric(c.y, a[1]));
+        let delta = DVec3::new(
+            if x == c.x { 0.0 } else { c.x - x },
+            if y == c.y { 0.0 } else { c.y - y },
+            c.z,
+        );
+        return certified_gap(delta, a, c, [u, v], b);
     }
     if a == [0.0, 0.0] {
-        let closest = c - u * clamp_symmetric(u.dot(c), b[0]) - v * clamp_symmetric(v.dot(c), b[1]);
-        return certified_gap(closest, a, c, [u, v], b);
+        let (s, t) = (u.dot(c), v.dot(c));
+        let (s_in, t_in) = (clamp_symmetric(s, b[0]), clamp_symmetric(t, b[1]));
+        let mut delta = c - u * s_in - v * t_in;
+        if s_in == s {
+            delta -= u * u.dot(delta);
+        }
+        if t_in == t {
+            delta -= v * v.dot(delta);
+        }
+        return certified_gap(delta, a, c, [u, v], b);
     }
     let pair = RectanglePair::new(a, c, u, v, b);
     let mut best = Closest {
@@ -702,7 +718,7 @@ fn separation_along(n: DVec3, a: [f64; 2], c: DVec3, [u, v]: [DVec3; 2], b: [f64
 }
 
 /// [`rectangle_distance`] when one rectangle is a point: the separation along `delta`, the
-/// vector from A's closest point to B's, or 0 when that is zero (they touch).
+/// closest pair's direction from A to B, or 0 when it is zero (they touch).
 #[inline(always)]
 fn certified_gap(delta: DVec3, a: [f64; 2], c: DVec3, dirs: [DVec3; 2], b: [f64; 2]) -> f64 {
     delta
