@@ -22,7 +22,8 @@
 //! true distance whatever the enumeration found, and equals it when the pair is the closest
 //! one. The certificate also ends the search early: the four pairs of edges that face the
 //! other rectangle's centre are tried first, and the other twelve only when the certified
-//! separation falls short of the best pair's distance (about 5% of random pairs).
+//! separation falls short of the best pair's distance (about 5% of random pairs). A point
+//! against a rectangle (a sphere's volume) is a clamp, certified the same way.
 //!
 //! Citation: E. Larsen, S. Gottschalk, M. C. Lin, D. Manocha, "Fast Proximity Queries with
 //! Swept Sphere Volumes", UNC TR99-018 (1999), the fit idea of PQP's RSS; Ericson,
@@ -529,12 +530,12 @@ impl Rss {
 #[must_use]
 #[inline]
 pub fn rectangle_distance(a: [f64; 2], c: DVec3, u: DVec3, v: DVec3, b: [f64; 2]) -> f64 {
-    // A point (a sphere's core) against a rectangle: its closest point in closed form,
-    // certified like the general case.
+    // A point (a sphere's core) against a rectangle: its closest point by a clamp, certified
+    // like the general case. The pair's direction is taken orthogonal to the rectangle's
+    // axes along which the closest point is inside it, as the general path snaps its normal
+    // ([`Closest::normal`]): on a large rectangle an unsnapped direction loses the
+    // half-lengths times its rounding.
     // PERF: a sphere against a mesh's RSS tree (`benches/convex_mesh.rs`).
-    // The normal of the closest pair is taken orthogonal to the rectangle's axes along which
-    // the closest point is inside it, as the general path snaps it ([`Closest::normal`]): on
-    // a large rectangle an unsnapped normal loses the half-lengths times its rounding.
     if b == [0.0, 0.0] {
         let (x, y) = (clamp_symmetric(c.x, a[0]), clamp_symmetric(c.y, a[1]));
         let delta = DVec3::new(
