@@ -531,19 +531,15 @@ impl Rss {
 #[inline]
 pub fn rectangle_distance(a: [f64; 2], c: DVec3, u: DVec3, v: DVec3, b: [f64; 2]) -> f64 {
     // A point (a sphere's core) against a rectangle: its closest point by a clamp, certified
-    // like the general case. The pair's direction is taken orthogonal to the rectangle's
+    // like the general case. The pair's direction must be orthogonal to the rectangle's
     // axes along which the closest point is inside it, as the general path snaps its normal
-    // ([`Closest::normal`]): on a large rectangle an unsnapped direction loses the
-    // half-lengths times its rounding.
+    // ([`Closest::normal`]): on a large rectangle a direction off by rounding loses the
+    // half-lengths times that rounding. In A's frame the clamp leaves those components
+    // exactly zero; along B's axes they are removed.
     // PERF: a sphere against a mesh's RSS tree (`benches/convex_mesh.rs`).
     if b == [0.0, 0.0] {
-        let (x, y) = (clamp_symmetric(c.x, a[0]), clamp_symmetric(c.y, a[1]));
-        let delta = DVec3::new(
-            if x == c.x { 0.0 } else { c.x - x },
-            if y == c.y { 0.0 } else { c.y - y },
-            c.z,
-        );
-        return certified_gap(delta, a, c, [u, v], b);
+        let closest = DVec3::new(clamp_symmetric(c.x, a[0]), clamp_symmetric(c.y, a[1]), 0.0);
+        return certified_gap(c - closest, a, c, [u, v], b);
     }
     if a == [0.0, 0.0] {
         let (s, t) = (u.dot(c), v.dot(c));
