@@ -157,14 +157,23 @@ impl<'a> SampleGrid<'a> {
         for z in sides[2].into_iter().flatten() {
             for y in sides[1].into_iter().flatten() {
                 for x in sides[0].into_iter().flatten() {
-                    let cell = self.flat([x, y, z]);
-                    self.items[self.starts[cell] as usize..self.starts[cell + 1] as usize]
-                        .iter()
-                        .try_for_each(|&i| f(i as usize))?;
+                    self.visit_cell([x, y, z], &mut f)?;
                 }
             }
         }
         ControlFlow::Continue(())
+    }
+
+    /// Calls `f` with every point of cell `c`, until it breaks.
+    fn visit_cell<B>(
+        &self,
+        c: [usize; 3],
+        f: &mut impl FnMut(usize) -> ControlFlow<B>,
+    ) -> ControlFlow<B> {
+        let cell = self.flat(c);
+        self.items[self.starts[cell] as usize..self.starts[cell + 1] as usize]
+            .iter()
+            .try_for_each(|&i| f(i as usize))
     }
 
     /// Calls `f` with every point in the cells at Chebyshev distance `ring` from `c`, until
@@ -176,12 +185,7 @@ impl<'a> SampleGrid<'a> {
         mut f: impl FnMut(usize) -> ControlFlow<B>,
     ) -> ControlFlow<B> {
         let range = |k: usize| c[k].saturating_sub(ring)..=(c[k] + ring).min(self.dims[k] - 1);
-        let mut visit_cell = |x: usize, y: usize, z: usize| {
-            let cell = self.flat([x, y, z]);
-            self.items[self.starts[cell] as usize..self.starts[cell + 1] as usize]
-                .iter()
-                .try_for_each(|&i| f(i as usize))
-        };
+        let mut visit_cell = |x: usize, y: usize, z: usize| self.visit_cell([x, y, z], &mut f);
         for z in range(2) {
             for y in range(1) {
                 let on_shell = z.abs_diff(c[2]) == ring || y.abs_diff(c[1]) == ring;
