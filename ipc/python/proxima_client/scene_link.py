@@ -278,9 +278,7 @@ class SceneLink:
         ids, positions, orientations = _check_fields(ids, positions, orientations)
         n = len(ids)
         if n > _STAGED_MAX_POSES:
-            sample, view = self._loan(frame_seq, budget_ns, query_flags, n)
-            _write_fields(view, ids, positions, orientations)
-            self._send(sample)
+            self._publish_fields(frame_seq, budget_ns, query_flags, ids, positions, orientations)
             return
         staging = self._staging
         if staging is None or staging.count != n:
@@ -314,9 +312,8 @@ class SceneLink:
         names = poses.dtype.names or ()
         if not {"body", "position", "orientation"} <= set(names):
             raise ValueError(f"poses need fields body, position, orientation; got {names}")
-        sample, view = self._loan(frame_seq, budget_ns, query_flags, n)
-        _write_fields(view, poses["body"], poses["position"], poses["orientation"])
-        self._send(sample)
+        self._publish_fields(frame_seq, budget_ns, query_flags, poses["body"], poses["position"],
+                             poses["orientation"])
 
     def loan_frame(self, frame_seq: int, budget_ns: int, query_flags: int, count: int) -> PoseFrame:
         """Loans pose frame ``frame_seq`` of ``count`` records to be written in place
@@ -361,6 +358,14 @@ class SceneLink:
         self._write_header(sample, frame_seq, budget_ns, query_flags, count)
         if count:
             ctypes.memmove(sample.payload_ptr, address, count * _POSE_BYTES)
+        self._send(sample)
+
+    def _publish_fields(self, frame_seq: int, budget_ns: int, query_flags: int, ids: np.ndarray,
+                        positions: np.ndarray, orientations: Optional[np.ndarray]) -> None:
+        """Publishes the pose fields (shapes checked), each written straight into a loaned
+        sample by one numpy copy."""
+        sample, view = self._loan(frame_seq, budget_ns, query_flags, len(ids))
+        _write_fields(view, ids, positions, orientations)
         self._send(sample)
 
     def _loan_sample(self, count: int) -> Any:
