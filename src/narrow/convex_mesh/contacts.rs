@@ -49,13 +49,12 @@
 //! shapes whose triangle manifold is one point (spheres and the GJK shapes). A pair beyond
 //! contact (distance `> 0`) gets an empty manifold with no walk at all.
 
+use super::node_bound::PlacedShape;
 use super::walk::{TRIANGLE_WORK, for_each_overlapping_triangle, nearest_triangle_within};
-use crate::bounding::BoundingVolume;
-use crate::bounding::{Aabb, Obb, Rss};
+use crate::bounding::{Aabb, Obb};
 use crate::geometry::SupportMap;
 use crate::geometry::Triangle;
 use crate::geometry::mesh::{EdgeKind, NO_NEIGHBOUR};
-use crate::math::DMat3;
 use crate::math::{DVec3, Isometry, Pose};
 use crate::narrow::contact::{DistanceBound, Manifold, ManifoldPoint, Reached, ShapeDistance};
 use crate::narrow::dispatch::{GJK, NarrowScratch};
@@ -121,8 +120,9 @@ pub(crate) fn shape_mesh_distance(
         unreachable!("the dispatcher sends only convex shapes here");
     };
     let local = shape.local_bounds();
+    let placed = PlacedShape::new(shape, &pose_ab.inverse().to_isometry());
     let walk = nearest_triangle_within(
-        &Rss::around(shape),
+        |node| placed.lower_bound(node),
         &mesh.distance_tree,
         pose_ab,
         limit,
@@ -285,7 +285,7 @@ pub(crate) fn shape_mesh_manifold(
         }
     } else {
         for_each_overlapping_triangle(
-            &Obb::around(shape),
+            &Obb::from_aabb(&shape.local_bounds()),
             &mesh.overlap_tree,
             pose_ab,
             convex_mesh,
@@ -643,45 +643,6 @@ pub fn shape_triangle_manifold(
             let d = shape_triangle_distance(shape, triangle, epa);
             out.set_from_distance(&d);
         }
-    }
-}
-
-/// The tightest volume of a tree's type around a convex shape, its local frame, for the
-/// mesh BVH walk: its lower bounds prune the walk, so a loose one costs triangles.
-trait ShapeBound: BoundingVolume {
-    fn around(shape: &Shape) -> Self;
-}
-
-impl ShapeBound for Rss {
-    /// A ball or a capsule exactly; a box as its xy rectangle swept by its z half extent;
-    /// anything else the volume fitted to its local box's corners.
-    fn around(shape: &Shape) -> Self {
-        match shape {
-            Shape::Sphere(s) => Rss::new(DVec3::ZERO, DMat3::IDENTITY, [0.0, 0.0], s.radius),
-            // Axes (Z, X, Y): the rectangle's first axis along the capsule's segment.
-            Shape::Capsule(c) => Rss::new(
-                DVec3::ZERO,
-                DMat3::from_cols(DVec3::Z, DVec3::X, DVec3::Y),
-                [c.half_height, 0.0],
-                c.radius,
-            ),
-            Shape::Cuboid(b) => {
-                let h = b.half_extents;
-                Rss::new(DVec3::ZERO, DMat3::IDENTITY, [h.x, h.y], h.z)
-            }
-            Shape::Cylinder(_)
-            | Shape::Cone(_)
-            | Shape::Convex(_)
-            | Shape::Mesh(_)
-            | Shape::Compound(_) => Rss::fit_points(&shape.local_bounds().corners()),
-        }
-    }
-}
-
-impl ShapeBound for Obb {
-    /// The shape's local box.
-    fn around(shape: &Shape) -> Self {
-        Obb::from_aabb(&shape.local_bounds())
     }
 }
 

@@ -1,5 +1,6 @@
 //! A convex shape against a triangle mesh: the walk of the mesh's BVH that finds the
-//! triangles that can matter (`walk.rs`), and the pair's signed distance and contact
+//! triangles that can matter (`walk.rs`), pruned by the shape's lower bounds on its
+//! distance to the tree's nodes (`node_bound.rs`), and the pair's signed distance and contact
 //! manifold over those triangles, ghost normals removed (`contacts.rs`).
 //!
 //! Meshes are surfaces: two-sided triangles with no thickness. The signed distance is the
@@ -7,11 +8,12 @@
 //! entirely inside a closed mesh without touching its surface is apart from it.
 
 mod contacts;
+mod node_bound;
 mod walk;
 
 pub(crate) use contacts::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 pub use contacts::{shape_triangle_distance, shape_triangle_manifold};
 pub use walk::{
     ConvexMeshWorkspace, TRIANGLE_WORK, Walk, for_each_overlapping_triangle, nearest_triangle,
-    nearest_triangle_within,
+    nearest_triangle_within, volume_bound,
 };

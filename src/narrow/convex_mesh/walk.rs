@@ -36,11 +36,16 @@ impl ConvexMeshWorkspace {
 }
 
 /// The smallest value of `triangle_value` over the mesh's triangles (each given with its id
-/// in the mesh and in A's frame), skipping every subtree whose volume's lower bound on the distance to the shape's
-/// volume `shape_bv` exceeds the best value so far (or 0, while the best is negative: a
-/// deeper penetration can hide in any subtree that overlaps the shape) or `limit` (metres;
-/// `f64::INFINITY` for the exact minimum). `None` for a mesh with no triangle, or when no
-/// subtree comes within `limit`; a returned value above `limit` is only an upper bound.
+/// in the mesh and in A's frame), skipping every subtree whose lower bound
+/// `node_bound(volume)` on the shape's distance to it exceeds the best value so far (or 0,
+/// while the best is negative: a deeper penetration can hide in any subtree that overlaps
+/// the shape) or `limit` (metres; `f64::INFINITY` for the exact minimum). `None` for a mesh
+/// with no triangle, or when no subtree comes within `limit`; a returned value above
+/// `limit` is only an upper bound.
+///
+/// `node_bound` gets a node's volume in B's frame (the mesh's) and must answer a lower
+/// bound, metres, on the distance between the shape and anything inside it, 0 where they
+/// may touch ([`volume_bound`] makes one from a volume around the shape).
 ///
 /// `triangle_value(id, triangle, threshold)` must never be below the true distance between
 /// the shape and the triangle minus its own error (a signed distance, or a distance clamped
@@ -52,7 +57,7 @@ impl ConvexMeshWorkspace {
 /// subtrees whose lower bound is positive), so a caller may collect the triangles the shape
 /// touches during this walk instead of walking again.
 pub fn nearest_triangle<B, T>(
-    shape_bv: &B,
+    node_bound: impl Fn(&B) -> f64,
     tree: &Bvh<B>,
     pose_ab: &Pose,
     limit: f64,
@@ -63,7 +68,7 @@ where
     B: BoundingVolume,
 {
     let walk = nearest_triangle_within(
-        shape_bv,
+        node_bound,
         tree,
         pose_ab,
         limit,
@@ -93,7 +98,7 @@ pub struct Walk<T> {
 /// triangle). Stopped, it returns what it found and the least lower bound of what it left:
 /// the leaves are visited nearest first, so that bound only grows with more work.
 pub fn nearest_triangle_within<B, T>(
-    shape_bv: &B,
+    node_bound: impl Fn(&B) -> f64,
     tree: &Bvh<B>,
     pose_ab: &Pose,
     limit: f64,
@@ -112,10 +117,8 @@ where
         return walk;
     }
     let iso_ab = pose_ab.to_isometry();
-    // The node volumes live in B's frame; the shape's volume is placed in it by `pose_ba`.
-    let iso_ba = pose_ab.inverse().to_isometry();
     let nodes = tree.nodes();
-    let bound = |node: usize| nodes[node].bv.distance_lower_bound(shape_bv, &iso_ba);
+    let bound = |node: usize| node_bound(&nodes[node].bv);
     let best = &mut walk.best;
     let heap = &mut workspace.ranked;
     heap.clear();
@@ -170,6 +173,13 @@ where
         }
     }
     walk
+}
+
+/// The node bound of [`nearest_triangle`] for a shape inside `shape_bv` (A's frame): the
+/// two volumes' lower bound, the shape's placed in B's frame by `pose_ab`'s inverse.
+pub fn volume_bound<B: BoundingVolume>(shape_bv: &B, pose_ab: &Pose) -> impl Fn(&B) -> f64 {
+    let iso_ba = pose_ab.inverse().to_isometry();
+    move |node| node.distance_lower_bound(shape_bv, &iso_ba)
 }
 
 /// Calls `visit` with every triangle (A's frame, with its id in the mesh) whose leaf volume
@@ -264,7 +274,7 @@ mod tests {
                 .map(|t| ball_triangle(center, radius, &t.transformed(&iso)))
                 .fold(f64::INFINITY, f64::min);
             let found_rss = nearest_triangle(
-                &ball_bv::<Rss>(center, radius),
+                volume_bound(&ball_bv::<Rss>(center, radius), &pose_ab),
                 &rss,
                 &pose_ab,
                 f64::INFINITY,
@@ -274,7 +284,7 @@ mod tests {
             .unwrap()
             .0;
             let found_obb = nearest_triangle(
-                &ball_bv::<Obb>(center, radius),
+                volume_bound(&ball_bv::<Obb>(center, radius), &pose_ab),
                 &obb,
                 &pose_ab,
                 f64::INFINITY,
@@ -287,7 +297,7 @@ mod tests {
             // an upper bound above it.
             let limit = rng.random_range(0.0..0.5);
             let limited = nearest_triangle(
-                &ball_bv::<Rss>(center, radius),
+                volume_bound(&ball_bv::<Rss>(center, radius), &pose_ab),
                 &rss,
                 &pose_ab,
                 limit,
