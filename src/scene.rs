@@ -207,6 +207,8 @@ pub struct Scene {
     shapes: Vec<Shape>,
     /// Whether any of `shapes` is a triangle mesh ([`Scene::has_mesh_shapes`]).
     any_mesh_shape: bool,
+    /// Whether any of `shapes` is a mesh or a compound ([`Scene::has_tree_shapes`]).
+    any_tree_shape: bool,
     /// `shape_boxes[i]` is shape `i`'s local box, computed once at registration.
     shape_boxes: Vec<LocalBox>,
     /// Slot `i` holds body `i` while it lives; removed bodies leave `None` until a new body
@@ -238,6 +240,7 @@ impl Clone for Scene {
         Self {
             shapes: self.shapes.clone(),
             any_mesh_shape: self.any_mesh_shape,
+            any_tree_shape: self.any_tree_shape,
             shape_boxes: self.shape_boxes.clone(),
             bodies: self.bodies.clone(),
             free: self.free.clone(),
@@ -264,6 +267,7 @@ impl Scene {
         Ok(Self {
             shapes: Vec::new(),
             any_mesh_shape: false,
+            any_tree_shape: false,
             shape_boxes: Vec::new(),
             bodies: Vec::new(),
             free: Vec::new(),
@@ -304,6 +308,7 @@ impl Scene {
         }
         self.shape_boxes.push(prepared.local);
         self.any_mesh_shape |= matches!(prepared.shape, Shape::Mesh(_));
+        self.any_tree_shape |= matches!(prepared.shape, Shape::Mesh(_) | Shape::Compound(_));
         self.shapes.push(prepared.shape);
         Ok(ShapeId(self.shapes.len() as u32 - 1))
     }
@@ -313,6 +318,13 @@ impl Scene {
     #[must_use]
     pub fn has_mesh_shapes(&self) -> bool {
         self.any_mesh_shape
+    }
+
+    /// Whether any registered shape is a mesh or a compound: without one no pair walks a
+    /// tree, and a frame skips looking for such pairs.
+    #[must_use]
+    pub fn has_tree_shapes(&self) -> bool {
+        self.any_tree_shape
     }
 
     /// The shape with id `id`, if registered.

@@ -79,6 +79,26 @@ impl PathCounts {
     pub fn bvh(&self) -> u32 {
         self.convex_mesh + self.mesh_mesh
     }
+
+    /// Adds `other`'s counts (another thread's, for pairs it answered for this frame).
+    pub fn add(&mut self, other: &Self) {
+        let Self {
+            closed_form,
+            gjk,
+            separating_axes,
+            epa,
+            convex_mesh,
+            mesh_mesh,
+            compound,
+        } = *other;
+        self.closed_form += closed_form;
+        self.gjk += gjk;
+        self.separating_axes += separating_axes;
+        self.epa += epa;
+        self.convex_mesh += convex_mesh;
+        self.mesh_mesh += mesh_mesh;
+        self.compound += compound;
+    }
 }
 
 /// Scratch of the dispatcher for one thread (no allocation once grown).

@@ -108,8 +108,8 @@ use separation::mark_separated;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use toi::answer_tois;
-pub use workers::{MIN_PARALLEL_MESH_PAIRS, WorkerPool};
-use workers::{MeshJob, MeshOutcome};
+use workers::{JobScratch, PairJob, PairOutcome};
+pub use workers::{MIN_PARALLEL_MESH_PAIRS, MIN_PARALLEL_WALKS, WorkerPool};
 
 /// What a frame asks for; at least one flag should be set, or the frame reports nothing.
 ///
@@ -380,12 +380,12 @@ pub struct PipelineWorkspace {
     memory: PairMemories,
     /// Per candidate (same index): whether a kept separation answers it this frame.
     separated: Vec<bool>,
-    /// Answers a frame's mesh–mesh pairs in parallel (see [`workers`]).
+    /// Answers a frame's mesh–mesh pairs and tree walks in parallel (see [`workers`]).
     workers: Option<Arc<WorkerPool>>,
     /// The pool's answers of this frame, by candidate slot.
-    outcomes: Vec<MeshOutcome>,
-    /// Contact scratch of one pair answered on this thread for the pool.
-    job_contacts: Vec<ContactPoint>,
+    outcomes: Vec<PairOutcome>,
+    /// Scratch of the pool's jobs this thread answers.
+    job_scratch: JobScratch,
     /// The dispatcher's scratch (GJK/EPA, convex–mesh traversal).
     narrow: NarrowScratch,
     /// One pair's manifold, before it joins the frame's contacts.
@@ -435,8 +435,9 @@ impl PipelineWorkspace {
         self
     }
 
-    /// A workspace that answers mesh–mesh pairs on `workers` too (when a frame has at least
-    /// [`MIN_PARALLEL_MESH_PAIRS`] of them). Results are identical with or without.
+    /// A workspace that answers mesh–mesh pairs and tree walks on `workers` too (when a
+    /// frame has at least [`MIN_PARALLEL_MESH_PAIRS`] mesh pairs or [`MIN_PARALLEL_WALKS`]
+    /// walks). Results are identical with or without.
     #[must_use]
     pub fn with_workers(workers: Arc<WorkerPool>) -> Self {
         Self {
@@ -714,8 +715,9 @@ fn mid_phase(
     (tests, stats)
 }
 
-/// Answers the frame's mesh–mesh pairs on the worker pool, into `workspace.outcomes`, when
-/// the plan lets it ([`FramePlan::wants_pool`]); returns whether it did.
+/// Answers the frame's mesh–mesh pairs and tree walks ([`plan::pool_work`]) on the worker
+/// pool, into `workspace.outcomes`, when the plan lets it ([`FramePlan::wants_pool`]);
+/// returns whether it did.
 fn answer_on_pool(
     scene: &Scene,
     query: Query,
@@ -724,44 +726,43 @@ fn answer_on_pool(
 ) -> bool {
     let PipelineWorkspace {
         candidates,
-        mesh,
         memory,
         separated,
         workers,
         outcomes,
-        job_contacts,
+        job_scratch,
         abandon,
         ..
     } = workspace;
     outcomes.clear();
-    // The mesh pairs no kept answer or separation answers, by candidate slot.
+    // The pairs for the pool that no kept answer or separation answers, by candidate slot,
+    // with their shapes and work.
     let needed = || {
-        candidates.iter().enumerate().filter(|&(slot, pair)| {
-            !separated[slot]
-                && mesh_pair(scene, pair).is_some()
-                && memory.kept_answer(scene, pair, query).is_none()
+        candidates.iter().enumerate().filter_map(|(slot, pair)| {
+            let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+            let shapes = (shape(scene, a), shape(scene, b));
+            let work = plan::pool_work(shapes.0, shapes.1)?;
+            let needed = !separated[slot] && memory.kept_answer(scene, pair, query).is_none();
+            needed.then_some((slot, pair, (a, b), shapes, work))
         })
     };
-    // A scene without a mesh shape has no mesh pair to look for.
-    let wanted = |_: &_| scene.has_mesh_shapes() && plan.wants_pool(needed());
+    // A scene without a mesh or compound has no pair for the pool to look for.
+    let wanted =
+        |_: &_| scene.has_tree_shapes() && plan.wants_pool(needed().map(|(.., work)| work));
     let Some(pool) = workers.as_ref().filter(wanted) else {
         return false;
     };
-    let jobs = needed().map(|(slot, pair)| {
-        let (mesh_a, mesh_b) = mesh_pair(scene, pair).expect("a mesh pair");
-        MeshJob {
-            slot: index(slot),
-            pair: *pair,
-            a: *body(scene, pair.a),
-            b: *body(scene, pair.b),
-            mesh_a: Arc::clone(mesh_a),
-            mesh_b: Arc::clone(mesh_b),
-            query,
-            cache: memory.mesh_cache(pair),
-            abandon: abandon.clone(),
-        }
+    let jobs = needed().map(|(slot, pair, (a, b), (sa, sb), _)| PairJob {
+        slot: index(slot),
+        pair: *pair,
+        a: *a,
+        b: *b,
+        shapes: (sa.clone(), sb.clone()),
+        query,
+        cache: memory.mesh_cache(pair),
+        abandon: abandon.clone(),
     });
-    pool.answer_all(jobs, outcomes, mesh, job_contacts);
+    pool.answer_all(jobs, outcomes, job_scratch);
     true
 }
 

@@ -7,7 +7,7 @@ use super::answer::{self, Answer, MeshScratch};
 use super::costs::TailTimer;
 use super::pair_memory::PairMemories;
 use super::plan::{FramePlan, PairPlan};
-use super::workers::MeshOutcome;
+use super::workers::PairOutcome;
 use super::{ContactPoint, FrameResults, PipelineWorkspace, Query, body, index, shape};
 use crate::broad::CandidatePair;
 use crate::budget::Completeness;
@@ -128,7 +128,7 @@ pub(super) fn answer_candidates(
 /// Where a pair's answer comes from besides its own query: the pool's outcomes and the
 /// frontier's answers, both in candidate order, and this thread's scratch.
 struct AnswerSources<'w> {
-    pooled: std::slice::Iter<'w, MeshOutcome>,
+    pooled: std::slice::Iter<'w, PairOutcome>,
     frontier:
         std::iter::Zip<std::slice::Iter<'w, CandidatePair>, std::slice::Iter<'w, FrontierAnswer>>,
     narrow: &'w mut NarrowScratch,
@@ -136,7 +136,7 @@ struct AnswerSources<'w> {
     mesh: &'w mut MeshScratch,
 }
 
-impl AnswerSources<'_> {
+impl<'w> AnswerSources<'w> {
     /// The answer of `pair` (candidate `slot`; bodies `a`, `b` with shapes `sa`, `sb`) by
     /// `plan`, its contacts appended to `contacts`, and the level it was truncated at when
     /// the frontier left it unfinished.
@@ -194,10 +194,13 @@ impl AnswerSources<'_> {
             }
             PairPlan::Pooled => {
                 narrow.paths.mesh_mesh += 1;
-                let outcome = self.pooled.next().expect("one pool outcome per mesh pair");
-                debug_assert_eq!(outcome.slot as usize, slot);
-                contacts.extend_from_slice(outcome.contacts());
+                let outcome = self.pooled(slot, contacts);
                 memory.entry(pair).mesh_cache = outcome.cache;
+                outcome.answer
+            }
+            PairPlan::PooledWalk => {
+                let outcome = self.pooled(slot, contacts);
+                self.narrow.paths.add(&outcome.paths);
                 outcome.answer
             }
             PairPlan::MeshMesh(ma, mb) => {
@@ -208,6 +211,18 @@ impl AnswerSources<'_> {
             }
         };
         (answer, None)
+    }
+
+    /// The pool's outcome for candidate `slot` (outcomes come in slot order), its contacts
+    /// appended to `contacts`.
+    fn pooled(&mut self, slot: usize, contacts: &mut Vec<ContactPoint>) -> &'w PairOutcome {
+        let outcome = self
+            .pooled
+            .next()
+            .expect("one pool outcome per pooled pair");
+        debug_assert_eq!(outcome.slot as usize, slot);
+        contacts.extend_from_slice(outcome.contacts());
+        outcome
     }
 }
 

@@ -7,7 +7,7 @@
 //! budget, and re-estimated before each pair.
 
 use super::costs::FrameCosts;
-use super::{MIN_PARALLEL_MESH_PAIRS, Query};
+use super::{MIN_PARALLEL_MESH_PAIRS, MIN_PARALLEL_WALKS, Query};
 use crate::budget::{Abandon, Budget, Stop, WORK_PER_CLOCK_READ, WorkClock};
 pub use crate::budget::{Deadline, Unlimited, VisitBudget};
 use crate::narrow::dispatch::{self, Route};
@@ -135,6 +135,9 @@ pub(super) enum PairPlan<'s> {
     Frontier(&'s Arc<MeshShape>, &'s Arc<MeshShape>),
     /// Mesh–mesh, read from the worker pool's outcome.
     Pooled,
+    /// A direct pair that walks a tree (see [`pool_work`]), read from the worker pool's
+    /// outcome.
+    PooledWalk,
     /// Mesh–mesh, the exact tandem queries on this thread.
     MeshMesh(&'s Arc<MeshShape>, &'s Arc<MeshShape>),
 }
@@ -253,14 +256,23 @@ impl FramePlan {
         all - fits
     }
 
-    /// Whether a frame with these mesh pairs to answer uses the worker pool: never under a
-    /// limited budget (the frontier runs on one thread) nor in a slice (the pool's pairs are
-    /// not polled), and only with at least
-    /// [`MIN_PARALLEL_MESH_PAIRS`] of them.
-    pub(super) fn wants_pool<T>(&self, mut needed: impl Iterator<Item = T>) -> bool {
+    /// Whether a frame with these pairs to answer on the pool (each its [`PoolWork`]) uses
+    /// the worker pool: never under a limited budget (the frontier runs on one thread) nor
+    /// in a slice (the pool's pairs are not polled), and only with at least
+    /// [`MIN_PARALLEL_MESH_PAIRS`] mesh pairs or [`MIN_PARALLEL_WALKS`] walks, a mesh pair
+    /// counting as `MIN_PARALLEL_WALKS / MIN_PARALLEL_MESH_PAIRS` walks.
+    pub(super) fn wants_pool(&self, needed: impl Iterator<Item = PoolWork>) -> bool {
+        const MESH_PAIR_WALKS: usize = MIN_PARALLEL_WALKS / MIN_PARALLEL_MESH_PAIRS;
+        let mut walks = 0;
         !self.limited
             && self.slice.is_none()
-            && needed.by_ref().take(MIN_PARALLEL_MESH_PAIRS).count() == MIN_PARALLEL_MESH_PAIRS
+            && needed.into_iter().any(|work| {
+                walks += match work {
+                    PoolWork::MeshPair => MESH_PAIR_WALKS,
+                    PoolWork::Walk => 1,
+                };
+                walks >= MIN_PARALLEL_WALKS
+            })
     }
 
     /// The route of a pair of shapes `sa`, `sb` (`separated` when a kept separation or the
@@ -274,6 +286,7 @@ impl FramePlan {
     ) -> PairPlan<'s> {
         match dispatch::route(sa, sb) {
             _ if separated => PairPlan::Separated,
+            Route::Direct if self.pool && pool_work(sa, sb).is_some() => PairPlan::PooledWalk,
             Route::Direct
                 if !dispatch::exact_costs_no_more_than_boxes(sa, sb)
                     && !clock.allows(pair_work(sa, sb)) =>
@@ -289,6 +302,27 @@ impl FramePlan {
             Route::MeshMesh(..) if !clock.allows(WORK_PER_CLOCK_READ) => PairPlan::Conservative,
             Route::MeshMesh(ma, mb) => PairPlan::MeshMesh(ma, mb),
         }
+    }
+}
+
+/// What answering a pair costs the worker pool, for the pairs it takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum PoolWork {
+    /// Mesh–mesh: the tandem searches.
+    MeshPair,
+    /// A convex shape or a compound against a mesh or a compound: one walk of a tree
+    /// (every part pair of a compound).
+    Walk,
+}
+
+/// The pool's work for a pair of shapes `sa`, `sb`; `None` for the pairs answered on the
+/// calling thread (closed forms, GJK/EPA between convex shapes: cheaper than a job).
+pub(super) fn pool_work(sa: &Shape, sb: &Shape) -> Option<PoolWork> {
+    use Shape::{Compound as K, Mesh as M};
+    match (sa, sb) {
+        (M(_), M(_)) => Some(PoolWork::MeshPair),
+        (M(_) | K(_), _) | (_, M(_) | K(_)) => Some(PoolWork::Walk),
+        _ => None,
     }
 }
 

@@ -1,7 +1,7 @@
 use super::*;
 use crate::bounding::Aabb;
 use crate::budget::{Stop, WorkClock};
-use crate::geometry::{Cuboid, Sphere};
+use crate::geometry::{Capsule, Cuboid, Cylinder, Sphere};
 use crate::math::Pose;
 use crate::narrow::MeshShape;
 use crate::narrow::mesh_mesh::{
@@ -159,17 +159,61 @@ fn torus_scene() -> (Scene, BodyId, BodyId, Arc<MeshShape>) {
 #[test]
 fn the_worker_pool_changes_nothing_but_who_answers() {
     let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.6, 0.15, 20, 8))));
-    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
-    let mut rng = rng(79);
-    let mut bodies = Vec::new();
-    for i in 0..10 {
-        let shape = if i % 3 == 2 {
-            Shape::Sphere(Sphere::new(0.3))
-        } else {
-            torus.clone()
-        };
-        bodies.push(add(&mut scene, shape, point_in_cube(&mut rng, 1.5), 0.2));
+    let shapes: Vec<Shape> = (0..10)
+        .map(|i| {
+            if i % 3 == 2 {
+                Shape::Sphere(Sphere::new(0.3))
+            } else {
+                torus.clone()
+            }
+        })
+        .collect();
+    let (pooled, contact_frames) = compare_with_pool(&shapes, 1.5, 79);
+    assert!(
+        pooled > 200 && contact_frames > 10,
+        "pairs through the pool {pooled}, frames with contacts {contact_frames}"
+    );
+}
+
+/// The same with two tori among many convex shapes: the pool takes the convex–mesh walks
+/// (more than [`MIN_PARALLEL_WALKS`] a frame, with fewer than [`MIN_PARALLEL_MESH_PAIRS`]
+/// mesh pairs), and the results, contacts and paths are those of one thread.
+#[test]
+fn the_worker_pool_takes_convex_mesh_walks_and_changes_nothing() {
+    let torus = Shape::Mesh(Arc::new(MeshShape::new(meshes::torus(0.6, 0.15, 20, 8))));
+    let mut shapes = vec![torus.clone(), torus];
+    for i in 0..40 {
+        shapes.push(match i % 4 {
+            0 => Shape::Sphere(Sphere::new(0.2)),
+            1 => Shape::Cuboid(Cuboid::new(DVec3::new(0.2, 0.1, 0.15))),
+            2 => Shape::Capsule(Capsule::new(0.15, 0.1)),
+            _ => Shape::Cylinder(Cylinder::new(0.1, 0.15)),
+        });
     }
+    let (pooled, contact_frames) = compare_with_pool(&shapes, 1.0, 83);
+    assert!(
+        pooled > 120 * MIN_PARALLEL_WALKS && contact_frames > 30,
+        "pairs through the pool {pooled}, frames with contacts {contact_frames}"
+    );
+}
+
+/// Bodies of `shapes` in a cube of half side `half`, moved coherently for 120 frames and
+/// answered with and without a worker pool of 2, every query in turn: identical results,
+/// contacts and reports. Returns the pairs the pool answered and the frames with contacts.
+fn compare_with_pool(shapes: &[Shape], half: f64, seed: u64) -> (usize, usize) {
+    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let mut rng = rng(seed);
+    let bodies: Vec<BodyId> = shapes
+        .iter()
+        .map(|shape| {
+            add(
+                &mut scene,
+                shape.clone(),
+                point_in_cube(&mut rng, half),
+                0.2,
+            )
+        })
+        .collect();
     let pool = Arc::new(WorkerPool::new(2));
     let queries = [
         Query::CLOSE.union(Query::CONTACTS),
@@ -181,12 +225,12 @@ fn the_worker_pool_changes_nothing_but_who_answers() {
         PipelineWorkspace::with_workers(pool),
     );
     let (mut expected, mut found) = (FrameResults::default(), FrameResults::default());
-    let (mut mesh_pairs, mut contact_frames) = (0, 0);
+    let (mut pooled, mut contact_frames) = (0, 0);
     for frame in 0..120 {
         for &body in &bodies {
             let pose = scene.body(body).unwrap().pose;
             let moved = Pose::new(
-                (pose.position + point_in_cube(&mut rng, 0.08)).clamp_length_max(1.8),
+                (pose.position + point_in_cube(&mut rng, 0.08)).clamp_length_max(half * 1.2),
                 rotation(&mut rng).slerp(pose.rotation, 0.9),
             );
             scene.set_pose(body, moved).unwrap();
@@ -197,16 +241,14 @@ fn the_worker_pool_changes_nothing_but_who_answers() {
         assert_eq!(found.pairs, expected.pairs, "frame {frame}");
         assert_eq!(found.contacts, expected.contacts, "frame {frame}");
         assert_eq!(
-            (a.completeness, a.candidates, a.pairs, a.contacts),
-            (b.completeness, b.candidates, b.pairs, b.contacts)
+            (a.completeness, a.candidates, a.pairs, a.contacts, a.paths),
+            (b.completeness, b.candidates, b.pairs, b.contacts, b.paths),
+            "frame {frame}"
         );
-        mesh_pairs += parallel.outcomes.len();
+        pooled += parallel.outcomes.len();
         contact_frames += usize::from(!found.contacts.is_empty());
     }
-    assert!(
-        mesh_pairs > 200 && contact_frames > 10,
-        "mesh pairs through the pool {mesh_pairs}, frames with contacts {contact_frames}"
-    );
+    (pooled, contact_frames)
 }
 
 /// Moves every body of `scene` by up to 0.1 m per axis, kept within 1.4 m of the origin,

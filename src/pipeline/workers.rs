@@ -1,16 +1,21 @@
 //! The pipeline's worker pool: persistent threads that answer a frame's expensive pairs
-//! (mesh–mesh) alongside the calling thread.
+//! (mesh–mesh, and a convex shape or compound against a mesh or compound: the pairs that
+//! walk a tree) alongside the calling thread.
 //!
 //! # Design note
-//! A job owns everything it needs (the two bodies, `Arc`s of their meshes, the query and
-//! the pair's warm-start cache), so workers hold no borrow of the scene and need no
-//! `unsafe`. Jobs travel over a bounded crossbeam channel (a fixed ring: no allocation per
-//! message); the calling thread takes queued jobs itself once it has handed them out, then
+//! A job owns everything it needs (the two bodies, their shapes, whose meshes, hulls and
+//! compounds are `Arc`s, the query and a mesh pair's warm-start cache), so workers hold no
+//! borrow of the scene and need no `unsafe`. Jobs travel over a bounded crossbeam channel
+//! (a fixed ring: no allocation per message); the calling thread takes queued jobs itself
+//! once it has handed them out, then
 //! collects the workers' outcomes and sorts them by candidate slot, so the frame's results
 //! are the same, in the same order, whichever thread answered which pair.
 //!
 //! Waking a parked worker costs 60–120 µs on a VM, so [`step`](super::step) hands out work
-//! only when a frame has at least [`MIN_PARALLEL_MESH_PAIRS`] mesh pairs. A pool serves one
+//! only when a frame has at least [`MIN_PARALLEL_MESH_PAIRS`] mesh pairs or
+//! [`MIN_PARALLEL_WALKS`] tree walks (a mesh pair counting as
+//! `MIN_PARALLEL_WALKS / MIN_PARALLEL_MESH_PAIRS` walks); the calling thread does not wait
+//! for the wake, it starts on the queue at once. A pool serves one
 //! frame at a time (a lock held for the frame), so scenes may share one.
 //!
 //! Budgeted frames refine their frontier on the calling thread only. Measured and not
@@ -32,50 +37,58 @@ use super::{ContactPoint, Query};
 use crate::broad::CandidatePair;
 use crate::budget::{Abandon, WorkClock};
 use crate::math::DVec3;
-use crate::narrow::MANIFOLD_POINTS;
-use crate::narrow::MeshShape;
+use crate::narrow::contact::Manifold;
+use crate::narrow::dispatch::{self, NarrowScratch, PathCounts, Route};
 use crate::narrow::mesh_mesh::DistanceCache;
+use crate::narrow::{MANIFOLD_POINTS, Shape};
 use crate::scene::Body;
 use crossbeam::channel::{self, Receiver, Sender, TrySendError};
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::{Mutex, PoisonError};
 use std::thread::JoinHandle;
 
 /// Fewest mesh–mesh pairs in a frame for the pool to be used (below it, waking a worker
 /// costs more than it saves).
 pub const MIN_PARALLEL_MESH_PAIRS: usize = 2;
+/// Fewest walks of a convex shape or compound over a tree (1–10 µs each in
+/// `examples/falling_bodies.rs`) for the pool to be used, a mesh pair counting as
+/// `MIN_PARALLEL_WALKS / MIN_PARALLEL_MESH_PAIRS` of them.
+pub const MIN_PARALLEL_WALKS: usize = 32;
 /// Jobs the channel holds; a frame with more answers the overflow on the calling thread.
 const QUEUE_CAPACITY: usize = 4096;
 
-/// One mesh–mesh pair to answer.
+/// One pair to answer: mesh–mesh, or a direct pair that walks a tree.
 #[derive(Debug, Clone)]
-pub(super) struct MeshJob {
+pub(super) struct PairJob {
     /// Index of the pair among the frame's candidates.
     pub slot: u32,
     pub pair: CandidatePair,
     pub a: Body,
     pub b: Body,
-    pub mesh_a: Arc<MeshShape>,
-    pub mesh_b: Arc<MeshShape>,
+    /// The bodies' shapes (clones share their meshes, hulls and compounds).
+    pub shapes: (Shape, Shape),
     pub query: Query,
+    /// A mesh pair's warm-start cache (unused by direct pairs).
     pub cache: DistanceCache,
     /// The frame's abandon flag.
     pub abandon: Abandon,
 }
 
-/// A pair's answer, its contacts and its updated warm-start cache.
+/// A pair's answer, its contacts, its updated warm-start cache and the dispatcher's paths
+/// it took (a direct pair's; a mesh pair's path is counted by the caller).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct MeshOutcome {
+pub(super) struct PairOutcome {
     pub slot: u32,
     pub answer: Answer,
     contacts: [ContactPoint; MANIFOLD_POINTS],
     contact_count: usize,
     pub cache: DistanceCache,
+    pub paths: PathCounts,
 }
 
-impl MeshOutcome {
+impl PairOutcome {
     /// The outcome of pair `slot`: its answer, the first [`MANIFOLD_POINTS`] of
-    /// `contacts` and its cache.
+    /// `contacts` and its cache (no paths).
     fn new(slot: u32, answer: Answer, contacts: &[ContactPoint], cache: DistanceCache) -> Self {
         let mut outcome = Self {
             slot,
@@ -83,6 +96,7 @@ impl MeshOutcome {
             contacts: [NO_CONTACT; MANIFOLD_POINTS],
             contact_count: contacts.len().min(MANIFOLD_POINTS),
             cache,
+            paths: PathCounts::default(),
         };
         outcome.contacts[..outcome.contact_count]
             .copy_from_slice(&contacts[..outcome.contact_count]);
@@ -105,41 +119,66 @@ const NO_CONTACT: ContactPoint = ContactPoint {
     error_bound: 0.0,
 };
 
-/// Answers `job` with `scratch`; `contacts` is scratch for the pair's contacts.
-pub(super) fn run(
-    job: &MeshJob,
-    scratch: &mut MeshScratch,
-    contacts: &mut Vec<ContactPoint>,
-) -> MeshOutcome {
+/// Scratch of one thread answering jobs, reused across jobs and frames.
+#[derive(Debug, Default)]
+pub(super) struct JobScratch {
+    mesh: MeshScratch,
+    narrow: NarrowScratch,
+    manifold: Manifold,
+    /// The contacts of the pair being answered.
+    contacts: Vec<ContactPoint>,
+}
+
+/// Answers `job` with `scratch`.
+fn run(job: &PairJob, scratch: &mut JobScratch) -> PairOutcome {
+    let JobScratch {
+        mesh,
+        narrow,
+        manifold,
+        contacts,
+    } = scratch;
     contacts.clear();
     let mut cache = job.cache;
-    let answer = answer::mesh_mesh(
-        &job.pair,
-        (&job.a, &job.mesh_a),
-        (&job.b, &job.mesh_b),
-        job.query,
-        &mut cache,
-        // The pool answers only frames without a limited budget: an unlimited clock, which
-        // stops only when the frame is abandoned.
-        (
-            scratch,
-            &mut WorkClock::default().abandonable(job.abandon.clone()),
+    // The pool answers only frames without a limited budget: an unlimited clock, which
+    // stops only when the frame is abandoned.
+    let mut clock = WorkClock::default().abandonable(job.abandon.clone());
+    let (sa, sb) = &job.shapes;
+    let answer = match dispatch::route(sa, sb) {
+        Route::MeshMesh(mesh_a, mesh_b) => answer::mesh_mesh(
+            &job.pair,
+            (&job.a, mesh_a),
+            (&job.b, mesh_b),
+            job.query,
+            &mut cache,
+            (mesh, &mut clock),
+            contacts,
         ),
-        contacts,
-    );
-    MeshOutcome::new(job.slot, answer, contacts, cache)
+        Route::Direct => {
+            narrow.clock = clock;
+            narrow.paths = PathCounts::default();
+            let answer = answer::direct(
+                &job.pair,
+                (&job.a, sa),
+                (&job.b, sb),
+                job.query,
+                narrow,
+                manifold,
+                contacts,
+            );
+            let mut outcome = PairOutcome::new(job.slot, answer, contacts, cache);
+            outcome.paths = narrow.paths;
+            return outcome;
+        }
+    };
+    PairOutcome::new(job.slot, answer, contacts, cache)
 }
 
 /// [`run`], with a panic turned into the pair's conservative box answer.
-fn run_guarded(
-    job: &MeshJob,
-    scratch: &mut MeshScratch,
-    contacts: &mut Vec<ContactPoint>,
-) -> MeshOutcome {
-    catch_unwind(AssertUnwindSafe(|| run(job, scratch, contacts))).unwrap_or_else(|_| {
+fn run_guarded(job: &PairJob, scratch: &mut JobScratch) -> PairOutcome {
+    catch_unwind(AssertUnwindSafe(|| run(job, scratch))).unwrap_or_else(|_| {
         // The scratch may be half-updated: start afresh.
-        *scratch = MeshScratch::default();
-        contacts.clear();
+        *scratch = JobScratch::default();
+        let contacts = &mut scratch.contacts;
         let answer = answer::boxes(
             &job.pair,
             &job.a.world_bounds,
@@ -147,7 +186,7 @@ fn run_guarded(
             job.query,
             contacts,
         );
-        MeshOutcome::new(job.slot, answer, contacts, DistanceCache::new())
+        PairOutcome::new(job.slot, answer, contacts, DistanceCache::new())
     })
 }
 
@@ -155,10 +194,10 @@ fn run_guarded(
 #[derive(Debug)]
 pub struct WorkerPool {
     /// `None` only while dropping (closing it stops the workers).
-    jobs: Option<Sender<MeshJob>>,
+    jobs: Option<Sender<PairJob>>,
     /// The same queue, for the calling thread to take jobs from.
-    queue: Receiver<MeshJob>,
-    outcomes: Receiver<MeshOutcome>,
+    queue: Receiver<PairJob>,
+    outcomes: Receiver<PairOutcome>,
     /// Held for the length of a frame: one frame at a time.
     frame: Mutex<()>,
     threads: Vec<JoinHandle<()>>,
@@ -171,7 +210,7 @@ impl WorkerPool {
     /// When the operating system cannot start a thread.
     #[must_use]
     pub fn new(workers: usize) -> Self {
-        let (jobs, queue) = channel::bounded::<MeshJob>(QUEUE_CAPACITY);
+        let (jobs, queue) = channel::bounded::<PairJob>(QUEUE_CAPACITY);
         let (outcome_tx, outcomes) = channel::bounded(QUEUE_CAPACITY);
         let threads = (0..workers)
             .map(|i| {
@@ -179,9 +218,9 @@ impl WorkerPool {
                 std::thread::Builder::new()
                     .name(format!("proxima-worker-{i}"))
                     .spawn(move || {
-                        let (mut scratch, mut contacts) = (MeshScratch::default(), Vec::new());
+                        let mut scratch = JobScratch::default();
                         for job in queue {
-                            let outcome = run_guarded(&job, &mut scratch, &mut contacts);
+                            let outcome = run_guarded(&job, &mut scratch);
                             if outcome_tx.send(outcome).is_err() {
                                 break;
                             }
@@ -205,14 +244,13 @@ impl WorkerPool {
         self.threads.len()
     }
 
-    /// Answers every job, on the workers and the calling thread (with `scratch` and
-    /// `contacts` as its scratch); `outcomes` receives one outcome per job, sorted by slot.
+    /// Answers every job, on the workers and the calling thread (with `scratch` as its
+    /// scratch); `outcomes` receives one outcome per job, sorted by slot.
     pub(super) fn answer_all(
         &self,
-        jobs: impl Iterator<Item = MeshJob>,
-        outcomes: &mut Vec<MeshOutcome>,
-        scratch: &mut MeshScratch,
-        contacts: &mut Vec<ContactPoint>,
+        jobs: impl Iterator<Item = PairJob>,
+        outcomes: &mut Vec<PairOutcome>,
+        scratch: &mut JobScratch,
     ) {
         let _frame = self.frame.lock().unwrap_or_else(PoisonError::into_inner);
         let sender = self.jobs.as_ref().expect("open until the pool drops");
@@ -221,12 +259,12 @@ impl WorkerPool {
             match sender.try_send(job) {
                 Ok(()) => pending += 1,
                 Err(TrySendError::Full(job) | TrySendError::Disconnected(job)) => {
-                    outcomes.push(run_guarded(&job, scratch, contacts));
+                    outcomes.push(run_guarded(&job, scratch));
                 }
             }
         }
         while let Ok(job) = self.queue.try_recv() {
-            outcomes.push(run_guarded(&job, scratch, contacts));
+            outcomes.push(run_guarded(&job, scratch));
             pending -= 1;
         }
         for _ in 0..pending {
