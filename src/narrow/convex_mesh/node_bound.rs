@@ -138,13 +138,20 @@ impl PlacedShape {
                 let mut y = rectangle_point(node, x);
                 x = on_box(y);
                 y = rectangle_point(node, x);
-                let mut gap = node_gap_with(node, x - y, q, width)
-                    .max(normal_gap(node, q, width))
-                    .max(node_gap_with(node, DVec3::X, q, width))
-                    .max(node_gap_with(node, DVec3::Y, q, width));
-                for axis in [m.x_axis, m.y_axis, m.z_axis] {
-                    gap = gap.max(node_gap_with(node, axis, q, width));
-                }
+                // The face axes are unit vectors (the box's to rounding, which the slack
+                // covers): their gaps need no normalising. The box's half widths along the
+                // node's axes, and the rectangle's along the box's.
+                let [l0, l1] = node.half_lengths;
+                let abs = [m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs()];
+                let box_width = abs[0] * e.x + abs[1] * e.y + abs[2] * e.z;
+                let by_node_axes = (q.x.abs() - l0 - box_width.x)
+                    .max(q.y.abs() - l1 - box_width.y)
+                    .max(q.z.abs() - box_width.z);
+                let by_box_axes = (q.dot(m.x_axis).abs() - e.x - l0 * abs[0].x - l1 * abs[0].y)
+                    .max(q.dot(m.y_axis).abs() - e.y - l0 * abs[1].x - l1 * abs[1].y)
+                    .max(q.dot(m.z_axis).abs() - e.z - l0 * abs[2].x - l1 * abs[2].y);
+                let gap = node_gap_with(node, x - y, q, width)
+                    .max(by_node_axes.max(by_box_axes) - node.radius);
                 (gap - slack(node, center, e.element_sum())).max(0.0)
             }
             Self::Fitted(ref rss) => node.distance_lower_bound(rss, &Isometry::IDENTITY),
