@@ -52,8 +52,9 @@ pub struct DaemonConfig {
     pub dead_client_grace: Duration,
     /// The least important messages written to stderr.
     pub log_level: Level,
-    /// Worker threads answering mesh–mesh pairs beside the frame thread (0: the frame
-    /// thread answers everything itself). Default: one fewer than the cores, at least one.
+    /// Worker threads answering the mesh–mesh pairs and tree walks of unbudgeted frames
+    /// beside the thread that runs the frame (0: it answers everything itself). Default:
+    /// one fewer than the cores, at least one.
     pub workers: usize,
     /// `SCHED_FIFO` priority (1–99) of the frame thread, so that no thread under the fair
     /// scheduler takes its CPU mid-frame ([`realtime`](super::realtime)); `None` (the

@@ -73,7 +73,7 @@ pub struct ServiceLoopSection {
     pub sweep_interval_ms: Option<u64>,
     /// How long a dead client's scenes live on, milliseconds.
     pub dead_client_grace_ms: Option<u64>,
-    /// Worker threads answering mesh–mesh pairs beside the loop (0: none).
+    /// Worker threads answering mesh–mesh pairs and tree walks beside the loop (0: none).
     pub workers: Option<usize>,
     /// `SCHED_FIFO` priority of the frame thread, 1–99.
     pub realtime_priority: Option<u8>,

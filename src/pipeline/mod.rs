@@ -9,8 +9,8 @@
 //!    traversal (`separation.rs`); under a limited budget the frontier refines the rest
 //!    (`frontier_run.rs`);
 //! 4. **narrow phase** (`pair_loop.rs`; the answers in `answer.rs`, on the worker pool for
-//!    many mesh pairs, `workers.rs`): each candidate's answer by its route, or its kept
-//!    answer;
+//!    many mesh pairs or tree walks on an unbudgeted frame, `workers.rs`): each
+//!    candidate's answer by its route, or its kept answer;
 //! 5. **time of impact** (`toi.rs`);
 //!
 //! and, across frames, what each pair remembers (`pair_memory.rs`). What each [`Query`] flag
