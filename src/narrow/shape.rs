@@ -15,7 +15,7 @@ use crate::narrow::convex_manifold::ContactFeatures;
 use crate::narrow::gjk::POINT;
 use crate::narrow::mesh_hull::MeshHull;
 use crate::narrow::mesh_mesh::{
-    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity,
+    DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, Proximity, cached_pair_within,
     distance_mesh_mesh_within, proximity_mesh_mesh_within, rounding_bound,
 };
 use std::sync::Arc;
@@ -172,6 +172,34 @@ impl MeshShape {
                 let (a, b) = self.sphere_trees(other);
                 let d = distance_mesh_mesh_within(a, b, pose_ab, exact, cache, workspace, clock);
                 restated(d, rounding_bound(a, b, &iso))
+            }
+        }
+    }
+
+    /// Whether the last closest triangle pair of [`distance_to_within`](Self::distance_to_within)
+    /// (remembered in `cache`) is within `max_distance` at `pose_ab`: a witness that
+    /// [`proximity`](Self::proximity) would answer [`Proximity::Within`], on the same trees
+    /// ([`mesh_mesh::cached_pair_within`](crate::narrow::mesh_mesh::cached_pair_within)).
+    #[must_use]
+    pub fn cached_pair_within(
+        &self,
+        other: &Self,
+        pose_ab: &Pose,
+        cache: &DistanceCache,
+        max_distance: f64,
+    ) -> bool {
+        match self.pair_volume(other, None) {
+            QueryVolume::Obb => {
+                let (a, b) = (&self.overlap_tree, &other.overlap_tree);
+                cached_pair_within(a, b, pose_ab, cache, max_distance)
+            }
+            QueryVolume::Rss => {
+                let (a, b) = (&self.distance_tree, &other.distance_tree);
+                cached_pair_within(a, b, pose_ab, cache, max_distance)
+            }
+            QueryVolume::Sphere => {
+                let (a, b) = self.sphere_trees(other);
+                cached_pair_within(a, b, pose_ab, cache, max_distance)
             }
         }
     }

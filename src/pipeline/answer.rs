@@ -197,7 +197,9 @@ pub(super) fn mesh_mesh(
     // could call a grazing contact apart, so when touching matters (`OVERLAP`,
     // `CONTACTS`) the exact predicates confirm before the pair is dismissed.
     let margins = a.margin + b.margin;
-    if query.close && !query.distance {
+    // PERF: a pair whose last closest triangle pair is still within the margins needs no
+    // proximity search (it would answer "within"): resting and sliding pairs.
+    if query.close && !query.distance && !ma.cached_pair_within(mb, &pose_ab, cache, margins) {
         let traversal = &mut scratch.traversal;
         let Some(proximity) = ma.proximity_within(mb, &pose_ab, margins, traversal, clock) else {
             return mesh_unsearched(pair, (a, b), query, contacts);

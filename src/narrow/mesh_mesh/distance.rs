@@ -245,6 +245,29 @@ pub fn proximity_mesh_mesh_within<B: BoundingVolume>(
     }
 }
 
+/// Whether the triangle pair `cache` remembers (the last closest pair of a distance search
+/// over these trees) is within `max_distance` at `pose_ab`: then some pair is, and
+/// [`proximity_mesh_mesh_within`] would answer [`Proximity::Within`] (it measures each pair
+/// with the same function, placed the same way), for the price of one triangle pair.
+/// `false` without a remembered pair, or one that names no triangle of these trees.
+#[must_use]
+pub fn cached_pair_within<B: BoundingVolume>(
+    a: &Bvh<B>,
+    b: &Bvh<B>,
+    pose_ab: &Pose,
+    cache: &DistanceCache,
+    max_distance: f64,
+) -> bool {
+    let (ta, tb) = (a.triangles(), b.triangles());
+    match cache.slots {
+        Some([sa, sb]) if (sa as usize) < ta.len() && (sb as usize) < tb.len() => {
+            let tri_b = tb[sb as usize].transformed(&pose_ab.to_isometry());
+            distance_triangle_triangle(&ta[sa as usize], &tri_b).distance <= max_distance
+        }
+        _ => false,
+    }
+}
+
 /// Rounding error of a triangle–triangle distance between these meshes at this pose: a few
 /// ulps of the largest coordinate involved (measured on the root volumes, so it depends on
 /// the volume type a little; the pipeline states it from the RSS trees on every path).
@@ -356,5 +379,53 @@ mod tests {
         }
         check::<Obb>(&fan, &above, expected);
         check::<Rss>(&fan, &above, expected);
+    }
+}
+
+#[cfg(test)]
+mod cached_pair_tests {
+    use super::*;
+    use crate::bounding::Rss;
+    use crate::bvh::BuildParams;
+    use crate::test_support::{meshes, point_in_cube, rng, rotation};
+
+    /// Two tori moving coherently, a distance search each frame keeping its cache: whenever
+    /// the remembered pair is within the limit at the next pose, the proximity search
+    /// answers "within" too (the pipeline skips it then), and the remembered pair is within
+    /// on many frames and not on many others.
+    #[test]
+    fn a_cached_pair_within_the_limit_means_the_proximity_search_says_within() {
+        let torus = meshes::torus(0.6, 0.15, 20, 8);
+        let tree = Bvh::<Rss>::from_mesh(&torus, &BuildParams::BINNED_SAH);
+        let mut rng = rng(2024);
+        let mut workspace = MeshMeshWorkspace::default();
+        let (mut within, mut not) = (0, 0);
+        for run in 0..40 {
+            let mut cache = DistanceCache::new();
+            let mut pose = Pose::new(point_in_cube(&mut rng, 0.8), rotation(&mut rng));
+            for frame in 0..50 {
+                let limit = 0.05;
+                if cached_pair_within(&tree, &tree, &pose, &cache, limit) {
+                    within += 1;
+                    let proximity = proximity_mesh_mesh(&tree, &tree, &pose, limit, &mut workspace);
+                    assert_eq!(proximity, Proximity::Within, "run {run} frame {frame}");
+                } else {
+                    not += 1;
+                }
+                let _ = distance_mesh_mesh(
+                    &tree,
+                    &tree,
+                    &pose,
+                    &DistanceParams::EXACT,
+                    &mut cache,
+                    &mut workspace,
+                );
+                pose = Pose::new(
+                    (pose.position + point_in_cube(&mut rng, 0.03)).clamp_length_max(1.0),
+                    rotation(&mut rng).slerp(pose.rotation, 0.97),
+                );
+            }
+        }
+        assert!(within > 300 && not > 200, "{within} / {not}");
     }
 }

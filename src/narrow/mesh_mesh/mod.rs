@@ -42,9 +42,9 @@ pub use collide::{
     intersects_mesh_mesh_within,
 };
 pub use distance::{
-    Proximity, TRIANGLE_DISTANCE_WORK, distance_mesh_mesh, distance_mesh_mesh_within,
-    precedes_in_ties, proximity_mesh_mesh, proximity_mesh_mesh_within, rounding_bound,
-    within_distance_mesh_mesh,
+    Proximity, TRIANGLE_DISTANCE_WORK, cached_pair_within, distance_mesh_mesh,
+    distance_mesh_mesh_within, precedes_in_ties, proximity_mesh_mesh, proximity_mesh_mesh_within,
+    rounding_bound, within_distance_mesh_mesh,
 };
 
 use crate::budget::WorkClock;
