@@ -88,15 +88,21 @@ pub(super) struct PairOutcome {
 
 impl PairOutcome {
     /// The outcome of pair `slot`: its answer, the first [`MANIFOLD_POINTS`] of
-    /// `contacts` and its cache (no paths).
-    fn new(slot: u32, answer: Answer, contacts: &[ContactPoint], cache: DistanceCache) -> Self {
+    /// `contacts`, its cache and its paths.
+    fn new(
+        slot: u32,
+        answer: Answer,
+        contacts: &[ContactPoint],
+        cache: DistanceCache,
+        paths: PathCounts,
+    ) -> Self {
         let mut outcome = Self {
             slot,
             answer,
             contacts: [NO_CONTACT; MANIFOLD_POINTS],
             contact_count: contacts.len().min(MANIFOLD_POINTS),
             cache,
-            paths: PathCounts::default(),
+            paths,
         };
         outcome.contacts[..outcome.contact_count]
             .copy_from_slice(&contacts[..outcome.contact_count]);
@@ -143,16 +149,19 @@ fn run(job: &PairJob, scratch: &mut JobScratch) -> PairOutcome {
     // stops only when the frame is abandoned.
     let mut clock = WorkClock::default().abandonable(job.abandon.clone());
     let (sa, sb) = &job.shapes;
-    let answer = match dispatch::route(sa, sb) {
-        Route::MeshMesh(mesh_a, mesh_b) => answer::mesh_mesh(
-            &job.pair,
-            (&job.a, mesh_a),
-            (&job.b, mesh_b),
-            job.query,
-            &mut cache,
-            (mesh, &mut clock),
-            contacts,
-        ),
+    let (answer, paths) = match dispatch::route(sa, sb) {
+        Route::MeshMesh(mesh_a, mesh_b) => {
+            let answer = answer::mesh_mesh(
+                &job.pair,
+                (&job.a, mesh_a),
+                (&job.b, mesh_b),
+                job.query,
+                &mut cache,
+                (mesh, &mut clock),
+                contacts,
+            );
+            (answer, PathCounts::default())
+        }
         Route::Direct => {
             narrow.clock = clock;
             narrow.paths = PathCounts::default();
@@ -165,12 +174,10 @@ fn run(job: &PairJob, scratch: &mut JobScratch) -> PairOutcome {
                 manifold,
                 contacts,
             );
-            let mut outcome = PairOutcome::new(job.slot, answer, contacts, cache);
-            outcome.paths = narrow.paths;
-            return outcome;
+            (answer, narrow.paths)
         }
     };
-    PairOutcome::new(job.slot, answer, contacts, cache)
+    PairOutcome::new(job.slot, answer, contacts, cache, paths)
 }
 
 /// [`run`], with a panic turned into the pair's conservative box answer.
@@ -186,7 +193,8 @@ fn run_guarded(job: &PairJob, scratch: &mut JobScratch) -> PairOutcome {
             job.query,
             contacts,
         );
-        PairOutcome::new(job.slot, answer, contacts, DistanceCache::new())
+        let paths = PathCounts::default();
+        PairOutcome::new(job.slot, answer, contacts, DistanceCache::new(), paths)
     })
 }
 
