@@ -536,7 +536,8 @@ pub fn rectangle_distance(a: [f64; 2], c: DVec3, u: DVec3, v: DVec3, b: [f64; 2]
     // ([`Closest::normal`]): on a large rectangle a direction off by rounding loses the
     // half-lengths times that rounding. In A's frame the clamp leaves those components
     // exactly zero; along B's axes they are removed.
-    // PERF: a sphere against a mesh's RSS tree (`benches/convex_mesh.rs`).
+    // PERF: a ball's volume against an RSS tree (`convex_mesh::volume_bound` of a ball);
+    // the pipeline's walk has its own inline copy (`convex_mesh/node_bound.rs`).
     if b == [0.0, 0.0] {
         let closest = DVec3::new(clamp_symmetric(c.x, a[0]), clamp_symmetric(c.y, a[1]), 0.0);
         return certified_gap(c - closest, a, c, [u, v], b);

@@ -6,9 +6,12 @@
 //! as `crate::test_support` (see `src/lib.rs`). Items unused by one test file are allowed.
 #![allow(dead_code)]
 
+use proxima::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere};
 use proxima::math::{DQuat, DVec3, Isometry, Pose};
+use proxima::narrow::Shape;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
+use std::sync::Arc;
 
 pub mod data;
 pub mod meshes;
@@ -184,4 +187,24 @@ pub fn min_distance(a: &[DVec3], b: &[DVec3]) -> f64 {
     a.iter()
         .flat_map(|p| b.iter().map(move |q| p.distance(*q)))
         .fold(f64::INFINITY, f64::min)
+}
+
+/// One of the first `kinds` convex kinds (box, ball, capsule, cylinder, cone, hull of 12
+/// points), each size a uniform fraction 0.2–1 of `scale`.
+pub fn random_convex(rng: &mut TestRng, scale: f64, kinds: usize) -> Shape {
+    let mut size = || rng.random_range(0.2..1.0) * scale;
+    let (p, q, r) = (size(), size(), size());
+    match rng.random_range(0..kinds) {
+        0 => Shape::Cuboid(Cuboid::new(DVec3::new(p, q, r))),
+        1 => Shape::Sphere(Sphere::new(p)),
+        2 => Shape::Capsule(Capsule::new(p, q * 0.5)),
+        3 => Shape::Cylinder(Cylinder::new(p, q)),
+        4 => Shape::Cone(Cone::new(p, q)),
+        _ => {
+            let points: Vec<DVec3> = (0..12).map(|_| point_in_cube(rng, scale)).collect();
+            Shape::Convex(Arc::new(
+                ConvexPolyhedron::try_from_points(&points).unwrap(),
+            ))
+        }
+    }
 }

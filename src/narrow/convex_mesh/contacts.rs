@@ -649,10 +649,10 @@ pub fn shape_triangle_manifold(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, TriMesh};
+    use crate::geometry::{Cuboid, Sphere, TriMesh};
     use crate::math::DQuat;
     use crate::narrow::dispatch::{distance, manifold};
-    use crate::test_support::{TestRng, meshes, point_in_cube, rng, rotation};
+    use crate::test_support::{TestRng, meshes, point_in_cube, random_convex, rng, rotation};
     use rand::Rng;
     use std::sync::Arc;
 
@@ -703,25 +703,6 @@ mod tests {
     fn small_rotation(rng: &mut TestRng, max_angle: f64) -> DQuat {
         let axis = (rotation(rng) * DVec3::X).normalize();
         DQuat::from_axis_angle(axis, rng.random_range(-max_angle..=max_angle))
-    }
-
-    /// One of the convex kinds, of size about `scale`.
-    fn random_convex(rng: &mut TestRng, scale: f64, kinds: usize) -> Shape {
-        let mut size = || rng.random_range(0.2..1.0) * scale;
-        let (p, q, r) = (size(), size(), size());
-        match rng.random_range(0..kinds) {
-            0 => Shape::Cuboid(Cuboid::new(DVec3::new(p, q, r))),
-            1 => Shape::Sphere(Sphere::new(p)),
-            2 => Shape::Capsule(Capsule::new(p, q * 0.5)),
-            3 => Shape::Cylinder(Cylinder::new(p, q)),
-            4 => Shape::Cone(Cone::new(p, q)),
-            _ => {
-                let points: Vec<DVec3> = (0..12).map(|_| point_in_cube(rng, scale)).collect();
-                Shape::Convex(Arc::new(
-                    ConvexPolyhedron::try_from_points(&points).unwrap(),
-                ))
-            }
-        }
     }
 
     /// The angle between two unit vectors, radians (accurate near 0).
