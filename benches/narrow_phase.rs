@@ -18,6 +18,7 @@
 //! | `cuboid_cuboid_manifold` | [`manifold_cuboid_cuboid`]: up to 4 points, clipped faces (empty when apart) | `PersistentQueryDispatcher::contact_manifold_convex_convex` with prediction 0 into one reused `ContactManifold` (no contact reuse between unrelated poses: each is a fresh manifold computation, as `contact_manifolds` would do on a new pair) |
 //! | `convex_distance/hullN` (separated poses) | [`gjk_distance`] on [`ConvexPolyhedron`] hulls of `N` = 8, 64, 512, 4,096 random points on the unit sphere: `proxima` plain GJK, `proxima-accelerated` with `GjkParams { accelerated: true, .. }`, `proxima-warm` plain with a [`GjkCache`] per pose kept across laps (the best case of frame-to-frame coherence); other runs use a fresh cache | `query::distance` on `ConvexPolyhedron::from_convex_hull` of the same points (GJK) |
 //! | `convex_depth/hullN` (penetrating poses) | [`signed_distance_convex`] (GJK, then EPA on penetration), same three variants, one [`EpaWorkspace`] per bench | `query::contact` with prediction 0 (GJK, then EPA) |
+//! | `curved_depth/cylinder_cylinder`, `curved_depth/cylinder_hull` (penetrating poses) | [`signed_distance_convex`] on a 2 cm × 6 cm cylinder against a 1.5 cm × 4 cm one, or against a hull of 40 random points in a 2.5 cm ball: EPA on a curved difference, the pile's slowest pairs; plain only | `query::contact` with prediction 0 (parry's cylinder stands on Y: turned onto Z by a fixed rotation in `pos12`) |
 //!
 //! Support maps differ: Proxima's hull climbs its vertex adjacency (a linear scan below
 //! `HILL_CLIMB_MIN_VERTICES` vertices), parry's `ConvexPolyhedron` scans every vertex, so
@@ -45,9 +46,9 @@ use parry3d_f64::math::Pose as ParryPose;
 use parry3d_f64::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d_f64::shape::{
     Ball as ParryBall, Capsule as ParryCapsule, ConvexPolyhedron as ParryHull,
-    Cuboid as ParryCuboid, Shape as ParryShape,
+    Cuboid as ParryCuboid, Cylinder as ParryCylinder, Shape as ParryShape,
 };
-use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Sphere};
+use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Sphere, SupportMap};
 use proxima::math::{DVec3, Isometry, Pose};
 use proxima::narrow::gjk::EpaWorkspace;
 use proxima::narrow::{
@@ -505,10 +506,102 @@ fn convex_hulls(c: &mut Criterion, rng: &mut TestRng) {
     depth.finish();
 }
 
-/// Proxima's signed distance of two hulls (GJK, EPA on penetration).
-fn signed(
-    a: &ConvexPolyhedron,
-    b: &ConvexPolyhedron,
+/// Penetration of curved pairs (module docs' `curved_depth`): GJK then EPA, where EPA's
+/// polytope must follow a cylinder's rim or side to the tolerance.
+fn curved_pairs(c: &mut Criterion, rng: &mut TestRng) {
+    let (big, small) = (Cylinder::new(0.03, 0.02), Cylinder::new(0.02, 0.015));
+    let points: Vec<DVec3> = (0..40)
+        .map(|_| support::rotation(rng) * DVec3::Z * (0.025 * rng.random::<f64>().cbrt()))
+        .collect();
+    let hull = ConvexPolyhedron::try_from_points(&points).expect("points in a ball");
+    let parry_big = ParryCylinder::new(big.half_height, big.radius);
+    let parry_small = ParryCylinder::new(small.half_height, small.radius);
+    let parry_hull =
+        ParryHull::from_convex_hull(&points.iter().map(|&p| parry_vector(p)).collect::<Vec<_>>())
+            .expect("parry builds the hull");
+    // parry's cylinders stand on Y; this turns Proxima's Z axis onto it.
+    let z_onto_y = Pose::new(
+        DVec3::ZERO,
+        proxima::math::DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2),
+    );
+    let mut group = c.benchmark_group("narrow_phase/curved_depth");
+    let mut workspace = EpaWorkspace::default();
+    let pairs: [(&str, &dyn SupportMap, &dyn ParryShape, bool); 2] = [
+        ("cylinder_cylinder", &small, &parry_small, true),
+        ("cylinder_hull", &hull, &parry_hull, false),
+    ];
+    for (name, b, parry_b, b_is_cylinder) in pairs {
+        let [_, penetrating] = sorted_poses(rng, 0.06, |pose| {
+            signed(
+                &big,
+                b,
+                pose,
+                &GjkParams::default(),
+                &mut GjkCache::default(),
+                &mut workspace,
+            )
+        });
+        let pos12: Vec<ParryPose> = penetrating
+            .proxima
+            .iter()
+            .map(|iso| {
+                let pose = iso.to_pose();
+                let b_frame = if b_is_cylinder {
+                    z_onto_y
+                } else {
+                    Pose::IDENTITY
+                };
+                parry_pose(&z_onto_y.inverse().compose(&pose).compose(&b_frame))
+            })
+            .collect();
+        let worst = penetrating
+            .proxima
+            .iter()
+            .zip(&pos12)
+            .map(|(p, q)| {
+                let ours = signed(
+                    &big,
+                    b,
+                    p,
+                    &GjkParams::default(),
+                    &mut GjkCache::default(),
+                    &mut workspace,
+                );
+                (ours - parry_signed(&parry_big, parry_b, q, false)).abs()
+            })
+            .fold(0.0, f64::max);
+        eprintln!(
+            "narrow_phase/curved_depth/{name}: largest |proxima − parry| signed distance {worst:e} m"
+        );
+        cycle_bench(
+            &mut group,
+            BenchmarkId::new("proxima", name),
+            &penetrating.proxima,
+            |_, pose| {
+                signed(
+                    black_box(&big),
+                    black_box(b),
+                    pose,
+                    &GjkParams::default(),
+                    &mut GjkCache::default(),
+                    &mut workspace,
+                )
+            },
+        );
+        cycle_bench(
+            &mut group,
+            BenchmarkId::new("parry", name),
+            &pos12,
+            |_, pos12| parry_signed(black_box(&parry_big), black_box(parry_b), pos12, false),
+        );
+    }
+    group.finish();
+}
+
+/// Proxima's signed distance of two convex shapes (GJK, EPA on penetration).
+fn signed<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
+    a: &A,
+    b: &B,
     pose_ab: &Isometry,
     params: &GjkParams,
     cache: &mut GjkCache,
@@ -524,6 +617,7 @@ fn narrow_phase(c: &mut Criterion) {
     let mut rng = support::rng(SEED);
     closed_form_pairs(c, &mut rng);
     convex_hulls(c, &mut rng);
+    curved_pairs(c, &mut rng);
 }
 
 criterion_group!(benches, narrow_phase);
