@@ -88,7 +88,7 @@ pub use plan::{
     COLD_RESERVE, Deadline, FRONTIER_RESERVE, FrontierClock, MIN_ANSWERED_PAIRS, Unlimited,
     VisitBudget, frontier_deadline,
 };
-use plan::{FramePlan, mandatory_work_fits};
+use plan::{FramePlan, PoolWork, mandatory_work_fits};
 pub use toi::{PairToi, TOI_TOLERANCE};
 
 use crate::broad::{BroadPhaseKind, BroadPhaseStats, CandidatePair};
@@ -97,6 +97,7 @@ use crate::narrow::MeshShape;
 use crate::narrow::Shape;
 use crate::narrow::contact::Manifold;
 use crate::narrow::dispatch::{self, NarrowScratch, Route};
+use crate::narrow::mesh_mesh::DistanceCache;
 use crate::narrow::mesh_mesh::frontier::{FrontierAnswer, FrontierStats, FrontierWorkspace};
 use crate::scene::{Body, BodyId, Scene};
 use answer::{Answer, MeshScratch};
@@ -382,6 +383,8 @@ pub struct PipelineWorkspace {
     separated: Vec<bool>,
     /// Answers a frame's mesh–mesh pairs and tree walks in parallel (see [`workers`]).
     workers: Option<Arc<WorkerPool>>,
+    /// The pairs for the pool this frame (candidate slot and work), found once.
+    pool_slots: Vec<(u32, PoolWork)>,
     /// The pool's answers of this frame, by candidate slot.
     outcomes: Vec<PairOutcome>,
     /// Scratch of the pool's jobs this thread answers.
@@ -729,38 +732,48 @@ fn answer_on_pool(
         memory,
         separated,
         workers,
+        pool_slots,
         outcomes,
         job_scratch,
         abandon,
         ..
     } = workspace;
     outcomes.clear();
-    // The pairs for the pool that no kept answer or separation answers, by candidate slot,
-    // with their shapes and work.
-    let needed = || {
-        candidates.iter().enumerate().filter_map(|(slot, pair)| {
-            let (a, b) = (body(scene, pair.a), body(scene, pair.b));
-            let shapes = (shape(scene, a), shape(scene, b));
-            let work = plan::pool_work(shapes.0, shapes.1)?;
-            let needed = !separated[slot] && memory.kept_answer(scene, pair, query).is_none();
-            needed.then_some((slot, pair, (a, b), shapes, work))
-        })
-    };
     // A scene without a mesh or compound has no pair for the pool to look for.
-    let wanted =
-        |_: &_| scene.has_tree_shapes() && plan.wants_pool(needed().map(|(.., work)| work));
-    let Some(pool) = workers.as_ref().filter(wanted) else {
+    let Some(pool) = workers
+        .as_ref()
+        .filter(|_| scene.has_tree_shapes() && plan.allows_pool())
+    else {
         return false;
     };
-    let jobs = needed().map(|(slot, pair, (a, b), (sa, sb), _)| PairJob {
-        slot: index(slot),
-        pair: *pair,
-        a: *a,
-        b: *b,
-        shapes: (sa.clone(), sb.clone()),
-        query,
-        cache: memory.mesh_cache(pair),
-        abandon: abandon.clone(),
+    // The pairs for the pool that no kept answer or separation answers: one look-up each.
+    pool_slots.clear();
+    pool_slots.extend(candidates.iter().enumerate().filter_map(|(slot, pair)| {
+        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+        let work = plan::pool_work(shape(scene, a), shape(scene, b))?;
+        let needed = !separated[slot] && memory.kept_answer(scene, pair, query).is_none();
+        needed.then_some((index(slot), work))
+    }));
+    if !plan.wants_pool(pool_slots.iter().map(|&(_, work)| work)) {
+        return false;
+    }
+    let jobs = pool_slots.iter().map(|&(slot, work)| {
+        let pair = &candidates[slot as usize];
+        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+        PairJob {
+            slot,
+            pair: *pair,
+            a: *a,
+            b: *b,
+            shapes: (shape(scene, a).clone(), shape(scene, b).clone()),
+            query,
+            // Only a mesh pair has a warm start.
+            cache: match work {
+                PoolWork::MeshPair => memory.mesh_cache(pair),
+                PoolWork::Walk => DistanceCache::new(),
+            },
+            abandon: abandon.clone(),
+        }
     });
     pool.answer_all(jobs, outcomes, job_scratch);
     true

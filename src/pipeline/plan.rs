@@ -256,17 +256,21 @@ impl FramePlan {
         all - fits
     }
 
+    /// Whether this frame may use the worker pool at all: never under a limited budget
+    /// (the frontier runs on one thread) nor in a slice (the pool's pairs are not polled).
+    pub(super) fn allows_pool(&self) -> bool {
+        !self.limited && self.slice.is_none()
+    }
+
     /// Whether a frame with these pairs to answer on the pool (each its [`PoolWork`]) uses
-    /// the worker pool: never under a limited budget (the frontier runs on one thread) nor
-    /// in a slice (the pool's pairs are not polled), and only with at least
+    /// the worker pool: when [`allows_pool`](Self::allows_pool), and only with at least
     /// [`MIN_PARALLEL_MESH_PAIRS`] mesh pairs or [`MIN_PARALLEL_WALKS`] walks, a mesh pair
     /// counting as `MIN_PARALLEL_WALKS / MIN_PARALLEL_MESH_PAIRS` walks.
-    pub(super) fn wants_pool(&self, needed: impl Iterator<Item = PoolWork>) -> bool {
+    pub(super) fn wants_pool(&self, mut needed: impl Iterator<Item = PoolWork>) -> bool {
         const MESH_PAIR_WALKS: usize = MIN_PARALLEL_WALKS / MIN_PARALLEL_MESH_PAIRS;
         let mut walks = 0;
-        !self.limited
-            && self.slice.is_none()
-            && needed.into_iter().any(|work| {
+        self.allows_pool()
+            && needed.any(|work| {
                 walks += match work {
                     PoolWork::MeshPair => MESH_PAIR_WALKS,
                     PoolWork::Walk => 1,
