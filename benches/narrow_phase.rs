@@ -41,7 +41,7 @@ mod parry_convert;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use cycle::cycle_bench;
-use parry_convert::{parry_pose, parry_vector};
+use parry_convert::{parry_cylinder_offset, parry_pose, parry_vector};
 use parry3d_f64::math::Pose as ParryPose;
 use parry3d_f64::query::{ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher};
 use parry3d_f64::shape::{
@@ -519,11 +519,7 @@ fn curved_pairs(c: &mut Criterion, rng: &mut TestRng) {
     let parry_hull =
         ParryHull::from_convex_hull(&points.iter().map(|&p| parry_vector(p)).collect::<Vec<_>>())
             .expect("parry builds the hull");
-    // parry's cylinders stand on Y; this turns Proxima's Z axis onto it.
-    let z_onto_y = Pose::new(
-        DVec3::ZERO,
-        proxima::math::DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2),
-    );
+    let cylinder_offset = parry_cylinder_offset();
     let mut group = c.benchmark_group("narrow_phase/curved_depth");
     let mut workspace = EpaWorkspace::default();
     let pairs: [(&str, &dyn SupportMap, &dyn ParryShape, bool); 2] = [
@@ -547,11 +543,11 @@ fn curved_pairs(c: &mut Criterion, rng: &mut TestRng) {
             .map(|iso| {
                 let pose = iso.to_pose();
                 let b_frame = if b_is_cylinder {
-                    z_onto_y
+                    cylinder_offset
                 } else {
                     Pose::IDENTITY
                 };
-                parry_pose(&z_onto_y.inverse().compose(&pose).compose(&b_frame))
+                parry_pose(&cylinder_offset.inverse().compose(&pose).compose(&b_frame))
             })
             .collect();
         let worst = penetrating

@@ -60,7 +60,7 @@ mod parry_convert;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use cycle::cycle_bench;
-use parry_convert::{parry_pose, parry_vector};
+use parry_convert::{parry_cylinder_offset, parry_pose, parry_vector};
 use parry3d_f64::math::{Pose as ParryPose, Vector as ParryVector};
 use parry3d_f64::shape::SharedShape;
 use pile::{PILE_RATE_HZ, pile_scene, pile_world};
@@ -75,7 +75,6 @@ use proxima::scene::{BodyId, Motion, Scene};
 use proxima_ipc::client::Primitive;
 use proxima_ipc::wire::ResultRecord;
 use spec::{SceneSpec, ShapeSpec};
-use std::f64::consts::FRAC_PI_2;
 use std::hint::black_box;
 
 /// The pile's seed (the one `examples/deadline_bench.rs` drops).
@@ -198,13 +197,12 @@ fn parry_shape(spec: &ShapeSpec) -> ParryShape {
         ShapeSpec::Primitive(Primitive::Cuboid {
             half_extents: [x, y, z],
         }) => plain(SharedShape::cuboid(x, y, z)),
-        // parry's cylinder is along Y, Proxima's along Z: a quarter turn about X maps Y to Z.
         ShapeSpec::Primitive(Primitive::Cylinder {
             radius,
             half_height,
         }) => ParryShape {
             shape: SharedShape::cylinder(half_height, radius),
-            offset: Pose::from_rotation(DQuat::from_rotation_x(FRAC_PI_2)),
+            offset: parry_cylinder_offset(),
         },
         ShapeSpec::Convex(ref points) => {
             let points: Vec<ParryVector> = points.iter().map(|p| parry_vector(*p)).collect();

@@ -6,7 +6,7 @@
 use parry3d_f64::math::{Pose as ParryPose, Rotation as ParryRotation, Vector as ParryVector};
 use parry3d_f64::shape::TriMesh as ParryMesh;
 use proxima::geometry::TriMesh;
-use proxima::math::{DVec3, Pose};
+use proxima::math::{DQuat, DVec3, Pose};
 
 /// The same vector.
 pub fn parry_vector(v: DVec3) -> ParryVector {
@@ -26,4 +26,11 @@ pub fn parry_pose(pose: &Pose) -> ParryPose {
 pub fn parry_mesh(mesh: &TriMesh) -> ParryMesh {
     let vertices = mesh.vertices().iter().map(|&p| parry_vector(p)).collect();
     ParryMesh::new(vertices, mesh.triangles().to_vec()).expect("parry accepts the mesh")
+}
+
+/// The pose of parry's cylinder (its axis along Y) in Proxima's cylinder frame (axis along
+/// Z): a quarter turn about X, which maps Y to Z. A Proxima cylinder at `pose` is parry's
+/// at `pose.compose(&parry_cylinder_offset())`.
+pub fn parry_cylinder_offset() -> Pose {
+    Pose::from_rotation(DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2))
 }

@@ -31,7 +31,7 @@ use crate::narrow::convex_manifold::{ManifoldScratch, manifold_convex_convex_in}
 use crate::narrow::convex_mesh::ConvexMeshWorkspace;
 use crate::narrow::convex_mesh::{MeshContactScratch, shape_mesh_distance, shape_mesh_manifold};
 use crate::narrow::gjk::{
-    EpaWorkspace, GjkCache, GjkOutcome, GjkParams, Rounded, signed_distance_convex_within,
+    self, EpaWorkspace, GjkCache, GjkOutcome, GjkParams, Rounded, signed_distance_convex_within,
 };
 use crate::narrow::mesh_mesh::{DistanceCache, MeshMeshWorkspace};
 use crate::narrow::pairs::{self, FaceCertificate};
@@ -453,7 +453,8 @@ fn beyond_along_centres(
         .transform_point(core_b.support(pose_ab.inverse_transform_vector(-normal)))
         - normal * radius_b;
     let scale = point_a.abs().max_element().max(point_b.abs().max_element());
-    let gap = normal.dot(point_b - point_a) - ROUNDING_ULPS * f64::EPSILON * scale;
+    // GJK's own allowance for the rounding of support points and pose.
+    let gap = normal.dot(point_b - point_a) - gjk::ROUNDING_ULPS * f64::EPSILON * scale;
     (gap > limit).then_some(ShapeDistance {
         distance: gap,
         point_a,
@@ -461,10 +462,6 @@ fn beyond_along_centres(
         normal,
     })
 }
-
-/// Multiple of `f64::EPSILON × scale` taken off [`beyond_along_centres`]' gap for the
-/// rounding of its support points and pose (GJK's own allowance).
-const ROUNDING_ULPS: f64 = 64.0;
 
 /// A convex pair's answer from `certificate` when it has one, else from a cylinder's
 /// certificate when either shape is a cylinder ([`cylinder_certificate`]), else from GJK

@@ -7,16 +7,16 @@
 //! compounds are `Arc`s, the query and a mesh pair's warm-start cache), so workers hold no
 //! borrow of the scene and need no `unsafe`. Jobs travel over a bounded crossbeam channel
 //! (a fixed ring: no allocation per message); the calling thread takes queued jobs itself
-//! once it has handed them out, then
-//! collects the workers' outcomes and sorts them by candidate slot, so the frame's results
-//! are the same, in the same order, whichever thread answered which pair.
+//! once it has handed them out, then collects the workers' outcomes and sorts them by
+//! candidate slot, so the frame's results are the same, in the same order, whichever
+//! thread answered which pair.
 //!
 //! Waking a parked worker costs 60–120 µs on a VM, so [`step`](super::step) hands out work
 //! only when a frame has at least [`MIN_PARALLEL_MESH_PAIRS`] mesh pairs or
 //! [`MIN_PARALLEL_WALKS`] tree walks (a mesh pair counting as
 //! `MIN_PARALLEL_WALKS / MIN_PARALLEL_MESH_PAIRS` walks); the calling thread does not wait
-//! for the wake, it starts on the queue at once. A pool serves one
-//! frame at a time (a lock held for the frame), so scenes may share one.
+//! for the wake, it starts on the queue at once. A pool serves one frame at a time (a lock
+//! held for the frame), so scenes may share one.
 //!
 //! Budgeted frames refine their frontier on the calling thread only. Measured and not
 //! kept (`examples/time_vs_error --workers 1`, mesh pile, 300 frames, two alternating runs

@@ -242,10 +242,10 @@ mod tests {
         (Rss::fit_triangles(&triangles), triangles)
     }
 
-    /// Over random shapes (every convex kind), poses and nodes, the bound never exceeds the shape's distance to
-    /// any triangle inside the node (the per-triangle closed forms or GJK/EPA, clamped at
-    /// 0 like the bound). Both pruning (a positive bound) and touching nodes occur, and for
-    /// balls the bound is the fitted RSS's exact distance.
+    /// Over random shapes (every convex kind), poses and nodes, the bound never exceeds the
+    /// shape's distance to any triangle inside the node (the per-triangle closed forms or
+    /// GJK/EPA, clamped at 0 like the bound). Both pruning (a positive bound) and touching
+    /// nodes occur, and for balls the bound is the fitted RSS's exact distance.
     #[test]
     fn the_bound_never_exceeds_the_distance_to_the_nodes_triangles() {
         let mut rng = rng(4242);

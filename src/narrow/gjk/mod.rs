@@ -34,7 +34,7 @@ pub use simplex::{Simplex, SupportPoint};
 
 /// Multiple of `f64::EPSILON × scale` (scale: the largest support point seen) under which
 /// the distance is rounding noise: GJK then answers [`GjkOutcome::Touching`].
-const ROUNDING_ULPS: f64 = 64.0;
+pub(crate) const ROUNDING_ULPS: f64 = 64.0;
 
 /// Parameters of [`gjk_distance`] and [`epa::penetration`].
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -298,6 +298,7 @@ mod tests {
     use crate::geometry::Triangle;
     use crate::math::DVec3;
     use crate::narrow::mesh_mesh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
+    use crate::test_support::{meshes, point_in_cube, rng, rotation};
 
     /// A flat fan of four triangles around the origin, and a triangle whose lowest vertex is
     /// 1 m above the origin: its closest point is the vertex every fan triangle shares, so
@@ -380,14 +381,6 @@ mod tests {
         check::<Obb>(&fan, &above, expected);
         check::<Rss>(&fan, &above, expected);
     }
-}
-
-#[cfg(test)]
-mod cached_pair_tests {
-    use super::*;
-    use crate::bounding::Rss;
-    use crate::bvh::BuildParams;
-    use crate::test_support::{meshes, point_in_cube, rng, rotation};
 
     /// Two tori moving coherently, a distance search each frame keeping its cache: whenever
     /// the remembered pair is within the limit at the next pose, the proximity search
