@@ -16,15 +16,16 @@
 #[path = "support/mod.rs"]
 mod support;
 
+use proxima::budget::WorkClock;
 use proxima::geometry::{Capsule, Segment, Sphere};
 use proxima::geometry::{Cone, ConvexPolyhedron, Cuboid, Cylinder, SupportMap, Triangle};
 use proxima::math::{DQuat, DVec3, Isometry, Pose};
 use proxima::narrow::gjk::{
     ConvexOutcome, EpaOutcome, EpaWorkspace, GjkCache, GjkOutcome, GjkParams, Rounded,
-    gjk_distance, signed_distance_convex,
+    gjk_distance, signed_distance_convex, signed_distance_convex_within,
 };
 use proxima::narrow::gjk::{POINT, capsule_core};
-use proxima::narrow::{ShapeDistance, distance_triangle_triangle};
+use proxima::narrow::{Reached, ShapeDistance, distance_triangle_triangle};
 use rand::Rng;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -257,7 +258,13 @@ fn box_pairs_match_the_triangle_and_sat_oracles() {
         let (ca, cb) = (random_box(&mut r, 0.1, 1.0), random_box(&mut r, 0.1, 1.0));
         let pose = isometry(&mut r, 1.8);
         let (d, out) = plain(&ca, &cb, &pose);
-        assert_ne!(out.epa, Some(EpaOutcome::Fallback), "{out:?}");
+        assert!(
+            !matches!(
+                out.epa,
+                Some(EpaOutcome::Fallback | EpaOutcome::RoundingLimited)
+            ),
+            "{out:?}"
+        );
         if check_polytopes(&Poly::of_box(&ca), &Poly::of_box(&cb), &d, &pose, 1e-9) {
             apart += 1;
         } else {
@@ -325,6 +332,80 @@ fn hulls_of_random_clouds_match_the_oracles_and_move_apart_by_their_depth() {
     }
     println!("hulls: {apart} apart, {deep} penetrating");
     assert!(apart > 150 && deep > 150);
+}
+
+/// EPA cut short by its iteration cap (the same exit as a full polytope) must not claim an
+/// exact depth: its answer is bounded, and the bounds hold the axis oracle's depth. Caps of
+/// 1 to 12 expansions on penetrating hulls of 8 to 80 points; both ends occur.
+#[test]
+fn an_epa_short_of_convergence_is_bounded_around_the_oracle_depth() {
+    let mut r = rng(12);
+    let (mut bounded, mut exact, mut gjk_capped) = (0, 0, 0);
+    for i in 0..3000 {
+        let (ha, hb) = (
+            random_hull(&mut r, 8 + i % 73, false),
+            random_hull(&mut r, 8 + i % 29, false),
+        );
+        let pose = isometry(&mut r, 0.8);
+        let params = GjkParams {
+            max_iterations: 1 + (i % 12) as u32,
+            ..GjkParams::default()
+        };
+        let (reached, out) = signed_distance_convex_within(
+            &Rounded::plain(&ha),
+            &Rounded::plain(&hb),
+            &pose,
+            &params,
+            &mut GjkCache::default(),
+            &mut EpaWorkspace::new(),
+            &mut WorkClock::default(),
+            f64::INFINITY,
+        );
+        if out.gjk == GjkOutcome::DidNotConverge {
+            gjk_capped += 1;
+            continue;
+        }
+        let (pa, pb) = (Poly::of_hull(&ha), Poly::of_hull(&hb).moved(&pose));
+        let depth = depth_oracle(&pa, &pb);
+        if depth <= 0.0 {
+            continue;
+        }
+        let tol = 1e-9;
+        match reached {
+            Reached::Exact(d) => {
+                exact += 1;
+                assert!(
+                    (-d.distance - depth).abs() <= tol,
+                    "case {i}: exact {} vs oracle {depth} ({out:?})",
+                    -d.distance
+                );
+            }
+            Reached::Bounded(bound) | Reached::Resolved(bound) => {
+                bounded += 1;
+                // Out of iterations, or stopped by rounding.
+                let ended = match reached {
+                    Reached::Resolved(_) => EpaOutcome::RoundingLimited,
+                    _ => EpaOutcome::Fallback,
+                };
+                assert_eq!(out.epa, Some(ended), "case {i}");
+                assert!(
+                    bound.lower <= -depth + tol && -depth <= bound.upper + tol,
+                    "case {i}: {bound:?} does not hold the oracle depth {depth}"
+                );
+                assert!(bound.upper - bound.lower > 0.0, "case {i}: {bound:?}");
+                // The lower signed distance is the overlap along the bound's normal.
+                assert!(
+                    (overlap(&pa, &pb, bound.normal) + bound.lower).abs() <= tol,
+                    "case {i}: {bound:?}"
+                );
+            }
+        }
+    }
+    println!("capped EPA: {bounded} bounded, {exact} exact, {gjk_capped} GJK capped");
+    assert!(
+        bounded > 300 && exact > 300,
+        "{bounded} bounded, {exact} exact"
+    );
 }
 
 #[test]
@@ -432,7 +513,10 @@ fn cylinders_and_cones_agree_with_membership_and_sampled_support_functions() {
         let cone = Cone::new(r.random_range(0.2..1.0), r.random_range(0.2..1.0));
         let pose = isometry(&mut r, 1.8);
         let (d, out) = plain(&cyl, &cone, &pose);
-        fallbacks += usize::from(out.epa == Some(EpaOutcome::Fallback));
+        fallbacks += usize::from(matches!(
+            out.epa,
+            Some(EpaOutcome::Fallback | EpaOutcome::RoundingLimited)
+        ));
         stalled += usize::from(out.gjk == GjkOutcome::DidNotConverge);
         check_contract(&d, 1e-7);
         let tol = 1e-6;
@@ -928,10 +1012,13 @@ fn needle_and_plate_boxes_of_mixed_sizes_match_the_oracles() {
 
 /// Hulls of 512 and 4,096 points on a sphere (the sizes where parry 0.31's EPA depths
 /// differed from ours by up to 8.7 cm in `benches/narrow_phase.rs`): the depth must separate
-/// the shapes when B moves by it along the normal, and must be no deeper than the overlap
-/// along any of 2,000 sampled directions (each an upper bound of the true depth).
+/// the shapes when B moves by it along the normal, and the depth known to lie under the true
+/// one (the exact depth, or a bounded answer's lower bound) must be no deeper than the
+/// overlap along any of 2,000 sampled directions (each an upper bound of the true depth).
+/// Nearly concentric poses fill EPA's polytope before its tolerance: those answers must be
+/// bounded, not exact.
 #[test]
-fn large_hull_depths_separate_and_are_no_deeper_than_any_sampled_direction() {
+fn large_hull_depths_separate_and_their_lower_bounds_are_no_deeper_than_any_sampled_direction() {
     let mut rng = rng(2_626);
     let mut epa = EpaWorkspace::new();
     for n in [512usize, 4096] {
@@ -943,9 +1030,13 @@ fn large_hull_depths_separate_and_are_no_deeper_than_any_sampled_direction() {
             ConvexPolyhedron::try_from_points(&cloud(&mut rng)).unwrap(),
         );
         let (ra, rb) = (Rounded::plain(&a), Rounded::plain(&b));
-        let (mut penetrating, mut apart) = (0, 0);
-        for case in 0..120 {
-            let pose = Pose::new(point_in_cube(&mut rng, 1.5), rotation(&mut rng));
+        let (mut penetrating, mut apart, mut bounded) = (0, 0, 0);
+        let mut worst_gap = 0.0_f64;
+        for case in 0..240 {
+            // Every other pose nearly concentric: the deepest overlaps, where EPA's polytope
+            // can fill up before the tolerance.
+            let reach = if case % 2 == 0 { 1.5 } else { 0.1 };
+            let pose = Pose::new(point_in_cube(&mut rng, reach), rotation(&mut rng));
             let iso = pose.to_isometry();
             let params = GjkParams::default();
             let (d, _) =
@@ -956,6 +1047,30 @@ fn large_hull_depths_separate_and_are_no_deeper_than_any_sampled_direction() {
             }
             penetrating += 1;
             let depth = -d.distance;
+            // The depth known to lie under the true one: the polytope's, when EPA ran out of
+            // room short of its tolerance (then the answer is bounded, not exact).
+            let (within, _) = signed_distance_convex_within(
+                &ra,
+                &rb,
+                &iso,
+                &params,
+                &mut GjkCache::default(),
+                &mut epa,
+                &mut WorkClock::default(),
+                f64::INFINITY,
+            );
+            let depth_lower = match within {
+                Reached::Exact(e) => {
+                    assert_eq!(e.distance, d.distance, "n {n} case {case}");
+                    depth
+                }
+                Reached::Bounded(bound) | Reached::Resolved(bound) => {
+                    bounded += 1;
+                    assert_eq!(bound.lower, d.distance, "n {n} case {case}");
+                    worst_gap = worst_gap.max((bound.upper - bound.lower) / depth);
+                    -bound.upper
+                }
+            };
             let moved = Pose::new(pose.position + d.normal * (depth + 1e-9), pose.rotation);
             let (after, _) = signed_distance_convex(
                 &ra,
@@ -970,21 +1085,29 @@ fn large_hull_depths_separate_and_are_no_deeper_than_any_sampled_direction() {
                 "n {n} case {case}: {}",
                 after.distance
             );
+            let mut min_overlap = f64::INFINITY;
             for _ in 0..2_000 {
                 let u = rotation(&mut rng) * DVec3::Z;
                 let reach_a = a.support(u).dot(u);
                 let reach_b = iso
                     .transform_point(b.support(iso.inverse_transform_vector(-u)))
                     .dot(u);
-                assert!(
-                    depth <= reach_a - reach_b + 1e-9,
-                    "n {n} case {case}: depth {depth} deeper than along {u}"
-                );
+                min_overlap = min_overlap.min(reach_a - reach_b);
             }
+            assert!(
+                depth_lower <= min_overlap + 1e-9,
+                "n {n} case {case}: lower bound {depth_lower} above a sampled overlap \
+                 {min_overlap}"
+            );
         }
+        println!(
+            "n {n}: {penetrating} penetrating ({bounded} bounded, widest gap {:.2} % of the \
+             depth), {apart} apart",
+            100.0 * worst_gap
+        );
         assert!(
-            penetrating > 50 && apart > 5,
-            "n {n}: {penetrating} / {apart}"
+            penetrating > 50 && apart > 5 && bounded > 5,
+            "n {n}: {penetrating} / {apart} / {bounded}"
         );
     }
 }
@@ -1306,7 +1429,7 @@ fn the_sphere_cylinder_closed_form_matches_gjk_and_epa() {
     use proxima::narrow::gjk::EpaOutcome;
     use proxima::narrow::pairs::distance_sphere_cylinder;
     let mut r = rng(32);
-    let (mut overlapping, mut apart, mut epa_fallbacks) = (0, 0, 0);
+    let (mut overlapping, mut apart, mut epa_fallbacks, mut bounded_fallbacks) = (0, 0, 0, 0);
     for case in 0..6000 {
         let sphere = Sphere::new(r.random_range(0.005..0.2));
         let cylinder = Cylinder::new(r.random_range(0.01..0.3), r.random_range(0.01..0.3));
@@ -1329,7 +1452,10 @@ fn the_sphere_cylinder_closed_form_matches_gjk_and_epa() {
             &GjkParams::default(),
         );
         let tol = 1e-9 * (1.0 + d.distance.abs());
-        if outcome.epa == Some(EpaOutcome::Fallback) {
+        if matches!(
+            outcome.epa,
+            Some(EpaOutcome::Fallback | EpaOutcome::RoundingLimited)
+        ) {
             // EPA did not converge on the curved side: its depth is an upper bound, and the
             // moves below decide the depth.
             epa_fallbacks += 1;
@@ -1339,6 +1465,35 @@ fn the_sphere_cylinder_closed_form_matches_gjk_and_epa() {
                 d.distance,
                 g.distance
             );
+            // Short of the tolerance, the answer is not exact: its bounds hold the closed
+            // form (to rounding).
+            let (reached, _) = signed_distance_convex_within(
+                &Rounded::new(&POINT, sphere.radius),
+                &Rounded::plain(&cylinder),
+                &pose,
+                &GjkParams::default(),
+                &mut GjkCache::default(),
+                &mut EpaWorkspace::new(),
+                &mut WorkClock::default(),
+                f64::INFINITY,
+            );
+            let rounding = 1e-15 * (1.0 + d.distance.abs());
+            match reached {
+                Reached::Exact(e) => assert!(
+                    (e.distance - d.distance).abs() <= tol,
+                    "case {case}: exact {} vs closed form {}",
+                    e.distance,
+                    d.distance
+                ),
+                Reached::Bounded(b) | Reached::Resolved(b) => {
+                    bounded_fallbacks += 1;
+                    assert!(
+                        b.lower <= d.distance + rounding && d.distance <= b.upper + rounding,
+                        "case {case}: {b:?} does not hold the closed form {}",
+                        d.distance
+                    );
+                }
+            }
         } else {
             assert!(
                 (d.distance - g.distance).abs() <= tol,
@@ -1373,7 +1528,11 @@ fn the_sphere_cylinder_closed_form_matches_gjk_and_epa() {
             );
         }
     }
-    println!("overlapping {overlapping} (EPA fell back on {epa_fallbacks}), apart {apart}");
+    println!(
+        "overlapping {overlapping} (EPA fell back on {epa_fallbacks}, {bounded_fallbacks} of \
+         them short of the tolerance), apart {apart}"
+    );
+    assert!(bounded_fallbacks > 0, "no answer short of the tolerance");
     assert!(
         overlapping > 1000 && apart > 1000 && epa_fallbacks < overlapping / 2,
         "{overlapping} {apart} {epa_fallbacks}"

@@ -57,6 +57,18 @@ fn check_every_stop(a: &Shape, b: &Shape, pose_ab: &Pose, seen: &mut Seen, case:
                 seen.finished += 1;
                 return;
             }
+            // Finished short of the tolerance by rounding: the bounds must hold the exact
+            // answer.
+            Reached::Resolved(bound) => {
+                assert!(
+                    bound.lower <= exact.distance + tol && exact.distance <= bound.upper + tol,
+                    "case {case}, resolved after {work} units: {bound:?} does not hold the \
+                     exact {}",
+                    exact.distance
+                );
+                seen.finished += 1;
+                return;
+            }
             Reached::Bounded(bound) => {
                 seen.stopped += 1;
                 assert!(bound.lower.is_finite(), "case {case}: {bound:?}");

@@ -127,6 +127,11 @@ pub enum Reached {
     /// The clock stopped it: bounds on the signed distance (`upper` may be `+∞` when it
     /// found no candidate yet), with the axis and witness of the best answer found.
     Bounded(DistanceBound),
+    /// The query finished, but rounding stopped it short of its tolerance (EPA's polytope
+    /// broken near the answer, [`gjk::epa`](super::gjk::epa)): the signed distance lies
+    /// between the bounds, a gap at f64's resolution on the shapes, and the answer is
+    /// [`DistanceBound::at_lower`]. Work left undone would not narrow it.
+    Resolved(DistanceBound),
 }
 
 impl Reached {
@@ -136,6 +141,16 @@ impl Reached {
         match self {
             Self::Exact(d) => Self::Exact(d.flipped(pose_ba)),
             Self::Bounded(b) => Self::Bounded(b.flipped(pose_ba)),
+            Self::Resolved(b) => Self::Resolved(b.flipped(pose_ba)),
+        }
+    }
+
+    /// The answer at the lower end: exact, or the bounds' [`DistanceBound::at_lower`].
+    #[must_use]
+    pub fn at_lower(&self) -> ShapeDistance {
+        match self {
+            Self::Exact(d) => *d,
+            Self::Bounded(b) | Self::Resolved(b) => b.at_lower(),
         }
     }
 }

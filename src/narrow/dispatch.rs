@@ -280,10 +280,7 @@ fn unlimited(
     let clock = std::mem::take(&mut scratch.clock);
     let reached = query(scratch);
     scratch.clock = clock;
-    match reached {
-        Reached::Exact(d) => d,
-        Reached::Bounded(bound) => bound.at_lower(),
-    }
+    reached.at_lower()
 }
 
 /// The convex pairs' arms of [`distance_within`].

@@ -67,7 +67,8 @@ impl MeshScratch {
 /// distance (closed forms, GJK/EPA, or a convex shape against a mesh's triangles) when the
 /// query needs a distance or a touching decision, and the manifold when it asks contacts
 /// and the shapes touch. Everything in world frame; exact to the methods' tolerance (error
-/// bound: GJK's relative tolerance times the distance plus 64 ulps of the coordinates).
+/// bound: GJK's relative tolerance times the distance plus 64 ulps of the coordinates, plus
+/// the gap of a [`Reached::Resolved`] answer, which rounding kept from its tolerance).
 pub(super) fn direct(
     pair: &CandidatePair,
     (a, sa): (&Body, &Shape),
@@ -79,8 +80,8 @@ pub(super) fn direct(
 ) -> Answer {
     let pose_ab = Pose::relative(&a.pose, &b.pose);
     let limit = reporting_limit(query, a, b);
-    let d = match dispatch::distance_within(sa, sb, &pose_ab, limit, scratch) {
-        Reached::Exact(d) => d,
+    // `resolution`: the metres rounding left between a finished answer and its upper end.
+    let (d, resolution) = match dispatch::distance_within(sa, sb, &pose_ab, limit, scratch) {
         Reached::Bounded(bound) if bound.upper.is_finite() => {
             return from_bound(pair, (a, b), &bound, query, contacts);
         }
@@ -89,6 +90,8 @@ pub(super) fn direct(
             let grown = |body: &Body| body.world_bounds.grown(body.margin);
             return boxes(pair, &grown(a), &grown(b), query, contacts);
         }
+        Reached::Exact(d) => (d, 0.0),
+        Reached::Resolved(bound) => (bound.at_lower(), bound.upper - bound.lower),
     };
     let scale = d
         .point_a
@@ -96,7 +99,7 @@ pub(super) fn direct(
         .max_element()
         .max(d.point_b.abs().max_element())
         + a.pose.position.abs().max_element();
-    let error_bound = 1e-10 * d.distance.abs() + 64.0 * f64::EPSILON * scale;
+    let error_bound = 1e-10 * d.distance.abs() + 64.0 * f64::EPSILON * scale + resolution;
     let mut result = in_world(pair, a, &d, error_bound, true);
     let touching = d.distance <= 0.0;
     if query.contacts && touching {

@@ -124,6 +124,8 @@ pub(crate) fn distance_within(
     own.touching_of = None;
     let mut best: Option<ShapeDistance> = None;
     let mut stopped: Option<DistanceBound> = None;
+    // The widest gap rounding left in a part pair's answer (0: all exact).
+    let mut resolution = 0.0_f64;
     // A lower bound of the distance of every part pair not touching.
     let mut others_apart_by = left_out;
     for (k, c) in own.candidates.iter().enumerate() {
@@ -142,8 +144,13 @@ pub(crate) fn distance_within(
         // Exact up to the best gap found, and every touching pair exact once one touches
         // (the whole compound's depth and the manifold want them all).
         let enough = best.map_or(limit, |d| d.distance.max(0.0).min(limit));
-        match dispatch::distance_within(part_a, part_b, pose_ab, enough, scratch) {
-            Reached::Exact(d) => {
+        let reached = dispatch::distance_within(part_a, part_b, pose_ab, enough, scratch);
+        if let Reached::Resolved(bound) = reached {
+            resolution = resolution.max(bound.upper - bound.lower);
+        }
+        match reached {
+            Reached::Exact(_) | Reached::Resolved(_) => {
+                let d = reached.at_lower();
                 // Beyond `enough`, a convex pair's value is a lower bound.
                 if d.distance > 0.0 {
                     others_apart_by = others_apart_by.min(d.distance);
@@ -183,7 +190,15 @@ pub(crate) fn distance_within(
         (None, None) => Reached::Exact(beyond_every_box(a, b, pose_ab, left_out)),
     };
     scratch.compound = own;
-    answer
+    match answer {
+        Reached::Exact(d) if resolution > 0.0 => Reached::Resolved(DistanceBound::new(
+            d.distance,
+            d.distance + resolution,
+            d.normal,
+            d.point_b,
+        )),
+        answer => answer,
+    }
 }
 
 /// The smallest lower bound of the part pairs `left` (sorted by their box bound): the

@@ -11,9 +11,10 @@
 //! # Fallback
 //! When `A − B` has no volume (flat or needle shapes), when the polytope runs out of
 //! capacity or iterations, or when rounding breaks its convexity, the answer is
-//! [`EpaOutcome::Fallback`]: the direction `n` with the smallest support value `h(n)` among
-//! the polytope's face normals evaluated so far (or, without a tetrahedron, among the normals
-//! of the span's complement), depth `max(h(n), 0)`. Translating B by that depth along `n`
+//! [`EpaOutcome::Fallback`] ([`EpaOutcome::RoundingLimited`] for the last): the direction
+//! `n` with the smallest support value `h(n)` among the polytope's face normals evaluated so
+//! far (or, without a tetrahedron, among the normals of the span's complement), depth
+//! `max(h(n), 0)`. Translating B by that depth along `n`
 //! always separates the shapes, so the fallback over-estimates the depth, never under.
 //! Its witnesses keep `point_a − point_b = depth · normal` exactly: `point_a` is a point of A
 //! (the origin's projection on the face of that normal, or GJK's common point of A and B
@@ -21,6 +22,11 @@
 //! lie off B's surface by the depth's uncertainty. Without a tetrahedron `A − B` is flat
 //! through the origin and the depth is 0 (to rounding), so both witnesses are GJK's common
 //! point.
+//!
+//! The polytope's vertices are points of `A − B` and it holds the origin, so its nearest
+//! face's distance is a lower bound on the depth: a fallback states it as
+//! [`EpaResult::depth_lower`] (0 without a tetrahedron), raised to the depth when the two
+//! are within the convergence tolerance (the answer is then as good as a converged one).
 //!
 //! Buffers live in an [`EpaWorkspace`] of fixed capacity, so a query allocates nothing.
 
@@ -48,8 +54,13 @@ pub enum EpaOutcome {
     /// along a valid direction), and [`EpaResult::depth_lower`] the polytope's nearest face
     /// distance, an under-estimate.
     Stopped,
-    /// See the [module docs](self): an upper bound on the depth along a valid direction.
+    /// See the [module docs](self): an upper bound on the depth along a valid direction,
+    /// and [`EpaResult::depth_lower`] the polytope's lower bound.
     Fallback,
+    /// The fallback's answer when rounding broke the polytope (a new face had the origin
+    /// outside): on curved differences this happens near the answer, with a gap a few
+    /// times the tolerance, which further expansions could not close.
+    RoundingLimited,
 }
 
 /// The answer of [`penetration`].
@@ -67,8 +78,10 @@ pub struct EpaResult {
     pub point_b: DVec3,
     /// Polytope expansions.
     pub iterations: u32,
-    /// A lower bound on the depth, metres: `depth` when converged, the polytope's nearest
-    /// face distance when stopped (the polytope lies inside `A − B`), 0 for a fallback.
+    /// A lower bound on the depth, metres: `depth` when converged; otherwise the polytope's
+    /// nearest face distance (the polytope lies inside `A − B`), 0 without a polytope, and
+    /// `depth` when the gap is within the convergence tolerance. `depth_lower < depth`
+    /// means the depth is known only between the two.
     pub depth_lower: f64,
 }
 
@@ -156,8 +169,18 @@ impl Fallback {
         }
     }
 
-    fn result(&self, iterations: u32) -> EpaResult {
+    /// The fallback's answer after `iterations` expansions, with the polytope's nearest face
+    /// at `face_distance` from the origin (0 without a polytope); `tolerance(d)` is the
+    /// convergence criterion's allowed gap at distance `d`.
+    fn result(
+        &self,
+        iterations: u32,
+        face_distance: f64,
+        tolerance: impl FnOnce(f64) -> f64,
+    ) -> EpaResult {
         let depth = self.h.max(0.0);
+        let lower = face_distance.max(0.0).min(depth);
+        let within_tolerance = depth - lower <= tolerance(lower);
         EpaResult {
             outcome: EpaOutcome::Fallback,
             depth,
@@ -165,18 +188,19 @@ impl Fallback {
             point_a: self.a,
             point_b: self.a - self.normal * depth,
             iterations,
-            depth_lower: 0.0,
+            depth_lower: if within_tolerance { depth } else { lower },
         }
     }
 
     /// The fallback's answer for an EPA its clock stopped with the polytope's nearest face
     /// at `face_distance` from the origin.
     fn stopped(&self, iterations: u32, face_distance: f64) -> EpaResult {
-        let depth_lower = face_distance.max(0.0);
+        let depth = self.h.max(0.0);
         EpaResult {
             outcome: EpaOutcome::Stopped,
-            depth_lower: depth_lower.min(self.h.max(0.0)),
-            ..self.result(iterations)
+            depth_lower: face_distance.max(0.0).min(depth),
+            // The lower bound is set above: no tolerance test.
+            ..self.result(iterations, 0.0, |_| f64::NEG_INFINITY)
         }
     }
 }
@@ -230,12 +254,16 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         .iter()
         .map(|p| p.a.abs().max_element().max(p.b.abs().max_element()))
         .fold(0.0, f64::max);
+    // The convergence criterion's allowed gap above a face at distance `d`.
+    let gap = |d: f64, scale: f64| params.epa_rel_tol * d.abs() + floor(params, scale);
     if !blow_up_to_tetrahedron(&mut sup, params, ws, &mut fallback, common, &mut scale) {
-        return fallback.result(0);
+        return fallback.result(0, 0.0, |d| gap(d, scale));
     }
     start_faces(ws);
 
     let mut iterations = 0;
+    // The polytope's nearest face distance: a lower bound on the depth.
+    let mut lower = 0.0;
     while iterations < params.max_iterations {
         iterations += 1;
         let Some(best_i) = nearest_face(&ws.faces) else {
@@ -245,6 +273,7 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         if !best.dist.is_finite() {
             break;
         }
+        lower = best.dist;
         let p = sup(best.normal);
         if !clock.allows(EXPANSION_WORK) {
             // The nearest face's direction is always offered, so the answer is finite.
@@ -260,7 +289,7 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         scale = scale.max(p.a.abs().max_element().max(p.b.abs().max_element()));
         let tol = floor(params, scale);
         let h = p.w.dot(best.normal);
-        if h - best.dist <= params.epa_rel_tol * best.dist.abs() + tol {
+        if h - best.dist <= gap(best.dist, scale) {
             // Coplanar faces tie on distance; the witnesses need the one whose triangle holds
             // the origin's projection. Only faces in the confirmed plane qualify: a face
             // through the origin at another angle has distance 0 too but no certificate.
@@ -280,11 +309,17 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         match expand(ws, p, best_i, tol) {
             Expansion::Grown => {}
             Expansion::Full => break,
-            // The origin fell outside: rounding broke the polytope.
-            Expansion::Broken => return fallback.result(iterations),
+            // The origin fell outside a new face: rounding broke the polytope (the one
+            // before this expansion still bounds the depth from below).
+            Expansion::Broken => {
+                return EpaResult {
+                    outcome: EpaOutcome::RoundingLimited,
+                    ..fallback.result(iterations, lower, |d| gap(d, scale))
+                };
+            }
         }
     }
-    fallback.result(iterations)
+    fallback.result(iterations, lower, |d| gap(d, scale))
 }
 
 /// The index of the first face of least distance; `None` when there is no face. Distances

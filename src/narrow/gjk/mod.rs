@@ -463,17 +463,16 @@ pub fn signed_distance_convex<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
         clock,
         f64::INFINITY,
     );
-    let distance = match reached {
-        Reached::Exact(d) => d,
-        // An unlimited clock never stops EPA.
-        Reached::Bounded(bound) => bound.at_lower(),
-    };
-    (distance, outcome)
+    // An unlimited clock never stops EPA; a fallback's answer is its lower end.
+    (reached.at_lower(), outcome)
 }
 
 /// [`signed_distance_convex`] with EPA polling `clock` ([`epa::penetration`]): exact, or,
-/// when the clock stopped EPA, bounds between its fallback's depth (the lower bound of the
-/// signed distance, with its normal and witnesses) and its polytope's (the upper bound).
+/// when EPA ended short of its tolerance ([`EpaResult::depth_lower`] below the depth),
+/// bounds between its fallback's depth (the lower bound of the signed distance, with its
+/// normal and witnesses) and its polytope's (the upper bound): [`Reached::Resolved`] when
+/// rounding broke the polytope, [`Reached::Bounded`] when the clock stopped it or it ran
+/// out of room.
 ///
 /// Shapes proven more than `limit` metres apart (signed distance) get
 /// [`Reached::Exact`] with a lower bound above `limit` as their distance instead of the
@@ -507,7 +506,10 @@ pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Si
         };
         return (Reached::Exact(answer), outcome);
     }
+    // The depth's lower bound when EPA left a gap, and whether rounding (not the clock or
+    // the polytope's room) left it.
     let mut depth_lower = None;
+    let mut rounding_limited = false;
     let (core, normal, epa) = match g.outcome {
         GjkOutcome::Separated | GjkOutcome::DidNotConverge | GjkOutcome::Beyond => (
             (g.distance, g.point_a, g.point_b),
@@ -524,8 +526,10 @@ pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Si
             let e = epa::penetration(
                 a.core, b.core, pose_ab, &g.simplex, params, workspace, clock,
             );
-            if e.outcome == EpaOutcome::Stopped {
+            // Stopped, or a fallback whose polytope left a gap: the depth is bounded.
+            if e.outcome == EpaOutcome::Stopped || e.depth_lower < e.depth {
                 depth_lower = Some(e.depth_lower);
+                rounding_limited = e.outcome == EpaOutcome::RoundingLimited;
             }
             if g.outcome == GjkOutcome::Touching && e.depth <= 0.0 {
                 (
@@ -556,13 +560,20 @@ pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Si
     };
     let reached = match depth_lower {
         None => Reached::Exact(answer),
-        Some(lower) => Reached::Bounded(DistanceBound {
-            lower: answer.distance,
-            upper: (-lower - radii).max(answer.distance),
-            normal,
-            point_a: answer.point_a,
-            point_b: answer.point_b,
-        }),
+        Some(lower) => {
+            let bound = DistanceBound {
+                lower: answer.distance,
+                upper: (-lower - radii).max(answer.distance),
+                normal,
+                point_a: answer.point_a,
+                point_b: answer.point_b,
+            };
+            if rounding_limited {
+                Reached::Resolved(bound)
+            } else {
+                Reached::Bounded(bound)
+            }
+        }
     };
     (
         reached,
