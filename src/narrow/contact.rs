@@ -145,6 +145,17 @@ impl Reached {
         }
     }
 
+    /// How far, metres, the true signed distance may lie above [`at_lower`](Self::at_lower):
+    /// 0 when exact, the bounds' width otherwise (for [`Resolved`](Self::Resolved), the gap
+    /// rounding left).
+    #[must_use]
+    pub fn width(&self) -> f64 {
+        match self {
+            Self::Exact(_) => 0.0,
+            Self::Bounded(b) | Self::Resolved(b) => b.upper - b.lower,
+        }
+    }
+
     /// The answer at the lower end: exact, or the bounds' [`DistanceBound::at_lower`].
     #[must_use]
     pub fn at_lower(&self) -> ShapeDistance {

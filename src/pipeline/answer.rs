@@ -80,8 +80,8 @@ pub(super) fn direct(
 ) -> Answer {
     let pose_ab = Pose::relative(&a.pose, &b.pose);
     let limit = reporting_limit(query, a, b);
-    // `resolution`: the metres rounding left between a finished answer and its upper end.
-    let (d, resolution) = match dispatch::distance_within(sa, sb, &pose_ab, limit, scratch) {
+    let reached = dispatch::distance_within(sa, sb, &pose_ab, limit, scratch);
+    match reached {
         Reached::Bounded(bound) if bound.upper.is_finite() => {
             return from_bound(pair, (a, b), &bound, query, contacts);
         }
@@ -90,16 +90,17 @@ pub(super) fn direct(
             let grown = |body: &Body| body.world_bounds.grown(body.margin);
             return boxes(pair, &grown(a), &grown(b), query, contacts);
         }
-        Reached::Exact(d) => (d, 0.0),
-        Reached::Resolved(bound) => (bound.at_lower(), bound.upper - bound.lower),
-    };
+        Reached::Exact(_) | Reached::Resolved(_) => {}
+    }
+    // Finished: exact, or short of the tolerance by the rounding gap `width()`.
+    let d = reached.at_lower();
     let scale = d
         .point_a
         .abs()
         .max_element()
         .max(d.point_b.abs().max_element())
         + a.pose.position.abs().max_element();
-    let error_bound = 1e-10 * d.distance.abs() + 64.0 * f64::EPSILON * scale + resolution;
+    let error_bound = 1e-10 * d.distance.abs() + 64.0 * f64::EPSILON * scale + reached.width();
     let mut result = in_world(pair, a, &d, error_bound, true);
     let touching = d.distance <= 0.0;
     if query.contacts && touching {

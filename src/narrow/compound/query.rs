@@ -145,11 +145,9 @@ pub(crate) fn distance_within(
         // (the whole compound's depth and the manifold want them all).
         let enough = best.map_or(limit, |d| d.distance.max(0.0).min(limit));
         let reached = dispatch::distance_within(part_a, part_b, pose_ab, enough, scratch);
-        if let Reached::Resolved(bound) = reached {
-            resolution = resolution.max(bound.upper - bound.lower);
-        }
         match reached {
             Reached::Exact(_) | Reached::Resolved(_) => {
+                resolution = resolution.max(reached.width());
                 let d = reached.at_lower();
                 // Beyond `enough`, a convex pair's value is a lower bound.
                 if d.distance > 0.0 {

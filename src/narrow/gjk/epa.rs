@@ -169,38 +169,28 @@ impl Fallback {
         }
     }
 
-    /// The fallback's answer after `iterations` expansions, with the polytope's nearest face
-    /// at `face_distance` from the origin (0 without a polytope); `tolerance(d)` is the
-    /// convergence criterion's allowed gap at distance `d`.
+    /// The fallback's answer, ended by `outcome` after `iterations` expansions with the
+    /// polytope's nearest face at `face_distance` from the origin (0 without a polytope):
+    /// its depth is known down to that face, or to itself when the gap is at most
+    /// `tolerance` (the convergence criterion's, [`EpaOutcome::Stopped`] excepted).
     fn result(
         &self,
+        outcome: EpaOutcome,
         iterations: u32,
         face_distance: f64,
-        tolerance: impl FnOnce(f64) -> f64,
+        tolerance: f64,
     ) -> EpaResult {
         let depth = self.h.max(0.0);
         let lower = face_distance.max(0.0).min(depth);
-        let within_tolerance = depth - lower <= tolerance(lower);
+        let converged = outcome != EpaOutcome::Stopped && depth - lower <= tolerance;
         EpaResult {
-            outcome: EpaOutcome::Fallback,
+            outcome,
             depth,
             normal: self.normal,
             point_a: self.a,
             point_b: self.a - self.normal * depth,
             iterations,
-            depth_lower: if within_tolerance { depth } else { lower },
-        }
-    }
-
-    /// The fallback's answer for an EPA its clock stopped with the polytope's nearest face
-    /// at `face_distance` from the origin.
-    fn stopped(&self, iterations: u32, face_distance: f64) -> EpaResult {
-        let depth = self.h.max(0.0);
-        EpaResult {
-            outcome: EpaOutcome::Stopped,
-            depth_lower: face_distance.max(0.0).min(depth),
-            // The lower bound is set above: no tolerance test.
-            ..self.result(iterations, 0.0, |_| f64::NEG_INFINITY)
+            depth_lower: if converged { depth } else { lower },
         }
     }
 }
@@ -257,7 +247,7 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
     // The convergence criterion's allowed gap above a face at distance `d`.
     let gap = |d: f64, scale: f64| params.epa_rel_tol * d.abs() + floor(params, scale);
     if !blow_up_to_tetrahedron(&mut sup, params, ws, &mut fallback, common, &mut scale) {
-        return fallback.result(0, 0.0, |d| gap(d, scale));
+        return fallback.result(EpaOutcome::Fallback, 0, 0.0, gap(0.0, scale));
     }
     start_faces(ws);
 
@@ -280,7 +270,7 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             if p.w.is_finite() {
                 fallback.offer_with(best.normal, &p, || face_point_a(&ws.vertices, &best));
             }
-            return fallback.stopped(iterations - 1, best.dist);
+            return fallback.result(EpaOutcome::Stopped, iterations - 1, best.dist, 0.0);
         }
         if !p.w.is_finite() {
             break;
@@ -312,14 +302,17 @@ pub fn penetration<A: SupportMap + ?Sized, B: SupportMap + ?Sized>(
             // The origin fell outside a new face: rounding broke the polytope (the one
             // before this expansion still bounds the depth from below).
             Expansion::Broken => {
-                return EpaResult {
-                    outcome: EpaOutcome::RoundingLimited,
-                    ..fallback.result(iterations, lower, |d| gap(d, scale))
-                };
+                let tolerance = gap(lower.max(0.0), scale);
+                return fallback.result(EpaOutcome::RoundingLimited, iterations, lower, tolerance);
             }
         }
     }
-    fallback.result(iterations, lower, |d| gap(d, scale))
+    fallback.result(
+        EpaOutcome::Fallback,
+        iterations,
+        lower,
+        gap(lower.max(0.0), scale),
+    )
 }
 
 /// The index of the first face of least distance; `None` when there is no face. Distances

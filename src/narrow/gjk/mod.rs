@@ -506,10 +506,8 @@ pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Si
         };
         return (Reached::Exact(answer), outcome);
     }
-    // The depth's lower bound when EPA left a gap, and whether rounding (not the clock or
-    // the polytope's room) left it.
+    // The depth's lower bound when EPA left a gap.
     let mut depth_lower = None;
-    let mut rounding_limited = false;
     let (core, normal, epa) = match g.outcome {
         GjkOutcome::Separated | GjkOutcome::DidNotConverge | GjkOutcome::Beyond => (
             (g.distance, g.point_a, g.point_b),
@@ -529,7 +527,6 @@ pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Si
             // Stopped, or a fallback whose polytope left a gap: the depth is bounded.
             if e.outcome == EpaOutcome::Stopped || e.depth_lower < e.depth {
                 depth_lower = Some(e.depth_lower);
-                rounding_limited = e.outcome == EpaOutcome::RoundingLimited;
             }
             if g.outcome == GjkOutcome::Touching && e.depth <= 0.0 {
                 (
@@ -568,7 +565,8 @@ pub fn signed_distance_convex_within<A: SupportMap + ?Sized, B: SupportMap + ?Si
                 point_a: answer.point_a,
                 point_b: answer.point_b,
             };
-            if rounding_limited {
+            // Rounding, not the clock or the polytope's room, left the gap.
+            if epa == Some(EpaOutcome::RoundingLimited) {
                 Reached::Resolved(bound)
             } else {
                 Reached::Bounded(bound)
