@@ -1,4 +1,4 @@
-//! One frame of the settling pile, Proxima against parry3d-f64 0.31 on the same pairs.
+//! Frames of the settling pile, Proxima against parry3d-f64 0.31 on the same pairs.
 //!
 //! # The frame
 //! The pile of `examples/scenes/pile.rs` (seed [`SEED`]: 100 bodies, spheres, capsules,
@@ -7,7 +7,8 @@
 //! `PILE_RATE_HZ`, each a `CLOSE | CONTACTS` [`step`] whose contacts the point-mass solver
 //! of `examples/scenes/point_mass.rs` bounces the bodies with, as the `pile` scene of
 //! `examples/deadline_bench.rs` does through the daemon. The poses of the last two frames
-//! (`k` and `k + 1`) are kept; the statistics of frame `k` are printed once.
+//! (`k` and `k + 1`) and of the [`SETTLING`] frames are kept; the statistics of frame `k`
+//! are printed once.
 //!
 //! # What is measured (group `pile`)
 //! - `proxima/frame`: one whole [`step`] (broad phase, narrow phase, contacts) at
@@ -18,6 +19,11 @@
 //! - `proxima/frame-all-pairs`: the same, alternating frame `k` and frame `k` with every
 //!   moving body shifted by [`SHIFT_M`] (the same shift for all, so their relative poses do
 //!   not change): every candidate pair is answered afresh each frame.
+//! - `proxima/frame-settling`: the same, over the [`SETTLING`] frames of the drop in
+//!   order (all bodies moving: every pair is answered afresh, at poses that change as in
+//!   the daemon), one frame per iteration: the frames that make the p99 of
+//!   `deadline_bench`'s pile, where the two frames above are a resting frame and one
+//!   frame's pairs answered over and over (warm caches and branch history).
 //! - `proxima/narrow`: the narrow phase alone on frame `k`'s candidate pairs (the
 //!   all-pairs broad phase of `proxima::broad::brute_force`, equal to the pipeline's), as
 //!   the pipeline answers a pair: `dispatch::distance` exact up to the two margins, then
@@ -82,6 +88,10 @@ const SEED: u64 = 29;
 /// Frames simulated before the kept frame `k`: 1.5 s at 240 Hz, when the pile has landed
 /// and most bodies rest on others.
 const SETTLE_FRAMES: usize = 360;
+/// The settling frames `proxima/frame-settling` replays, in order: the frames of the drop
+/// when every body moves and the p99 of `deadline_bench`'s pile is made (frames 80–300 of
+/// its 1,000).
+const SETTLING: std::ops::Range<usize> = 100..300;
 /// What every frame asks, as the pile's client does.
 const QUERY: Query = Query::CLOSE.union(Query::CONTACTS);
 /// Shift of every moving body in `proxima/frame-all-pairs`'s second pose set, metres:
@@ -91,12 +101,14 @@ const SHIFT_M: f64 = 1e-9;
 /// Each moving body's pose in one frame.
 type PoseSet = Vec<(BodyId, Pose)>;
 
-/// The settled pile: the scene at frame `k`, the poses of frames `k` and `k + 1`.
+/// The settled pile: the scene at frame `k`, the poses of frames `k` and `k + 1`, and of
+/// the [`SETTLING`] frames.
 struct Settled {
     spec: SceneSpec,
     scene: Scene,
     frame_k: PoseSet,
     frame_k1: PoseSet,
+    settling: Vec<PoseSet>,
 }
 
 /// Drops the pile and runs [`SETTLE_FRAMES`] + 2 frames; the scene is left at frame `k`.
@@ -125,6 +137,7 @@ fn settle() -> Settled {
         world.resolve(&pairs, &contacts);
         kept.push(moving_poses(&scene));
     }
+    let settling = kept[SETTLING].to_vec();
     let frame_k1 = kept.pop().expect("two frames kept");
     let frame_k = kept.pop().expect("two frames kept");
     set_poses(&mut scene, &frame_k);
@@ -138,6 +151,7 @@ fn settle() -> Settled {
         scene,
         frame_k,
         frame_k1,
+        settling,
     }
 }
 
@@ -464,6 +478,7 @@ fn bench_pile(c: &mut Criterion) {
         mut scene,
         frame_k,
         frame_k1,
+        settling,
     } = settle();
     let frozen = scene.clone();
     let parry: Vec<ParryShape> = spec.shapes.iter().map(parry_shape).collect();
@@ -482,9 +497,13 @@ fn bench_pile(c: &mut Criterion) {
 
     let mut group = c.benchmark_group("pile");
     let (mut workspace, mut results) = (PipelineWorkspace::default(), FrameResults::default());
+    let fixed = [&frame_k, &frame_k1];
+    let all_pairs = [&frame_k, &shifted];
+    let settling: Vec<&PoseSet> = settling.iter().collect();
     for (name, sets) in [
-        ("frame", [&frame_k, &frame_k1]),
-        ("frame-all-pairs", [&frame_k, &shifted]),
+        ("frame", &fixed[..]),
+        ("frame-all-pairs", &all_pairs[..]),
+        ("frame-settling", &settling[..]),
     ] {
         let mut frame = |poses: &PoseSet| {
             set_poses(&mut scene, poses);
@@ -502,7 +521,7 @@ fn bench_pile(c: &mut Criterion) {
         cycle_bench(
             &mut group,
             BenchmarkId::new("proxima", name),
-            &sets,
+            sets,
             |_, poses| f64::from(frame(poses).contacts),
         );
     }
