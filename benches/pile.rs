@@ -19,11 +19,11 @@
 //! - `proxima/frame-all-pairs`: the same, alternating frame `k` and frame `k` with every
 //!   moving body shifted by [`SHIFT_M`] (the same shift for all, so their relative poses do
 //!   not change): every candidate pair is answered afresh each frame.
-//! - `proxima/frame-settling`: the same, over the [`SETTLING`] frames of the drop in
-//!   order (all bodies moving: every pair is answered afresh, at poses that change as in
-//!   the daemon), one frame per iteration: the frames that make the p99 of
-//!   `deadline_bench`'s pile, where the two frames above are a resting frame and one
-//!   frame's pairs answered over and over (warm caches and branch history).
+//! - `proxima/frame-settling`: the same step over the [`SETTLING`] frames of the drop, one
+//!   per iteration, in order. Every body moves, so every pair is answered afresh at poses
+//!   that change from frame to frame, as in the daemon: these frames make the p99 of
+//!   `deadline_bench`'s pile. (The two benches above time a resting frame, and one
+//!   frame's pairs answered over and over with warm caches and branch history.)
 //! - `proxima/narrow`: the narrow phase alone on frame `k`'s candidate pairs (the
 //!   all-pairs broad phase of `proxima::broad::brute_force`, equal to the pipeline's), as
 //!   the pipeline answers a pair: `dispatch::distance` exact up to the two margins, then
@@ -92,6 +92,10 @@ const SETTLE_FRAMES: usize = 360;
 /// when every body moves and the p99 of `deadline_bench`'s pile is made (frames 80–300 of
 /// its 1,000).
 const SETTLING: std::ops::Range<usize> = 100..300;
+const _: () = assert!(
+    SETTLING.end <= SETTLE_FRAMES,
+    "settling frames are simulated first"
+);
 /// What every frame asks, as the pile's client does.
 const QUERY: Query = Query::CLOSE.union(Query::CONTACTS);
 /// Shift of every moving body in `proxima/frame-all-pairs`'s second pose set, metres:
