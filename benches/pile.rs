@@ -24,6 +24,9 @@
 //!   that change from frame to frame, as in the daemon: these frames make the p99 of
 //!   `deadline_bench`'s pile. (The two benches above time a resting frame, and one
 //!   frame's pairs answered over and over with warm caches and branch history.)
+//! - `proxima/frame-settling-helped`: the same with the daemon's workspace, a worker pool
+//!   of one, whose helper thread answers convex pairs on the other core
+//!   (`src/pipeline/helper.rs`).
 //! - `proxima/narrow`: the narrow phase alone on frame `k`'s candidate pairs (the
 //!   all-pairs broad phase of `proxima::broad::brute_force`, equal to the pipeline's), as
 //!   the pipeline answers a pair: `dispatch::distance` exact up to the two margins, then
@@ -76,12 +79,13 @@ use proxima::daemon::records::{contact_record, pair_record};
 use proxima::math::{DQuat, DVec3, Pose};
 use proxima::narrow::dispatch::{self, NarrowScratch};
 use proxima::narrow::{Manifold, Shape};
-use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, step};
+use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, WorkerPool, step};
 use proxima::scene::{BodyId, Motion, Scene};
 use proxima_ipc::client::Primitive;
 use proxima_ipc::wire::ResultRecord;
 use spec::{SceneSpec, ShapeSpec};
 use std::hint::black_box;
+use std::sync::Arc;
 
 /// The pile's seed (the one `examples/deadline_bench.rs` drops).
 const SEED: u64 = 29;
@@ -501,6 +505,11 @@ fn bench_pile(c: &mut Criterion) {
 
     let mut group = c.benchmark_group("pile");
     let (mut workspace, mut results) = (PipelineWorkspace::default(), FrameResults::default());
+    if std::env::var_os("ZZH").is_some() {
+        workspace = PipelineWorkspace::with_workers(std::sync::Arc::new(
+            proxima::pipeline::WorkerPool::new(1),
+        ));
+    }
     let fixed = [&frame_k, &frame_k1];
     let all_pairs = [&frame_k, &shifted];
     let settling: Vec<&PoseSet> = settling.iter().collect();
@@ -508,7 +517,12 @@ fn bench_pile(c: &mut Criterion) {
         ("frame", &fixed[..]),
         ("frame-all-pairs", &all_pairs[..]),
         ("frame-settling", &settling[..]),
+        ("frame-settling-helped", &settling[..]),
     ] {
+        if name == "frame-settling-helped" {
+            // The daemon's workspace: a pool of one worker, whose helper takes pairs.
+            workspace = PipelineWorkspace::with_workers(Arc::new(WorkerPool::new(1)));
+        }
         let mut frame = |poses: &PoseSet| {
             set_poses(&mut scene, poses);
             let report = step(&scene, QUERY, &mut workspace, &mut results);

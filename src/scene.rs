@@ -42,6 +42,7 @@ use crate::math::{DVec3, Pose, conservative_slack};
 use crate::narrow::Shape;
 use crate::narrow::toi::{FrameMotion, swept_bounds};
 use std::fmt;
+use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A shape's id within its scene.
@@ -204,7 +205,9 @@ fn next_uid() -> u64 {
 /// Shapes and bodies of one scene (see the [module docs](self)).
 #[derive(Debug)]
 pub struct Scene {
-    shapes: Vec<Shape>,
+    /// Shared, copied on write: a frame's helper thread reads the table of the frame it
+    /// helps ([`Scene::shape_table`]) while a later registration extends the scene's own.
+    shapes: Arc<Vec<Shape>>,
     /// Whether any of `shapes` is a triangle mesh ([`Scene::has_mesh_shapes`]).
     any_mesh_shape: bool,
     /// Whether any of `shapes` is a mesh or a compound ([`Scene::has_tree_shapes`]).
@@ -265,7 +268,7 @@ impl Scene {
     pub fn try_new(default_margin: f64, limits: SceneLimits) -> Result<Self, SceneError> {
         check_margin(default_margin)?;
         Ok(Self {
-            shapes: Vec::new(),
+            shapes: Arc::new(Vec::new()),
             any_mesh_shape: false,
             any_tree_shape: false,
             shape_boxes: Vec::new(),
@@ -309,8 +312,9 @@ impl Scene {
         self.shape_boxes.push(prepared.local);
         self.any_mesh_shape |= matches!(prepared.shape, Shape::Mesh(_));
         self.any_tree_shape |= matches!(prepared.shape, Shape::Mesh(_) | Shape::Compound(_));
-        self.shapes.push(prepared.shape);
-        Ok(ShapeId(self.shapes.len() as u32 - 1))
+        let shapes = Arc::make_mut(&mut self.shapes);
+        shapes.push(prepared.shape);
+        Ok(ShapeId(shapes.len() as u32 - 1))
     }
 
     /// Whether any registered shape is a triangle mesh: without one the scene has no
@@ -331,6 +335,20 @@ impl Scene {
     #[must_use]
     pub fn shape(&self, id: ShapeId) -> Option<&Shape> {
         self.shapes.get(id.0 as usize)
+    }
+
+    /// Every registered shape, indexed by [`ShapeId`]: a handle that stays as it is when the
+    /// scene registers more (for a thread that reads a frame's shapes without borrowing
+    /// the scene).
+    #[must_use]
+    pub fn shape_table(&self) -> Arc<Vec<Shape>> {
+        Arc::clone(&self.shapes)
+    }
+
+    /// Every body slot, indexed by [`BodyId`] (`None`: no live body).
+    #[must_use]
+    pub fn body_slots(&self) -> &[Option<Body>] {
+        &self.bodies
     }
 
     /// Adds a body.

@@ -9,7 +9,8 @@
 //!    traversal (`separation.rs`); under a limited budget the frontier refines the rest
 //!    (`frontier_run.rs`);
 //! 4. **narrow phase** (`pair_loop.rs`; the answers in `answer.rs`, on the worker pool for
-//!    many mesh pairs or tree walks on an unbudgeted frame, `workers.rs`): each
+//!    many mesh pairs or tree walks on an unbudgeted frame, `workers.rs`, and by the pool's
+//!    helper thread for many convex pairs to answer afresh, `helper.rs`): each
 //!    candidate's answer by its route, or its kept answer;
 //! 5. **time of impact** (`toi.rs`);
 //!
@@ -73,6 +74,7 @@ mod answer;
 mod broad_sync;
 mod costs;
 mod frontier_run;
+mod helper;
 mod pair_loop;
 mod pair_memory;
 mod plan;
@@ -331,6 +333,9 @@ pub struct StepReport {
     /// Candidate pairs answered by last frame's answer, neither body having changed (see
     /// the [module docs](self)).
     pub reused_pairs: u32,
+    /// Candidate pairs the pool's helper thread answered on the other core (a budgeted or
+    /// unbudgeted frame with many convex pairs to answer afresh: `helper.rs`).
+    pub helped_pairs: u32,
     /// Mesh–mesh candidate pairs answered "apart" with no traversal: by a separation an
     /// earlier frame proved, their relative motion since being smaller than its slack, or
     /// by their convex hulls this frame (see the [module docs](self)); they take no path
@@ -409,6 +414,9 @@ pub struct PipelineWorkspace {
     abandon: Abandon,
     /// The end of an unlimited frame's slice, during [`step_sliced`].
     slice: Option<Instant>,
+    /// Candidates the last frame answered afresh (neither kept nor proven apart): whether
+    /// this one is worth the pool's helper ([`helper::MIN_HELPED_PAIRS`]).
+    fresh_last_frame: usize,
 }
 
 impl PipelineWorkspace {
@@ -667,6 +675,7 @@ pub fn step_within(
         broad_stats: broad.stats,
         paths: workspace.narrow.paths,
         reused_pairs: tally.reused,
+        helped_pairs: tally.helped,
         separated_pairs: tally.separated,
         hull_tests: index(hull_tests as usize),
         mid_ns,

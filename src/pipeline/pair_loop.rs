@@ -5,15 +5,17 @@
 
 use super::answer::{self, Answer, MeshScratch};
 use super::costs::TailTimer;
+use super::helper::{BODIES_PER_HELPED_PAIR, Helping, MIN_HELPED_PAIRS};
 use super::pair_memory::PairMemories;
+use super::plan;
 use super::plan::{FramePlan, PairPlan};
-use super::workers::PairOutcome;
+use super::workers::{PairOutcome, WorkerPool};
 use super::{ContactPoint, FrameResults, PipelineWorkspace, Query, body, index, shape};
 use crate::broad::CandidatePair;
 use crate::budget::Completeness;
 use crate::narrow::Shape;
 use crate::narrow::contact::Manifold;
-use crate::narrow::dispatch::NarrowScratch;
+use crate::narrow::dispatch::{self, NarrowScratch, Route};
 use crate::narrow::mesh_mesh::frontier::FrontierAnswer;
 use crate::scene::{Body, Scene};
 
@@ -23,6 +25,8 @@ pub(super) struct PairTally {
     pub(super) completeness: Completeness,
     /// Pairs answered by their kept answer.
     pub(super) reused: u32,
+    /// Pairs the helper thread answered.
+    pub(super) helped: u32,
     /// Pairs answered apart by a kept separation or their hulls.
     pub(super) separated: u32,
     /// Pairs answered short of exact.
@@ -42,6 +46,7 @@ pub(super) fn answer_candidates(
     let mut tally = PairTally {
         completeness: Completeness::Exact,
         reused: 0,
+        helped: 0,
         separated: 0,
         truncated: 0,
     };
@@ -57,8 +62,16 @@ pub(super) fn answer_candidates(
         manifold,
         mesh,
         costs,
+        workers,
+        fresh_last_frame,
+        abandon,
         ..
     } = workspace;
+    let fresh = *fresh_last_frame;
+    let mut helping = workers
+        .as_deref()
+        .filter(|_| !plan.pool && !abandon.is_raised() && fresh >= MIN_HELPED_PAIRS)
+        .and_then(|pool| start_helper(pool, scene, query, candidates, separated));
     let mut sources = AnswerSources {
         pooled: outcomes.iter(),
         frontier: frontier_pairs.iter().zip(frontier_answers.iter()),
@@ -94,14 +107,27 @@ pub(super) fn answer_candidates(
         if matches!(pair_plan, PairPlan::Conservative) {
             tail.begin(candidates.len() - slot);
         }
-        let (answer, truncated_level) = sources.answer(
-            query,
-            (slot, pair),
-            ((a, shapes.0), (b, shapes.1)),
-            &pair_plan,
-            memory,
-            &mut results.contacts,
-        );
+        let from_helper = match (&mut helping, &pair_plan) {
+            (Some(helping), PairPlan::Direct | PairPlan::Conservative) => {
+                helping.take(index(slot)).copied()
+            }
+            _ => None,
+        };
+        let (answer, truncated_level) = match from_helper {
+            Some(outcome) => {
+                tally.helped += 1;
+                results.contacts.extend_from_slice(outcome.contacts());
+                (outcome.answer, None)
+            }
+            None => sources.answer(
+                query,
+                (slot, pair),
+                ((a, shapes.0), (b, shapes.1)),
+                &pair_plan,
+                memory,
+                &mut results.contacts,
+            ),
+        };
         tally.separated += u32::from(matches!(pair_plan, PairPlan::Separated));
         tally.truncated += u32::from(!answer.result.exact);
         if pair_plan.searches_mesh_pair() {
@@ -120,9 +146,44 @@ pub(super) fn answer_candidates(
         }
         report(query, answer, (a, b), first_contact, results);
     }
+    if let Some(helping) = helping {
+        sources.narrow.paths.add(&helping.end());
+    }
     memory.forget_unvisited();
     tail.end(costs);
+    *fresh_last_frame = candidates.len() - (tally.reused + tally.separated) as usize;
     tally
+}
+
+/// Hands the pool's helper (when no other frame holds it) the candidates it may answer,
+/// when there are at least [`MIN_HELPED_PAIRS`] of them and at most
+/// [`BODIES_PER_HELPED_PAIR`] body slots to copy for each.
+fn start_helper(
+    pool: &WorkerPool,
+    scene: &Scene,
+    query: Query,
+    candidates: &[CandidatePair],
+    separated: &[bool],
+) -> Option<Helping> {
+    let helped = |(slot, pair): (usize, &CandidatePair)| {
+        let (a, b) = (body(scene, pair.a), body(scene, pair.b));
+        let direct = !separated[slot] && helps(shape(scene, a), shape(scene, b));
+        direct.then_some((index(slot), *pair))
+    };
+    let count = candidates.iter().enumerate().filter_map(helped).count();
+    let few_bodies = scene.body_slots().len() <= BODIES_PER_HELPED_PAIR * count;
+    if count < MIN_HELPED_PAIRS || !few_bodies {
+        return None;
+    }
+    let pairs = candidates.iter().enumerate().filter_map(helped);
+    // The guard may go once the frame is handed over: the frame's claims are its own.
+    Some(pool.helper()?.begin(scene, query, pairs))
+}
+
+/// Whether the helper may answer a pair of these shapes: a direct pair between convex
+/// shapes (closed forms, GJK/EPA), not a walk of a tree.
+fn helps(sa: &Shape, sb: &Shape) -> bool {
+    matches!(dispatch::route(sa, sb), Route::Direct) && plan::pool_work(sa, sb).is_none()
 }
 
 /// Where a pair's answer comes from besides its own query: the pool's outcomes and the

@@ -238,17 +238,27 @@ fn compare_with_pool(shapes: &[Shape], half: f64, seed: u64) -> (usize, usize) {
         let query = queries[frame % queries.len()];
         let a = step(&scene, query, &mut serial, &mut expected);
         let b = step(&scene, query, &mut parallel, &mut found);
-        assert_eq!(found.pairs, expected.pairs, "frame {frame}");
-        assert_eq!(found.contacts, expected.contacts, "frame {frame}");
-        assert_eq!(
-            (a.completeness, a.candidates, a.pairs, a.contacts, a.paths),
-            (b.completeness, b.candidates, b.pairs, b.contacts, b.paths),
-            "frame {frame}"
-        );
+        assert_same_frame((&a, &expected), (&b, &found), frame);
         pooled += parallel.outcomes.len();
         contact_frames += usize::from(!found.contacts.is_empty());
     }
     (pooled, contact_frames)
+}
+
+/// Two workspaces' answers to the same frame `frame` (its report and results each) are
+/// the same records, contacts, completeness, counts and paths.
+fn assert_same_frame(
+    (a, expected): (&StepReport, &FrameResults),
+    (b, found): (&StepReport, &FrameResults),
+    frame: usize,
+) {
+    assert_eq!(found.pairs, expected.pairs, "frame {frame}");
+    assert_eq!(found.contacts, expected.contacts, "frame {frame}");
+    assert_eq!(
+        (a.completeness, a.candidates, a.pairs, a.contacts, a.paths),
+        (b.completeness, b.candidates, b.pairs, b.contacts, b.paths),
+        "frame {frame}"
+    );
 }
 
 /// Moves every body of `scene` by up to 0.1 m per axis, kept within 1.4 m of the origin,
@@ -1014,5 +1024,135 @@ fn a_mesh_pair_whose_search_stops_answers_conservatively() {
     assert!(
         stopped > 300 && touching > 10 && apart > 10,
         "stopped {stopped}, touching {touching}, apart {apart}"
+    );
+}
+
+/// 80 convex bodies of every convex kind packed in a 1.6 m cube: about a hundred
+/// candidate pairs a frame, most touching.
+fn convex_crowd(seed: u64) -> (Scene, Vec<BodyId>, crate::test_support::TestRng) {
+    use crate::geometry::{Cone, ConvexPolyhedron};
+    let hull: Vec<DVec3> = meshes::uv_sphere(0.2, 6, 4).vertices().to_vec();
+    let hull = Arc::new(ConvexPolyhedron::try_from_points(&hull).unwrap());
+    let mut scene = Scene::try_new(0.0, SceneLimits::STANDARD).unwrap();
+    let mut rng = rng(seed);
+    let bodies = (0..80)
+        .map(|i| {
+            let shape = match i % 6 {
+                0 => Shape::Sphere(Sphere::new(0.15)),
+                1 => Shape::Capsule(Capsule::new(0.15, 0.1)),
+                2 => Shape::Cuboid(Cuboid::new(DVec3::new(0.15, 0.1, 0.2))),
+                3 => Shape::Cylinder(Cylinder::new(0.15, 0.12)),
+                4 => Shape::Cone(Cone::new(0.15, 0.15)),
+                _ => Shape::Convex(Arc::clone(&hull)),
+            };
+            add(&mut scene, shape, point_in_cube(&mut rng, 0.8), 0.02)
+        })
+        .collect();
+    (scene, bodies, rng)
+}
+
+/// Moves and turns every body a little, as a settling pile does: no answer can be kept.
+fn jostle(scene: &mut Scene, bodies: &[BodyId], rng: &mut crate::test_support::TestRng) {
+    for &body in bodies {
+        let pose = scene.body(body).unwrap().pose;
+        let moved = Pose::new(
+            (pose.position + point_in_cube(rng, 0.02)).clamp_length_max(0.9),
+            rotation(rng).slerp(pose.rotation, 0.95),
+        );
+        scene.set_pose(body, moved).unwrap();
+    }
+}
+
+/// A crowd of convex bodies all moving: with the pool's helper answering pairs from the
+/// back, every frame's records, contacts and paths are those of one thread, unbudgeted
+/// and under a deadline too far to stop anything; the helper and the pair loop each
+/// answer a share (the helper waited for, so that it does on a busy machine too).
+#[test]
+fn the_pair_helper_changes_nothing_but_who_answers() {
+    let (mut scene, bodies, mut rng) = convex_crowd(211);
+    let pool = Arc::new(WorkerPool::with_helper(
+        1,
+        Some(helper::PairHelper::eager()),
+    ));
+    let (mut alone, mut helped) = (
+        PipelineWorkspace::default(),
+        PipelineWorkspace::with_workers(pool),
+    );
+    let (mut expected, mut found) = (FrameResults::default(), FrameResults::default());
+    let (mut by_helper, mut fresh, mut contacts) = (0, 0, 0);
+    for frame in 0..80 {
+        jostle(&mut scene, &bodies, &mut rng);
+        let query = if frame % 2 == 0 {
+            Query::CLOSE.union(Query::CONTACTS)
+        } else {
+            Query::DISTANCE.union(Query::CONTACTS)
+        };
+        let (a, b) = if frame % 4 < 2 {
+            (
+                step(&scene, query, &mut alone, &mut expected),
+                step(&scene, query, &mut helped, &mut found),
+            )
+        } else {
+            let far = || Deadline(Instant::now() + Duration::from_secs(60));
+            (
+                step_within(&scene, query, &mut far(), &mut alone, &mut expected),
+                step_within(&scene, query, &mut far(), &mut helped, &mut found),
+            )
+        };
+        assert_same_frame((&a, &expected), (&b, &found), frame);
+        assert_eq!(a.helped_pairs, 0, "no pool, no helper");
+        by_helper += b.helped_pairs;
+        fresh += b.candidates - b.reused_pairs - b.separated_pairs;
+        contacts += b.contacts;
+    }
+    assert!(
+        by_helper > 500 && by_helper < fresh && contacts > 1000,
+        "pairs answered by the helper {by_helper} of {fresh} afresh, contacts {contacts}"
+    );
+}
+
+/// A helper held mid-pair (as if preempted) never holds up the frame: the pair loop
+/// answers the pair the helper holds itself, every frame ends with the records of one
+/// thread, and nothing the held helper claimed is taken from it.
+#[test]
+fn a_held_pair_helper_never_delays_the_frame() {
+    let gate: helper::Gate = Arc::default();
+    let pool = Arc::new(WorkerPool::with_helper(
+        1,
+        Some(helper::PairHelper::held(Arc::clone(&gate))),
+    ));
+    let (done_tx, done_rx) = std::sync::mpsc::channel();
+    let frames = std::thread::spawn(move || {
+        let (mut scene, bodies, mut rng) = convex_crowd(223);
+        let (mut alone, mut helped) = (
+            PipelineWorkspace::default(),
+            PipelineWorkspace::with_workers(pool),
+        );
+        let (mut expected, mut found) = (FrameResults::default(), FrameResults::default());
+        let mut fresh = 0;
+        // The first frame's last pair is held; later frames find the helper still held.
+        for frame in 0..4 {
+            jostle(&mut scene, &bodies, &mut rng);
+            let query = Query::CLOSE.union(Query::CONTACTS);
+            step(&scene, query, &mut alone, &mut expected);
+            let report = step(&scene, query, &mut helped, &mut found);
+            assert_eq!(found.pairs, expected.pairs, "frame {frame}");
+            assert_eq!(found.contacts, expected.contacts, "frame {frame}");
+            assert_eq!(report.helped_pairs, 0, "frame {frame}: the helper is held");
+            fresh += report.candidates - report.reused_pairs;
+        }
+        done_tx.send(fresh).unwrap();
+    });
+    // A pair loop that waited for the held helper would never send: the gate opens only
+    // after the frames, or after a wait no frame of 80 bodies comes near.
+    let fresh = done_rx.recv_timeout(Duration::from_secs(120));
+    let (open, opened) = &*gate;
+    *open.lock().unwrap() = true;
+    opened.notify_all();
+    frames.join().unwrap();
+    let fresh = fresh.expect("the frames ended while the helper was held");
+    assert!(
+        fresh > 4 * helper::MIN_HELPED_PAIRS as u32,
+        "{fresh} pairs answered afresh"
     );
 }

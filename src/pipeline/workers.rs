@@ -31,8 +31,13 @@
 //!
 //! A worker that panics on a job (a bug, never client input, which is validated at ingest)
 //! answers that pair with the conservative box answer instead of leaving the frame waiting.
+//!
+//! The pool also holds the pair loop's helper thread (`helper.rs`), which answers convex
+//! pairs beside the calling thread on frames the pool does not take, budgeted ones
+//! included, and is never waited for.
 
 use super::answer::{self, Answer, MeshScratch};
+use super::helper::PairHelper;
 use super::{ContactPoint, Query};
 use crate::broad::CandidatePair;
 use crate::budget::{Abandon, WorkClock};
@@ -89,7 +94,7 @@ pub(super) struct PairOutcome {
 impl PairOutcome {
     /// The outcome of pair `slot`: its answer, the first [`MANIFOLD_POINTS`] of
     /// `contacts`, its cache and its paths.
-    fn new(
+    pub(super) fn new(
         slot: u32,
         answer: Answer,
         contacts: &[ContactPoint],
@@ -209,6 +214,9 @@ pub struct WorkerPool {
     /// Held for the length of a frame: one frame at a time.
     frame: Mutex<()>,
     threads: Vec<JoinHandle<()>>,
+    /// The pair loop's helper ([`helper`](super::helper)), when the
+    /// pool has workers: one for the pool, taken by one frame at a time.
+    helper: Option<Mutex<PairHelper>>,
 }
 
 impl WorkerPool {
@@ -218,6 +226,11 @@ impl WorkerPool {
     /// When the operating system cannot start a thread.
     #[must_use]
     pub fn new(workers: usize) -> Self {
+        Self::with_helper(workers, (workers > 0).then(PairHelper::new))
+    }
+
+    /// A pool of `workers` threads whose pair helper is `helper` (tests give a held one).
+    pub(super) fn with_helper(workers: usize, helper: Option<PairHelper>) -> Self {
         let (jobs, queue) = channel::bounded::<PairJob>(QUEUE_CAPACITY);
         let (outcome_tx, outcomes) = channel::bounded(QUEUE_CAPACITY);
         let threads = (0..workers)
@@ -243,7 +256,13 @@ impl WorkerPool {
             outcomes,
             frame: Mutex::new(()),
             threads,
+            helper: helper.map(Mutex::new),
         }
+    }
+
+    /// The pool's pair helper, unless the pool has no workers or another frame holds it.
+    pub(super) fn helper(&self) -> Option<std::sync::MutexGuard<'_, PairHelper>> {
+        self.helper.as_ref()?.try_lock().ok()
     }
 
     /// Number of worker threads.
