@@ -41,7 +41,7 @@ use crate::pipeline::ContactPoint;
 use crate::scene::{Body, Scene};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
-use std::sync::{Arc, Condvar, Mutex, OnceLock, PoisonError};
+use std::sync::{Arc, Condvar, Mutex, OnceLock, PoisonError, TryLockError};
 use std::thread::JoinHandle;
 
 /// Fewest pairs the helper is woken for, answered afresh in the last frame and open to it
@@ -250,13 +250,23 @@ impl PairHelper {
     }
 
     /// Hands the helper `pairs` (candidate slot and pair, in candidate order) of `scene`
-    /// under `query`, and returns the pair loop's side of the frame.
+    /// under `query`, and returns the pair loop's side of the frame; `None` (the frame goes
+    /// unhelped) when the helper is taking the last frame just then.
     pub(super) fn begin(
         &mut self,
         scene: &Scene,
         query: Query,
         pairs: impl Iterator<Item = (u32, CandidatePair)>,
-    ) -> Helping {
+    ) -> Option<Helping> {
+        // Never waited for, not even for the hand-over: a helper preempted (it runs only
+        // on an idle core) while it takes a frame holds this lock, and then the frame goes
+        // without it.
+        let shared = Arc::clone(&self.shared);
+        let mut posted = match shared.posted.try_lock() {
+            Ok(posted) => posted,
+            Err(TryLockError::Poisoned(poisoned)) => poisoned.into_inner(),
+            Err(TryLockError::WouldBlock) => return None,
+        };
         let mut frame = match self.last.take() {
             Some(frame) if Arc::strong_count(&frame) == 1 => frame,
             _ => Arc::new(HelperFrame::default()),
@@ -277,10 +287,8 @@ impl PairHelper {
         }
         f.outcomes.resize_with(n, OnceLock::new);
         *f.closed.get_mut() = false;
-        {
-            let mut posted = self.posted();
-            posted.frame = Some(Arc::clone(&frame));
-        }
+        posted.frame = Some(Arc::clone(&frame));
+        drop(posted);
         self.shared.wake.notify_one();
         #[cfg(test)]
         if self.eager && n > 0 {
@@ -295,11 +303,11 @@ impl PairHelper {
             }
         }
         self.last = Some(Arc::clone(&frame));
-        Helping {
+        Some(Helping {
             frame,
             next: 0,
             taken: PathCounts::default(),
-        }
+        })
     }
 
     fn posted(&self) -> std::sync::MutexGuard<'_, Posted> {

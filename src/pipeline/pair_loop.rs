@@ -177,7 +177,7 @@ fn start_helper(
     }
     let pairs = candidates.iter().enumerate().filter_map(helped);
     // The guard may go once the frame is handed over: the frame's claims are its own.
-    Some(pool.helper()?.begin(scene, query, pairs))
+    pool.helper()?.begin(scene, query, pairs)
 }
 
 /// Whether the helper may answer a pair of these shapes: a direct pair between convex
