@@ -145,9 +145,9 @@ fn settle() -> Settled {
         world.resolve(&pairs, &contacts);
         kept.push(moving_poses(&scene));
     }
-    let settling = kept[SETTLING].to_vec();
     let frame_k1 = kept.pop().expect("two frames kept");
     let frame_k = kept.pop().expect("two frames kept");
+    let settling = kept.drain(SETTLING).collect();
     set_poses(&mut scene, &frame_k);
     println!(
         "pile: seed {SEED}, frame {SETTLE_FRAMES} at {PILE_RATE_HZ} Hz: {} bodies, {} at rest",
@@ -505,11 +505,6 @@ fn bench_pile(c: &mut Criterion) {
 
     let mut group = c.benchmark_group("pile");
     let (mut workspace, mut results) = (PipelineWorkspace::default(), FrameResults::default());
-    if std::env::var_os("ZZH").is_some() {
-        workspace = PipelineWorkspace::with_workers(std::sync::Arc::new(
-            proxima::pipeline::WorkerPool::new(1),
-        ));
-    }
     let fixed = [&frame_k, &frame_k1];
     let all_pairs = [&frame_k, &shifted];
     let settling: Vec<&PoseSet> = settling.iter().collect();

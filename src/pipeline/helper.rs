@@ -30,14 +30,11 @@
 //!   so the loop answers it; the helper starts its scratch afresh.
 
 use super::Query;
-use super::answer;
-use super::workers::PairOutcome;
+use super::workers::{JobScratch, PairOutcome};
 use crate::broad::CandidatePair;
+use crate::budget::WorkClock;
 use crate::narrow::Shape;
-use crate::narrow::contact::Manifold;
-use crate::narrow::dispatch::{NarrowScratch, PathCounts};
-use crate::narrow::mesh_mesh::DistanceCache;
-use crate::pipeline::ContactPoint;
+use crate::narrow::dispatch::PathCounts;
 use crate::scene::{Body, Scene};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
@@ -83,7 +80,7 @@ struct HelperFrame {
 impl HelperFrame {
     /// The helper's part: the pairs from the back, until one is the loop's or the frame
     /// ends.
-    fn help(&self, scratch: &mut HelperScratch, shared: &Shared) {
+    fn help(&self, scratch: &mut JobScratch, shared: &Shared) {
         for (i, (slot, pair)) in self.pairs.iter().enumerate().rev() {
             if self.closed.load(Ordering::Relaxed)
                 || self.claims[i]
@@ -102,56 +99,27 @@ impl HelperFrame {
                 }
                 // Left as the helper's, unfinished: the loop answers it.
                 Ok(None) => {}
-                Err(_) => *scratch = HelperScratch::default(),
+                Err(_) => *scratch = JobScratch::default(),
             }
         }
     }
 
-    /// Pair `slot`'s outcome, as the pair loop's `answer::direct` gives it; `None` when a
-    /// body or shape is missing (never, for a frame's candidates).
+    /// Pair `slot`'s outcome, as the pair loop's `answer::direct` gives it, with a clock
+    /// that never stops; `None` when a body or shape is missing (never, for a frame's
+    /// candidates).
     fn answer(
         &self,
         slot: u32,
         pair: &CandidatePair,
-        scratch: &mut HelperScratch,
+        scratch: &mut JobScratch,
     ) -> Option<PairOutcome> {
         let body = |id: u32| self.bodies.get(id as usize)?.as_ref();
         let (a, b) = (body(pair.a)?, body(pair.b)?);
         let shape = |body: &Body| self.shapes.get(body.shape.0 as usize);
         let (sa, sb) = (shape(a)?, shape(b)?);
-        let HelperScratch {
-            narrow,
-            manifold,
-            contacts,
-        } = scratch;
-        contacts.clear();
-        narrow.paths = PathCounts::default();
-        let answer = answer::direct(
-            pair,
-            (a, sa),
-            (b, sb),
-            self.query,
-            narrow,
-            manifold,
-            contacts,
-        );
-        let cache = DistanceCache::new();
-        Some(PairOutcome::new(
-            slot,
-            answer,
-            contacts,
-            cache,
-            narrow.paths,
-        ))
+        let clock = WorkClock::default();
+        Some(scratch.direct((slot, pair), ((a, sa), (b, sb)), self.query, clock))
     }
-}
-
-/// The helper thread's scratch, kept across frames.
-#[derive(Debug, Default)]
-struct HelperScratch {
-    narrow: NarrowScratch,
-    manifold: Manifold,
-    contacts: Vec<ContactPoint>,
 }
 
 /// The frame handed to the helper thread, or its stop.
@@ -250,8 +218,10 @@ impl PairHelper {
     }
 
     /// Hands the helper `pairs` (candidate slot and pair, in candidate order) of `scene`
-    /// under `query`, and returns the pair loop's side of the frame; `None` (the frame goes
-    /// unhelped) when the helper is taking the last frame just then.
+    /// under `query`, and returns the pair loop's side of the frame. `None`, the frame going
+    /// unhelped: fewer than [`MIN_HELPED_PAIRS`] pairs, more than
+    /// [`BODIES_PER_HELPED_PAIR`] body slots to copy for each, or the helper taking the
+    /// last frame just then.
     pub(super) fn begin(
         &mut self,
         scene: &Scene,
@@ -272,13 +242,17 @@ impl PairHelper {
             _ => Arc::new(HelperFrame::default()),
         };
         let f = Arc::get_mut(&mut frame).expect("a frame no other thread holds");
+        f.pairs.clear();
+        f.pairs.extend(pairs);
+        let n = f.pairs.len();
+        if n < MIN_HELPED_PAIRS || scene.body_slots().len() > BODIES_PER_HELPED_PAIR * n {
+            self.last = Some(frame);
+            return None;
+        }
         f.shapes = scene.shape_table();
         f.bodies.clear();
         f.bodies.extend_from_slice(scene.body_slots());
         f.query = query;
-        f.pairs.clear();
-        f.pairs.extend(pairs);
-        let n = f.pairs.len();
         f.claims.clear();
         f.claims.resize_with(n, || AtomicU8::new(FREE));
         f.outcomes.truncate(n);
@@ -337,7 +311,7 @@ impl Drop for PairHelper {
 /// The helper thread: each frame posted, helped until its end or the loop's claims.
 fn run(shared: &Shared) {
     run_when_idle();
-    let mut scratch = HelperScratch::default();
+    let mut scratch = JobScratch::default();
     loop {
         let frame = {
             let mut posted = shared.posted.lock().unwrap_or_else(PoisonError::into_inner);

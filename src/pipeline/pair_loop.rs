@@ -5,7 +5,7 @@
 
 use super::answer::{self, Answer, MeshScratch};
 use super::costs::TailTimer;
-use super::helper::{BODIES_PER_HELPED_PAIR, Helping, MIN_HELPED_PAIRS};
+use super::helper::{Helping, MIN_HELPED_PAIRS};
 use super::pair_memory::PairMemories;
 use super::plan;
 use super::plan::{FramePlan, PairPlan};
@@ -108,9 +108,7 @@ pub(super) fn answer_candidates(
             tail.begin(candidates.len() - slot);
         }
         let from_helper = match (&mut helping, &pair_plan) {
-            (Some(helping), PairPlan::Direct | PairPlan::Conservative) => {
-                helping.take(index(slot)).copied()
-            }
+            (Some(helping), PairPlan::Direct | PairPlan::Conservative) => helping.take(index(slot)),
             _ => None,
         };
         let (answer, truncated_level) = match from_helper {
@@ -155,9 +153,8 @@ pub(super) fn answer_candidates(
     tally
 }
 
-/// Hands the pool's helper (when no other frame holds it) the candidates it may answer,
-/// when there are at least [`MIN_HELPED_PAIRS`] of them and at most
-/// [`BODIES_PER_HELPED_PAIR`] body slots to copy for each.
+/// Hands the pool's helper (when no other frame holds it) the candidates it may answer
+/// ([`PairHelper::begin`](super::helper::PairHelper::begin) says when it takes them).
 fn start_helper(
     pool: &WorkerPool,
     scene: &Scene,
@@ -165,17 +162,11 @@ fn start_helper(
     candidates: &[CandidatePair],
     separated: &[bool],
 ) -> Option<Helping> {
-    let helped = |(slot, pair): (usize, &CandidatePair)| {
+    let pairs = candidates.iter().enumerate().filter_map(|(slot, pair)| {
         let (a, b) = (body(scene, pair.a), body(scene, pair.b));
         let direct = !separated[slot] && helps(shape(scene, a), shape(scene, b));
         direct.then_some((index(slot), *pair))
-    };
-    let count = candidates.iter().enumerate().filter_map(helped).count();
-    let few_bodies = scene.body_slots().len() <= BODIES_PER_HELPED_PAIR * count;
-    if count < MIN_HELPED_PAIRS || !few_bodies {
-        return None;
-    }
-    let pairs = candidates.iter().enumerate().filter_map(helped);
+    });
     // The guard may go once the frame is handed over: the frame's claims are its own.
     pool.helper()?.begin(scene, query, pairs)
 }

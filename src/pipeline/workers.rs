@@ -140,22 +140,42 @@ pub(super) struct JobScratch {
     contacts: Vec<ContactPoint>,
 }
 
+impl JobScratch {
+    /// The outcome of direct pair `slot` (bodies `a`, `b` with shapes `sa`, `sb`) under
+    /// `query`, answered by [`answer::direct`] on `clock`: a pool job's, or the pair
+    /// helper's ([`helper`](super::helper), whose clock never stops).
+    pub(super) fn direct(
+        &mut self,
+        (slot, pair): (u32, &CandidatePair),
+        ((a, sa), (b, sb)): ((&Body, &Shape), (&Body, &Shape)),
+        query: Query,
+        clock: WorkClock,
+    ) -> PairOutcome {
+        let Self {
+            narrow,
+            manifold,
+            contacts,
+            ..
+        } = self;
+        contacts.clear();
+        narrow.clock = clock;
+        narrow.paths = PathCounts::default();
+        let answer = answer::direct(pair, (a, sa), (b, sb), query, narrow, manifold, contacts);
+        PairOutcome::new(slot, answer, contacts, DistanceCache::new(), narrow.paths)
+    }
+}
+
 /// Answers `job` with `scratch`.
 fn run(job: &PairJob, scratch: &mut JobScratch) -> PairOutcome {
-    let JobScratch {
-        mesh,
-        narrow,
-        manifold,
-        contacts,
-    } = scratch;
-    contacts.clear();
-    let mut cache = job.cache;
     // The pool answers only frames without a limited budget: an unlimited clock, which
     // stops only when the frame is abandoned.
     let mut clock = WorkClock::default().abandonable(job.abandon.clone());
     let (sa, sb) = &job.shapes;
-    let (answer, paths) = match dispatch::route(sa, sb) {
+    match dispatch::route(sa, sb) {
         Route::MeshMesh(mesh_a, mesh_b) => {
+            let JobScratch { mesh, contacts, .. } = scratch;
+            contacts.clear();
+            let mut cache = job.cache;
             let answer = answer::mesh_mesh(
                 &job.pair,
                 (&job.a, mesh_a),
@@ -165,24 +185,15 @@ fn run(job: &PairJob, scratch: &mut JobScratch) -> PairOutcome {
                 (mesh, &mut clock),
                 contacts,
             );
-            (answer, PathCounts::default())
+            PairOutcome::new(job.slot, answer, contacts, cache, PathCounts::default())
         }
-        Route::Direct => {
-            narrow.clock = clock;
-            narrow.paths = PathCounts::default();
-            let answer = answer::direct(
-                &job.pair,
-                (&job.a, sa),
-                (&job.b, sb),
-                job.query,
-                narrow,
-                manifold,
-                contacts,
-            );
-            (answer, narrow.paths)
-        }
-    };
-    PairOutcome::new(job.slot, answer, contacts, cache, paths)
+        Route::Direct => scratch.direct(
+            (job.slot, &job.pair),
+            ((&job.a, sa), (&job.b, sb)),
+            job.query,
+            clock,
+        ),
+    }
 }
 
 /// [`run`], with a panic turned into the pair's conservative box answer.
