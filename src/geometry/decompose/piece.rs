@@ -18,7 +18,10 @@
 //!
 //! A cut is Sutherland–Hodgman clipping of every loop against each side of the plane, with
 //! one point per crossed edge shared by the loops on both sides of that edge, then the
-//! cap: the new edges on the plane chained into loops. A point's side is decided once per cut
+//! cap: the new edges on the plane chained into loops. A cap can be concave, and a cut can
+//! leave several stretches of it on one side: those are joined along the cut line where the
+//! cap lies on it ([`Clipper::clip_stretches`]), never across a gap, so every corner of a
+//! piece lies in the solid. A point's side is decided once per cut
 //! from its signed distance (`≤ 0` below), so both pieces and all loops agree on it.
 
 use crate::math::DVec3;
@@ -392,6 +395,14 @@ impl Clipper {
         side: &[f64],
         crossings: &mut Crossings,
     ) {
+        let n = corners.len();
+        let crossed = (0..n)
+            .filter(|&k| inside(corners[k]) != inside(corners[(k + 1) % n]))
+            .count();
+        // More than one stretch inside: only a cap can be concave enough for that.
+        if crossed > 2 && self.clip_stretches(parent, corners, kind, inside, side, crossings) {
+            return;
+        }
         self.scratch.clear();
         let (mut first_entry, mut open_exit) = (None, None);
         for (k, &a) in corners.iter().enumerate() {
@@ -419,6 +430,103 @@ impl Clipper {
             self.push_loop(parent, crossings, &ids, kind.surface, kind.cut);
             self.scratch = ids;
         }
+    }
+
+    /// Clips a loop that enters and leaves the kept side more than once (a concave cap):
+    /// each stretch inside runs from an entry to an exit, and the stretches are joined
+    /// along the cut line the way the loop's own region lies on it. Sorted along the line,
+    /// the crossings bound, pair by pair, the line's segments inside the loop; each pair
+    /// joins an exit to an entry. (Sutherland–Hodgman would join the stretches in walk
+    /// order instead, by bridges across the gaps between them: outside the solid, and a
+    /// later cut through a bridge would put a corner there.) Returns `false`, having done
+    /// nothing, when the sorted crossings do not pair up so (ties of near-coincident
+    /// crossings): the caller then clips it the plain way.
+    fn clip_stretches(
+        &mut self,
+        parent: &Piece,
+        corners: &[u32],
+        kind: Loop,
+        inside: &dyn Fn(u32) -> bool,
+        side: &[f64],
+        crossings: &mut Crossings,
+    ) -> bool {
+        let n = corners.len();
+        // Walk from just after an exit so that every stretch is whole.
+        let Some(start) = (0..n).find(|&k| !inside(corners[k]) && inside(corners[(k + 1) % n]))
+        else {
+            return false;
+        };
+        let mut stretches: Vec<Vec<u32>> = Vec::new();
+        for step in 0..n {
+            let k = (start + step) % n;
+            let (a, b) = (corners[k], corners[(k + 1) % n]);
+            if inside(a) != inside(b) {
+                let x = crossings.on_edge(parent, side, a, b);
+                if inside(a) {
+                    stretches.last_mut().expect("an entry came first").push(x);
+                } else {
+                    stretches.push(vec![x]);
+                }
+            }
+            if inside(b) {
+                stretches.last_mut().expect("an entry came first").push(b);
+            }
+        }
+        // Crossings along the line, each with its stretch and whether it ends it (exit).
+        let at = |id: u32| crossings.point(parent, id);
+        let origin = at(stretches[0][0]);
+        let far = stretches
+            .iter()
+            .flat_map(|s| [s[0], s[s.len() - 1]])
+            .map(at)
+            .max_by(|p, q| {
+                (*p - origin)
+                    .length_squared()
+                    .total_cmp(&(*q - origin).length_squared())
+            })
+            .expect("stretches");
+        let along = (far - origin).normalize_or_zero();
+        let mut ends: Vec<(f64, usize, bool)> = Vec::with_capacity(2 * stretches.len());
+        for (i, s) in stretches.iter().enumerate() {
+            ends.push(((at(s[0]) - origin).dot(along), i, false));
+            ends.push(((at(s[s.len() - 1]) - origin).dot(along), i, true));
+        }
+        ends.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // Pair by pair: a segment of the line inside the loop, from one stretch's exit to
+        // the entry of the stretch that follows it.
+        let joins: Option<Vec<(usize, usize)>> = ends
+            .chunks_exact(2)
+            .map(|pair| match (pair[0], pair[1]) {
+                ((_, exit, true), (_, entry, false)) | ((_, entry, false), (_, exit, true)) => {
+                    Some((exit, entry))
+                }
+                _ => None,
+            })
+            .collect();
+        let Some(joins) = joins else {
+            return false;
+        };
+        let mut next = vec![usize::MAX; stretches.len()];
+        for (exit, entry) in joins {
+            next[exit] = entry;
+            // The new cap runs along the segment the other way: entry → exit.
+            let exit_id = *stretches[exit].last().expect("a stretch ends at its exit");
+            self.cap_edges.push([stretches[entry][0], exit_id]);
+        }
+        let mut done = vec![false; stretches.len()];
+        for first in 0..stretches.len() {
+            let mut ids = Vec::new();
+            let mut s = first;
+            while !done[s] {
+                done[s] = true;
+                ids.extend_from_slice(&stretches[s]);
+                s = next[s];
+            }
+            if ids.len() >= 3 {
+                self.push_loop(parent, crossings, &ids, kind.surface, kind.cut);
+            }
+        }
+        true
     }
 
     fn push_loop(

@@ -173,3 +173,93 @@ fn a_flat_mesh_is_not_a_solid() {
         Some(DecomposeError::NotSolid { .. })
     ));
 }
+
+/// Whether `p` lies in or on [`u_prism`] (3 × 2 × 1, its notch `[1, 2] × [1, 2]`), within
+/// `tol` metres.
+fn in_u_prism(p: DVec3, tol: f64) -> bool {
+    let in_box =
+        p.cmpge(DVec3::splat(-tol)).all() && p.cmple(DVec3::new(3.0, 2.0, 1.0) + tol).all();
+    let in_notch = p.x > 1.0 + tol && p.x < 2.0 - tol && p.y > 1.0 + tol;
+    in_box && !in_notch
+}
+
+/// Cuts `piece` by each plane in turn, keeping every piece; returns them all.
+fn cut_all(piece: Piece, planes: &[Plane]) -> Vec<Piece> {
+    let mut pieces = vec![piece];
+    for plane in planes {
+        pieces = pieces
+            .into_iter()
+            .flat_map(|p| match p.cut(plane) {
+                Some((a, b)) => vec![a, b],
+                None => vec![p],
+            })
+            .collect();
+    }
+    pieces
+}
+
+#[test]
+fn a_cut_through_a_concave_cap_puts_no_corner_outside_the_solid() {
+    // z = 0.5 leaves U-shaped caps; y = 1.5 keeps both arms of one, two stretches of it;
+    // x = 1.5 then crosses the gap between them, where a bridge joining the arms would be.
+    let whole = solid_piece(&u_prism());
+    let planes = [
+        Plane {
+            normal: DVec3::Z,
+            offset: 0.5,
+        },
+        Plane {
+            normal: DVec3::Y,
+            offset: 1.5,
+        },
+        Plane {
+            normal: DVec3::X,
+            offset: 1.5,
+        },
+    ];
+    let pieces = cut_all(whole.clone(), &planes);
+    assert_eq!(pieces.len(), 8, "each cut splits every piece it meets");
+    for piece in &pieces {
+        for p in piece.corner_points() {
+            assert!(in_u_prism(p, 1e-12), "corner {p} outside the U");
+        }
+    }
+    let total: f64 = pieces.iter().map(Piece::volume).sum();
+    assert!((total - whole.volume()).abs() < 1e-12, "{total}");
+}
+
+#[test]
+fn random_cuts_of_a_u_leave_every_corner_in_the_solid() {
+    let mut r = rng(3302);
+    let whole = solid_piece(&u_prism());
+    let centre = DVec3::new(1.5, 1.0, 0.5);
+    let (mut corners, mut split) = (0, 0);
+    for _ in 0..300 {
+        let planes: Vec<Plane> = (0..3)
+            .map(|_| {
+                let plane = random_plane(&mut r, 1.0);
+                Plane {
+                    offset: plane.offset + plane.normal.dot(centre),
+                    ..plane
+                }
+            })
+            .collect();
+        let pieces = cut_all(whole.clone(), &planes);
+        split += usize::from(pieces.len() > 4);
+        for piece in &pieces {
+            for p in piece.corner_points() {
+                corners += 1;
+                assert!(
+                    in_u_prism(p, 1e-9),
+                    "corner {p} outside the U, planes {planes:?}"
+                );
+            }
+        }
+        let total: f64 = pieces.iter().map(Piece::volume).sum();
+        assert!((total - whole.volume()).abs() < 1e-9, "{total}");
+    }
+    assert!(
+        split > 50 && corners > 10_000,
+        "{split} splits, {corners} corners"
+    );
+}
