@@ -14,7 +14,11 @@
 //!   when its probe `p + τ n`, just outside `H_i`, is in no other hull `H_j` deeper than
 //!   `τ / 2` (depth: the smallest distance to `H_j`'s face planes). Samples inside another
 //!   hull go, and so do samples on a face that another hull covers from the other side: a
-//!   cube cut in two keeps only the cube's own faces. Kept samples sample `∂U`.
+//!   cube cut in two keeps only the cube's own faces. A vertex is kept when one of its
+//!   probes, its own direction and [`VERTEX_PROBES`] more over the sphere, is in no hull
+//!   deeper than `−τ / 2`: where cuts meet inside the solid, the corner they make is a
+//!   vertex of every piece but not on `∂U`, whichever way one probe is aimed. Kept samples
+//!   sample `∂U`.
 //! - **Hull → mesh:** the largest exact distance from a kept sample to `M`.
 //! - **Mesh → hulls:** the largest, over mesh samples `m`, of: when `m` is in no hull
 //!   deeper than `τ`, its exact distance to `U` (to the nearest hull surface); otherwise `m`
@@ -246,16 +250,46 @@ impl<'a> HullSet<'a> {
                 kept.push(p);
             }
         }
-        for (i, h) in self.hulls.iter().enumerate() {
+        let directions = probe_directions();
+        for h in self.hulls {
             let centre = h.centroid();
             for &v in h.vertices() {
-                if self.on_boundary(i, v, (v - centre).normalize_or_zero()) {
+                if self.vertex_on_boundary(v, (v - centre).normalize_or_zero(), &directions) {
                     kept.push(v);
                 }
             }
         }
         kept
     }
+
+    /// Whether the hull vertex `v` is on the union's boundary: one of its probes `v + τ d`
+    /// is in no hull, its own included, deeper than `−τ / 2` (first `d` = `outward`, the
+    /// direction from its hull's centroid, then [`VERTEX_PROBES`] directions over the
+    /// sphere). A face sample needs only its one probe, but a vertex is where faces meet:
+    /// where several cuts meet inside the solid, the corner is every piece's vertex, and its
+    /// probe lies on or near another piece's face however it is aimed.
+    fn vertex_on_boundary(&self, v: DVec3, outward: DVec3, directions: &[DVec3]) -> bool {
+        std::iter::once(outward)
+            .chain(directions.iter().copied())
+            .any(|d| self.depth(v + d * self.tau, None) < -0.5 * self.tau)
+    }
+}
+
+/// Directions a hull vertex is probed in besides its own: enough that an opening of the
+/// union's outside about 30° wide at a vertex meets one.
+const VERTEX_PROBES: usize = 64;
+
+/// [`VERTEX_PROBES`] unit vectors spread evenly over the sphere (a Fibonacci lattice).
+fn probe_directions() -> Vec<DVec3> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..VERTEX_PROBES)
+        .map(|k| {
+            let z = 1.0 - 2.0 * (k as f64 + 0.5) / VERTEX_PROBES as f64;
+            let r = (1.0 - z * z).sqrt();
+            let angle = golden * k as f64;
+            DVec3::new(r * angle.cos(), r * angle.sin(), z)
+        })
+        .collect()
 }
 
 /// The triangles of a hull, counter-clockwise seen from outside.

@@ -66,6 +66,82 @@ fn cube_cut_along_a_diagonal_plane_scores_zero() {
     assert!(m.volume_overshoot.abs() < EXACT, "{m:?}");
 }
 
+/// The convex polytope `{x : n · x ≤ d}` for the given planes `(n, d)`, as a hull: its
+/// corners are the points where three planes meet that every plane keeps.
+fn polytope(planes: &[(DVec3, f64)]) -> ConvexPolyhedron {
+    let mut corners = Vec::new();
+    for i in 0..planes.len() {
+        for j in i + 1..planes.len() {
+            for k in j + 1..planes.len() {
+                let (a, b, c) = (planes[i], planes[j], planes[k]);
+                let det = a.0.dot(b.0.cross(c.0));
+                if det.abs() < 1e-9 {
+                    continue;
+                }
+                let p = (b.0.cross(c.0) * a.1 + c.0.cross(a.0) * b.1 + a.0.cross(b.0) * c.1) / det;
+                if planes.iter().all(|(n, d)| n.dot(p) <= d + 1e-12) {
+                    corners.push(p);
+                }
+            }
+        }
+    }
+    ConvexPolyhedron::try_from_points(&corners).unwrap()
+}
+
+#[test]
+fn cube_cut_by_three_oblique_planes_scores_zero_at_their_inner_corner() {
+    // The eight pieces meet at `centre`, inside the cube: a corner of each hull but not on
+    // the union's boundary, whatever direction its hull's centroid lies in.
+    let centre = DVec3::new(0.1, 0.2, -0.1);
+    let normals = [
+        DVec3::new(1.0, 0.3, 0.0).normalize(),
+        DVec3::new(0.2, 1.0, 0.5).normalize(),
+        DVec3::new(0.0, -0.4, 1.0).normalize(),
+    ];
+    let cube: Vec<(DVec3, f64)> = [DVec3::X, DVec3::Y, DVec3::Z]
+        .into_iter()
+        .flat_map(|a| [(a, 0.5), (-a, 0.5)])
+        .collect();
+    let hulls: Vec<ConvexPolyhedron> = (0..8)
+        .map(|octant: usize| {
+            let mut planes = cube.clone();
+            for (k, n) in normals.iter().enumerate() {
+                let n = if octant & (1 << k) == 0 { *n } else { -*n };
+                planes.push((n, n.dot(centre)));
+            }
+            polytope(&planes)
+        })
+        .collect();
+    let m = Reference::new(&unit_cube()).measure(&hulls);
+    assert!(m.hausdorff_rel < EXACT, "{m:?}");
+    assert!(m.volume_overshoot.abs() < EXACT, "{m:?}");
+}
+
+#[test]
+fn a_spike_over_a_cut_cube_scores_its_tip_exactly() {
+    // The tip is a vertex of one hull, sharp, beside another hull: it is on the boundary
+    // and its distance, 1 m, is a vertex's, exact.
+    let cube = unit_cube();
+    let half = DVec3::splat(0.5);
+    let mut spiked: Vec<DVec3> = (0..8)
+        .map(|i| {
+            DVec3::new(
+                if i & 1 == 0 { -0.5 } else { 0.0 },
+                if i & 2 == 0 { -0.5 } else { 0.5 },
+                if i & 4 == 0 { -0.5 } else { 0.5 },
+            )
+        })
+        .collect();
+    spiked.push(DVec3::new(0.0, 0.0, 1.5));
+    let hulls = [
+        ConvexPolyhedron::try_from_points(&spiked).unwrap(),
+        box_hull(DVec3::new(0.0, -0.5, -0.5), half),
+    ];
+    let m = Reference::new(&cube).measure(&hulls);
+    let expected = 1.0 / 3f64.sqrt();
+    assert!((m.hull_to_mesh_rel - expected).abs() < EXACT, "{m:?}");
+}
+
 #[test]
 fn cube_under_a_hull_shrunk_by_ten_percent_scores_its_corner_gap() {
     // The shrunk cube [-0.45, 0.45]³ is 0.05 inside every face: 0.05 from the hull to the
