@@ -3,14 +3,69 @@
 use super::concavity::{Surface, concavity};
 use super::nearest::SampleGrid;
 use super::piece::Piece;
-use crate::geometry::ConvexPolyhedron;
+use crate::geometry::{ConvexHullError, ConvexPolyhedron, HullTriangle};
 use crate::math::{DVec3, bounds_of};
+
+/// A piece's convex hull as the search weighs it: quickhull's triangles, unchecked and
+/// unmerged, and the points they span. A search builds thousands of these and keeps a few
+/// dozen, so the checked [`ConvexPolyhedron`] (faces merged, validated, every input point
+/// tested against it) is built only for the parts kept ([`Fitted::polyhedron`]).
+#[derive(Debug, Clone)]
+pub(super) struct QuickHull {
+    /// The hull's corners; every input point when the hull spans no solid.
+    pub points: Vec<DVec3>,
+    /// Counter-clockwise from outside; empty when the points span no solid (a sliver).
+    pub triangles: Vec<HullTriangle>,
+}
+
+impl QuickHull {
+    /// The hull of `points` (finite).
+    pub fn of(points: Vec<DVec3>) -> Self {
+        let Some(triangles) = ConvexPolyhedron::quick_hull_triangles(&points) else {
+            return Self {
+                points,
+                triangles: Vec::new(),
+            };
+        };
+        let mut corners: Vec<DVec3> = triangles.iter().flat_map(|t| t.corners).collect();
+        corners.sort_unstable_by(|a, b| a.to_array().partial_cmp(&b.to_array()).expect("finite"));
+        corners.dedup();
+        Self {
+            points: corners,
+            triangles,
+        }
+    }
+
+    /// Enclosed volume, m³ (0 for a sliver).
+    pub fn volume(&self) -> f64 {
+        let Some(o) = self.triangles.first().map(|t| t.corners[0]) else {
+            return 0.0;
+        };
+        self.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.corners.map(|p| p - o);
+                a.dot(b.cross(c))
+            })
+            .sum::<f64>()
+            / 6.0
+    }
+
+    /// The greatest signed distance of `p` above a face plane, metres: negative inside, its
+    /// depth; `None` for a sliver.
+    pub fn max_plane_distance(&self, p: DVec3) -> Option<f64> {
+        self.triangles
+            .iter()
+            .map(|t| t.normal.dot(p) - t.offset)
+            .reduce(f64::max)
+    }
+}
 
 /// A piece of the solid, measured.
 #[derive(Debug, Clone)]
 pub(super) struct Fitted {
     pub piece: Piece,
-    pub hull: ConvexPolyhedron,
+    pub hull: QuickHull,
     /// Where concavity is measured: the piece's surface samples (see
     /// [`Piece::surface_samples`]).
     pub samples: Vec<DVec3>,
@@ -28,13 +83,16 @@ impl Fitted {
     /// Measures `piece`, sampling its surface about `spacing` metres apart (see
     /// [`Piece::surface_samples`]); `None` when it has no corners.
     pub fn new(piece: Piece, spacing: f64) -> Option<Self> {
-        let corners: Vec<DVec3> = piece.corner_points().collect();
-        let hull = ConvexPolyhedron::try_from_points(&corners).ok()?;
+        let corners = piece.used_points();
+        if corners.is_empty() {
+            return None;
+        }
+        let hull = QuickHull::of(corners);
         let samples = piece.surface_samples(spacing);
         let volume = piece.volume();
         let concavity = hull_concavity(&hull, &samples, &piece, spacing);
         Some(Self {
-            bounds: bounds_of(hull.vertices().iter().copied()),
+            bounds: bounds_of(hull.points.iter().copied()),
             piece,
             hull,
             samples,
@@ -44,38 +102,38 @@ impl Fitted {
         })
     }
 
-    /// The union of two pieces, measured; `None` if the hull of both cannot be built.
-    pub fn merged(&self, other: &Fitted) -> Option<Fitted> {
-        let hull = self.merged_hull(other)?;
+    /// The union of two pieces, measured.
+    pub fn merged(&self, other: &Fitted) -> Fitted {
+        let hull = self.merged_hull(other);
         let mut samples = self.samples.clone();
         samples.extend_from_slice(&other.samples);
         let piece = self.piece.merged(&other.piece);
         let concavity = hull_concavity(&hull, &samples, &piece, self.spacing);
-        Some(Self {
-            bounds: bounds_of(hull.vertices().iter().copied()),
+        Self {
+            bounds: bounds_of(hull.points.iter().copied()),
             piece,
             hull,
             samples,
             volume: self.volume + other.volume,
             concavity,
             spacing: self.spacing,
-        })
+        }
     }
 
     /// The concavity the union of two pieces would have, metres, without building it.
-    pub fn merged_concavity(&self, other: &Fitted) -> Option<f64> {
-        let hull = self.merged_hull(other)?;
+    pub fn merged_concavity(&self, other: &Fitted) -> f64 {
+        let hull = self.merged_hull(other);
         let mut samples = self.samples.clone();
         samples.extend_from_slice(&other.samples);
         let piece = self.piece.merged(&other.piece);
-        Some(hull_concavity(&hull, &samples, &piece, self.spacing))
+        hull_concavity(&hull, &samples, &piece, self.spacing)
     }
 
     /// The hull of the union of two pieces (the hull of their hulls).
-    pub fn merged_hull(&self, other: &Fitted) -> Option<ConvexPolyhedron> {
-        let mut points = self.hull.vertices().to_vec();
-        points.extend_from_slice(other.hull.vertices());
-        ConvexPolyhedron::try_from_points(&points).ok()
+    pub fn merged_hull(&self, other: &Fitted) -> QuickHull {
+        let mut points = self.hull.points.clone();
+        points.extend_from_slice(&other.hull.points);
+        QuickHull::of(points)
     }
 
     /// Whether the two pieces' hull bounds touch or overlap, within `slack` metres: the
@@ -85,14 +143,20 @@ impl Fitted {
         let slack = DVec3::splat(slack);
         (a.0 - slack).cmple(b.1).all() && (b.0 - slack).cmple(a.1).all()
     }
+
+    /// The part's checked hull: of every corner of the piece, so it contains the piece
+    /// whatever quickhull's tolerance left out of [`QuickHull::points`].
+    pub fn polyhedron(&self) -> Result<ConvexPolyhedron, ConvexHullError> {
+        ConvexPolyhedron::try_from_points(&self.piece.used_points())
+    }
 }
 
 /// The concavity of a piece with this hull, surface samples and cut planes, metres.
-fn hull_concavity(hull: &ConvexPolyhedron, samples: &[DVec3], piece: &Piece, spacing: f64) -> f64 {
+fn hull_concavity(hull: &QuickHull, samples: &[DVec3], piece: &Piece, spacing: f64) -> f64 {
     // A hull that is not solid (a sliver of a piece) holds no concavity.
-    let Some(triangles) = ConvexPolyhedron::quick_hull_triangles(hull.vertices()) else {
+    if hull.triangles.is_empty() {
         return 0.0;
-    };
+    }
     let grid = SampleGrid::new(samples);
     let surface = Surface {
         grid: &grid,
@@ -102,5 +166,5 @@ fn hull_concavity(hull: &ConvexPolyhedron, samples: &[DVec3], piece: &Piece, spa
         pending: None,
         spacing,
     };
-    concavity(&triangles, samples, &surface)
+    concavity(&hull.triangles, samples, &surface)
 }

@@ -94,15 +94,14 @@ pub(super) fn merge_within(
 /// until `done(lowest cost, live pieces)` or no pair is left.
 fn merge_cheapest(
     pool: &mut Pool,
-    cost: impl Fn(&Fitted, &Fitted) -> Option<f64>,
+    cost: impl Fn(&Fitted, &Fitted) -> f64,
     done: impl Fn(f64, usize) -> bool,
 ) {
     // Non-negative floats order as their bits: (cost bits, i, j) sorts by cost.
     let mut costs: BTreeSet<(u64, usize, usize)> = BTreeSet::new();
     let price = |pool: &Pool, costs: &mut BTreeSet<_>, i: usize, j: usize| {
-        if let Some(c) = cost(pool.get(i), pool.get(j)) {
-            costs.insert((c.max(0.0).to_bits(), i.min(j), i.max(j)));
-        }
+        let c = cost(pool.get(i), pool.get(j));
+        costs.insert((c.max(0.0).to_bits(), i.min(j), i.max(j)));
     };
     for i in 0..pool.pieces.len() {
         if pool.pieces[i].is_some() {
@@ -115,11 +114,7 @@ fn merge_cheapest(
         if done(f64::from_bits(bits), pool.live()) {
             break;
         }
-        let Some(union) = pool.get(i).merged(pool.get(j)) else {
-            // This pair cannot merge; the others of `i` and `j` still may.
-            costs.remove(&(bits, i, j));
-            continue;
-        };
+        let union = pool.get(i).merged(pool.get(j));
         costs.retain(|&(_, a, b)| a != i && a != j && b != i && b != j);
         let k = pool.replace(i, j, union);
         for n in pool.neighbours[k].clone() {
@@ -129,13 +124,13 @@ fn merge_cheapest(
 }
 
 /// The fraction of the hull of `a ∪ b` that the union leaves empty (0 for a convex union).
-fn empty_fraction(a: &Fitted, b: &Fitted) -> Option<f64> {
-    let hull = a.merged_hull(b)?.volume();
-    Some(if hull > 0.0 {
+fn empty_fraction(a: &Fitted, b: &Fitted) -> f64 {
+    let hull = a.merged_hull(b).volume();
+    if hull > 0.0 {
         (1.0 - (a.volume + b.volume) / hull).max(0.0)
     } else {
         0.0
-    })
+    }
 }
 
 /// The lecture's relaxation: the smallest piece merges with the neighbour whose union leaves
@@ -157,11 +152,8 @@ pub(super) fn merge_by_volume(
         let Some(i) = smallest else { break };
         match best_partner(&pool, i) {
             Some((j, empty)) if empty <= max_empty => {
-                if let Some(union) = pool.get(i).merged(pool.get(j)) {
-                    pool.replace(i, j, union);
-                } else {
-                    settled.insert(i);
-                }
+                let union = pool.get(i).merged(pool.get(j));
+                pool.replace(i, j, union);
             }
             _ => {
                 settled.insert(i);
@@ -177,6 +169,6 @@ pub(super) fn merge_by_volume(
 fn best_partner(pool: &Pool, i: usize) -> Option<(usize, f64)> {
     pool.neighbours[i]
         .iter()
-        .filter_map(|&j| empty_fraction(pool.get(i), pool.get(j)).map(|e| (j, e)))
+        .map(|&j| (j, empty_fraction(pool.get(i), pool.get(j))))
         .min_by(|a, b| a.1.total_cmp(&b.1))
 }

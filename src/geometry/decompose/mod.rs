@@ -30,7 +30,7 @@ mod solid;
 #[cfg(test)]
 mod tests;
 
-use super::{ConvexPolyhedron, TriMesh};
+use super::{ConvexHullError, ConvexPolyhedron, TriMesh};
 use fitted::Fitted;
 use std::fmt;
 
@@ -135,6 +135,9 @@ pub enum DecomposeError {
     },
     /// An option is out of range: concavity not positive and finite, or zero parts.
     BadOptions,
+    /// A part's hull could not be built (not expected: a part's corners lie in the mesh's
+    /// bounds, which [`TriMesh`] keeps finite and in range).
+    Hull(ConvexHullError),
 }
 
 impl fmt::Display for DecomposeError {
@@ -147,6 +150,7 @@ impl fmt::Display for DecomposeError {
             Self::BadOptions => f.write_str(
                 "decomposition options out of range: max_concavity must be positive and finite, max_parts at least 1",
             ),
+            Self::Hull(e) => write!(f, "a part's convex hull could not be built: {e}"),
         }
     }
 }
@@ -192,14 +196,16 @@ pub fn decompose(mesh: &TriMesh, options: &Options) -> Result<Decomposition, Dec
     };
     let mut repairs = solid.repairs;
     repairs.parts_with_forced_caps = pieces.iter().filter(|p| p.piece.forced_caps > 0).count();
-    let parts: Vec<Part> = pieces
+    let parts = pieces
         .into_iter()
-        .map(|p| Part {
-            hull: p.hull,
-            volume: p.volume,
-            concavity: p.concavity,
+        .map(|p| {
+            Ok(Part {
+                hull: p.polyhedron().map_err(DecomposeError::Hull)?,
+                volume: p.volume,
+                concavity: p.concavity,
+            })
         })
-        .collect();
+        .collect::<Result<Vec<Part>, DecomposeError>>()?;
     let concavity = parts.iter().map(|p| p.concavity).fold(0.0, f64::max);
     Ok(Decomposition {
         parts,

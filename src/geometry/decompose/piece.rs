@@ -121,9 +121,18 @@ impl Piece {
         }
     }
 
-    /// The corners of every loop, with repeats (the hull's input).
-    pub fn corner_points(&self) -> impl Iterator<Item = DVec3> + '_ {
-        self.corners.iter().map(|&i| self.points[i as usize])
+    /// Every point some loop uses, once each: the hull's input. (The root's pool can hold
+    /// points no triangle uses, which are no part of the solid.)
+    pub fn used_points(&self) -> Vec<DVec3> {
+        let mut used = vec![false; self.points.len()];
+        for &c in &self.corners {
+            used[c as usize] = true;
+        }
+        self.points
+            .iter()
+            .zip(used)
+            .filter_map(|(&p, used)| used.then_some(p))
+            .collect()
     }
 
     fn loop_corners(&self, l: Loop) -> &[u32] {

@@ -54,7 +54,7 @@ pub(super) fn relax(
 
 /// The plane through the middle of the piece's oriented box, across its longest axis.
 fn box_split(piece: &Fitted) -> Option<Plane> {
-    let points = piece.hull.vertices();
+    let points = &piece.hull.points;
     let axes = principal_axes(&point_moments(points).covariance);
     let (axis, (lo, hi)) = [axes.x_axis, axes.y_axis, axes.z_axis]
         .into_iter()

@@ -99,7 +99,9 @@ fn the_corner_where_three_cuts_meet_inside_is_on_the_hull() {
     let octant = Fitted::new(piece, 0.01).expect("octant");
     assert!((octant.volume - 1.0).abs() < 1e-12);
     assert!((octant.hull.volume() - 1.0).abs() < 1e-9);
-    assert!(octant.hull.contains_point(DVec3::ZERO));
+    let hull = octant.polyhedron().expect("octant hull");
+    assert!((hull.volume() - 1.0).abs() < 1e-9);
+    assert!(hull.contains_point(DVec3::ZERO));
     // Sampled distances carry the sample spacing (0.01 m) as a floor.
     assert!(octant.concavity < 0.01, "{}", octant.concavity);
 }
@@ -220,7 +222,7 @@ fn a_cut_through_a_concave_cap_puts_no_corner_outside_the_solid() {
     let pieces = cut_all(whole.clone(), &planes);
     assert_eq!(pieces.len(), 8, "each cut splits every piece it meets");
     for piece in &pieces {
-        for p in piece.corner_points() {
+        for p in piece.used_points() {
             assert!(in_u_prism(p, 1e-12), "corner {p} outside the U");
         }
     }
@@ -247,7 +249,7 @@ fn random_cuts_of_a_u_leave_every_corner_in_the_solid() {
         let pieces = cut_all(whole.clone(), &planes);
         split += usize::from(pieces.len() > 4);
         for piece in &pieces {
-            for p in piece.corner_points() {
+            for p in piece.used_points() {
                 corners += 1;
                 assert!(
                     in_u_prism(p, 1e-9),
