@@ -122,8 +122,16 @@ fn best_cut(piece: &Fitted, limit: f64) -> Option<(Fitted, Fitted)> {
                 offset: normal.dot(*p),
             })
     });
-    finalists
-        .chain(through_deepest)
+    // A finalist that refining did not move can be a plane through the deepest sample
+    // too (about one cut in twenty): each plane is cut once.
+    let mut planes: Vec<Plane> = Vec::with_capacity(EXACT_FINALISTS + 6);
+    for plane in finalists.chain(through_deepest) {
+        if !planes.contains(&plane) {
+            planes.push(plane);
+        }
+    }
+    planes
+        .into_iter()
         .filter_map(|plane| {
             let (a, b) = cut_fitted(piece, &plane)?;
             Some((exact_score(&a, &b, piece.volume, limit), a, b))
