@@ -24,7 +24,7 @@ use proxima::narrow::{CompoundShape, Shape, distance_triangle_triangle};
 use rand::Rng;
 use std::sync::Arc;
 use support::meshes::{brute_force_distance, l_prism, torus, u_prism, winding_number};
-use support::{point_in_cube, rng, rotation};
+use support::{point_in_cube, rng, rotation, sphere_directions};
 
 /// The signed distance from `p` to the closed `mesh`'s surface, negative inside.
 fn signed_distance(mesh: &TriMesh, p: DVec3) -> f64 {
@@ -71,19 +71,6 @@ fn solids() -> Vec<Solid> {
     ]
 }
 
-/// Unit directions spread evenly over the sphere (a Fibonacci lattice).
-fn directions(n: usize) -> Vec<DVec3> {
-    let golden = std::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
-    (0..n)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-            let ring = (1.0 - z * z).sqrt();
-            let angle = golden * i as f64;
-            DVec3::new(ring * angle.cos(), ring * angle.sin(), z)
-        })
-        .collect()
-}
-
 /// The shortest move of a ball of `radius` at `c` that frees it from the closed `mesh`,
 /// over `dirs`: along each, the first point where the mesh's field reaches the radius,
 /// stepping by the field's shortfall (the field is 1-Lipschitz, so no step passes a free
@@ -114,7 +101,7 @@ fn freeing_depth(mesh: &TriMesh, c: DVec3, radius: f64, dirs: &[DVec3]) -> f64 {
 fn a_ball_in_a_compound_is_never_shallower_than_in_its_mesh_by_more_than_the_concavity() {
     let mut r = rng(3310);
     let mut s = NarrowScratch::default();
-    let dirs = directions(300);
+    let dirs = sphere_directions(300);
     for (solid, cases) in solids().into_iter().zip([1000, 1000, 200]) {
         let (min, max) = solid.mesh.bounds();
         let (centre, half) = ((min + max) / 2.0, (max - min) / 2.0 + DVec3::splat(0.2));

@@ -250,7 +250,7 @@ impl<'a> HullSet<'a> {
                 kept.push(p);
             }
         }
-        let directions = probe_directions();
+        let directions = crate::support::sphere_directions(VERTEX_PROBES);
         for h in self.hulls {
             let centre = h.centroid();
             for &v in h.vertices() {
@@ -278,19 +278,6 @@ impl<'a> HullSet<'a> {
 /// Directions a hull vertex is probed in besides its own: enough that an opening of the
 /// union's outside about 30° wide at a vertex meets one.
 const VERTEX_PROBES: usize = 64;
-
-/// [`VERTEX_PROBES`] unit vectors spread evenly over the sphere (a Fibonacci lattice).
-fn probe_directions() -> Vec<DVec3> {
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    (0..VERTEX_PROBES)
-        .map(|k| {
-            let z = 1.0 - 2.0 * (k as f64 + 0.5) / VERTEX_PROBES as f64;
-            let r = (1.0 - z * z).sqrt();
-            let angle = golden * k as f64;
-            DVec3::new(r * angle.cos(), r * angle.sin(), z)
-        })
-        .collect()
-}
 
 /// The triangles of a hull, counter-clockwise seen from outside.
 fn hull_triangles(h: &ConvexPolyhedron) -> impl Iterator<Item = Triangle> + '_ {

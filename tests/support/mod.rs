@@ -183,6 +183,19 @@ pub fn random_cloud(rng: &mut TestRng, max_n: usize) -> (Vec<DVec3>, f64) {
 
 /// The smallest distance between two point sets (brute force over all pairs); infinite if
 /// either is empty.
+/// `n` unit directions spread evenly over the sphere (a Fibonacci lattice).
+pub fn sphere_directions(n: usize) -> Vec<DVec3> {
+    let golden = std::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let ring = (1.0 - z * z).sqrt();
+            let angle = golden * i as f64;
+            DVec3::new(ring * angle.cos(), ring * angle.sin(), z)
+        })
+        .collect()
+}
+
 pub fn min_distance(a: &[DVec3], b: &[DVec3]) -> f64 {
     a.iter()
         .flat_map(|p| b.iter().map(move |q| p.distance(*q)))
