@@ -12,16 +12,7 @@ fn unit_cube() -> TriMesh {
 
 /// The hull of the box `[lo, hi]`.
 fn box_hull(lo: DVec3, hi: DVec3) -> ConvexPolyhedron {
-    let corners: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            )
-        })
-        .collect();
-    ConvexPolyhedron::try_from_points(&corners).unwrap()
+    ConvexPolyhedron::try_from_points(&Aabb::new(lo, hi).corners()).unwrap()
 }
 
 /// The hull of the mesh's vertices.
@@ -123,15 +114,7 @@ fn a_spike_over_a_cut_cube_scores_its_tip_exactly() {
     // and its distance, 1 m, is a vertex's, exact.
     let cube = unit_cube();
     let half = DVec3::splat(0.5);
-    let mut spiked: Vec<DVec3> = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 0 { -0.5 } else { 0.0 },
-                if i & 2 == 0 { -0.5 } else { 0.5 },
-                if i & 4 == 0 { -0.5 } else { 0.5 },
-            )
-        })
-        .collect();
+    let mut spiked = Aabb::new(-half, DVec3::new(0.0, 0.5, 0.5)).corners().to_vec();
     spiked.push(DVec3::new(0.0, 0.0, 1.5));
     let hulls = [
         ConvexPolyhedron::try_from_points(&spiked).unwrap(),
