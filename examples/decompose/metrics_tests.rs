@@ -114,7 +114,9 @@ fn a_spike_over_a_cut_cube_scores_its_tip_exactly() {
     // and its distance, 1 m, is a vertex's, exact.
     let cube = unit_cube();
     let half = DVec3::splat(0.5);
-    let mut spiked = Aabb::new(-half, DVec3::new(0.0, 0.5, 0.5)).corners().to_vec();
+    let mut spiked = Aabb::new(-half, DVec3::new(0.0, 0.5, 0.5))
+        .corners()
+        .to_vec();
     spiked.push(DVec3::new(0.0, 0.0, 1.5));
     let hulls = [
         ConvexPolyhedron::try_from_points(&spiked).unwrap(),

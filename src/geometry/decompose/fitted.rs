@@ -28,7 +28,11 @@ impl QuickHull {
             };
         };
         let mut corners: Vec<DVec3> = triangles.iter().flat_map(|t| t.corners).collect();
-        corners.sort_unstable_by(|a, b| a.to_array().partial_cmp(&b.to_array()).expect("finite"));
+        corners.sort_unstable_by(|a, b| {
+            (a.x.total_cmp(&b.x))
+                .then(a.y.total_cmp(&b.y))
+                .then(a.z.total_cmp(&b.z))
+        });
         corners.dedup();
         Self {
             points: corners,
@@ -118,15 +122,6 @@ impl Fitted {
             concavity,
             spacing: self.spacing,
         }
-    }
-
-    /// The concavity the union of two pieces would have, metres, without building it.
-    pub fn merged_concavity(&self, other: &Fitted) -> f64 {
-        let hull = self.merged_hull(other);
-        let mut samples = self.samples.clone();
-        samples.extend_from_slice(&other.samples);
-        let piece = self.piece.merged(&other.piece);
-        hull_concavity(&hull, &samples, &piece, self.spacing)
     }
 
     /// The hull of the union of two pieces (the hull of their hulls).

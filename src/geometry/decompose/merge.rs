@@ -84,7 +84,7 @@ pub(super) fn merge_within(
     let mut pool = Pool::new(pieces, slack);
     merge_cheapest(
         &mut pool,
-        |a, b| a.merged_concavity(b),
+        |a, b| a.merged(b).concavity,
         |concavity, live| concavity > limit && live <= max_parts,
     );
     pool.into_pieces()

@@ -404,13 +404,16 @@ impl Clipper {
         side: &[f64],
         crossings: &mut Crossings,
     ) {
-        let n = corners.len();
-        let crossed = (0..n)
-            .filter(|&k| inside(corners[k]) != inside(corners[(k + 1) % n]))
-            .count();
-        // More than one stretch inside: only a cap can be concave enough for that.
-        if crossed > 2 && self.clip_stretches(parent, corners, kind, inside, side, crossings) {
-            return;
+        // More than one stretch inside: only a cap can be concave enough for that (surface
+        // loops are convex).
+        if !kind.surface {
+            let n = corners.len();
+            let crossed = (0..n)
+                .filter(|&k| inside(corners[k]) != inside(corners[(k + 1) % n]))
+                .count();
+            if crossed > 2 && self.clip_stretches(parent, corners, kind, inside, side, crossings) {
+                return;
+            }
         }
         self.scratch.clear();
         let (mut first_entry, mut open_exit) = (None, None);
@@ -447,9 +450,9 @@ impl Clipper {
     /// the crossings bound, pair by pair, the line's segments inside the loop; each pair
     /// joins an exit to an entry. (Sutherland–Hodgman would join the stretches in walk
     /// order instead, by bridges across the gaps between them: outside the solid, and a
-    /// later cut through a bridge would put a corner there.) Returns `false`, having done
-    /// nothing, when the sorted crossings do not pair up so (ties of near-coincident
-    /// crossings): the caller then clips it the plain way.
+    /// later cut through a bridge would put a corner there.) Returns `false` when the
+    /// sorted crossings do not pair up so (ties of near-coincident crossings), having added
+    /// nothing to the piece: the caller then clips it the plain way.
     fn clip_stretches(
         &mut self,
         parent: &Piece,
