@@ -228,15 +228,6 @@ impl PairHelper {
         query: Query,
         pairs: impl Iterator<Item = (u32, CandidatePair)>,
     ) -> Option<Helping> {
-        // Never waited for, not even for the hand-over: a helper preempted (it runs only
-        // on an idle core) while it takes a frame holds this lock, and then the frame goes
-        // without it.
-        let shared = Arc::clone(&self.shared);
-        let mut posted = match shared.posted.try_lock() {
-            Ok(posted) => posted,
-            Err(TryLockError::Poisoned(poisoned)) => poisoned.into_inner(),
-            Err(TryLockError::WouldBlock) => return None,
-        };
         let mut frame = match self.last.take() {
             Some(frame) if Arc::strong_count(&frame) == 1 => frame,
             _ => Arc::new(HelperFrame::default()),
@@ -261,6 +252,17 @@ impl PairHelper {
         }
         f.outcomes.resize_with(n, OnceLock::new);
         *f.closed.get_mut() = false;
+        // Never waited for, not even for the hand-over: a helper preempted (it runs only
+        // on an idle core) while it takes a frame holds this lock, and then the frame goes
+        // without it.
+        let mut posted = match self.shared.posted.try_lock() {
+            Ok(posted) => posted,
+            Err(TryLockError::Poisoned(poisoned)) => poisoned.into_inner(),
+            Err(TryLockError::WouldBlock) => {
+                self.last = Some(frame);
+                return None;
+            }
+        };
         posted.frame = Some(Arc::clone(&frame));
         drop(posted);
         self.shared.wake.notify_one();
