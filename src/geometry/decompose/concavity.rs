@@ -13,8 +13,9 @@
 //! Distances to the nearest surface sample carry the samples' spacing as a floor: a convex
 //! piece measures up to about that, never 0 (the options' limit is twice the spacing).
 
+use super::cap_outline::CapOutlines;
 use super::nearest::SampleGrid;
-use super::piece::{CapOutline, Piece, Plane, lattice_samples};
+use super::piece::{Plane, lattice_samples};
 use crate::geometry::HullTriangle;
 use crate::math::DVec3;
 
@@ -26,8 +27,8 @@ pub(super) struct Surface<'a> {
     pub member: &'a dyn Fn(usize) -> bool,
     /// Further surface points not in the grid (a candidate cut's section outline).
     pub extra: &'a [DVec3],
-    /// The piece (its cut planes and caps).
-    pub piece: &'a Piece,
+    /// The piece's cut planes and caps.
+    pub caps: &'a CapOutlines<'a>,
     /// A cut being weighed, not made yet: hull faces on it are left out (its cap is not
     /// known; the cut's own result is measured in full once made).
     pub pending: Option<Plane>,
@@ -38,28 +39,53 @@ pub(super) struct Surface<'a> {
 /// The concavity of a piece whose hull is `hull` and whose surface samples below the hull are
 /// `samples` (module docs), metres.
 pub(super) fn concavity(hull: &[HullTriangle], samples: &[DVec3], surface: &Surface) -> f64 {
-    let mut deepest: f64 = 0.0;
-    // The plane that last showed a sample no deeper than `deepest`: samples come triangle
-    // by triangle, so the next one is most often shown by the same plane, in one test.
+    let depth = deepest_samples(hull, samples, 1)
+        .first()
+        .map_or(0.0, |&(depth, _)| depth);
+    depth.max(0.0).max(bridge_height(hull, surface))
+}
+
+/// The `k` samples deepest below the hull's boundary, with their depths (metres, negative
+/// outside), deepest first; fewer when there are fewer samples, none when the hull has no
+/// triangles.
+///
+/// A sample's depth is its least height below a face plane: once one plane shows it no
+/// deeper than the `k`-th deepest so far, the rest cannot put it among the `k`.
+pub(super) fn deepest_samples(
+    hull: &[HullTriangle],
+    samples: &[DVec3],
+    k: usize,
+) -> Vec<(f64, DVec3)> {
+    let mut deepest: Vec<(f64, DVec3)> = Vec::with_capacity(k + 1);
+    if hull.is_empty() || k == 0 {
+        return deepest;
+    }
+    // The plane that last dismissed a sample: samples come triangle by triangle, so the
+    // next one is most often dismissed by the same plane, in one test.
     let mut last_shown = 0;
     'samples: for &p in samples {
-        // The sample's depth is its least height below a plane: once one plane shows it no
-        // deeper than the deepest so far, the rest cannot raise the maximum.
+        let bar = if deepest.len() < k {
+            f64::NEG_INFINITY
+        } else {
+            deepest[k - 1].0
+        };
         let height = |t: &HullTriangle| t.offset - t.normal.dot(p);
-        if hull.get(last_shown).is_some_and(|t| height(t) <= deepest) {
+        if height(&hull[last_shown]) <= bar {
             continue;
         }
         let mut least = f64::INFINITY;
         for (i, t) in hull.iter().enumerate() {
             least = least.min(height(t));
-            if least <= deepest {
+            if least <= bar {
                 last_shown = i;
                 continue 'samples;
             }
         }
-        deepest = least;
+        let at = deepest.partition_point(|&(d, _)| d >= least);
+        deepest.insert(at, (least, p));
+        deepest.truncate(k);
     }
-    deepest.max(bridge_height(hull, surface))
+    deepest
 }
 
 /// The greatest distance from the hull's boundary (off the cut planes) to the surface.
@@ -78,8 +104,7 @@ fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
     let mut lattice = Vec::new();
     let mut highest: f64 = 0.0;
     let mut hint = 0;
-    // The cap outlines met so far, by their cuts.
-    let mut outlines: Vec<(Vec<usize>, CapOutline)> = Vec::new();
+    let cuts = &surface.caps.piece.cuts;
     for t in hull {
         let on = |c: &Plane| {
             c.normal.dot(t.normal) > 0.0
@@ -91,44 +116,34 @@ fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
             continue;
         }
         // Merged pieces can hold caps of one plane under several cut indices.
-        let caps: Vec<usize> = (0..surface.piece.cuts.len())
-            .filter(|&k| on(&surface.piece.cuts[k]))
-            .collect();
-        let outline = if caps.is_empty() {
-            None
-        } else {
-            let known = outlines.iter().position(|(cuts, _)| *cuts == caps);
-            let at = known.unwrap_or_else(|| {
-                outlines.push((caps.clone(), surface.piece.cap_outline(&caps)));
-                outlines.len() - 1
-            });
-            Some(&outlines[at].1)
-        };
+        let on_caps: Vec<usize> = (0..cuts.len()).filter(|&k| on(&cuts[k])).collect();
+        let outline = (!on_caps.is_empty()).then(|| surface.caps.of(&on_caps));
         lattice.clear();
         lattice.extend_from_slice(&t.corners);
         let [a, b, c] = t.corners;
         lattice_samples(a, b, c, surface.spacing, MAX_HULL_DIVISIONS, &mut lattice);
         for &p in &lattice {
-            let near_extra = surface
-                .extra
-                .iter()
-                .map(|&q| (q - p).length())
-                .fold(f64::INFINITY, f64::min);
-            if near_extra <= highest
-                || surface
-                    .grid
-                    .near_within(p, highest, surface.member, &mut hint)
+            let within = |q: &DVec3| (*q - p).length_squared() <= highest * highest;
+            if surface
+                .grid
+                .near_within(p, highest, surface.member, &mut hint)
+                || surface.extra.iter().any(within)
             {
                 continue;
             }
             // Caps are sampled along their outlines only: the nearest sample to a point
             // inside one is far, and its search the dearest of all.
-            if outline.is_some_and(|o| o.contains(p)) {
+            if outline.as_ref().is_some_and(|o| o.contains(p)) {
                 continue;
             }
             let Some(near) = surface.grid.nearest_above(p, highest, surface.member) else {
                 continue;
             };
+            let near_extra = surface
+                .extra
+                .iter()
+                .map(|&q| (q - p).length())
+                .fold(f64::INFINITY, f64::min);
             let near = near.min(near_extra);
             if near.is_finite() {
                 highest = highest.max(near);

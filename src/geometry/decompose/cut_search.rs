@@ -17,10 +17,11 @@
 //! Citation: X. Wei, M. Liu, Z. Ling, H. Su, "Approximate Convex Decomposition for 3D Meshes
 //! with Collision-Aware Concavity and Tree Search", SIGGRAPH 2022 (CoACD).
 
-use super::concavity::{Surface, concavity};
+use super::cap_outline::CapOutlines;
+use super::concavity::{Surface, concavity, deepest_samples};
 use super::fitted::Fitted;
 use super::nearest::SampleGrid;
-use super::piece::{Piece, Plane};
+use super::piece::Plane;
 use crate::geometry::ConvexPolyhedron;
 use crate::geometry::pca::{point_moments, principal_axes};
 use crate::math::{DVec3, bounds_of};
@@ -37,7 +38,8 @@ const OFFSETS: usize = 9;
 const REFINE_ROUNDS: usize = 3;
 /// Cosine above which a principal axis counts as along a coordinate axis (about 8°).
 const NEAR_PARALLEL: f64 = 0.99;
-/// Deepest samples that candidate planes are also put through.
+/// Samples deepest below the piece's hull that candidate planes are also put through: a
+/// concave edge is where a cut through it may remove the concavity whole.
 const DEEPEST_SAMPLES: usize = 3;
 /// Candidates cut exactly after the thinned scoring, best first.
 const EXACT_FINALISTS: usize = 4;
@@ -87,8 +89,12 @@ pub(super) fn cut_fitted(piece: &Fitted, plane: &Plane) -> Option<(Fitted, Fitte
 fn best_cut(piece: &Fitted, limit: f64) -> Option<(Fitted, Fitted)> {
     let samples = thinned(&piece.samples, SCORE_SAMPLES);
     let scorer = Scorer::new(piece, &samples);
-    let mut scored: Vec<(f64, Plane, f64)> = Vec::new(); // (score, plane, step)
-    let deepest = deepest_samples(piece);
+    let deepest: Vec<DVec3> =
+        deepest_samples(&piece.hull.triangles, &piece.samples, DEEPEST_SAMPLES)
+            .into_iter()
+            .map(|(_, p)| p)
+            .collect();
+    let mut candidates: Vec<(Plane, f64)> = Vec::new(); // (plane, step)
     for axis in candidate_axes(scorer.samples) {
         let (lo, hi) = extent_along(scorer.samples, axis);
         let step = (hi - lo) / (OFFSETS + 1) as f64;
@@ -98,20 +104,20 @@ fn best_cut(piece: &Fitted, limit: f64) -> Option<(Fitted, Fitted)> {
         let even = (1..=OFFSETS).map(|k| lo + step * k as f64);
         let through_deepest = deepest.iter().map(|p| p.dot(axis));
         for offset in even.chain(through_deepest) {
-            let plane = Plane {
-                normal: axis,
-                offset,
-            };
-            if let Some(score) = scorer.score(&plane) {
-                scored.push((score, plane, step));
-            }
+            let normal = axis;
+            candidates.push((Plane { normal, offset }, step));
         }
     }
+    let mut scored: Vec<(f64, Plane, f64)> = candidates
+        .iter()
+        .filter_map(|&(plane, step)| scorer.score(&plane).map(|score| (score, plane, step)))
+        .collect();
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
+    scored.truncate(EXACT_FINALISTS);
     let finalists = scored
-        .into_iter()
-        .take(EXACT_FINALISTS)
-        .map(|(score, plane, step)| refined(&scorer, score, plane, step));
+        .iter()
+        .map(|&(score, plane, step)| refined(&scorer, score, plane, step))
+        .collect::<Vec<_>>();
     // Near convex halves score alike up to the thinned samples' noise: the planes through
     // the deepest sample, which a concave edge calls for, are always cut exactly too.
     let through_deepest = deepest.first().into_iter().flat_map(|p| {
@@ -125,35 +131,19 @@ fn best_cut(piece: &Fitted, limit: f64) -> Option<(Fitted, Fitted)> {
     // A finalist that refining did not move can be a plane through the deepest sample
     // too (about one cut in twenty): each plane is cut once.
     let mut planes: Vec<Plane> = Vec::with_capacity(EXACT_FINALISTS + 6);
-    for plane in finalists.chain(through_deepest) {
+    for plane in finalists.into_iter().chain(through_deepest) {
         if !planes.contains(&plane) {
             planes.push(plane);
         }
     }
     planes
-        .into_iter()
+        .iter()
         .filter_map(|plane| {
-            let (a, b) = cut_fitted(piece, &plane)?;
+            let (a, b) = cut_fitted(piece, plane)?;
             Some((exact_score(&a, &b, piece.volume, limit), a, b))
         })
         .min_by(|x, y| x.0.total_cmp(&y.0))
         .map(|(_, a, b)| (a, b))
-}
-
-/// The [`DEEPEST_SAMPLES`] surface samples deepest below the piece's hull: a concave edge
-/// is where a cut through it may remove the concavity whole.
-fn deepest_samples(piece: &Fitted) -> Vec<DVec3> {
-    let mut by_depth: Vec<(f64, DVec3)> = piece
-        .samples
-        .iter()
-        .filter_map(|&p| piece.hull.max_plane_distance(p).map(|d| (d, p)))
-        .collect();
-    let k = DEEPEST_SAMPLES.min(by_depth.len());
-    if k == 0 {
-        return Vec::new();
-    }
-    by_depth.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0));
-    by_depth[..k].iter().map(|&(_, p)| p).collect()
 }
 
 /// Moves `plane` by halving steps while the thinned score improves.
@@ -216,7 +206,8 @@ struct Scorer<'a> {
     samples: &'a [DVec3],
     grid: SampleGrid<'a>,
     edges: Vec<[DVec3; 2]>,
-    piece: &'a Piece,
+    /// The piece's cap outlines, gathered once for every candidate.
+    caps: CapOutlines<'a>,
     /// Hull lattice spacing, metres: coarser than the piece's for speed.
     spacing: f64,
 }
@@ -228,7 +219,7 @@ impl<'a> Scorer<'a> {
             samples,
             grid: SampleGrid::new(samples),
             edges: thinned(&piece.piece.surface_edges(), SCORE_EDGES),
-            piece: &piece.piece,
+            caps: CapOutlines::new(&piece.piece),
             spacing: piece
                 .spacing
                 .max((hi - lo).max_element() / SCORE_LATTICE_DIVISIONS),
@@ -284,7 +275,7 @@ impl<'a> Scorer<'a> {
             grid: &self.grid,
             member: &|i| below[i] == side,
             extra: section,
-            piece: self.piece,
+            caps: &self.caps,
             pending: Some(cut),
             spacing: self.spacing,
         };

@@ -1,5 +1,6 @@
 //! A piece with its convex hull and its concavity.
 
+use super::cap_outline::CapOutlines;
 use super::concavity::{Surface, concavity};
 use super::nearest::SampleGrid;
 use super::piece::Piece;
@@ -53,15 +54,6 @@ impl QuickHull {
             })
             .sum::<f64>()
             / 6.0
-    }
-
-    /// The greatest signed distance of `p` above a face plane, metres: negative inside, its
-    /// depth; `None` for a sliver.
-    pub fn max_plane_distance(&self, p: DVec3) -> Option<f64> {
-        self.triangles
-            .iter()
-            .map(|t| t.normal.dot(p) - t.offset)
-            .reduce(f64::max)
     }
 }
 
@@ -157,7 +149,7 @@ fn hull_concavity(hull: &QuickHull, samples: &[DVec3], piece: &Piece, spacing: f
         grid: &grid,
         member: &|_| true,
         extra: &[],
-        piece,
+        caps: &CapOutlines::new(piece),
         pending: None,
         spacing,
     };

@@ -24,6 +24,7 @@
 //! piece lies in the solid. A point's side is decided once per cut
 //! from its signed distance (`≤ 0` below), so both pieces and all loops agree on it.
 
+use super::cap_outline::CapOutline;
 use crate::math::DVec3;
 use std::collections::{HashMap, HashSet};
 
@@ -53,36 +54,6 @@ struct Loop {
     surface: bool,
     /// For a cap, the index of its plane in [`Piece::cuts`].
     cut: u32,
-}
-
-/// The outlines of a piece's caps on one cut plane, gathered once from its loops to test
-/// many points against ([`Piece::cap_outline`]).
-pub(super) struct CapOutline {
-    /// The plane's axes.
-    u: DVec3,
-    v: DVec3,
-    /// Every directed outline edge.
-    edges: Vec<[DVec3; 2]>,
-}
-
-impl CapOutline {
-    /// Whether `p`, a point on the plane, lies on the caps: the winding number of their
-    /// outlines about it, seen along the plane's normal, is not zero (Sunday's crossings
-    /// of the ray from `p` along `+u`).
-    pub fn contains(&self, p: DVec3) -> bool {
-        let flat = |q: DVec3| ((q - p).dot(self.u), (q - p).dot(self.v));
-        let mut winding = 0i32;
-        for &[a, b] in &self.edges {
-            let (a, b) = (flat(a), flat(b));
-            let left = (b.0 - a.0) * (0.0 - a.1) - (0.0 - a.0) * (b.1 - a.1);
-            if a.1 <= 0.0 && b.1 > 0.0 && left > 0.0 {
-                winding += 1;
-            } else if a.1 > 0.0 && b.1 <= 0.0 && left < 0.0 {
-                winding -= 1;
-            }
-        }
-        winding != 0
-    }
 }
 
 /// A piece of a closed solid, bounded by polygon loops (see the module docs).
@@ -255,9 +226,6 @@ impl Piece {
     /// The outlines of the caps of the cuts `cuts` (one plane, named once or more by a
     /// merged piece), to test points against ([`CapOutline::contains`]).
     pub fn cap_outline(&self, cuts: &[usize]) -> CapOutline {
-        let normal = self.cuts[cuts[0]].normal;
-        let u = normal.any_orthonormal_vector();
-        let v = normal.cross(u);
         let mut edges = Vec::new();
         for l in self
             .loops
@@ -270,7 +238,7 @@ impl Piece {
                 edges.push([self.points[a as usize], self.points[b as usize]]);
             }
         }
-        CapOutline { u, v, edges }
+        CapOutline::new(self.cuts[cuts[0]].normal, &edges)
     }
 
     /// The union of two pieces that touch along a cut: their loops together (the shared caps
