@@ -2,7 +2,7 @@
 //! method and parry's V-HACD on the same meshes, one table per mesh, one row per method.
 //!
 //! ```text
-//! cargo run --release --example decompose -- MESH... [--max-concavity C] [--max-parts N] [--out DIR]
+//! cargo run --release --example decompose -- MESH... [--max-concavity C] [--max-parts N] [--threads T] [--out DIR]
 //! cargo run --release --example decompose -- --all
 //! ```
 //!
@@ -61,6 +61,10 @@ struct Args {
     /// Most parts allowed (≥ 1).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     max_parts: Option<u32>,
+    /// Threads our cut search may use (default: every available core; parry's V-HACD
+    /// uses one). The parts are the same for any count.
+    #[arg(long, value_name = "T", value_parser = clap::value_parser!(u32).range(1..))]
+    threads: Option<u32>,
     /// Folder to write every method's parts to, as OBJ.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -111,6 +115,7 @@ fn run(args: &Args, loaded: &[(String, TriMesh)]) -> Result<(), Box<dyn Error>> 
     let limits = Limits {
         max_concavity: args.max_concavity,
         max_parts: args.max_parts.map(|n| n as usize),
+        threads: args.threads.map(|n| n as usize),
     };
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir)?;

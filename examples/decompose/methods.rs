@@ -31,6 +31,8 @@ pub struct Limits {
     pub max_concavity: Option<f64>,
     /// Most parts.
     pub max_parts: Option<usize>,
+    /// Threads of our cut search.
+    pub threads: Option<usize>,
 }
 
 impl Limits {
@@ -41,6 +43,7 @@ impl Limits {
             method,
             max_concavity: self.max_concavity.unwrap_or(defaults.max_concavity),
             max_parts: self.max_parts.unwrap_or(defaults.max_parts),
+            threads: self.threads.unwrap_or(defaults.threads),
             ..defaults
         }
     }

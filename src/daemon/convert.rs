@@ -242,6 +242,9 @@ fn decompose_options(dimensions: [f64; 4]) -> Result<decompose::Options, Rejecti
         } else {
             parts as usize
         },
+        // The builder thread keeps to itself: a second search thread would take the core
+        // the frame thread counts on.
+        threads: 1,
         ..defaults
     })
 }

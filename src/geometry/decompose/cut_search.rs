@@ -21,6 +21,7 @@ use super::cap_outline::CapOutlines;
 use super::concavity::{Surface, concavity, deepest_samples};
 use super::fitted::Fitted;
 use super::nearest::SampleGrid;
+use super::parallel::map_in_order;
 use super::piece::Plane;
 use crate::geometry::ConvexPolyhedron;
 use crate::geometry::pca::{point_moments, principal_axes};
@@ -48,8 +49,9 @@ const EXACT_FINALISTS: usize = 4;
 const LESSER_HALF_WEIGHT: f64 = 0.25;
 
 /// Cuts the most concave piece until all are within `limit` metres or there are
-/// `max_parts`; returns the pieces (not yet merged).
-pub(super) fn cut_until(root: Fitted, limit: f64, max_parts: usize) -> Vec<Fitted> {
+/// `max_parts`; returns the pieces (not yet merged). Each cut's candidates are weighed on up
+/// to `threads` threads; the pieces are the same for any count.
+pub(super) fn cut_until(root: Fitted, limit: f64, max_parts: usize, threads: usize) -> Vec<Fitted> {
     let mut pieces = vec![root];
     // Pieces no plane could cut, set aside with their concavity.
     let mut uncuttable = Vec::new();
@@ -61,7 +63,7 @@ pub(super) fn cut_until(root: Fitted, limit: f64, max_parts: usize) -> Vec<Fitte
             break;
         }
         let piece = pieces.swap_remove(worst);
-        match best_cut(&piece, limit) {
+        match best_cut(&piece, limit, threads) {
             Some((a, b)) => pieces.extend([a, b]),
             None => uncuttable.push(piece),
         }
@@ -85,8 +87,9 @@ pub(super) fn cut_fitted(piece: &Fitted, plane: &Plane) -> Option<(Fitted, Fitte
 
 /// The cut that leaves the least concavity in the halves of `piece` (see the module docs):
 /// the [`EXACT_FINALISTS`] best candidates by the thinned score, each refined, are cut
-/// exactly and the best exact result is kept.
-fn best_cut(piece: &Fitted, limit: f64) -> Option<(Fitted, Fitted)> {
+/// exactly and the best exact result is kept. Each stage's candidates are weighed on up to
+/// `threads` threads.
+fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitted)> {
     let samples = thinned(&piece.samples, SCORE_SAMPLES);
     let scorer = Scorer::new(piece, &samples);
     let deepest: Vec<DVec3> =
@@ -108,16 +111,18 @@ fn best_cut(piece: &Fitted, limit: f64) -> Option<(Fitted, Fitted)> {
             candidates.push((Plane { normal, offset }, step));
         }
     }
-    let mut scored: Vec<(f64, Plane, f64)> = candidates
-        .iter()
-        .filter_map(|&(plane, step)| scorer.score(&plane).map(|score| (score, plane, step)))
+    let mut scored: Vec<(f64, Plane, f64)> =
+        map_in_order(&candidates, threads, |&(plane, step)| {
+            scorer.score(&plane).map(|score| (score, plane, step))
+        })
+        .into_iter()
+        .flatten()
         .collect();
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
     scored.truncate(EXACT_FINALISTS);
-    let finalists = scored
-        .iter()
-        .map(|&(score, plane, step)| refined(&scorer, score, plane, step))
-        .collect::<Vec<_>>();
+    let finalists = map_in_order(&scored, threads, |&(score, plane, step)| {
+        refined(&scorer, score, plane, step)
+    });
     // Near convex halves score alike up to the thinned samples' noise: the planes through
     // the deepest sample, which a concave edge calls for, are always cut exactly too.
     let through_deepest = deepest.first().into_iter().flat_map(|p| {
@@ -136,14 +141,14 @@ fn best_cut(piece: &Fitted, limit: f64) -> Option<(Fitted, Fitted)> {
             planes.push(plane);
         }
     }
-    planes
-        .iter()
-        .filter_map(|plane| {
-            let (a, b) = cut_fitted(piece, plane)?;
-            Some((exact_score(&a, &b, piece.volume, limit), a, b))
-        })
-        .min_by(|x, y| x.0.total_cmp(&y.0))
-        .map(|(_, a, b)| (a, b))
+    map_in_order(&planes, threads, |plane| {
+        let (a, b) = cut_fitted(piece, plane)?;
+        Some((exact_score(&a, &b, piece.volume, limit), a, b))
+    })
+    .into_iter()
+    .flatten()
+    .min_by(|x, y| x.0.total_cmp(&y.0))
+    .map(|(_, a, b)| (a, b))
 }
 
 /// Moves `plane` by halving steps while the thinned score improves.

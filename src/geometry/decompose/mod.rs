@@ -25,6 +25,7 @@ mod cut_search;
 mod fitted;
 mod merge;
 mod nearest;
+mod parallel;
 mod piece;
 mod relaxation;
 mod solid;
@@ -72,6 +73,10 @@ pub struct Options {
     /// [`Method::Relaxation`] only: the largest fraction of a merged part's hull it may leave
     /// empty (default 0.05).
     pub max_empty_fraction: f64,
+    /// [`Method::CutSearch`] only: threads the search may use, the caller's among them
+    /// (default: the machine's available parallelism; 0 counts as 1). The parts are the
+    /// same for any count.
+    pub threads: usize,
 }
 
 impl Default for Options {
@@ -81,6 +86,7 @@ impl Default for Options {
             max_concavity: 0.02,
             max_parts: 64,
             max_empty_fraction: 0.05,
+            threads: std::thread::available_parallelism().map_or(1, usize::from),
         }
     }
 }
@@ -184,7 +190,7 @@ pub fn decompose(mesh: &TriMesh, options: &Options) -> Result<Decomposition, Dec
     let slack = 1e-6 * solid.diagonal;
     let pieces = match options.method {
         Method::CutSearch => {
-            let cut = cut_search::cut_until(root, limit, options.max_parts);
+            let cut = cut_search::cut_until(root, limit, options.max_parts, options.threads);
             merge::merge_within(cut, limit, options.max_parts, slack)
         }
         Method::Relaxation => relaxation::relax(
