@@ -91,9 +91,9 @@ pub(super) fn deepest_samples(
 /// The greatest distance from the hull's boundary (off the cut planes) to the surface.
 ///
 /// A maximum of nearest distances: a point with a sample within the greatest so far cannot
-/// raise it, so each point is first dismissed by the cheapest test that can (the section
-/// outline, the samples next to it), then by whether it lies on a cap, and only then pays
-/// for a whole nearest-sample search.
+/// raise it, so each point is first dismissed by the cheapest test that can (the samples
+/// next to it, then the section outline), then by whether it lies on a cap, and only then
+/// pays for a whole nearest-sample search.
 fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
     let reach = hull
         .iter()
