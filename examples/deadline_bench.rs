@@ -46,9 +46,6 @@
 mod coincident_meshes;
 #[path = "scenes/compound_pile.rs"]
 mod compound_pile;
-#[path = "../tests/support/data.rs"]
-#[allow(dead_code)]
-mod data;
 #[path = "../src/demo/scene.rs"]
 mod demo_scene;
 #[path = "scenes/falling.rs"]
@@ -71,6 +68,9 @@ mod robot_chain;
 mod spec;
 #[path = "scenes/sphere_swarm.rs"]
 mod sphere_swarm;
+// The data folder's rule and the sphere lattice (the rest is the tests').
+#[path = "../tests/support/mod.rs"]
+mod support;
 #[path = "deadline/workloads.rs"]
 mod workloads;
 
@@ -181,7 +181,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         session: Session::start(&exe, args.realtime_priority)?,
         exe,
         realtime_priority: args.realtime_priority,
-        data: data::data_dir(),
+        data: support::data::data_dir(),
         rows: Vec::new(),
     };
     for class in classes {

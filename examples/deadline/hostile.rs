@@ -142,13 +142,8 @@ fn grid_mesh() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 /// Points spread evenly over a sphere of radius 0.5 m (a Fibonacci lattice): every one is
 /// a hull vertex.
 fn sphere_points() -> Vec<[f64; 3]> {
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    (0..CONVEX_POINTS)
-        .map(|k| {
-            let z = 1.0 - 2.0 * (k as f64 + 0.5) / CONVEX_POINTS as f64;
-            let r = (1.0 - z * z).sqrt();
-            let phi = golden * k as f64;
-            [0.5 * r * phi.cos(), 0.5 * r * phi.sin(), 0.5 * z]
-        })
+    crate::support::sphere_directions(CONVEX_POINTS)
+        .into_iter()
+        .map(|d| (d * 0.5).to_array())
         .collect()
 }

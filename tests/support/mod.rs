@@ -181,8 +181,6 @@ pub fn random_cloud(rng: &mut TestRng, max_n: usize) -> (Vec<DVec3>, f64) {
     (cloud(rng, kind, n, center, scale), scale)
 }
 
-/// The smallest distance between two point sets (brute force over all pairs); infinite if
-/// either is empty.
 /// `n` unit directions spread evenly over the sphere (a Fibonacci lattice).
 pub fn sphere_directions(n: usize) -> Vec<DVec3> {
     let golden = std::f64::consts::PI * (3.0 - 5.0_f64.sqrt());
@@ -196,6 +194,8 @@ pub fn sphere_directions(n: usize) -> Vec<DVec3> {
         .collect()
 }
 
+/// The smallest distance between two point sets (brute force over all pairs); infinite if
+/// either is empty.
 pub fn min_distance(a: &[DVec3], b: &[DVec3]) -> f64 {
     a.iter()
         .flat_map(|p| b.iter().map(move |q| p.distance(*q)))

@@ -175,14 +175,10 @@ mod tests {
 
     /// A hull of 200 points on a unit sphere about (3, −2, 1), which validates.
     fn round_hull() -> ConvexPolyhedron {
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        let points: Vec<DVec3> = (0..200)
-            .map(|i| {
-                let z = 1.0 - 2.0 * (f64::from(i) + 0.5) / 200.0;
-                let (s, c) = (golden * f64::from(i)).sin_cos();
-                let r = (1.0 - z * z).sqrt();
-                DVec3::new(3.0 + r * c, -2.0 + r * s, 1.0 + z)
-            })
+        let centre = DVec3::new(3.0, -2.0, 1.0);
+        let points: Vec<DVec3> = crate::test_support::sphere_directions(200)
+            .into_iter()
+            .map(|d| centre + d)
             .collect();
         let hull = ConvexPolyhedron::try_from_points(&points).expect("a solid");
         assert_eq!(hull.validate(), Ok(()));
