@@ -7,9 +7,11 @@
 //! (a point's crossing count needs only the edges of its band), and [`CapOutlines`] keeps
 //! every outline a piece has given for the next hull.
 
+use super::buckets::Buckets;
 use super::piece::Piece;
 use crate::math::DVec3;
 use glam::DVec2;
+use std::ops::RangeInclusive;
 use std::sync::{Arc, Mutex, PoisonError};
 
 /// The outlines of a piece's caps on one cut plane, to test many points against.
@@ -19,13 +21,10 @@ pub(super) struct CapOutline {
     v: DVec3,
     /// Every directed outline edge, in the plane's coordinates `(p·u, p·v)`, metres.
     edges: Vec<[DVec2; 2]>,
-    /// The least `v` of any edge, and the height of a band, metres.
-    v_low: f64,
-    band_height: f64,
-    /// Band `k` holds the edges `members[starts[k] .. starts[k + 1]]`: those whose `v`
-    /// range meets `v_low + band_height · [k, k + 1]`.
-    starts: Vec<u32>,
-    members: Vec<u32>,
+    /// Bands across the plane, along `v`.
+    bands: Bands,
+    /// The edges of each band: those whose `v` range meets it.
+    members: Buckets,
 }
 
 /// Outline edges per band, on average (about; long edges sit in several bands).
@@ -34,72 +33,65 @@ const EDGES_PER_BAND: usize = 4;
 /// Most bands of one outline.
 const MAX_BANDS: usize = 4096;
 
+/// `count` bands of equal height from `v_low` up, metres.
+#[derive(Debug, Clone, Copy)]
+struct Bands {
+    v_low: f64,
+    height: f64,
+    count: usize,
+}
+
+impl Bands {
+    /// The band `v` falls in, if any.
+    fn of(self, v: f64) -> Option<usize> {
+        let at = (v - self.v_low) / self.height;
+        if at.is_nan() {
+            // A flat outline (every edge at one v): one band holds it.
+            return (v == self.v_low).then_some(0);
+        }
+        (0.0..=self.count as f64)
+            .contains(&at)
+            .then(|| (at as usize).min(self.count - 1))
+    }
+
+    /// The bands the edge `a b` meets.
+    fn met_by(self, [a, b]: [DVec2; 2]) -> RangeInclusive<usize> {
+        let low = self.of(a.y.min(b.y)).unwrap_or(0);
+        let high = self.of(a.y.max(b.y)).unwrap_or(0);
+        low..=high
+    }
+}
+
 impl CapOutline {
     /// The outline made of the directed `edges` (ends in space, on a plane of unit normal
     /// `normal`).
     pub fn new(normal: DVec3, edges: &[[DVec3; 2]]) -> Self {
         let u = normal.any_orthonormal_vector();
         let v = normal.cross(u);
-        let flat: Vec<[DVec2; 2]> = edges
+        let edges: Vec<[DVec2; 2]> = edges
             .iter()
             .map(|e| e.map(|q| DVec2::new(q.dot(u), q.dot(v))))
             .collect();
-        let (v_low, v_high) = flat
+        let (v_low, v_high) = edges
             .iter()
             .flatten()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
                 (lo.min(q.y), hi.max(q.y))
             });
-        let bands = (flat.len() / EDGES_PER_BAND).clamp(1, MAX_BANDS);
-        let band_height = (v_high - v_low) / bands as f64;
-        let mut outline = Self {
+        let count = (edges.len() / EDGES_PER_BAND).clamp(1, MAX_BANDS);
+        let bands = Bands {
+            v_low,
+            height: (v_high - v_low) / count as f64,
+            count,
+        };
+        let members = Buckets::new(count, edges.len(), |k| bands.met_by(edges[k]));
+        Self {
             u,
             v,
-            edges: flat,
-            v_low,
-            band_height,
-            starts: vec![0; bands + 1],
-            members: Vec::new(),
-        };
-        // Counting sort of edge indices by band: counts, prefix sums, then a fill.
-        for k in 0..outline.edges.len() {
-            for band in outline.bands_of(k) {
-                outline.starts[band + 1] += 1;
-            }
+            edges,
+            bands,
+            members,
         }
-        for band in 0..bands {
-            outline.starts[band + 1] += outline.starts[band];
-        }
-        let mut next = outline.starts.clone();
-        outline.members = vec![0; outline.starts[bands] as usize];
-        for k in 0..outline.edges.len() {
-            for band in outline.bands_of(k) {
-                outline.members[next[band] as usize] = k as u32;
-                next[band] += 1;
-            }
-        }
-        outline
-    }
-
-    /// The band `v` falls in, if any.
-    fn band(&self, v: f64) -> Option<usize> {
-        let at = (v - self.v_low) / self.band_height;
-        let bands = self.starts.len() - 1;
-        if at.is_nan() {
-            // A flat outline (every edge at one v): one band holds it.
-            return (v == self.v_low).then_some(0);
-        }
-        (0.0..=bands as f64)
-            .contains(&at)
-            .then(|| (at as usize).min(bands - 1))
-    }
-
-    /// The bands edge `k` meets.
-    fn bands_of(&self, k: usize) -> std::ops::RangeInclusive<usize> {
-        let [a, b] = self.edges[k];
-        let low = self.band(a.y.min(b.y)).unwrap_or(0);
-        let high = self.band(a.y.max(b.y)).unwrap_or(0);
-        low..=high
     }
 
     /// Whether `p`, a point on the plane, lies on the caps: the winding number of their
@@ -107,12 +99,11 @@ impl CapOutline {
     /// of the ray from `p` along `+u`). Only the edges of `p`'s band can cross that ray.
     pub fn contains(&self, p: DVec3) -> bool {
         let (x, y) = (p.dot(self.u), p.dot(self.v));
-        let Some(band) = self.band(y) else {
+        let Some(band) = self.bands.of(y) else {
             return false;
         };
-        let members = &self.members[self.starts[band] as usize..self.starts[band + 1] as usize];
         let mut winding = 0i32;
-        for &k in members {
+        for &k in self.members.get(band) {
             let [a, b] = self.edges[k as usize];
             let left = (b.x - a.x) * (y - a.y) - (x - a.x) * (b.y - a.y);
             if a.y <= y && b.y > y && left > 0.0 {

@@ -19,6 +19,7 @@
 //! **Concavity** of a part (metres) is the greatest depth of the mesh surface inside the part
 //! below its hull's boundary: how far an object touching the hull may still be from the mesh.
 
+mod buckets;
 mod cap_outline;
 mod concavity;
 mod cut_search;

@@ -1,5 +1,6 @@
 //! The nearest of many sample points to a query, through a uniform grid.
 
+use super::buckets::Buckets;
 use crate::math::DVec3;
 use std::ops::ControlFlow;
 
@@ -10,9 +11,20 @@ pub(super) struct SampleGrid<'a> {
     /// Cell edge, metres.
     cell: f64,
     dims: [usize; 3],
-    /// Cell `c` holds `items[starts[c] .. starts[c + 1]]`.
-    starts: Vec<u32>,
-    items: Vec<u32>,
+    /// The points of each cell (by [`Self::flat`] index).
+    cells: Buckets,
+}
+
+/// The cell of a grid (least corner `lo`, cells `cell` metres wide, `dims` along the axes)
+/// that holds `p`, or the nearest cell to it.
+fn cell_index(lo: DVec3, cell: f64, dims: [usize; 3], p: DVec3) -> [usize; 3] {
+    let q = ((p - lo) / cell).to_array();
+    [0, 1, 2].map(|k| (q[k].max(0.0) as usize).min(dims[k] - 1))
+}
+
+/// The index of cell `c` among the `dims` cells, x fastest.
+fn flat_index(dims: [usize; 3], c: [usize; 3]) -> usize {
+    (c[2] * dims[1] + c[1]) * dims[0] + c[0]
 }
 
 /// Points per cell the grid aims for.
@@ -32,36 +44,25 @@ impl<'a> SampleGrid<'a> {
         let dims = (extent / cell)
             .to_array()
             .map(|d| (d.ceil() as usize).clamp(1, MAX_DIM));
-        let mut grid = Self {
+        let cells: Vec<usize> = points
+            .iter()
+            .map(|&p| flat_index(dims, cell_index(lo, cell, dims, p)))
+            .collect();
+        Self {
             points,
             lo,
             cell,
             dims,
-            starts: vec![0; dims[0] * dims[1] * dims[2] + 1],
-            items: vec![0; points.len()],
-        };
-        let cells: Vec<usize> = points.iter().map(|&p| grid.flat(grid.cell_of(p))).collect();
-        for &c in &cells {
-            grid.starts[c + 1] += 1;
+            cells: Buckets::new(dims.iter().product(), points.len(), |i| cells[i]..=cells[i]),
         }
-        for c in 1..grid.starts.len() {
-            grid.starts[c] += grid.starts[c - 1];
-        }
-        let mut fill = grid.starts.clone();
-        for (i, &c) in cells.iter().enumerate() {
-            grid.items[fill[c] as usize] = i as u32;
-            fill[c] += 1;
-        }
-        grid
     }
 
     fn cell_of(&self, p: DVec3) -> [usize; 3] {
-        let q = ((p - self.lo) / self.cell).to_array();
-        [0, 1, 2].map(|k| (q[k].max(0.0) as usize).min(self.dims[k] - 1))
+        cell_index(self.lo, self.cell, self.dims, p)
     }
 
     fn flat(&self, c: [usize; 3]) -> usize {
-        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+        flat_index(self.dims, c)
     }
 
     /// Whether an accepted point lies within `floor` of `p`, found cheaply: the point
@@ -170,8 +171,8 @@ impl<'a> SampleGrid<'a> {
         c: [usize; 3],
         f: &mut impl FnMut(usize) -> ControlFlow<B>,
     ) -> ControlFlow<B> {
-        let cell = self.flat(c);
-        self.items[self.starts[cell] as usize..self.starts[cell + 1] as usize]
+        self.cells
+            .get(self.flat(c))
             .iter()
             .try_for_each(|&i| f(i as usize))
     }
