@@ -23,12 +23,16 @@ fn mesh_hull(mesh: &TriMesh) -> ConvexPolyhedron {
 /// Rounding of coordinates of size 1, far below any sampling error.
 const EXACT: f64 = 1e-12;
 
-#[test]
-fn unit_cube_as_its_own_hull_scores_zero() {
-    let cube = unit_cube();
-    let m = Reference::new(&cube).measure(&[mesh_hull(&cube)]);
+/// Asserts that `hulls` fit the unit cube exactly: no Hausdorff distance, no overshoot.
+fn assert_fit_the_cube_exactly(hulls: &[ConvexPolyhedron]) {
+    let m = Reference::new(&unit_cube()).measure(hulls);
     assert!(m.hausdorff_rel < EXACT, "{m:?}");
     assert!(m.volume_overshoot.abs() < EXACT, "{m:?}");
+}
+
+#[test]
+fn unit_cube_as_its_own_hull_scores_zero() {
+    assert_fit_the_cube_exactly(&[mesh_hull(&unit_cube())]);
 }
 
 #[test]
@@ -38,9 +42,7 @@ fn cube_cut_in_two_scores_zero_because_the_cut_faces_are_dropped() {
         box_hull(-half, DVec3::new(0.0, 0.5, 0.5)),
         box_hull(DVec3::new(0.0, -0.5, -0.5), half),
     ];
-    let m = Reference::new(&unit_cube()).measure(&hulls);
-    assert!(m.hausdorff_rel < EXACT, "{m:?}");
-    assert!(m.volume_overshoot.abs() < EXACT, "{m:?}");
+    assert_fit_the_cube_exactly(&hulls);
 }
 
 #[test]
@@ -52,9 +54,7 @@ fn cube_cut_along_a_diagonal_plane_scores_zero() {
         ConvexPolyhedron::try_from_points(&points).unwrap()
     };
     let hulls = [side(|v| v.x <= v.y), side(|v| v.x >= v.y)];
-    let m = Reference::new(&cube).measure(&hulls);
-    assert!(m.hausdorff_rel < EXACT, "{m:?}");
-    assert!(m.volume_overshoot.abs() < EXACT, "{m:?}");
+    assert_fit_the_cube_exactly(&hulls);
 }
 
 /// The convex polytope `{x : n · x ≤ d}` for the given planes `(n, d)`, as a hull: its
@@ -103,9 +103,7 @@ fn cube_cut_by_three_oblique_planes_scores_zero_at_their_inner_corner() {
             polytope(&planes)
         })
         .collect();
-    let m = Reference::new(&unit_cube()).measure(&hulls);
-    assert!(m.hausdorff_rel < EXACT, "{m:?}");
-    assert!(m.volume_overshoot.abs() < EXACT, "{m:?}");
+    assert_fit_the_cube_exactly(&hulls);
 }
 
 #[test]
