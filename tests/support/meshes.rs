@@ -171,6 +171,40 @@ pub fn u_prism() -> TriMesh {
     prism(&outline, 1.0)
 }
 
+/// A comb: three teeth on a bar, 5 wide, 2 deep, 1 high (volume 8).
+pub fn comb_prism() -> TriMesh {
+    let outline = [
+        [0.0, 0.0],
+        [5.0, 0.0],
+        [5.0, 2.0],
+        [4.0, 2.0],
+        [4.0, 1.0],
+        [3.0, 1.0],
+        [3.0, 2.0],
+        [2.0, 2.0],
+        [2.0, 1.0],
+        [1.0, 1.0],
+        [1.0, 2.0],
+        [0.0, 2.0],
+    ];
+    prism(&outline, 1.0)
+}
+
+/// Three steps, each 1 × 1 × 1 tread on the one below (volume 6).
+pub fn stairs_prism() -> TriMesh {
+    let outline = [
+        [0.0, 0.0],
+        [3.0, 0.0],
+        [3.0, 1.0],
+        [2.0, 1.0],
+        [2.0, 2.0],
+        [1.0, 2.0],
+        [1.0, 3.0],
+        [0.0, 3.0],
+    ];
+    prism(&outline, 1.0)
+}
+
 /// The box `[-half, half]` with 12 triangles (8 vertices).
 pub fn cuboid(half: DVec3) -> TriMesh {
     subdivided_cuboid(half, 1)

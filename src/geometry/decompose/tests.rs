@@ -1,13 +1,17 @@
 //! Pieces and cuts against analytic volumes; the repairs of `solid.rs`.
 
+use super::fitted::QuickHull;
 use super::piece::{Piece, Plane};
 use super::solid::prepare;
 use super::{DecomposeError, Fitted};
 use crate::geometry::TriMesh;
-use crate::math::DVec3;
-use crate::test_support::meshes::{cuboid, l_prism, torus, u_prism, uv_sphere};
-use crate::test_support::{point_in_cube, rng};
+use crate::math::{DQuat, DVec3};
+use crate::test_support::meshes::{
+    comb_prism, cuboid, l_prism, stairs_prism, torus, u_prism, uv_sphere, winding_number,
+};
+use crate::test_support::{point_in_cube, rng, rotation};
 use rand::Rng;
+use rand::seq::SliceRandom;
 use std::f64::consts::PI;
 
 fn solid_piece(mesh: &TriMesh) -> Piece {
@@ -264,4 +268,106 @@ fn random_cuts_of_a_u_leave_every_corner_in_the_solid() {
         split > 50 && corners > 10_000,
         "{split} splits, {corners} corners"
     );
+}
+
+#[test]
+fn cuts_along_faces_leave_pieces_whose_hulls_hold_only_their_solid() {
+    // Rectilinear prisms cut by every plane through their vertices' coordinates (and z = ½),
+    // in random order and orientation, some turned and moved off the origin: every piece is
+    // one cell of that grid, a box, whose hull is exactly its solid. A face along a plane
+    // sent to the side its solid is not on would be closed there by a cap over it: a
+    // zero-volume fin whose corners stretch that piece's hull across a notch.
+    let mut r = rng(3303);
+    let (mut turned, mut reversed, mut pieces_seen) = (0, 0, 0);
+    for mesh in [u_prism(), l_prism(), comb_prism(), stairs_prism()] {
+        let bounds = crate::math::bounds_of(mesh.vertices().iter().copied());
+        let mut planes = Vec::new();
+        for axis in 0..3 {
+            let mut at: Vec<f64> = mesh.vertices().iter().map(|v| v[axis]).collect();
+            at.push(0.5);
+            at.sort_by(f64::total_cmp);
+            at.dedup();
+            at.retain(|&c| c > bounds.0[axis] && c < bounds.1[axis]);
+            planes.extend(at.into_iter().map(|c| (DVec3::AXES[axis], c)));
+        }
+        let cells = grid_cells_inside(&mesh, &planes, bounds);
+        for round in 0..20 {
+            // Half the rounds turn and move the prism (and its planes) by a random pose.
+            let pose = if round % 2 == 1 {
+                turned += 1;
+                (rotation(&mut r), point_in_cube(&mut r, 50.0))
+            } else {
+                (DQuat::IDENTITY, DVec3::ZERO)
+            };
+            let moved = mesh_moved(&mesh, pose);
+            let mut cuts: Vec<Plane> = planes
+                .iter()
+                .map(|&(axis, c)| {
+                    let normal = pose.0 * axis;
+                    let offset = normal.dot(pose.0 * (axis * c) + pose.1);
+                    if r.random_bool(0.5) {
+                        reversed += 1;
+                        Plane {
+                            normal: -normal,
+                            offset: -offset,
+                        }
+                    } else {
+                        Plane { normal, offset }
+                    }
+                })
+                .collect();
+            cuts.shuffle(&mut r);
+            let whole = solid_piece(&moved);
+            let pieces = cut_all(whole.clone(), &cuts);
+            assert_eq!(
+                pieces.len(),
+                cells,
+                "one piece per solid cell, round {round}"
+            );
+            for piece in &pieces {
+                let (solid, hull) = (piece.volume(), QuickHull::of(piece.used_points()).volume());
+                assert!(
+                    solid > 0.1 && (hull - solid).abs() <= 1e-9,
+                    "a cell of solid {solid} has a hull of {hull}, round {round}"
+                );
+                pieces_seen += 1;
+            }
+            let total: f64 = pieces.iter().map(Piece::volume).sum();
+            assert!((total - whole.volume()).abs() <= 1e-9, "{total}");
+        }
+    }
+    assert!(turned > 10 && reversed > 100 && pieces_seen > 500);
+}
+
+/// How many cells of the grid the axis-aligned `planes` make of `bounds` have their centre
+/// inside `mesh`.
+fn grid_cells_inside(mesh: &TriMesh, planes: &[(DVec3, f64)], bounds: (DVec3, DVec3)) -> usize {
+    let ticks = |axis: usize| {
+        let mut at = vec![bounds.0[axis], bounds.1[axis]];
+        at.extend(
+            planes
+                .iter()
+                .filter(|(a, _)| a[axis] == 1.0)
+                .map(|&(_, c)| c),
+        );
+        at.sort_by(f64::total_cmp);
+        at.windows(2)
+            .map(|w| (w[0] + w[1]) / 2.0)
+            .collect::<Vec<f64>>()
+    };
+    let (xs, ys, zs) = (ticks(0), ticks(1), ticks(2));
+    let mut inside = 0;
+    for &x in &xs {
+        for &y in &ys {
+            for &z in &zs {
+                inside += usize::from(winding_number(mesh, DVec3::new(x, y, z)) > 0.5);
+            }
+        }
+    }
+    inside
+}
+
+fn mesh_moved(mesh: &TriMesh, (turn, shift): (DQuat, DVec3)) -> TriMesh {
+    let vertices = mesh.vertices().iter().map(|&v| turn * v + shift).collect();
+    crate::test_support::meshes::mesh(vertices, mesh.triangles().to_vec())
 }
