@@ -129,22 +129,28 @@ fn concavity_is_within_the_limit_when_parts_are_ample() {
 #[test]
 fn the_thread_count_does_not_change_the_parts() {
     let mesh = torus(1.0, 0.3, 32, 16);
-    let with = |threads: usize| {
-        let options = Options {
-            threads,
-            ..options(Method::CutSearch, 0.02, 64)
+    for method in [Method::CutSearch, Method::Relaxation] {
+        let with = |threads: usize| {
+            let options = Options {
+                threads,
+                ..options(method, 0.02, 64)
+            };
+            decompose(&mesh, &options).expect("torus")
         };
-        decompose(&mesh, &options).expect("torus")
-    };
-    let one = with(1);
-    assert!(one.parts.len() > 1, "a torus is not convex");
-    for threads in [2, 3] {
-        let many = with(threads);
-        assert_eq!(many.parts.len(), one.parts.len(), "{threads} threads");
-        for (a, b) in one.parts.iter().zip(&many.parts) {
-            assert_eq!(a.volume.to_bits(), b.volume.to_bits(), "{threads} threads");
-            assert_eq!(a.concavity.to_bits(), b.concavity.to_bits());
-            assert_eq!(a.hull.vertices(), b.hull.vertices());
+        let one = with(1);
+        assert!(one.parts.len() > 1, "a torus is not convex");
+        for threads in [2, 3] {
+            let many = with(threads);
+            assert_eq!(
+                many.parts.len(),
+                one.parts.len(),
+                "{method:?}, {threads} threads"
+            );
+            for (a, b) in one.parts.iter().zip(&many.parts) {
+                assert_eq!(a.volume.to_bits(), b.volume.to_bits(), "{threads} threads");
+                assert_eq!(a.concavity.to_bits(), b.concavity.to_bits());
+                assert_eq!(a.hull.vertices(), b.hull.vertices());
+            }
         }
     }
 }

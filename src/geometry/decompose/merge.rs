@@ -11,6 +11,7 @@
 //! by its own concavity or empty volume).
 
 use super::fitted::Fitted;
+use super::parallel::map_in_order;
 use std::collections::BTreeSet;
 
 /// Live pieces and who may touch whom.
@@ -18,10 +19,12 @@ struct Pool {
     pieces: Vec<Option<Fitted>>,
     neighbours: Vec<BTreeSet<usize>>,
     slack: f64,
+    /// Threads the pairs' unions are weighed on.
+    threads: usize,
 }
 
 impl Pool {
-    fn new(pieces: Vec<Fitted>, slack: f64) -> Self {
+    fn new(pieces: Vec<Fitted>, slack: f64, threads: usize) -> Self {
         let n = pieces.len();
         let mut neighbours = vec![BTreeSet::new(); n];
         for i in 0..n {
@@ -36,6 +39,7 @@ impl Pool {
             pieces: pieces.into_iter().map(Some).collect(),
             neighbours,
             slack,
+            threads,
         }
     }
 
@@ -74,14 +78,16 @@ impl Pool {
 }
 
 /// Merges the least concave union of neighbours while its concavity is within `limit`
-/// metres, then (if still above `max_parts`) the least concave unions regardless.
+/// metres, then (if still above `max_parts`) the least concave unions regardless. Unions
+/// are weighed on up to `threads` threads; the result is the same for any count.
 pub(super) fn merge_within(
     pieces: Vec<Fitted>,
     limit: f64,
     max_parts: usize,
     slack: f64,
+    threads: usize,
 ) -> Vec<Fitted> {
-    let mut pool = Pool::new(pieces, slack);
+    let mut pool = Pool::new(pieces, slack, threads);
     merge_cheapest(
         &mut pool,
         |a, b| a.merged(b).concavity,
@@ -94,22 +100,24 @@ pub(super) fn merge_within(
 /// until `done(lowest cost, live pieces)` or no pair is left.
 fn merge_cheapest(
     pool: &mut Pool,
-    cost: impl Fn(&Fitted, &Fitted) -> f64,
+    cost: impl Fn(&Fitted, &Fitted) -> f64 + Sync,
     done: impl Fn(f64, usize) -> bool,
 ) {
     // Non-negative floats order as their bits: (cost bits, i, j) sorts by cost.
     let mut costs: BTreeSet<(u64, usize, usize)> = BTreeSet::new();
-    let price = |pool: &Pool, costs: &mut BTreeSet<_>, i: usize, j: usize| {
-        let c = cost(pool.get(i), pool.get(j));
-        costs.insert((c.max(0.0).to_bits(), i.min(j), i.max(j)));
-    };
-    for i in 0..pool.pieces.len() {
-        if pool.pieces[i].is_some() {
-            for j in pool.neighbours[i].clone().into_iter().filter(|&j| j > i) {
-                price(pool, &mut costs, i, j);
-            }
+    let price = |pool: &Pool, costs: &mut BTreeSet<_>, pairs: &[(usize, usize)]| {
+        let prices = map_in_order(pairs, pool.threads, |&(i, j)| {
+            cost(pool.get(i), pool.get(j))
+        });
+        for (&(i, j), c) in pairs.iter().zip(prices) {
+            costs.insert((c.max(0.0).to_bits(), i.min(j), i.max(j)));
         }
-    }
+    };
+    let pairs: Vec<(usize, usize)> = (0..pool.pieces.len())
+        .filter(|&i| pool.pieces[i].is_some())
+        .flat_map(|i| pool.neighbours[i].range(i + 1..).map(move |&j| (i, j)))
+        .collect();
+    price(pool, &mut costs, &pairs);
     while let Some(&(bits, i, j)) = costs.first() {
         if done(f64::from_bits(bits), pool.live()) {
             break;
@@ -117,9 +125,8 @@ fn merge_cheapest(
         let union = pool.get(i).merged(pool.get(j));
         costs.retain(|&(_, a, b)| a != i && a != j && b != i && b != j);
         let k = pool.replace(i, j, union);
-        for n in pool.neighbours[k].clone() {
-            price(pool, &mut costs, n, k);
-        }
+        let pairs: Vec<(usize, usize)> = pool.neighbours[k].iter().map(|&n| (n, k)).collect();
+        price(pool, &mut costs, &pairs);
     }
 }
 
@@ -142,8 +149,9 @@ pub(super) fn merge_by_volume(
     max_empty: f64,
     max_parts: usize,
     slack: f64,
+    threads: usize,
 ) -> Vec<Fitted> {
-    let mut pool = Pool::new(pieces, slack);
+    let mut pool = Pool::new(pieces, slack, threads);
     let mut settled = BTreeSet::new();
     loop {
         let smallest = (0..pool.pieces.len())

@@ -74,9 +74,9 @@ pub struct Options {
     /// [`Method::Relaxation`] only: the largest fraction of a merged part's hull it may leave
     /// empty (default 0.05).
     pub max_empty_fraction: f64,
-    /// [`Method::CutSearch`] only: threads the search may use, the caller's among them
-    /// (default: the machine's available parallelism; 0 counts as 1). The parts are the
-    /// same for any count.
+    /// Threads the search and the merging may use, the caller's among them (default: the
+    /// machine's available parallelism; 0 counts as 1). The parts are the same for any
+    /// count.
     pub threads: usize,
 }
 
@@ -192,7 +192,7 @@ pub fn decompose(mesh: &TriMesh, options: &Options) -> Result<Decomposition, Dec
     let pieces = match options.method {
         Method::CutSearch => {
             let cut = cut_search::cut_until(root, limit, options.max_parts, options.threads);
-            merge::merge_within(cut, limit, options.max_parts, slack)
+            merge::merge_within(cut, limit, options.max_parts, slack, options.threads)
         }
         Method::Relaxation => relaxation::relax(
             root,
@@ -200,6 +200,7 @@ pub fn decompose(mesh: &TriMesh, options: &Options) -> Result<Decomposition, Dec
             options.max_parts,
             options.max_empty_fraction,
             slack,
+            options.threads,
         ),
     };
     let mut repairs = solid.repairs;

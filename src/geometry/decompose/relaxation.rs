@@ -19,13 +19,15 @@ const LEAVES_PER_PART: usize = 4;
 /// Most leaves the split makes, whatever the part count.
 const MAX_LEAVES: usize = 256;
 
-/// Splits `root` into small leaves and merges them back (module docs).
+/// Splits `root` into small leaves and merges them back (module docs); unions are weighed
+/// on up to `threads` threads.
 pub(super) fn relax(
     root: Fitted,
     limit: f64,
     max_parts: usize,
     max_empty: f64,
     slack: f64,
+    threads: usize,
 ) -> Vec<Fitted> {
     let target = max_parts
         .saturating_mul(LEAVES_PER_PART)
@@ -49,7 +51,7 @@ pub(super) fn relax(
         }
     }
     leaves.extend(open);
-    merge_by_volume(leaves, max_empty, max_parts, slack)
+    merge_by_volume(leaves, max_empty, max_parts, slack, threads)
 }
 
 /// The plane through the middle of the piece's oriented box, across its longest axis.
