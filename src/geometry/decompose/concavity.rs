@@ -60,9 +60,10 @@ pub(super) fn deepest_samples(
     if hull.is_empty() || k == 0 {
         return deepest;
     }
-    // The plane that last dismissed a sample: samples come triangle by triangle, so the
-    // next one is most often dismissed by the same plane, in one test.
-    let mut last_shown = 0;
+    // The faces that dismissed the latest samples, most recent first: samples come
+    // triangle by triangle, so the next one is most often dismissed by one of them, in a
+    // few tests rather than a scan of the hull.
+    let mut recent = [0; RECENT_FACES];
     'samples: for &p in samples {
         let bar = if deepest.len() < k {
             f64::NEG_INFINITY
@@ -70,14 +71,16 @@ pub(super) fn deepest_samples(
             deepest[k - 1].0
         };
         let height = |t: &HullTriangle| t.offset - t.normal.dot(p);
-        if height(&hull[last_shown]) <= bar {
+        if let Some(r) = recent.iter().position(|&f| height(&hull[f]) <= bar) {
+            recent[..=r].rotate_right(1);
             continue;
         }
         let mut least = f64::INFINITY;
         for (i, t) in hull.iter().enumerate() {
             least = least.min(height(t));
             if least <= bar {
-                last_shown = i;
+                recent.rotate_right(1);
+                recent[0] = i;
                 continue 'samples;
             }
         }
@@ -87,6 +90,9 @@ pub(super) fn deepest_samples(
     }
     deepest
 }
+
+/// How many of the faces that dismissed the latest samples [`deepest_samples`] tries first.
+const RECENT_FACES: usize = 8;
 
 /// The greatest distance from the hull's boundary (off the cut planes) to the surface.
 ///
@@ -158,3 +164,56 @@ const MAX_HULL_DIVISIONS: usize = 16;
 
 /// A hull triangle within this fraction of the coordinates' magnitude of a cut plane lies on it.
 const ON_CUT_RELATIVE: f64 = 1e-9;
+
+#[cfg(test)]
+mod tests {
+    use super::deepest_samples;
+    use crate::geometry::ConvexPolyhedron;
+    use crate::math::DVec3;
+    use crate::test_support::{point_in_cube, rng};
+    use rand::Rng;
+
+    /// The `k` deepest against every face scanned for every sample, on random hulls with
+    /// samples inside and outside, walked both in a spatially coherent order (as a piece's
+    /// samples come) and shuffled.
+    #[test]
+    fn the_deepest_samples_agree_with_a_scan_of_every_face() {
+        let mut r = rng(4501);
+        let (mut inside, mut outside) = (0, 0);
+        for round in 0..200 {
+            let corners: Vec<DVec3> = (0..r.random_range(4..60))
+                .map(|_| point_in_cube(&mut r, 1.0))
+                .collect();
+            let Some(hull) = ConvexPolyhedron::quick_hull_triangles(&corners) else {
+                continue;
+            };
+            let mut samples: Vec<DVec3> = (0..r.random_range(1..400))
+                .map(|_| point_in_cube(&mut r, 1.1))
+                .collect();
+            if round % 2 == 0 {
+                samples.sort_by(|a, b| a.x.total_cmp(&b.x));
+            }
+            let depth = |p: DVec3| {
+                hull.iter()
+                    .map(|t| t.offset - t.normal.dot(p))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let mut expected: Vec<f64> = samples.iter().map(|&p| depth(p)).collect();
+            inside += expected.iter().filter(|&&d| d > 0.0).count();
+            outside += expected.iter().filter(|&&d| d < 0.0).count();
+            expected.sort_by(|a, b| b.total_cmp(a));
+            for k in [1, 3, 7] {
+                let found = deepest_samples(&hull, &samples, k);
+                assert_eq!(found.len(), k.min(samples.len()));
+                for (i, &(d, p)) in found.iter().enumerate() {
+                    assert_eq!(d, expected[i], "round {round}, k {k}, rank {i}");
+                    assert_eq!(d, depth(p));
+                }
+            }
+        }
+        assert!(
+            inside > 1000 && outside > 1000,
+            "{inside} inside, {outside} outside"
+        );
+    }
+}
