@@ -69,6 +69,7 @@ pub(super) fn quickhull(
         noise,
         faces: Vec::new(),
         epoch: 0,
+        scratch: Scratch::default(),
     };
     hull.start(simplex);
     let mut stack: Vec<usize> = (0..hull.faces.len()).collect();
@@ -96,6 +97,23 @@ struct Builder<'a> {
     noise: f64,
     faces: Vec<HullFace>,
     epoch: u32,
+    /// Buffers each eye reuses, so adding a vertex allocates nothing once they have grown.
+    scratch: Scratch,
+}
+
+/// The per-eye working sets of [`Builder::add_eye`], kept between eyes.
+#[derive(Default)]
+struct Scratch {
+    /// Faces that see the eye.
+    visible: Vec<usize>,
+    /// The visible set's boundary edges `(a, b, face beyond)`, unordered.
+    edges: Vec<(usize, usize, usize)>,
+    /// The same edges as one loop.
+    horizon: Vec<(usize, usize, usize)>,
+    /// Points to reassign to the new cone's faces.
+    pool: Vec<usize>,
+    /// Corners of visible faces off the horizon.
+    swallowed: Vec<usize>,
 }
 
 impl Builder<'_> {
@@ -142,15 +160,15 @@ impl Builder<'_> {
         let pool: Vec<usize> = (0..self.pts.len())
             .filter(|i| !simplex.contains(i))
             .collect();
-        self.assign(&pool, &[0, 1, 2, 3]);
+        self.assign(&pool, 0..4);
     }
 
     /// Gives each pool point to the face (among `faces`) it is farthest outside of, or drops
     /// it when it is within `eps` of all of them.
-    fn assign(&mut self, pool: &[usize], faces: &[usize]) {
+    fn assign(&mut self, pool: &[usize], faces: impl Iterator<Item = usize> + Clone) {
         for &p in pool {
             let mut best = (self.eps, usize::MAX);
-            for &f in faces {
+            for f in faces.clone() {
                 let d = self.distance(f, p);
                 if d > best.0 {
                     best = (d, f);
@@ -175,28 +193,36 @@ impl Builder<'_> {
             }
             self.faces[fi].outside.swap_remove(best.1)
         };
-        let mut found = None;
-        for threshold in [self.eps, 0.0, -self.eps] {
-            let visible = self.visible_set(fi, eye, threshold);
-            if let Some(horizon) = self.horizon(&visible) {
-                found = Some((visible, horizon));
-                break;
-            }
-        }
-        let Some((visible, horizon)) = found else {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        let found = [self.eps, 0.0, -self.eps].into_iter().any(|threshold| {
+            self.visible_set(fi, eye, threshold, &mut scratch.visible);
+            self.horizon(&scratch.visible, &mut scratch.edges, &mut scratch.horizon)
+        });
+        if !found {
             // NOTE: no consistent cone exists for this eye; dropping it keeps the surface a
             // manifold. The caller checks containment and retries with a coarser tolerance.
+            self.scratch = scratch;
             stack.push(fi);
             return;
-        };
-        let on_horizon: Vec<usize> = horizon.iter().map(|e| e.0).collect();
-        let mut pool = Vec::new();
-        for &f in &visible {
+        }
+        let Scratch {
+            visible,
+            horizon,
+            pool,
+            swallowed,
+            ..
+        } = &mut scratch;
+        pool.clear();
+        // Corners of visible faces off the horizon, each once. (A hull vertex is in no
+        // outside set, so these are the only repeats the pool could get.)
+        swallowed.clear();
+        for &f in visible.iter() {
             let face = &mut self.faces[f];
             face.alive = false;
             pool.append(&mut face.outside);
             for v in face.v {
-                if !on_horizon.contains(&v) && !pool.contains(&v) {
+                if !horizon.iter().any(|e| e.0 == v) && !swallowed.contains(&v) {
+                    swallowed.push(v);
                     pool.push(v);
                 }
             }
@@ -212,20 +238,19 @@ impl Builder<'_> {
                 .expect("horizon neighbour shares the edge");
             self.faces[g].adj[gk] = nf;
         }
-        let new_faces: Vec<usize> = (first..first + m).collect();
-        self.assign(&pool, &new_faces);
-        stack.extend(
-            new_faces
-                .iter()
-                .filter(|&&f| !self.faces[f].outside.is_empty()),
-        );
+        let new_faces = first..first + m;
+        self.assign(pool, new_faces.clone());
+        stack.extend(new_faces.filter(|&f| !self.faces[f].outside.is_empty()));
+        self.scratch = scratch;
     }
 
-    /// The faces connected to `start` that see `eye` by more than `threshold`.
-    fn visible_set(&mut self, start: usize, eye: usize, threshold: f64) -> Vec<usize> {
+    /// Fills `visible` with the faces connected to `start` that see `eye` by more than
+    /// `threshold`.
+    fn visible_set(&mut self, start: usize, eye: usize, threshold: f64, visible: &mut Vec<usize>) {
         self.epoch += 1;
         let epoch = self.epoch;
-        let mut visible = vec![start];
+        visible.clear();
+        visible.push(start);
         self.faces[start].visible_epoch = epoch;
         let mut i = 0;
         while i < visible.len() {
@@ -241,7 +266,6 @@ impl Builder<'_> {
                 }
             }
         }
-        visible
     }
 
     /// Whether the cone face `[a, b, eye]` over the edge `a → b` (edge `k` of face `f`) would
@@ -269,11 +293,17 @@ impl Builder<'_> {
         normal.dot(self.pts[far]) - offset > self.eps
     }
 
-    /// The boundary of the visible set as one loop of edges `(a, b, face beyond)`, in the
-    /// visible faces' orientation; `None` when it is not a single simple loop.
-    fn horizon(&self, visible: &[usize]) -> Option<Vec<(usize, usize, usize)>> {
+    /// The boundary of the visible set as one loop of edges `(a, b, face beyond)` in
+    /// `horizon`, in the visible faces' orientation (`edges` is working space); `false` when
+    /// it is not a single simple loop.
+    fn horizon(
+        &self,
+        visible: &[usize],
+        edges: &mut Vec<(usize, usize, usize)>,
+        horizon: &mut Vec<(usize, usize, usize)>,
+    ) -> bool {
         let epoch = self.epoch;
-        let mut edges = Vec::new();
+        edges.clear();
         for &f in visible {
             let face = &self.faces[f];
             for k in 0..3 {
@@ -283,25 +313,33 @@ impl Builder<'_> {
                 }
             }
         }
-        let mut by_start: HashMap<usize, usize> = HashMap::with_capacity(edges.len());
+        if edges.is_empty() {
+            return false;
+        }
+        // A horizon has a handful of edges: a linear search finds the next one sooner than
+        // a hash map is built.
+        let starting_at = |v: usize| edges.iter().position(|e| e.0 == v);
         for (i, e) in edges.iter().enumerate() {
-            if by_start.insert(e.0, i).is_some() {
-                return None; // a vertex where the loop touches itself
+            if edges[..i].iter().any(|d| d.0 == e.0) {
+                return false; // a vertex where the loop touches itself
             }
         }
-        let mut ordered = Vec::with_capacity(edges.len());
+        horizon.clear();
         let mut cur = 0;
         loop {
-            ordered.push(edges[cur]);
-            cur = *by_start.get(&edges[cur].1)?;
+            horizon.push(edges[cur]);
+            let Some(next) = starting_at(edges[cur].1) else {
+                return false;
+            };
+            cur = next;
             if cur == 0 {
                 break;
             }
-            if ordered.len() > edges.len() {
-                return None;
+            if horizon.len() > edges.len() {
+                return false;
             }
         }
         // Fewer edges in the loop than on the boundary: the visible set has a hole.
-        (ordered.len() == edges.len() && ordered.len() >= 3).then_some(ordered)
+        horizon.len() == edges.len() && horizon.len() >= 3
     }
 }
