@@ -1,6 +1,6 @@
-//! The independent jobs of one search step (candidate planes to score, cuts to measure)
-//! spread over threads, their results in input order: a decomposition is the same whatever
-//! the thread count.
+//! The independent jobs of one search or merge step (candidate planes to score, cuts to
+//! measure, unions to weigh) spread over threads, their results in input order: a
+//! decomposition is the same whatever the thread count.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 

@@ -12,8 +12,8 @@
 //!    to the side their solid is on, opposite their outward normal. Splitting them by the
 //!    sign of a rounding error would give the other side a face whose solid is not there,
 //!    closed by a cap over it: a zero-volume fin whose corners stretch that side's hull.
-//! 3. **The cap** of each side is what leaves it open: the edges on the plane whose reverse
-//!    no loop of that side holds (the clipped loops' closing edges, and edges along the
+//! 3. **The cap** of each side closes what the first two leave open: the edges on the plane
+//!    whose reverse no loop of that side holds (the clipped loops' closing edges, and edges along the
 //!    plane whose other face went to the other side), reversed and chained into outlines.
 //!    It therefore covers exactly where the plane crosses solid.
 //!
@@ -25,9 +25,10 @@ use super::{Loop, Piece, Plane};
 use crate::math::DVec3;
 use std::collections::HashMap;
 
-/// A point within this fraction of the piece's largest coordinate magnitude (or of its
-/// largest distance from the plane, if larger) lies on the plane: a few hundred times the
-/// rounding of a signed distance, so a plane through a mesh face finds all of its corners.
+/// A point within this fraction of the cut's scale lies on the plane (the scale: the largest
+/// of the piece's coordinate magnitudes, its points' distances from the plane and the
+/// plane's offset): a few hundred times the rounding of a signed distance, so a plane
+/// through a mesh face finds all of its corners.
 const ON_PLANE: f64 = 1e-12;
 
 impl Piece {
@@ -66,7 +67,7 @@ impl Piece {
         Some((below, above))
     }
 
-    /// Twice the loop's area times its unit normal (Newell's sum), m².
+    /// Twice the loop's area times its unit normal (the sum of its fan's cross products), m².
     fn area_vector(&self, corners: &[u32]) -> DVec3 {
         let o = self.points[corners[0] as usize];
         corners[1..].windows(2).fold(DVec3::ZERO, |sum, w| {
