@@ -156,37 +156,26 @@ pub fn l_prism() -> TriMesh {
     prism(&L_OUTLINE, 1.0)
 }
 
-/// A U-shaped prism, 3 wide, 2 deep and 1 high, its notch 1 × 1 (volume 5).
+/// A U-shaped prism, 3 wide, 2 deep and 1 high, its notch 1 × 1 (volume 5): the comb of two
+/// teeth.
 pub fn u_prism() -> TriMesh {
-    let outline = [
-        [0.0, 0.0],
-        [3.0, 0.0],
-        [3.0, 2.0],
-        [2.0, 2.0],
-        [2.0, 1.0],
-        [1.0, 1.0],
-        [1.0, 2.0],
-        [0.0, 2.0],
-    ];
-    prism(&outline, 1.0)
+    comb_prism(2)
 }
 
-/// A comb: three teeth on a bar, 5 wide, 2 deep, 1 high (volume 8).
-pub fn comb_prism() -> TriMesh {
-    let outline = [
-        [0.0, 0.0],
-        [5.0, 0.0],
-        [5.0, 2.0],
-        [4.0, 2.0],
-        [4.0, 1.0],
-        [3.0, 1.0],
-        [3.0, 2.0],
-        [2.0, 2.0],
-        [2.0, 1.0],
-        [1.0, 1.0],
-        [1.0, 2.0],
-        [0.0, 2.0],
-    ];
+/// A comb of `teeth` (≥ 1) unit-wide teeth 1 apart on a unit-deep bar, all 1 high: 2 teeth − 1
+/// wide, 2 deep (volume 3 teeth − 1). Its outline runs along the bottom, then back along the
+/// teeth from the right.
+pub fn comb_prism(teeth: u32) -> TriMesh {
+    assert!(teeth >= 1);
+    let width = f64::from(2 * teeth - 1);
+    let mut outline = vec![[0.0, 0.0], [width, 0.0]];
+    for t in (0..teeth).rev() {
+        let (left, right) = (f64::from(2 * t), f64::from(2 * t + 1));
+        outline.extend([[right, 2.0], [left, 2.0]]);
+        if t > 0 {
+            outline.extend([[left, 1.0], [left - 1.0, 1.0]]);
+        }
+    }
     prism(&outline, 1.0)
 }
 

@@ -150,7 +150,7 @@ impl<'a> CapOutlines<'a> {
 #[cfg(test)]
 mod tests {
     use super::CapOutline;
-    use crate::math::DVec3;
+    use crate::math::{DVec3, orthonormal_basis};
     use crate::test_support::{point_in_cube, rng};
     use rand::Rng;
     use std::f64::consts::TAU;
@@ -198,8 +198,7 @@ mod tests {
         let (mut inside, mut outside) = (0, 0);
         for _ in 0..20 {
             let normal = point_in_cube(&mut r, 1.0).normalize_or(DVec3::Z);
-            let u = normal.any_orthonormal_vector();
-            let v = normal.cross(u);
+            let (u, v) = orthonormal_basis(normal);
             let offset = normal * r.random_range(-2.0..2.0);
             let mut edges = star(&mut r, 300, (0.8, 1.0), (u, v), false);
             edges.extend(star(&mut r, 40, (0.2, 0.4), (u, v), true));

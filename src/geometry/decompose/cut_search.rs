@@ -107,8 +107,13 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
         let even = (1..=OFFSETS).map(|k| lo + step * k as f64);
         let through_deepest = deepest.iter().map(|p| p.dot(axis));
         for offset in even.chain(through_deepest) {
-            let normal = axis;
-            candidates.push((Plane { normal, offset }, step));
+            candidates.push((
+                Plane {
+                    normal: axis,
+                    offset,
+                },
+                step,
+            ));
         }
     }
     let mut scored: Vec<(f64, Plane, f64)> =
@@ -263,14 +268,17 @@ impl<'a> Scorer<'a> {
         cut: Plane,
         section: &[DVec3],
     ) -> Option<f64> {
-        let half: Vec<DVec3> = (0..self.samples.len())
-            .filter(|&i| below[i] == side)
-            .map(|i| self.samples[i])
-            .collect();
-        if half.is_empty() {
+        // The half's samples, then the section outline: the hull's input.
+        let mut points: Vec<DVec3> = Vec::with_capacity(self.samples.len() + section.len());
+        points.extend(
+            (0..self.samples.len())
+                .filter(|&i| below[i] == side)
+                .map(|i| self.samples[i]),
+        );
+        let half = points.len();
+        if half == 0 {
             return None;
         }
-        let mut points = half.clone();
         points.extend_from_slice(section);
         // A half that spans no solid (a sliver) holds no concavity.
         let Some(hull) = ConvexPolyhedron::quick_hull_triangles(&points) else {
@@ -284,7 +292,7 @@ impl<'a> Scorer<'a> {
             pending: Some(cut),
             spacing: self.spacing,
         };
-        Some(concavity(&hull, &half, &surface))
+        Some(concavity(&hull, &points[..half], &surface))
     }
 }
 
