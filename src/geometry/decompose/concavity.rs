@@ -37,12 +37,23 @@ pub(super) struct Surface<'a> {
 }
 
 /// The concavity of a piece whose hull is `hull` and whose surface samples below the hull are
-/// `samples` (module docs), metres.
-pub(super) fn concavity(hull: &[HullTriangle], samples: &[DVec3], surface: &Surface) -> f64 {
+/// `samples` (module docs), metres, when it is at most `bar`; above `bar`, some value
+/// between `bar` and the concavity (the measure stops as soon as it knows it is above).
+/// `f64::INFINITY` asks for the concavity whatever it is.
+pub(super) fn concavity(
+    hull: &[HullTriangle],
+    samples: &[DVec3],
+    surface: &Surface,
+    bar: f64,
+) -> f64 {
     let depth = deepest_samples(hull, samples, 1)
         .first()
-        .map_or(0.0, |&(depth, _)| depth);
-    depth.max(0.0).max(bridge_height(hull, surface))
+        .map_or(0.0, |&(depth, _)| depth)
+        .max(0.0);
+    if depth > bar {
+        return depth;
+    }
+    bridge_height(hull, surface, depth, bar)
 }
 
 /// The `k` samples deepest below the hull's boundary, with their depths (metres, negative
@@ -94,13 +105,16 @@ pub(super) fn deepest_samples(
 /// How many of the faces that dismissed the latest samples [`deepest_samples`] tries first.
 const RECENT_FACES: usize = 8;
 
-/// The greatest distance from the hull's boundary (off the cut planes) to the surface.
+/// The greatest distance from the hull's boundary (off the cut planes) to the surface, or
+/// `floor` when that is greater; once above `bar`, some value between `bar` and that.
 ///
 /// A maximum of nearest distances: a point with a sample within the greatest so far cannot
 /// raise it, so each point is first dismissed by the cheapest test that can (the samples
 /// next to it, then the section outline), then by whether it lies on a cap, and only then
-/// pays for a whole nearest-sample search.
-fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
+/// pays for a whole nearest-sample search. The largest triangles, where a bridge is most
+/// likely, go first: the sooner the greatest so far is high, the more points the cheap
+/// tests dismiss (the maximum is the same in any order).
+fn bridge_height(hull: &[HullTriangle], surface: &Surface, floor: f64, bar: f64) -> f64 {
     let reach = hull
         .iter()
         .flat_map(|t| t.corners)
@@ -108,10 +122,18 @@ fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
         .fold(0.0, f64::max);
     let on_plane = ON_CUT_RELATIVE * reach.max(f64::MIN_POSITIVE);
     let mut lattice = Vec::new();
-    let mut highest: f64 = 0.0;
+    let mut highest: f64 = floor;
     let mut hint = 0;
     let cuts = &surface.caps.piece.cuts;
-    for t in hull {
+    let mut largest_first: Vec<(f64, &HullTriangle)> = hull
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.corners;
+            ((b - a).cross(c - a).length_squared(), t)
+        })
+        .collect();
+    largest_first.sort_unstable_by(|x, y| y.0.total_cmp(&x.0));
+    for &(_, t) in &largest_first {
         let on = |c: &Plane| {
             c.normal.dot(t.normal) > 0.0
                 && t.corners
@@ -153,6 +175,9 @@ fn bridge_height(hull: &[HullTriangle], surface: &Surface) -> f64 {
             let near = near.min(near_extra);
             if near.is_finite() {
                 highest = highest.max(near);
+                if highest > bar {
+                    return highest;
+                }
             }
         }
     }

@@ -14,6 +14,11 @@
 //! refined by halving the step around them, then cut exactly, and the best exact cut is kept
 //! (the thinned score cannot tell apart cuts closer than its samples).
 //!
+//! Only the finalists' scores are needed in full: once [`EXACT_FINALISTS`] scores are known,
+//! a candidate is measured only until it is known to score worse than all of them (its
+//! halves' concavity measured up to a bar, see `concavity.rs`). The finalists are the same
+//! as with every score in full, for any thread count.
+//!
 //! Citation: X. Wei, M. Liu, Z. Ling, H. Su, "Approximate Convex Decomposition for 3D Meshes
 //! with Collision-Aware Concavity and Tree Search", SIGGRAPH 2022 (CoACD).
 
@@ -26,6 +31,7 @@ use super::piece::Plane;
 use crate::geometry::ConvexPolyhedron;
 use crate::geometry::pca::{point_moments, principal_axes};
 use crate::math::{DVec3, bounds_of};
+use std::sync::{Mutex, PoisonError};
 
 /// Most surface samples a candidate is scored on.
 const SCORE_SAMPLES: usize = 1200;
@@ -116,13 +122,23 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
             ));
         }
     }
+    // Only the best few scores matter: once that many are known, a candidate is measured
+    // only until it is known to score worse than all of them.
+    let best_scores = Mutex::new(Vec::with_capacity(EXACT_FINALISTS + 1));
     let mut scored: Vec<(f64, Plane, f64)> =
         map_in_order(&candidates, threads, |&(plane, step)| {
-            scorer.score(&plane).map(|score| (score, plane, step))
+            let bar = worst_of_best(&best_scores);
+            let score = scorer.score(&plane, bar)?;
+            if score <= bar {
+                keep_among_best(&best_scores, score);
+            }
+            Some((score, plane, step))
         })
         .into_iter()
         .flatten()
         .collect();
+    // The scores above their bar are only known to be above it, but so are they above the
+    // finalists' scores: the finalists are the same as if every score were measured whole.
     scored.sort_by(|a, b| a.0.total_cmp(&b.0));
     scored.truncate(EXACT_FINALISTS);
     let finalists = map_in_order(&scored, threads, |&(score, plane, step)| {
@@ -156,13 +172,32 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
     .map(|(_, a, b)| (a, b))
 }
 
+/// The greatest of the [`EXACT_FINALISTS`] best scores so far, or infinity while there are
+/// fewer.
+fn worst_of_best(best: &Mutex<Vec<f64>>) -> f64 {
+    let best = best.lock().unwrap_or_else(PoisonError::into_inner);
+    if best.len() < EXACT_FINALISTS {
+        f64::INFINITY
+    } else {
+        best[EXACT_FINALISTS - 1]
+    }
+}
+
+/// Puts `score` among the [`EXACT_FINALISTS`] best so far (ascending) if it is one of them.
+fn keep_among_best(best: &Mutex<Vec<f64>>, score: f64) {
+    let mut best = best.lock().unwrap_or_else(PoisonError::into_inner);
+    let at = best.partition_point(|&s| s <= score);
+    best.insert(at, score);
+    best.truncate(EXACT_FINALISTS);
+}
+
 /// Moves `plane` by halving steps while the thinned score improves.
 fn refined(scorer: &Scorer, mut score: f64, mut plane: Plane, mut step: f64) -> Plane {
     for _ in 0..REFINE_ROUNDS {
         step *= 0.5;
         for offset in [plane.offset - step, plane.offset + step] {
             let moved = Plane { offset, ..plane };
-            if let Some(s) = scorer.score(&moved)
+            if let Some(s) = scorer.score(&moved, score)
                 && s < score
             {
                 (score, plane) = (s, moved);
@@ -236,8 +271,10 @@ impl<'a> Scorer<'a> {
         }
     }
 
-    /// The candidate's score, metres (lower is better); `None` when a side is empty.
-    fn score(&self, plane: &Plane) -> Option<f64> {
+    /// The candidate's score, metres (lower is better), when at most `bar`; above `bar`,
+    /// some value between `bar` and the score. `None` when a side is empty (or, for a
+    /// score above `bar`, may be).
+    fn score(&self, plane: &Plane, bar: f64) -> Option<f64> {
         let section: Vec<DVec3> = self
             .edges
             .iter()
@@ -255,18 +292,23 @@ impl<'a> Scorer<'a> {
             normal: -plane.normal,
             offset: -plane.offset,
         };
-        let a = self.half_concavity(&below, true, *plane, &section)?;
-        let b = self.half_concavity(&below, false, flipped, &section)?;
+        let a = self.half_concavity(&below, true, *plane, &section, bar)?;
+        if a > bar {
+            return Some(a);
+        }
+        let b = self.half_concavity(&below, false, flipped, &section, other_half_bar(a, bar))?;
         Some(a.max(b) + LESSER_HALF_WEIGHT * a.min(b))
     }
 
-    /// The concavity of the half on side `side` (per sample in `below`), cut off by `cut`.
+    /// The concavity of the half on side `side` (per sample in `below`), cut off by `cut`,
+    /// up to `bar` (see [`concavity`]).
     fn half_concavity(
         &self,
         below: &[bool],
         side: bool,
         cut: Plane,
         section: &[DVec3],
+        bar: f64,
     ) -> Option<f64> {
         // The half's samples, then the section outline: the hull's input.
         let mut points: Vec<DVec3> = Vec::with_capacity(self.samples.len() + section.len());
@@ -292,12 +334,75 @@ impl<'a> Scorer<'a> {
             pending: Some(cut),
             spacing: self.spacing,
         };
-        Some(concavity(&hull, &points[..half], &surface))
+        Some(concavity(&hull, &points[..half], &surface, bar))
     }
 }
+
+/// The concavity `b` of one half above which a score `max(a, b) + w·min(a, b)` is above
+/// `bar`, the other half's concavity being `a` (at most `bar`), raised by a relative
+/// [`BAR_MARGIN`] so that rounding cannot put a score just over `bar` at or under it.
+fn other_half_bar(a: f64, bar: f64) -> f64 {
+    let w = LESSER_HALF_WEIGHT;
+    let b = if bar - w * a >= a {
+        bar - w * a
+    } else {
+        (bar - a) / w
+    };
+    b + BAR_MARGIN * bar.abs().max(a)
+}
+
+/// Relative margin on the bar of [`other_half_bar`], far above the rounding of a score.
+const BAR_MARGIN: f64 = 1e-9;
 
 /// Every `len / most`-th item, so at most about `most` remain, spread over the input.
 fn thinned<T: Copy>(items: &[T], most: usize) -> Vec<T> {
     let stride = items.len().div_ceil(most.max(1)).max(1);
     items.iter().step_by(stride).copied().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{SCORE_SAMPLES, Scorer, thinned};
+    use crate::geometry::decompose::fitted::Fitted;
+    use crate::geometry::decompose::piece::Plane;
+    use crate::geometry::decompose::solid::prepare;
+    use crate::geometry::decompose::tests::{BAR_FRACTIONS, check_barred};
+    use crate::math::DVec3;
+    use crate::test_support::meshes::{comb_prism, torus};
+    use crate::test_support::{point_in_cube, rng};
+
+    /// A candidate scored up to a bar scores as in full when that is within the bar, and
+    /// otherwise above the bar and no more than in full: on planes through a torus and a
+    /// comb, at bars below, at and above each score.
+    #[test]
+    fn a_score_up_to_a_bar_is_exact_within_it_and_bounded_above_it() {
+        let mut r = rng(5302);
+        let mut counts = (0, 0);
+        for (mesh, half) in [(torus(1.0, 0.3, 24, 12), 1.3), (comb_prism(3), 2.0)] {
+            let solid = prepare(&mesh).expect("closed test mesh").piece;
+            let piece = Fitted::new(solid, 0.05).expect("solid");
+            let samples = thinned(&piece.samples, SCORE_SAMPLES);
+            let scorer = Scorer::new(&piece, &samples);
+            let centre = (piece.bounds.0 + piece.bounds.1) * 0.5;
+            for round in 0..40 {
+                let normal = point_in_cube(&mut r, 1.0).normalize_or(DVec3::X);
+                let plane = Plane {
+                    normal,
+                    offset: normal.dot(centre + point_in_cube(&mut r, 0.5 * half)),
+                };
+                let Some(full) = scorer.score(&plane, f64::INFINITY) else {
+                    continue;
+                };
+                for bar in BAR_FRACTIONS.map(|f| f * full) {
+                    // A side is empty only when the full score says so.
+                    let barred = scorer.score(&plane, bar).expect("both sides hold samples");
+                    check_barred(full, bar, barred, &mut counts, &format!("round {round}"));
+                }
+            }
+        }
+        assert!(
+            counts.0 > 150 && counts.1 > 150,
+            "{counts:?} (within, above)"
+        );
+    }
 }

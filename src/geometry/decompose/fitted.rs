@@ -86,7 +86,7 @@ impl Fitted {
         let hull = QuickHull::of(corners);
         let samples = piece.surface_samples(spacing);
         let volume = piece.volume();
-        let concavity = hull_concavity(&hull, &samples, &piece, spacing);
+        let concavity = hull_concavity(&hull, &samples, &piece, spacing, f64::INFINITY);
         Some(Self {
             bounds: bounds_of(hull.points.iter().copied()),
             piece,
@@ -100,11 +100,22 @@ impl Fitted {
 
     /// The union of two pieces, measured.
     pub fn merged(&self, other: &Fitted) -> Fitted {
+        self.union(other, f64::INFINITY)
+    }
+
+    /// The concavity of the union of two pieces, metres, when at most `bar`; above `bar`,
+    /// some value between `bar` and the concavity (see [`concavity`]).
+    pub fn union_concavity(&self, other: &Fitted, bar: f64) -> f64 {
+        self.union(other, bar).concavity
+    }
+
+    /// The union of two pieces, its concavity measured up to `bar` (see [`concavity`]).
+    fn union(&self, other: &Fitted, bar: f64) -> Fitted {
         let hull = self.merged_hull(other);
         let mut samples = self.samples.clone();
         samples.extend_from_slice(&other.samples);
         let piece = self.piece.merged(&other.piece);
-        let concavity = hull_concavity(&hull, &samples, &piece, self.spacing);
+        let concavity = hull_concavity(&hull, &samples, &piece, self.spacing, bar);
         Self {
             bounds: bounds_of(hull.points.iter().copied()),
             piece,
@@ -138,8 +149,15 @@ impl Fitted {
     }
 }
 
-/// The concavity of a piece with this hull, surface samples and cut planes, metres.
-fn hull_concavity(hull: &QuickHull, samples: &[DVec3], piece: &Piece, spacing: f64) -> f64 {
+/// The concavity of a piece with this hull, surface samples and cut planes, metres, up to
+/// `bar` (see [`concavity`]).
+fn hull_concavity(
+    hull: &QuickHull,
+    samples: &[DVec3],
+    piece: &Piece,
+    spacing: f64,
+    bar: f64,
+) -> f64 {
     // A hull that is not solid (a sliver of a piece) holds no concavity.
     if hull.triangles.is_empty() {
         return 0.0;
@@ -153,5 +171,5 @@ fn hull_concavity(hull: &QuickHull, samples: &[DVec3], piece: &Piece, spacing: f
         pending: None,
         spacing,
     };
-    concavity(&hull.triangles, samples, &surface)
+    concavity(&hull.triangles, samples, &surface, bar)
 }

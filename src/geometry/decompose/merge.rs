@@ -90,24 +90,35 @@ pub(super) fn merge_within(
     let mut pool = Pool::new(pieces, slack, threads);
     merge_cheapest(
         &mut pool,
-        |a, b| a.merged(b).concavity,
+        |a, b, live| {
+            // With no more than `max_parts` pieces left (and merging only lowers the
+            // count), a union above the limit is never merged: it is enough to know
+            // that it is above.
+            let bar = if live <= max_parts {
+                limit
+            } else {
+                f64::INFINITY
+            };
+            a.union_concavity(b, bar)
+        },
         |concavity, live| concavity > limit && live <= max_parts,
     );
     pool.into_pieces()
 }
 
-/// Merges, over and over, the pair of neighbours with the lowest `cost` (non-negative),
-/// until `done(lowest cost, live pieces)` or no pair is left.
+/// Merges, over and over, the pair of neighbours with the lowest `cost(a, b, live
+/// pieces)` (non-negative), until `done(lowest cost, live pieces)` or no pair is left.
 fn merge_cheapest(
     pool: &mut Pool,
-    cost: impl Fn(&Fitted, &Fitted) -> f64 + Sync,
+    cost: impl Fn(&Fitted, &Fitted, usize) -> f64 + Sync,
     done: impl Fn(f64, usize) -> bool,
 ) {
     // Non-negative floats order as their bits: (cost bits, i, j) sorts by cost.
     let mut costs: BTreeSet<(u64, usize, usize)> = BTreeSet::new();
     let price = |pool: &Pool, costs: &mut BTreeSet<_>, pairs: &[(usize, usize)]| {
+        let live = pool.live();
         let prices = map_in_order(pairs, pool.threads, |&(i, j)| {
-            cost(pool.get(i), pool.get(j))
+            cost(pool.get(i), pool.get(j), live)
         });
         for (&(i, j), c) in pairs.iter().zip(prices) {
             costs.insert((c.max(0.0).to_bits(), i.min(j), i.max(j)));
@@ -168,7 +179,11 @@ pub(super) fn merge_by_volume(
             }
         }
     }
-    merge_cheapest(&mut pool, empty_fraction, |_, live| live <= max_parts);
+    merge_cheapest(
+        &mut pool,
+        |a, b, _| empty_fraction(a, b),
+        |_, live| live <= max_parts,
+    );
     pool.into_pieces()
 }
 

@@ -371,3 +371,65 @@ fn mesh_moved(mesh: &TriMesh, (turn, shift): (DQuat, DVec3)) -> TriMesh {
     let vertices = mesh.vertices().iter().map(|&v| turn * v + shift).collect();
     crate::test_support::meshes::mesh(vertices, mesh.triangles().to_vec())
 }
+
+/// Bars tried below, at and above a full measure, as fractions of it.
+pub(super) const BAR_FRACTIONS: [f64; 7] = [0.0, 0.3, 0.9, 0.999, 1.0, 1.001, 2.0];
+
+/// Checks a measure taken up to `bar` against the `full` one: the same when `full` is within
+/// the bar, otherwise above the bar and no more than `full`. Counts the case in
+/// `(within, above)`.
+pub(super) fn check_barred(
+    full: f64,
+    bar: f64,
+    barred: f64,
+    counts: &mut (usize, usize),
+    at: &str,
+) {
+    if full <= bar {
+        counts.0 += 1;
+        assert_eq!(barred.to_bits(), full.to_bits(), "{at}, bar {bar}");
+    } else {
+        counts.1 += 1;
+        assert!(
+            barred > bar && barred <= full,
+            "{at}: {barred} for bar {bar}, in full {full}"
+        );
+    }
+}
+
+/// The concavity measured up to a bar is the concavity when that is within the bar, and
+/// otherwise a value above the bar and no more than the concavity: on unions of random
+/// halves of a torus, a comb and a sphere, at bars below, at and above each concavity.
+#[test]
+fn a_union_measured_up_to_a_bar_is_exact_within_it_and_bounded_above_it() {
+    let mut r = rng(5301);
+    let solids = [
+        (solid_piece(&torus(1.0, 0.3, 24, 12)), 1.3),
+        (solid_piece(&comb_prism(3)), 2.0),
+        (solid_piece(&uv_sphere(1.0, 16, 8)), 1.0),
+    ];
+    let mut counts = (0, 0);
+    for round in 0..60 {
+        let (solid, half) = &solids[round % solids.len()];
+        let Some((a, b)) = solid.cut(&random_plane(&mut r, 0.5 * half)) else {
+            continue;
+        };
+        let (Some(a), Some(b)) = (Fitted::new(a, 0.05), Fitted::new(b, 0.05)) else {
+            continue;
+        };
+        let full = a.merged(&b).concavity;
+        assert!(full > 0.0, "round {round}: no concavity to measure");
+        for bar in BAR_FRACTIONS
+            .map(|f| f * full)
+            .into_iter()
+            .chain([f64::INFINITY])
+        {
+            let barred = a.union_concavity(&b, bar);
+            check_barred(full, bar, barred, &mut counts, &format!("round {round}"));
+        }
+    }
+    assert!(
+        counts.0 > 150 && counts.1 > 150,
+        "{counts:?} (within, above)"
+    );
+}
