@@ -17,7 +17,8 @@
 //! Only the finalists' scores are needed in full: once [`EXACT_FINALISTS`] scores are known,
 //! a candidate is measured only until it is known to score worse than all of them (its
 //! halves' concavity measured up to a bar, see `concavity.rs`). The finalists are the same
-//! as with every score in full, for any thread count.
+//! as with every score in full, for any thread count. Likewise an exact cut is measured
+//! only until it is known to score worse than the best exact cut so far.
 //!
 //! Citation: X. Wei, M. Liu, Z. Ling, H. Su, "Approximate Convex Decomposition for 3D Meshes
 //! with Collision-Aware Concavity and Tree Search", SIGGRAPH 2022 (CoACD).
@@ -162,9 +163,15 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
             planes.push(plane);
         }
     }
+    // Only the best exact cut is kept: once one is known, a cut is measured only until it
+    // is known to score worse.
+    let best_exact = Mutex::new(f64::INFINITY);
     map_in_order(&planes, threads, |plane| {
-        let (a, b) = cut_fitted(piece, plane)?;
-        Some((exact_score(&a, &b, piece.volume, limit), a, b))
+        let bar = *best_exact.lock().unwrap_or_else(PoisonError::into_inner);
+        let (score, a, b) = exact_cut(piece, plane, limit, bar)?;
+        let mut best = best_exact.lock().unwrap_or_else(PoisonError::into_inner);
+        *best = best.min(score);
+        Some((score, a, b))
     })
     .into_iter()
     .flatten()
@@ -189,6 +196,31 @@ fn keep_among_best(best: &Mutex<Vec<f64>>, score: f64) {
     let at = best.partition_point(|&s| s <= score);
     best.insert(at, score);
     best.truncate(EXACT_FINALISTS);
+}
+
+/// Cuts `piece` by `plane` and measures both halves, with the cut's [`exact_score`]; `None`
+/// when the cut leaves a side empty or scores above `bar` (then the halves are measured
+/// only as far as it takes to know).
+fn exact_cut(piece: &Fitted, plane: &Plane, limit: f64, bar: f64) -> Option<(f64, Fitted, Fitted)> {
+    let (below, above) = piece.piece.cut(plane)?;
+    // The score is at least either half's concavity less `limit`.
+    let bar_a = raised(bar + limit);
+    let a = Fitted::new_up_to(below, piece.spacing, bar_a)?;
+    if a.concavity > bar_a {
+        return None;
+    }
+    // Above `limit`, the other half adds no finished share, and the score rises with it.
+    let finished = if a.concavity <= limit && piece.volume > 0.0 {
+        (a.volume / piece.volume).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let bar_b = limit.max(other_half_bar(a.concavity, bar + limit * finished));
+    let b = Fitted::new_up_to(above, piece.spacing, bar_b)?;
+    if b.concavity > bar_b {
+        return None;
+    }
+    Some((exact_score(&a, &b, piece.volume, limit), a, b))
 }
 
 /// Moves `plane` by halving steps while the thinned score improves.
@@ -349,6 +381,11 @@ fn other_half_bar(a: f64, bar: f64) -> f64 {
         (bar - a) / w
     };
     b + BAR_MARGIN * bar.abs().max(a)
+}
+
+/// `bar` raised by the relative [`BAR_MARGIN`].
+fn raised(bar: f64) -> f64 {
+    bar + BAR_MARGIN * bar.abs()
 }
 
 /// Relative margin on the bar of [`other_half_bar`], far above the rounding of a score.

@@ -79,6 +79,12 @@ impl Fitted {
     /// Measures `piece`, sampling its surface about `spacing` metres apart (see
     /// [`Piece::surface_samples`]); `None` when it has no corners.
     pub fn new(piece: Piece, spacing: f64) -> Option<Self> {
+        Self::new_up_to(piece, spacing, f64::INFINITY)
+    }
+
+    /// [`Fitted::new`], its concavity measured only up to `bar` (see [`concavity`]): a
+    /// piece measured above `bar` is only known to be above it.
+    pub fn new_up_to(piece: Piece, spacing: f64, bar: f64) -> Option<Self> {
         let corners = piece.used_points();
         if corners.is_empty() {
             return None;
@@ -86,7 +92,7 @@ impl Fitted {
         let hull = QuickHull::of(corners);
         let samples = piece.surface_samples(spacing);
         let volume = piece.volume();
-        let concavity = hull_concavity(&hull, &samples, &piece, spacing, f64::INFINITY);
+        let concavity = hull_concavity(&hull, &samples, &piece, spacing, bar);
         Some(Self {
             bounds: bounds_of(hull.points.iter().copied()),
             piece,

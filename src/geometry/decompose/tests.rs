@@ -398,10 +398,11 @@ pub(super) fn check_barred(
 }
 
 /// The concavity measured up to a bar is the concavity when that is within the bar, and
-/// otherwise a value above the bar and no more than the concavity: on unions of random
-/// halves of a torus, a comb and a sphere, at bars below, at and above each concavity.
+/// otherwise a value above the bar and no more than the concavity: on random halves of a
+/// torus, a comb and a sphere and on their unions, at bars below, at and above each
+/// concavity.
 #[test]
-fn a_union_measured_up_to_a_bar_is_exact_within_it_and_bounded_above_it() {
+fn a_concavity_measured_up_to_a_bar_is_exact_within_it_and_bounded_above_it() {
     let mut r = rng(5301);
     let solids = [
         (solid_piece(&torus(1.0, 0.3, 24, 12)), 1.3),
@@ -414,6 +415,16 @@ fn a_union_measured_up_to_a_bar_is_exact_within_it_and_bounded_above_it() {
         let Some((a, b)) = solid.cut(&random_plane(&mut r, 0.5 * half)) else {
             continue;
         };
+        for half in [&a, &b] {
+            let Some(full) = Fitted::new(half.clone(), 0.05).map(|h| h.concavity) else {
+                continue;
+            };
+            for bar in BAR_FRACTIONS.map(|f| f * full) {
+                let barred = Fitted::new_up_to(half.clone(), 0.05, bar).expect("measured");
+                let at = format!("round {round}, a half");
+                check_barred(full, bar, barred.concavity, &mut counts, &at);
+            }
+        }
         let (Some(a), Some(b)) = (Fitted::new(a, 0.05), Fitted::new(b, 0.05)) else {
             continue;
         };
@@ -429,7 +440,7 @@ fn a_union_measured_up_to_a_bar_is_exact_within_it_and_bounded_above_it() {
         }
     }
     assert!(
-        counts.0 > 150 && counts.1 > 150,
+        counts.0 > 400 && counts.1 > 400,
         "{counts:?} (within, above)"
     );
 }
