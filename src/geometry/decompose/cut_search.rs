@@ -388,7 +388,9 @@ fn raised(bar: f64) -> f64 {
     bar + BAR_MARGIN * bar.abs()
 }
 
-/// Relative margin on the bar of [`other_half_bar`], far above the rounding of a score.
+/// Relative margin by which a derived bar is raised ([`other_half_bar`], [`raised`]): far
+/// above the rounding of a score, so a measure cut short at the bar always scores above
+/// the bar it was derived from.
 const BAR_MARGIN: f64 = 1e-9;
 
 /// Every `len / most`-th item, so at most about `most` remain, spread over the input.
