@@ -147,9 +147,10 @@ fn the_thread_count_does_not_change_the_parts() {
                 "{method:?}, {threads} threads"
             );
             for (a, b) in one.parts.iter().zip(&many.parts) {
-                assert_eq!(a.volume.to_bits(), b.volume.to_bits(), "{threads} threads");
-                assert_eq!(a.concavity.to_bits(), b.concavity.to_bits());
-                assert_eq!(a.hull.vertices(), b.hull.vertices());
+                let at = format!("{method:?}, {threads} threads");
+                assert_eq!(a.volume.to_bits(), b.volume.to_bits(), "{at}");
+                assert_eq!(a.concavity.to_bits(), b.concavity.to_bits(), "{at}");
+                assert_eq!(a.hull.vertices(), b.hull.vertices(), "{at}");
             }
         }
     }

@@ -104,8 +104,9 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
             .into_iter()
             .map(|(_, p)| p)
             .collect();
+    let axes = candidate_axes(scorer.samples);
     let mut candidates: Vec<(Plane, f64)> = Vec::new(); // (plane, step)
-    for axis in candidate_axes(scorer.samples) {
+    for &axis in &axes {
         let (lo, hi) = extent_along(scorer.samples, axis);
         let step = (hi - lo) / (OFFSETS + 1) as f64;
         if !step.is_finite() || step <= 0.0 {
@@ -125,13 +126,13 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
     }
     // Only the best few scores matter: once that many are known, a candidate is measured
     // only until it is known to score worse than all of them.
-    let best_scores = Mutex::new(Vec::with_capacity(EXACT_FINALISTS + 1));
+    let leaders = Leaders::new(EXACT_FINALISTS);
     let mut scored: Vec<(f64, Plane, f64)> =
         map_in_order(&candidates, threads, |&(plane, step)| {
-            let bar = worst_of_best(&best_scores);
+            let bar = leaders.bar();
             let score = scorer.score(&plane, bar)?;
             if score <= bar {
-                keep_among_best(&best_scores, score);
+                leaders.offer(score);
             }
             Some((score, plane, step))
         })
@@ -148,12 +149,10 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
     // Near convex halves score alike up to the thinned samples' noise: the planes through
     // the deepest sample, which a concave edge calls for, are always cut exactly too.
     let through_deepest = deepest.first().into_iter().flat_map(|p| {
-        candidate_axes(scorer.samples)
-            .into_iter()
-            .map(move |normal| Plane {
-                normal,
-                offset: normal.dot(*p),
-            })
+        axes.iter().map(move |&normal| Plane {
+            normal,
+            offset: normal.dot(*p),
+        })
     });
     // A finalist that refining did not move can be a plane through the deepest sample
     // too (about one cut in twenty): each plane is cut once.
@@ -165,12 +164,10 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
     }
     // Only the best exact cut is kept: once one is known, a cut is measured only until it
     // is known to score worse.
-    let best_exact = Mutex::new(f64::INFINITY);
+    let best_exact = Leaders::new(1);
     map_in_order(&planes, threads, |plane| {
-        let bar = *best_exact.lock().unwrap_or_else(PoisonError::into_inner);
-        let (score, a, b) = exact_cut(piece, plane, limit, bar)?;
-        let mut best = best_exact.lock().unwrap_or_else(PoisonError::into_inner);
-        *best = best.min(score);
+        let (score, a, b) = exact_cut(piece, plane, limit, best_exact.bar())?;
+        best_exact.offer(score);
         Some((score, a, b))
     })
     .into_iter()
@@ -179,23 +176,42 @@ fn best_cut(piece: &Fitted, limit: f64, threads: usize) -> Option<(Fitted, Fitte
     .map(|(_, a, b)| (a, b))
 }
 
-/// The greatest of the [`EXACT_FINALISTS`] best scores so far, or infinity while there are
-/// fewer.
-fn worst_of_best(best: &Mutex<Vec<f64>>) -> f64 {
-    let best = best.lock().unwrap_or_else(PoisonError::into_inner);
-    if best.len() < EXACT_FINALISTS {
-        f64::INFINITY
-    } else {
-        best[EXACT_FINALISTS - 1]
-    }
+/// The lowest scores the jobs of one stage have measured in full so far, shared across the
+/// stage's threads: a job measured only up to [`Leaders::bar`] still knows whether it is
+/// among them.
+struct Leaders {
+    /// How many lowest scores are kept.
+    kept: usize,
+    /// They, ascending.
+    scores: Mutex<Vec<f64>>,
 }
 
-/// Puts `score` among the [`EXACT_FINALISTS`] best so far (ascending) if it is one of them.
-fn keep_among_best(best: &Mutex<Vec<f64>>, score: f64) {
-    let mut best = best.lock().unwrap_or_else(PoisonError::into_inner);
-    let at = best.partition_point(|&s| s <= score);
-    best.insert(at, score);
-    best.truncate(EXACT_FINALISTS);
+impl Leaders {
+    fn new(kept: usize) -> Self {
+        Self {
+            kept,
+            scores: Mutex::new(Vec::with_capacity(kept + 1)),
+        }
+    }
+
+    /// The highest of the kept scores, or infinity while fewer are known: a score above it
+    /// is among them no more.
+    fn bar(&self) -> f64 {
+        let scores = self.scores.lock().unwrap_or_else(PoisonError::into_inner);
+        if scores.len() < self.kept {
+            f64::INFINITY
+        } else {
+            scores[self.kept - 1]
+        }
+    }
+
+    /// Keeps `score`, measured in full, if it is among the lowest.
+    fn offer(&self, score: f64) {
+        let mut scores = self.scores.lock().unwrap_or_else(PoisonError::into_inner);
+        let at = scores.partition_point(|&s| s <= score);
+        scores.insert(at, score);
+        scores.truncate(self.kept);
+    }
 }
 
 /// Cuts `piece` by `plane` and measures both halves, with the cut's [`exact_score`]; `None`
@@ -210,11 +226,7 @@ fn exact_cut(piece: &Fitted, plane: &Plane, limit: f64, bar: f64) -> Option<(f64
         return None;
     }
     // Above `limit`, the other half adds no finished share, and the score rises with it.
-    let finished = if a.concavity <= limit && piece.volume > 0.0 {
-        (a.volume / piece.volume).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let finished = finished_share(&[&a], piece.volume, limit);
     let bar_b = limit.max(other_half_bar(a.concavity, bar + limit * finished));
     let b = Fitted::new_up_to(above, piece.spacing, bar_b)?;
     if b.concavity > bar_b {
@@ -244,14 +256,22 @@ fn refined(scorer: &Scorer, mut score: f64, mut plane: Plane, mut step: f64) -> 
 /// volume the cut finishes (halves within the limit). The last term settles near ties, as
 /// a U's first cut: taking off a large finished part leaves less to cut.
 fn exact_score(a: &Fitted, b: &Fitted, volume: f64, limit: f64) -> f64 {
-    let finished: f64 = [a, b]
+    a.concavity.max(b.concavity) + LESSER_HALF_WEIGHT * a.concavity.min(b.concavity)
+        - limit * finished_share(&[a, b], volume, limit)
+}
+
+/// The share of a piece's `volume` (m³) that those of `halves` within `limit` finish, 0 to 1.
+fn finished_share(halves: &[&Fitted], volume: f64, limit: f64) -> f64 {
+    let finished: f64 = halves
         .iter()
         .filter(|h| h.concavity <= limit)
         .map(|h| h.volume)
         .sum();
-    let share = if volume > 0.0 { finished / volume } else { 0.0 };
-    a.concavity.max(b.concavity) + LESSER_HALF_WEIGHT * a.concavity.min(b.concavity)
-        - limit * share.clamp(0.0, 1.0)
+    if volume > 0.0 {
+        (finished / volume).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
 }
 
 /// The coordinate axes and the piece's principal axes, a principal axis within a few

@@ -273,10 +273,10 @@ fn random_cuts_of_a_u_leave_every_corner_in_the_solid() {
 #[test]
 fn cuts_along_faces_leave_pieces_whose_hulls_hold_only_their_solid() {
     // Rectilinear prisms cut by every axis plane through their vertices' coordinates (and
-    // at ½ along each axis), in random order and orientation, some turned and moved off the origin: every piece is
-    // one cell of that grid, a box, whose hull is exactly its solid. A face along a plane
-    // sent to the side its solid is not on would be closed there by a cap over it: a
-    // zero-volume fin whose corners stretch that piece's hull across a notch.
+    // at ½ along each axis), in random order and orientation, some turned and moved off the
+    // origin: every piece is one cell of that grid, a box, whose hull is exactly its solid.
+    // A face along a plane sent to the side its solid is not on would be closed there by a
+    // cap over it: a zero-volume fin whose corners stretch that piece's hull across a notch.
     let mut r = rng(3303);
     let (mut turned, mut reversed, mut pieces_seen) = (0, 0, 0);
     for mesh in [u_prism(), l_prism(), comb_prism(3), stairs_prism()] {

@@ -13,9 +13,9 @@
 //!    sign of a rounding error would give the other side a face whose solid is not there,
 //!    closed by a cap over it: a zero-volume fin whose corners stretch that side's hull.
 //! 3. **The cap** of each side closes what the first two leave open: the edges on the plane
-//!    whose reverse no loop of that side holds (the clipped loops' closing edges, and edges along the
-//!    plane whose other face went to the other side), reversed and chained into outlines.
-//!    It therefore covers exactly where the plane crosses solid.
+//!    whose reverse no loop of that side holds (the clipped loops' closing edges, and edges
+//!    along the plane whose other face went to the other side), reversed and chained into
+//!    outlines. It therefore covers exactly where the plane crosses solid.
 //!
 //! A cap can be concave, and a cut can leave several stretches of it on one side: those are
 //! joined along the cut line where the cap lies on it ([`Clipper::clip_stretches`]), never
