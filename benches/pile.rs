@@ -66,6 +66,8 @@ mod spec;
 
 #[path = "common/parry_convert.rs"]
 mod parry_convert;
+#[path = "common/simulated.rs"]
+mod simulated;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use cycle::cycle_bench;
@@ -75,14 +77,13 @@ use parry3d_f64::shape::SharedShape;
 use pile::{PILE_RATE_HZ, pile_scene, pile_world};
 use proxima::broad::CandidatePair;
 use proxima::broad::brute_force::pairs_brute_force;
-use proxima::daemon::records::{contact_record, pair_record};
-use proxima::math::{DQuat, DVec3, Pose};
+use proxima::math::{DVec3, Pose};
 use proxima::narrow::dispatch::{self, NarrowScratch};
 use proxima::narrow::{Manifold, Shape};
 use proxima::pipeline::{FrameResults, PipelineWorkspace, Query, WorkerPool, step};
-use proxima::scene::{BodyId, Motion, Scene};
+use proxima::scene::{BodyId, Scene};
 use proxima_ipc::client::Primitive;
-use proxima_ipc::wire::ResultRecord;
+use simulated::{PoseSet, set_poses, simulate};
 use spec::{SceneSpec, ShapeSpec};
 use std::hint::black_box;
 use std::sync::Arc;
@@ -106,9 +107,6 @@ const QUERY: Query = Query::CLOSE.union(Query::CONTACTS);
 /// enough to change every body's pose, far below any tolerance of the answers.
 const SHIFT_M: f64 = 1e-9;
 
-/// Each moving body's pose in one frame.
-type PoseSet = Vec<(BodyId, Pose)>;
-
 /// The settled pile: the scene at frame `k`, the poses of frames `k` and `k + 1`, and of
 /// the [`SETTLING`] frames.
 struct Settled {
@@ -127,24 +125,13 @@ fn settle() -> Settled {
         .map(|i| u32::try_from(i).expect("few bodies"))
         .collect();
     let mut world = pile_world(&spec, &ids, SEED);
-    let (mut workspace, mut results) = (PipelineWorkspace::default(), FrameResults::default());
-    let (mut pairs, mut contacts) = (Vec::new(), Vec::new());
-    let mut kept = Vec::new();
-    for _ in 0..SETTLE_FRAMES + 2 {
-        world.integrate(1.0 / PILE_RATE_HZ);
-        for i in 0..world.moving_count() {
-            let r = world.pose(i);
-            let [x, y, z, w] = r.orientation;
-            let pose = Pose::try_new(DVec3::from_array(r.position), DQuat::from_xyzw(x, y, z, w))
-                .expect("the solver keeps poses valid");
-            scene.set_pose(BodyId(r.body), pose).expect("a pile body");
-        }
-        step(&scene, QUERY, &mut workspace, &mut results);
-        scene.end_frame();
-        records(&results, &mut pairs, &mut contacts);
-        world.resolve(&pairs, &contacts);
-        kept.push(moving_poses(&scene));
-    }
+    let mut kept = simulate(
+        &mut world,
+        &mut scene,
+        PILE_RATE_HZ,
+        QUERY,
+        SETTLE_FRAMES + 2,
+    );
     let frame_k1 = kept.pop().expect("two frames kept");
     let frame_k = kept.pop().expect("two frames kept");
     let settling = kept.drain(SETTLING).collect();
@@ -160,32 +147,6 @@ fn settle() -> Settled {
         frame_k,
         frame_k1,
         settling,
-    }
-}
-
-/// The records of a frame's pairs and contacts, as the daemon writes them.
-fn records(
-    results: &FrameResults,
-    pairs: &mut Vec<ResultRecord>,
-    contacts: &mut Vec<ResultRecord>,
-) {
-    pairs.clear();
-    pairs.extend(results.pairs.iter().map(pair_record));
-    contacts.clear();
-    contacts.extend((results.contacts.iter()).map(|c| contact_record(&results.pairs, c)));
-}
-
-fn moving_poses(scene: &Scene) -> PoseSet {
-    scene
-        .bodies()
-        .filter(|(_, b)| b.motion != Motion::Static)
-        .map(|(id, b)| (id, b.pose))
-        .collect()
-}
-
-fn set_poses(scene: &mut Scene, poses: &PoseSet) {
-    for &(id, pose) in poses {
-        scene.set_pose(id, pose).expect("a pile body");
     }
 }
 
