@@ -13,7 +13,7 @@
 //! # What is compared
 //! | query | Proxima (`proxima`, and for the convex hulls `proxima-accelerated`, `proxima-warm`) | parry (`parry`) |
 //! |---|---|---|
-//! | `sphere_sphere`, `sphere_capsule`, `capsule_capsule`, `sphere_cuboid`, `capsule_cuboid`, `cuboid_cuboid` | the closed-form `proxima::narrow::distance_X_Y`: signed distance, witnesses and normal under the contact contract, for both cases | `separated`: `query::distance`; `penetrating`: `query::contact` with prediction 0 (depth, points, normal), each parry's dedicated pair routine where it has one, GJK/EPA otherwise |
+//! | `sphere_sphere`, `sphere_capsule`, `capsule_capsule`, `sphere_cuboid`, `capsule_cuboid`, `cuboid_cuboid`, and against one triangle of a mesh's size `sphere_triangle`, `capsule_triangle`, `cuboid_triangle` | the closed-form `proxima::narrow::distance_X_Y`: signed distance, witnesses and normal under the contact contract, for both cases | `separated`: `query::distance`; `penetrating`: `query::contact` with prediction 0 (depth, points, normal), each parry's dedicated pair routine where it has one, GJK/EPA otherwise |
 //! | `capsule_capsule`, `capsule_cuboid`, `cuboid_cuboid` (`proxima-bound`) | `distance_bound_X_Y` (no limit): the bounds the pipeline answers with past a frame's deadline, on the same poses; checked to hold the exact distance before timing | — (parry has no bound query; its exact query is the comparison) |
 //! | `cuboid_cuboid_manifold` | [`manifold_cuboid_cuboid`]: up to 4 points, clipped faces (empty when apart) | `PersistentQueryDispatcher::contact_manifold_convex_convex` with prediction 0 into one reused `ContactManifold` (no contact reuse between unrelated poses: each is a fresh manifold computation, as `contact_manifolds` would do on a new pair) |
 //! | `convex_distance/hullN` (separated poses) | [`gjk_distance`] on [`ConvexPolyhedron`] hulls of `N` = 8, 64, 512, 4,096 random points on the unit sphere: `proxima` plain GJK, `proxima-accelerated` with `GjkParams { accelerated: true, .. }`, `proxima-warm` plain with a [`GjkCache`] per pose kept across laps (the best case of frame-to-frame coherence); other runs use a fresh cache | `query::distance` on `ConvexPolyhedron::from_convex_hull` of the same points (GJK) |
@@ -47,15 +47,19 @@ use parry3d_f64::query::{ContactManifold, DefaultQueryDispatcher, PersistentQuer
 use parry3d_f64::shape::{
     Ball as ParryBall, Capsule as ParryCapsule, ConvexPolyhedron as ParryHull,
     Cuboid as ParryCuboid, Cylinder as ParryCylinder, Shape as ParryShape,
+    Triangle as ParryTriangle,
 };
-use proxima::geometry::{Capsule, ConvexPolyhedron, Cuboid, Cylinder, Sphere, SupportMap};
+use proxima::geometry::{
+    Capsule, ConvexPolyhedron, Cuboid, Cylinder, Sphere, SupportMap, Triangle,
+};
 use proxima::math::{DVec3, Isometry, Pose};
 use proxima::narrow::gjk::EpaWorkspace;
 use proxima::narrow::{
     DistanceBound, GjkCache, GjkParams, Manifold, Rounded, ShapeDistance,
     distance_bound_capsule_capsule, distance_bound_capsule_cuboid, distance_bound_cuboid_cuboid,
-    distance_capsule_capsule, distance_capsule_cuboid, distance_cuboid_cuboid,
-    distance_sphere_capsule, distance_sphere_cuboid, distance_sphere_sphere, gjk_distance,
+    distance_capsule_capsule, distance_capsule_cuboid, distance_capsule_triangle,
+    distance_cuboid_cuboid, distance_cuboid_triangle, distance_sphere_capsule,
+    distance_sphere_cuboid, distance_sphere_sphere, distance_sphere_triangle, gjk_distance,
     manifold_cuboid_cuboid, signed_distance_convex,
 };
 use rand::Rng;
@@ -289,6 +293,59 @@ fn closed_form_pairs(c: &mut Criterion, rng: &mut TestRng) {
         (&p_box_a, &p_box_b),
     );
     cuboid_manifolds(c, rng, (&box_a, &box_b), (&p_box_a, &p_box_b));
+    triangle_pairs(
+        c,
+        rng,
+        (&sphere, &capsule, &box_a),
+        (&p_sphere, &p_capsule, &p_box_a),
+    );
+}
+
+/// The ball, the capsule and the box against one triangle of a mesh's size: the
+/// per-triangle queries of a convex shape's walk of a mesh.
+fn triangle_pairs(
+    c: &mut Criterion,
+    rng: &mut TestRng,
+    (sphere, capsule, cuboid): (&Sphere, &Capsule, &Cuboid),
+    (p_sphere, p_capsule, p_cuboid): (&ParryBall, &ParryCapsule, &ParryCuboid),
+) {
+    let triangle = Triangle::new(
+        DVec3::new(-0.4, -0.3, 0.0),
+        DVec3::new(0.5, -0.2, 0.0),
+        DVec3::new(0.0, 0.45, 0.0),
+    );
+    let p_triangle = ParryTriangle::new(
+        parry_vector(triangle.a),
+        parry_vector(triangle.b),
+        parry_vector(triangle.c),
+    );
+    bench_pair(
+        c,
+        rng,
+        "sphere_triangle",
+        1.5,
+        |p| distance_sphere_triangle(black_box(sphere), black_box(&triangle), p),
+        None,
+        (p_sphere, &p_triangle),
+    );
+    bench_pair(
+        c,
+        rng,
+        "capsule_triangle",
+        2.0,
+        |p| distance_capsule_triangle(black_box(capsule), black_box(&triangle), p),
+        None,
+        (p_capsule, &p_triangle),
+    );
+    bench_pair(
+        c,
+        rng,
+        "cuboid_triangle",
+        2.0,
+        |p| distance_cuboid_triangle(black_box(cuboid), black_box(&triangle), p),
+        None,
+        (p_cuboid, &p_triangle),
+    );
 }
 
 /// parry's manifold of two cuboids into `manifold`; returns its point count.

@@ -1,10 +1,12 @@
 //! Capsule–triangle: segment–triangle distance (endpoints against the triangle, edges
 //! against the segment) minus the radius; a segment piercing the triangle takes the
 //! separating-axis depth over the triangle normal and the segment × edge axes, plus the
-//! radius. Through [`super::query`]; manifold: up to 2 points (segment clipped against the
-//! triangle face), else 1 ([`super::clip`]).
+//! radius. A segment apart from the triangle takes its closest pair straight from the
+//! features ([`super::triangle_apart`]), any other [`super::query`]; manifold: up to 2
+//! points (segment clipped against the triangle face), else 1 ([`super::clip`]).
 
 use super::placed_core::PlacedCore;
+use super::triangle_apart::apart_segment_triangle;
 use super::{clip, query};
 use crate::geometry::{Capsule, Triangle};
 use crate::math::Isometry;
@@ -15,9 +17,14 @@ use crate::narrow::contact::{Manifold, ShapeDistance};
 /// negative: minus the penetration depth. Never NaN, degenerate sizes included.
 #[must_use]
 pub fn distance_capsule_triangle(a: &Capsule, b: &Triangle, pose_ab: &Isometry) -> ShapeDistance {
-    query::distance(
-        &PlacedCore::capsule(a, &Isometry::IDENTITY),
-        &PlacedCore::triangle(b, pose_ab),
+    let axis = a.segment();
+    apart_segment_triangle((axis.a, axis.b), a.radius, &b.transformed(pose_ab)).unwrap_or_else(
+        || {
+            query::distance(
+                &PlacedCore::capsule(a, &Isometry::IDENTITY),
+                &PlacedCore::triangle(b, pose_ab),
+            )
+        },
     )
 }
 

@@ -1,10 +1,13 @@
 //! Cuboid–triangle: separating axes (3 box faces, the triangle normal, 9 edge × edge) for
 //! the exact depth; apart, the best of box corners against the triangle, triangle corners
-//! clamped to the box, and 36 edge–edge pairs (Akenine-Möller, *Fast 3D triangle-box
-//! overlap testing*, 2001, for the axis set). Through [`super::query`]; manifold: face
-//! clipping reduced to 4 points ([`super::clip`]).
+//! clamped to the box, and the edge–edge pairs (Akenine-Möller, *Fast 3D triangle-box
+//! overlap testing*, 2001, for the axis set). A pair apart along a face axis takes its
+//! closest pair straight from the features the triangle can be nearest to
+//! ([`super::triangle_apart`]), any other [`super::query`]; manifold: face clipping reduced
+//! to 4 points ([`super::clip`]).
 
 use super::placed_core::PlacedCore;
+use super::triangle_apart::apart_box_triangle;
 use super::{clip, query};
 use crate::geometry::{Cuboid, Triangle};
 use crate::math::Isometry;
@@ -15,10 +18,12 @@ use crate::narrow::contact::{Manifold, ShapeDistance};
 /// negative: minus the penetration depth. Never NaN, degenerate sizes included.
 #[must_use]
 pub fn distance_cuboid_triangle(a: &Cuboid, b: &Triangle, pose_ab: &Isometry) -> ShapeDistance {
-    query::distance(
-        &PlacedCore::cuboid(a, &Isometry::IDENTITY),
-        &PlacedCore::triangle(b, pose_ab),
-    )
+    apart_box_triangle(a.half_extents, &b.transformed(pose_ab)).unwrap_or_else(|| {
+        query::distance(
+            &PlacedCore::cuboid(a, &Isometry::IDENTITY),
+            &PlacedCore::triangle(b, pose_ab),
+        )
+    })
 }
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4

@@ -12,8 +12,10 @@
 //! (a sphere a point, a capsule a segment, cuboid and triangle radius 0; `placed_core`); the
 //! distance is the separating-axis test over the complete axis set of the two cores plus
 //! closed-form vertex/edge closest points (`query`); manifolds clip an incident feature
-//! against a reference face (`clip`). Exact to rounding, except the documented skip of
-//! near-parallel cross axes (`≤ 1e-12` × extent).
+//! against a reference face (`clip`). A ball, capsule or box apart from a triangle (the
+//! convex–mesh walk's usual case) skips the axis test: its closest pair comes straight from
+//! the features, certified by the separation along it (`triangle_apart`). Exact to
+//! rounding, except the documented skip of near-parallel cross axes (`≤ 1e-12` × extent).
 //!
 //! Cylinders and hulls are not polytope cores; for them this module holds the proofs the
 //! dispatcher tries before GJK/EPA, each answering exactly (to GJK's tolerance) or not at
@@ -36,6 +38,7 @@
 mod clip;
 mod placed_core;
 mod query;
+mod triangle_apart;
 
 mod capsule_capsule;
 mod capsule_cuboid;

@@ -1,12 +1,14 @@
 //! Sphere–triangle: the centre's closest point on the triangle (Voronoi regions, Ericson
 //! §5.1.5) minus the radius; a centre on the (two-sided, flat) triangle gives depth = radius
-//! along the triangle normal. Zero-area triangles are their segment or point. Through
+//! along the triangle normal. Zero-area triangles are their segment or point. A centre off
+//! the triangle takes its closest point straight ([`super::triangle_apart`]), one on it
 //! [`super::query`]; manifold: one point.
 
 use super::placed_core::PlacedCore;
+use super::triangle_apart::apart_point_triangle;
 use super::{clip, query};
 use crate::geometry::{Sphere, Triangle};
-use crate::math::Isometry;
+use crate::math::{DVec3, Isometry};
 use crate::narrow::contact::{Manifold, ShapeDistance};
 
 /// Exact signed distance from `a` to `b` placed by `pose_ab` (B's frame in A's), with
@@ -14,10 +16,12 @@ use crate::narrow::contact::{Manifold, ShapeDistance};
 /// negative: minus the penetration depth. Never NaN, degenerate sizes included.
 #[must_use]
 pub fn distance_sphere_triangle(a: &Sphere, b: &Triangle, pose_ab: &Isometry) -> ShapeDistance {
-    query::distance(
-        &PlacedCore::sphere(a, &Isometry::IDENTITY),
-        &PlacedCore::triangle(b, pose_ab),
-    )
+    apart_point_triangle(DVec3::ZERO, a.radius, &b.transformed(pose_ab)).unwrap_or_else(|| {
+        query::distance(
+            &PlacedCore::sphere(a, &Isometry::IDENTITY),
+            &PlacedCore::triangle(b, pose_ab),
+        )
+    })
 }
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4
