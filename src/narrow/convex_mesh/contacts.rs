@@ -45,9 +45,10 @@
 //! then the manifold of a touching pair with that distance. The distance walk visits every
 //! triangle the shape touches (its pruning keeps all subtrees whose lower bound is `≤ 0`)
 //! and records them with their per-triangle signed distances; the manifold then answers
-//! from that record without walking again, and without a second per-triangle query for
-//! shapes whose triangle manifold is one point (spheres and the GJK shapes). A pair beyond
-//! contact (distance `> 0`) gets an empty manifold with no walk at all.
+//! from that record without walking again: a capsule's or a box's triangle manifold is
+//! clipped along the recorded distance's normal (no second separating-axis test), every
+//! other shape's is that distance's one point. A pair beyond contact (distance `> 0`) gets
+//! an empty manifold with no walk at all.
 
 use super::node_bound::PlacedShape;
 use super::walk::{TRIANGLE_WORK, for_each_overlapping_triangle, nearest_triangle_within};
@@ -271,16 +272,14 @@ pub(crate) fn shape_mesh_manifold(
     if *walked == Some(PairKey::new(shape, mesh, pose_ab)) {
         let one_point = !matches!(shape, Shape::Capsule(_) | Shape::Cuboid(_));
         for (id, triangle, d_t) in touching.iter() {
-            if one_point {
-                triangle_manifold.set_from_distance(d_t);
-            } else {
+            if !one_point {
                 if !clock.allows(TRIANGLE_WORK) {
                     stopped = true;
                     break;
                 }
                 *triangle_queries += 1;
-                shape_triangle_manifold(shape, triangle, epa, triangle_manifold);
             }
+            shape_triangle_manifold_from(shape, triangle, d_t, triangle_manifold);
             gather(*id, triangle, triangle_manifold);
         }
     } else {
@@ -643,6 +642,30 @@ pub fn shape_triangle_manifold(
             let d = shape_triangle_distance(shape, triangle, epa);
             out.set_from_distance(&d);
         }
+    }
+}
+
+/// [`shape_triangle_manifold`] from the pair's signed distance `d` (from
+/// [`shape_triangle_distance`] of the same shape and triangle, A's frame): a capsule's or a
+/// box's clipped along `d`'s normal without its separating axes again, every other
+/// shape's the one point of `d` (as [`shape_triangle_manifold`] gives it).
+fn shape_triangle_manifold_from(
+    shape: &Shape,
+    triangle: &Triangle,
+    d: &ShapeDistance,
+    out: &mut Manifold,
+) {
+    let identity = Isometry::IDENTITY;
+    out.reset(DVec3::ZERO);
+    match shape {
+        Shape::Capsule(c) => pairs::manifold_capsule_triangle_from(c, triangle, &identity, d, out),
+        Shape::Cuboid(b) => pairs::manifold_cuboid_triangle_from(b, triangle, &identity, d, out),
+        Shape::Sphere(_)
+        | Shape::Cylinder(_)
+        | Shape::Cone(_)
+        | Shape::Convex(_)
+        | Shape::Mesh(_)
+        | Shape::Compound(_) => out.set_from_distance(d),
     }
 }
 

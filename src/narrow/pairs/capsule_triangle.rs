@@ -43,6 +43,25 @@ pub fn manifold_capsule_triangle(
     );
 }
 
+/// [`manifold_capsule_triangle`] from the pair's signed distance `d` (from
+/// [`distance_capsule_triangle`], A's frame): clipped along `d`'s normal without the
+/// separating axes again. PERF: a capsule against a mesh, whose distance walk records each
+/// touching triangle's distance (`benches/falling.rs`).
+pub fn manifold_capsule_triangle_from(
+    a: &Capsule,
+    b: &Triangle,
+    pose_ab: &Isometry,
+    d: &ShapeDistance,
+    out: &mut Manifold,
+) {
+    clip::manifold_from_distance(
+        &PlacedCore::capsule(a, &Isometry::IDENTITY),
+        &PlacedCore::triangle(b, pose_ab),
+        d,
+        out,
+    );
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

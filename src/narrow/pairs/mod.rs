@@ -64,12 +64,16 @@ pub use capsule_cuboid::{
     manifold_capsule_cuboid_from,
 };
 pub use capsule_cylinder::distance_capsule_cylinder;
-pub use capsule_triangle::{distance_capsule_triangle, manifold_capsule_triangle};
+pub use capsule_triangle::{
+    distance_capsule_triangle, manifold_capsule_triangle, manifold_capsule_triangle_from,
+};
 pub(crate) use cuboid_cuboid::distance_cuboid_cuboid_within;
 pub use cuboid_cuboid::{
     distance_bound_cuboid_cuboid, distance_cuboid_cuboid, manifold_cuboid_cuboid,
 };
-pub use cuboid_triangle::{distance_cuboid_triangle, manifold_cuboid_triangle};
+pub use cuboid_triangle::{
+    distance_cuboid_triangle, manifold_cuboid_triangle, manifold_cuboid_triangle_from,
+};
 pub use cylinder_certificate::certified_distance_cylinder_convex;
 pub use face_certificate::{FaceCertificate, face_distance_cuboid_convex};
 pub use sphere_capsule::{distance_sphere_capsule, manifold_sphere_capsule};
