@@ -22,14 +22,13 @@
 //! or a gap under the feature tolerance, whose direction is rounding noise) returns `None`
 //! and is left to the separating-axis test.
 
+use super::query::FEATURE_RELATIVE;
 use crate::geometry::Triangle;
 use crate::math::DVec3;
 use crate::narrow::closest_points::{
     HingeFrame, closest_point_segment, closest_points_segment_segment,
 };
 use crate::narrow::contact::ShapeDistance;
-
-use super::query::FEATURE_RELATIVE;
 
 /// The closest of the point pairs offered so far, with the triangle's features.
 struct Closest<'t> {
@@ -208,8 +207,10 @@ pub(super) fn apart_box_triangle(half: DVec3, triangle: &Triangle) -> Option<Sha
             closest.offer_core_vertex(corner(signs));
         }
     }
-    // An edge along axis `k`, its other two axes on the sides `signs` (the triangle must
-    // reach across them, and overlap the edge's span along `k`).
+    // An edge along axis `k` lies on the sides `(sj, sl)` of the other two axes: tried when
+    // the triangle reaches beyond both, and not wholly past either end of the edge along
+    // `k` (there the nearest box points are on that end's face, whose corners and edges
+    // the other passes try).
     for k in 0..3 {
         if low[k] >= half[k] || high[k] <= -half[k] {
             continue;
