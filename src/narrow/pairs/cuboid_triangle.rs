@@ -3,9 +3,11 @@
 //! clamped to the box, and the edge–edge pairs (Akenine-Möller, *Fast 3D triangle-box
 //! overlap testing*, 2001, for the axis set). A pair apart along a face axis takes its
 //! closest pair straight from the features the triangle can be nearest to
-//! ([`super::triangle_apart`]), any other [`super::query`]; manifold: face clipping reduced
-//! to 4 points ([`super::clip`]).
+//! ([`super::triangle_apart`]), a triangle sunk into one face of the box its depth from
+//! that face ([`super::box_face_depth`]), any other [`super::query`]; manifold: face
+//! clipping reduced to 4 points ([`super::clip`]).
 
+use super::box_face_depth::face_depth_box_triangle;
 use super::placed_core::PlacedCore;
 use super::triangle_apart::apart_box_triangle;
 use super::{clip, query};
@@ -18,12 +20,15 @@ use crate::narrow::contact::{Manifold, ShapeDistance};
 /// negative: minus the penetration depth. Never NaN, degenerate sizes included.
 #[must_use]
 pub fn distance_cuboid_triangle(a: &Cuboid, b: &Triangle, pose_ab: &Isometry) -> ShapeDistance {
-    apart_box_triangle(a.half_extents, &b.transformed(pose_ab)).unwrap_or_else(|| {
-        query::distance(
-            &PlacedCore::cuboid(a, &Isometry::IDENTITY),
-            &PlacedCore::triangle(b, pose_ab),
-        )
-    })
+    let placed = b.transformed(pose_ab);
+    apart_box_triangle(a.half_extents, &placed)
+        .or_else(|| face_depth_box_triangle(a.half_extents, &placed))
+        .unwrap_or_else(|| {
+            query::distance(
+                &PlacedCore::cuboid(a, &Isometry::IDENTITY),
+                &PlacedCore::triangle(b, pose_ab),
+            )
+        })
 }
 
 /// Fills `out` with the contact manifold of `a` and `b` placed by `pose_ab`: at most 4

@@ -35,6 +35,7 @@
 //!   zero-area triangles are the segment or point they span. None yields NaN.
 //! - Triangles are two-sided and have no thickness.
 
+mod box_face_depth;
 mod clip;
 mod placed_core;
 mod query;
