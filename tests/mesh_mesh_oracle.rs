@@ -1114,17 +1114,55 @@ fn spot_against_rob_agrees_with_the_oracle() {
         .centered_on_bounds();
     assert_eq!((spot.triangle_count(), rob.triangle_count()), (5856, 216));
     let pairs = [MeshPair::new("spot × rob", spot, rob, 0.9)];
-    // Every other pose grazing (see `grazing_pose`).
-    let pose_of = |pair: &MeshPair, r: &mut TestRng, k: usize| {
-        if k.is_multiple_of(2) {
-            pair.pose(r)
-        } else {
-            grazing_pose(pair, r, GRAZING_EPSILONS[(k / 2) % GRAZING_EPSILONS.len()])
-        }
-    };
-    let (tally, within) = every_query_on_poses(&pairs, 56, REAL_MESH_POSES, 4, pose_of);
+    let (tally, within) =
+        every_query_on_poses(&pairs, 56, REAL_MESH_POSES, 4, every_other_pose_grazing);
     tally.assert_both_outcomes("spot × rob");
     within.assert_both_outcomes("spot × rob");
+}
+
+#[test]
+fn large_flat_triangles_against_detailed_meshes_agree_with_the_oracle() {
+    // A leaf of one large triangle is tested by the triangle itself against the small
+    // nodes of the other tree (its volume, a rectangle or box around it, is half empty):
+    // a two-triangle plate and one big triangle against fine meshes, every other pose
+    // grazing, so that pairs near the volumes' empty half, touching and apart all occur.
+    let big = TriMesh::try_new(
+        vec![
+            DVec3::new(-1.2, -0.9, 0.0),
+            DVec3::new(1.3, -0.7, 0.05),
+            DVec3::new(-0.2, 1.1, -0.03),
+        ],
+        vec![[0, 1, 2]],
+    )
+    .expect("one triangle");
+    let pairs = [
+        MeshPair::new(
+            "plate × fine sphere",
+            meshes::grid(1.0, 1),
+            meshes::uv_sphere(0.5, 40, 24),
+            1.2,
+        ),
+        MeshPair::new(
+            "big triangle × torus",
+            big,
+            meshes::torus(0.4, 0.15, 40, 16),
+            1.1,
+        ),
+    ];
+    let (tally, within) =
+        every_query_on_poses(&pairs, 57, STRESS_POSES, 8, every_other_pose_grazing);
+    tally.assert_both_outcomes("large flat triangles");
+    within.assert_both_outcomes("large flat triangles");
+}
+
+/// Pose `k` of a pair: a random one for even `k`, a grazing one (see [`grazing_pose`])
+/// for odd `k`, cycling through [`GRAZING_EPSILONS`].
+fn every_other_pose_grazing(pair: &MeshPair, r: &mut TestRng, k: usize) -> Pose {
+    if k.is_multiple_of(2) {
+        pair.pose(r)
+    } else {
+        grazing_pose(pair, r, GRAZING_EPSILONS[(k / 2) % GRAZING_EPSILONS.len()])
+    }
 }
 
 /// Relative gaps left by [`grazing_pose`].

@@ -1,6 +1,7 @@
 //! Tandem traversal: descend two BVHs together under their relative pose.
 //!
-//! A pair of nodes is tested with a caller-given volume test; when it passes, the larger
+//! A pair of nodes is tested with a caller-given test on the two nodes (their volumes, and
+//! for a leaf its triangles if the caller wants them); when it passes, the larger
 //! node (by [`BvhNode::size`]; the internal one when the other is a leaf) is replaced by its
 //! two children. Pairs of leaves that pass go to a visitor, which may stop the traversal.
 //! This is the depth-first mid phase every exact mesh–mesh query uses; the budgeted
@@ -32,7 +33,7 @@ pub fn descend_a<B>(a: &BvhNode<B>, b: &BvhNode<B>) -> bool {
 }
 
 /// Visits every pair of leaves `(leaf_a, leaf_b)` (node indices) reached through node pairs
-/// that all pass `passes(bv_a, bv_b)`, depth first, until `visit` returns `Break`.
+/// that all pass `passes(node_a, node_b)`, depth first, until `visit` returns `Break`.
 ///
 /// Returns `Break` when the visitor stopped the traversal.
 pub fn for_each_leaf_pair<B, T, V>(
@@ -43,12 +44,12 @@ pub fn for_each_leaf_pair<B, T, V>(
     mut visit: V,
 ) -> ControlFlow<()>
 where
-    T: Fn(&B, &B) -> bool,
+    T: Fn(&BvhNode<B>, &BvhNode<B>) -> bool,
     V: FnMut(usize, usize) -> ControlFlow<()>,
 {
     let (na, nb) = (a.nodes(), b.nodes());
     stack.clear();
-    if !passes(&na[0].bv, &nb[0].bv) {
+    if !passes(&na[0], &nb[0]) {
         return ControlFlow::Continue(());
     }
     stack.push([0, 0]);
@@ -59,13 +60,13 @@ where
         } else if descend_a(x, y) {
             // Push the second child first so the first is visited first.
             for c in x.children().into_iter().rev() {
-                if passes(&na[c].bv, &y.bv) {
+                if passes(&na[c], y) {
                     stack.push([c as u32, ib]);
                 }
             }
         } else {
             for c in y.children().into_iter().rev() {
-                if passes(&x.bv, &nb[c].bv) {
+                if passes(x, &nb[c]) {
                     stack.push([ia, c as u32]);
                 }
             }
@@ -106,7 +107,7 @@ impl PartialOrd for RankedPair {
 
 /// Best-first branch and bound for the smallest leaf-pair value.
 ///
-/// `bound(bv_a, bv_b, best)` must never exceed the value of any leaf pair beneath the two
+/// `bound(node_a, node_b, best)` must never exceed the value of any leaf pair beneath the two
 /// nodes; once it reaches `best` (the best value so far) it may return any such bound that
 /// is `≥ best` (a cheaper one: the pair is pruned either way). `visit(leaf_a, leaf_b)`
 /// evaluates a leaf pair and returns its value. `prune(bound, best)` says whether a pair with
@@ -132,14 +133,14 @@ pub fn nearest_leaf_pairs<B, L, P, V>(
     mut visit: V,
 ) -> Nearest
 where
-    L: Fn(&B, &B, f64) -> f64,
+    L: Fn(&BvhNode<B>, &BvhNode<B>, f64) -> f64,
     P: Fn(f64, f64) -> bool,
     V: FnMut(usize, usize) -> f64,
 {
     let (na, nb) = (a.nodes(), b.nodes());
     queue.clear();
     queue.push(RankedPair {
-        bound: bound(&na[0].bv, &nb[0].bv, best),
+        bound: bound(&na[0], &nb[0], best),
         a: 0,
         b: 0,
     });
@@ -162,7 +163,7 @@ where
         } else if descend_a(x, y) {
             for c in x.children() {
                 let child = RankedPair {
-                    bound: bound(&na[c].bv, &y.bv, best),
+                    bound: bound(&na[c], y, best),
                     a: c as u32,
                     b: pair.b,
                 };
@@ -173,7 +174,7 @@ where
         } else {
             for c in y.children() {
                 let child = RankedPair {
-                    bound: bound(&x.bv, &nb[c].bv, best),
+                    bound: bound(x, &nb[c], best),
                     a: pair.a,
                     b: c as u32,
                 };

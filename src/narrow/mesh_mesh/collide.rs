@@ -1,5 +1,6 @@
 //! Collision queries: does any triangle pair intersect, and which ones do.
 
+use super::leaf_triangle::LeafTriangles;
 use super::{
     FALLBACK_NORMAL, MeshMeshWorkspace, TriangleContact, clock_allows_leaf_pair,
     for_each_triangle_pair,
@@ -42,12 +43,13 @@ pub fn intersects_mesh_mesh_within<B: BoundingVolume>(
     clock: &mut WorkClock,
 ) -> Option<bool> {
     let iso = pose_ab.to_isometry();
+    let leaf = LeafTriangles { a, b, iso: &iso };
     let mut stopped = false;
     let flow = for_each_leaf_pair(
         a,
         b,
         &mut workspace.pairs,
-        |x, y| x.overlaps(y, &iso),
+        |x, y| x.bv.overlaps(&y.bv, &iso) && !leaf.apart(x, y),
         |la, lb| {
             if !clock_allows_leaf_pair(clock, (a, b), [la, lb], TRIANGLE_PAIR_WORK) {
                 stopped = true;
@@ -105,12 +107,13 @@ where
     S: FnMut(TriangleContact) -> ControlFlow<()>,
 {
     let iso = pose_ab.to_isometry();
+    let leaf = LeafTriangles { a, b, iso: &iso };
     let mut stopped = false;
     let _ = for_each_leaf_pair(
         a,
         b,
         &mut workspace.pairs,
-        |x, y| x.overlaps(y, &iso),
+        |x, y| x.bv.overlaps(&y.bv, &iso) && !leaf.apart(x, y),
         |la, lb| {
             if !clock_allows_leaf_pair(clock, (a, b), [la, lb], TRIANGLE_PAIR_WORK) {
                 stopped = true;

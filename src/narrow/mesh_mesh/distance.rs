@@ -1,13 +1,14 @@
 //! Distance queries: the smallest triangle–triangle distance, and "within distance d?".
 
+use super::leaf_triangle::LeafTriangles;
 use super::{
     DistanceCache, DistanceParams, MeshDistance, MeshMeshWorkspace, clock_allows_leaf_pair,
     for_each_triangle_pair,
 };
 use crate::bounding::BoundingVolume;
 use crate::budget::WorkClock;
-use crate::bvh::Bvh;
 use crate::bvh::tandem::{for_each_leaf_pair, nearest_leaf_pairs};
+use crate::bvh::{Bvh, BvhNode};
 use crate::math::{Isometry, Pose, conservative_slack};
 use crate::narrow::{TriangleDistance, distance_triangle_triangle};
 use std::ops::ControlFlow;
@@ -58,6 +59,7 @@ pub fn distance_mesh_mesh_within<B: BoundingVolume>(
     clock: &mut WorkClock,
 ) -> MeshDistance {
     let iso = pose_ab.to_isometry();
+    let leaf = LeafTriangles { a, b, iso: &iso };
     let (ta, tb) = (a.triangles(), b.triangles());
     let pair_distance =
         |sa: usize, sb: usize| distance_triangle_triangle(&ta[sa], &tb[sb].transformed(&iso));
@@ -77,7 +79,14 @@ pub fn distance_mesh_mesh_within<B: BoundingVolume>(
         &mut workspace.ranked,
         closest.0.distance,
         (
-            |x: &B, y: &B, limit| x.distance_lower_bound_within(y, &iso, limit),
+            |x: &BvhNode<B>, y: &BvhNode<B>, limit| {
+                let bound = x.bv.distance_lower_bound_within(&y.bv, &iso, limit);
+                if bound >= limit {
+                    bound
+                } else {
+                    bound.max(leaf.lower_bound(x, y))
+                }
+            },
             |bound, best| params.can_skip(bound, best),
         ),
         clock,
@@ -202,6 +211,7 @@ pub fn proximity_mesh_mesh_within<B: BoundingVolume>(
     clock: &mut WorkClock,
 ) -> Option<Proximity> {
     let iso = pose_ab.to_isometry();
+    let leaf = LeafTriangles { a, b, iso: &iso };
     let rounding = rounding_bound(a, b, &iso);
     let mut stopped = false;
     // The smallest bound of everything ruled out so far (a `Cell`: both closures lower it).
@@ -211,7 +221,12 @@ pub fn proximity_mesh_mesh_within<B: BoundingVolume>(
         b,
         &mut workspace.pairs,
         |x, y| {
-            let bound = x.distance_lower_bound_within(y, &iso, max_distance);
+            let bound = x.bv.distance_lower_bound_within(&y.bv, &iso, max_distance);
+            let bound = if bound > max_distance {
+                bound
+            } else {
+                bound.max(leaf.lower_bound(x, y))
+            };
             if bound > max_distance {
                 floor.set(floor.get().min(bound));
                 return false;

@@ -3,7 +3,8 @@
 //!
 //! Both meshes are given as [`Bvh`]s over their triangles, each in its own local frame, and
 //! compared under `pose_ab` (B's frame expressed in A's). Node pairs are culled with the
-//! volume type's own test ([`crate::bvh::tandem`]); surviving triangle pairs are decided by
+//! volume type's own test ([`crate::bvh::tandem`]), and a leaf of one large triangle against
+//! a small node by the triangle itself (`leaf_triangle.rs`); surviving triangle pairs are decided by
 //! the exact primitives of [`crate::narrow::triangle_triangle`] on A's triangle and B's
 //! triangle mapped into A's frame by [`Triangle::transformed`](crate::geometry::Triangle::transformed).
 //! Because every volume test is conservative, the answers are *identical* to a brute-force
@@ -36,6 +37,7 @@
 mod collide;
 mod distance;
 pub mod frontier;
+mod leaf_triangle;
 
 pub use collide::{
     TRIANGLE_PAIR_WORK, contacts_mesh_mesh, contacts_mesh_mesh_within, intersects_mesh_mesh,

@@ -3,10 +3,11 @@
 //! different volume types, each pair's chosen by measured tightness (the pipeline's
 //! [`MeshPairTrees`](crate::narrow::mesh_mesh::frontier::MeshPairTrees)).
 
+use super::super::leaf_triangle::LeafTriangles;
 use super::FrontierWitnesses;
 use crate::bounding::BoundingVolume;
-use crate::bvh::Bvh;
 use crate::bvh::tandem::descend_a;
+use crate::bvh::{Bvh, BvhNode};
 use crate::math::{Isometry, conservative_slack};
 use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::{precedes_in_ties, rounding_bound};
@@ -54,7 +55,8 @@ pub trait PairTrees {
     fn seed_distance(&self) -> Option<(f64, FrontierWitnesses)>;
 
     /// A lower bound of the distance between the two nodes' triangles, metres
-    /// ([`BoundingVolume::distance_lower_bound_within`] with `limit`).
+    /// ([`BoundingVolume::distance_lower_bound_within`] with `limit`, raised for a large
+    /// triangle's leaf against a small node as the exact queries raise it).
     fn bound(&self, nodes: [u32; 2], limit: f64) -> f64;
 
     /// An upper bound of the distance between the two nodes' triangles (centres plus
@@ -122,11 +124,24 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
     #[inline]
     #[must_use]
     pub fn bound(&self, [a, b]: [u32; 2], limit: f64) -> f64 {
-        let (x, y) = (
-            &self.a.nodes()[a as usize].bv,
-            &self.b.nodes()[b as usize].bv,
-        );
-        x.distance_lower_bound_within(y, self.pose_ab, limit)
+        let (x, y) = (&self.a.nodes()[a as usize], &self.b.nodes()[b as usize]);
+        let bound = x.bv.distance_lower_bound_within(&y.bv, self.pose_ab, limit);
+        self.refined(bound, (x, y), limit)
+    }
+
+    /// `bound` of nodes `x` (A) and `y` (B), raised by the test of a large triangle's leaf
+    /// against a small node (`leaf_triangle.rs`) when it is still under `limit`.
+    #[inline]
+    fn refined(&self, bound: f64, (x, y): (&BvhNode<B>, &BvhNode<B>), limit: f64) -> f64 {
+        if bound >= limit {
+            return bound;
+        }
+        let leaf = LeafTriangles {
+            a: self.a,
+            b: self.b,
+            iso: self.pose_ab,
+        };
+        bound.max(leaf.lower_bound(x, y))
     }
 
     /// See [`PairTrees::upper_bound`].
@@ -168,8 +183,14 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
             limit,
         );
         [0, 1].map(|k| {
-            let c = children[k] as u32;
-            (if split_a { [c, b] } else { [a, c] }, bounds[k])
+            let c = children[k];
+            let child = &tree.nodes()[c];
+            let pair = if split_a { (child, y) } else { (x, child) };
+            let c = c as u32;
+            (
+                if split_a { [c, b] } else { [a, c] },
+                self.refined(bounds[k], pair, limit),
+            )
         })
     }
 
