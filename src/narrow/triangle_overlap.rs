@@ -112,7 +112,7 @@ pub(crate) fn common_point(a: &Hull, b: &Hull) -> Option<DVec3> {
 /// determinants (proportional to signed distances).
 #[must_use]
 #[inline]
-pub(crate) fn plane_sides(plane: &ProperTriangle, t: &ProperTriangle) -> ([i8; 3], [f64; 3]) {
+fn plane_sides(plane: &ProperTriangle, t: &ProperTriangle) -> Sides {
     let [a, b, c] = plane.v;
     // PERF(benches/mesh_pair.rs, collide_all): a floating-point filter with the plane's
     // normal computed once; only vertices too close to the plane to be sure of go to the
@@ -155,17 +155,56 @@ pub(crate) fn strictly_one_side(s: [i8; 3]) -> bool {
 }
 
 fn triangle_triangle(ta: &ProperTriangle, tb: &ProperTriangle) -> Option<DVec3> {
-    let (sb, _) = plane_sides(ta, tb);
-    if strictly_one_side(sb) {
-        return None;
+    match planes(ta, tb) {
+        Planes::Apart => None,
+        Planes::Coplanar => coplanar_triangle_triangle(ta, tb),
+        Planes::Crossing { a, b } => crossing_common_point(ta, tb, a.0, b.0),
     }
-    if sb == [0, 0, 0] {
-        return coplanar_triangle_triangle(ta, tb);
+}
+
+/// Each proper triangle's vertices against the other's plane: exact signs, with the
+/// approximate determinants of [`plane_sides`].
+pub(crate) type Sides = ([i8; 3], [f64; 3]);
+
+/// What the two planes of a pair of proper triangles decide.
+pub(crate) enum Planes {
+    /// One triangle lies strictly on one side of the other's plane: no common point.
+    Apart,
+    /// Both lie in one plane.
+    Coplanar,
+    /// Each touches or crosses the other's plane: `a`'s vertices against `b`'s plane and
+    /// `b`'s against `a`'s.
+    Crossing { a: Sides, b: Sides },
+}
+
+/// The plane-side rejection of a pair of proper triangles (Möller; Devillers–Guigue).
+#[must_use]
+#[inline]
+pub(crate) fn planes(ta: &ProperTriangle, tb: &ProperTriangle) -> Planes {
+    let b = plane_sides(ta, tb);
+    if strictly_one_side(b.0) {
+        return Planes::Apart;
     }
-    let (sa, _) = plane_sides(tb, ta);
-    if strictly_one_side(sa) {
-        return None;
+    if b.0 == [0, 0, 0] {
+        return Planes::Coplanar;
     }
+    let a = plane_sides(tb, ta);
+    if strictly_one_side(a.0) {
+        return Planes::Apart;
+    }
+    Planes::Crossing { a, b }
+}
+
+/// A common point of two proper triangles that each touch or cross the other's plane
+/// (`sa`: `ta`'s vertices against `tb`'s plane, `sb` the converse), or `None` when they are
+/// exactly disjoint: an edge of one meets the other.
+#[must_use]
+pub(crate) fn crossing_common_point(
+    ta: &ProperTriangle,
+    tb: &ProperTriangle,
+    sa: [i8; 3],
+    sb: [i8; 3],
+) -> Option<DVec3> {
     for (i, j) in EDGES {
         if sa[i] * sa[j] <= 0
             && let Some(p) = segment_triangle(ta.v[i], ta.v[j], sa[i], sa[j], tb)
@@ -192,14 +231,17 @@ fn segment_triangle(p: DVec3, q: DVec3, sp: i8, sq: i8, t: &ProperTriangle) -> O
     if sp * sq > 0 {
         return None;
     }
-    let [a, b, c] = t.v;
-    let s = [
-        sign(orient3d(p, q, a, b)),
-        sign(orient3d(p, q, b, c)),
-        sign(orient3d(p, q, c, a)),
-    ];
-    if s.contains(&1) && s.contains(&-1) {
-        return None;
+    // The line misses the triangle as soon as two of its edges' signs disagree: most
+    // segments a collision query tests are settled by the first two predicates.
+    let mut seen = 0_i8;
+    for (i, j) in EDGES {
+        let s = sign(orient3d(p, q, t.v[i], t.v[j]));
+        if s * seen < 0 {
+            return None;
+        }
+        if s != 0 {
+            seen = s;
+        }
     }
     if sp == 0 {
         return Some(p);

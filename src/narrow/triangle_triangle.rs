@@ -30,7 +30,9 @@
 //! [`orient2d`]: crate::geometry::predicates::orient2d
 
 use super::closest_points::{HingeFrame, closest_points_segment_segment};
-use super::triangle_overlap::{Hull, ProperTriangle, common_point, plane_sides};
+use super::triangle_overlap::{
+    Hull, Planes, ProperTriangle, common_point, crossing_common_point, planes,
+};
 use crate::geometry::Triangle;
 use crate::math::DVec3;
 
@@ -71,33 +73,37 @@ pub fn intersection_segment_triangle_triangle(
     b: &Triangle,
 ) -> Option<(DVec3, DVec3)> {
     let (ha, hb) = (Hull::of(a), Hull::of(b));
-    let p = common_point(&ha, &hb)?;
-    if let (Hull::Triangle(ta), Hull::Triangle(tb)) = (ha, hb) {
-        let (sb, db) = plane_sides(&ta, &tb);
-        if sb != [0, 0, 0] {
-            let (sa, da) = plane_sides(&tb, &ta);
-            let line = plane_normal(&ta).cross(plane_normal(&tb));
-            let (lo_a, hi_a) = cut_interval(&ta, sa, da, line);
-            let (lo_b, hi_b) = cut_interval(&tb, sb, db, line);
-            let lo = if lo_a.dot(line) >= lo_b.dot(line) {
-                lo_a
-            } else {
-                lo_b
-            };
-            let hi = if hi_a.dot(line) <= hi_b.dot(line) {
-                hi_a
-            } else {
-                hi_b
-            };
-            if lo.dot(line) <= hi.dot(line) {
-                return Some((lo, hi));
-            }
-            // Touching: rounding put the two end points out of order.
-            let mid = (lo + hi) * 0.5;
-            return Some((mid, mid));
-        }
+    let (Hull::Triangle(ta), Hull::Triangle(tb)) = (ha, hb) else {
+        return common_point(&ha, &hb).map(|p| (p, p));
+    };
+    // The plane sides decide the pair and, when the planes cross, cut the intervals.
+    let Planes::Crossing {
+        a: (sa, da),
+        b: (sb, db),
+    } = planes(&ta, &tb)
+    else {
+        return common_point(&ha, &hb).map(|p| (p, p));
+    };
+    crossing_common_point(&ta, &tb, sa, sb)?;
+    let line = plane_normal(&ta).cross(plane_normal(&tb));
+    let (lo_a, hi_a) = cut_interval(&ta, sa, da, line);
+    let (lo_b, hi_b) = cut_interval(&tb, sb, db, line);
+    let lo = if lo_a.dot(line) >= lo_b.dot(line) {
+        lo_a
+    } else {
+        lo_b
+    };
+    let hi = if hi_a.dot(line) <= hi_b.dot(line) {
+        hi_a
+    } else {
+        hi_b
+    };
+    if lo.dot(line) <= hi.dot(line) {
+        return Some((lo, hi));
     }
-    Some((p, p))
+    // Touching: rounding put the two end points out of order.
+    let mid = (lo + hi) * 0.5;
+    Some((mid, mid))
 }
 
 /// The distance between the closed triangles `a` and `b` (same frame), with witnesses.
