@@ -17,7 +17,9 @@
 //! stdout: one TSV row per query, `query n mean_us median_us p95_us max_us colliding tri_pairs
 //! mean_dist`. `distance` starts every run cold (a fresh cache); `distance_warm` keeps the
 //! pair's cache between runs, as a simulation querying the same pair every frame would.
-//! `--dump DIR` writes `DIR/proxima.tsv`: `i collide_bool collide_all contacts tri_pairs distance`.
+//! `--dump DIR` writes `DIR/proxima.tsv`: `i collide_bool collide_all contacts tri_pairs distance`,
+//! and `DIR/proxima_times.tsv`: each pose's µs per query (`i collide_bool_us collide_all_us
+//! distance_us`), to find the poses behind a mean.
 
 use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, Rss};
 use proxima::bvh::{BuildParams, Bvh};
@@ -300,7 +302,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         "{}",
         summary(
             "collide_bool",
-            collide.time_bool,
+            collide.time_bool.clone(),
             colliding,
             "-".into(),
             "-".into()
@@ -310,7 +312,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         "{}",
         summary(
             "collide_all",
-            collide.time_all,
+            collide.time_all.clone(),
             touching,
             total_pairs.to_string(),
             "-".into()
@@ -320,7 +322,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         "{}",
         summary(
             "distance",
-            distance.time_cold,
+            distance.time_cold.clone(),
             zero,
             "-".into(),
             mean_dist.clone()
@@ -349,8 +351,17 @@ fn main() -> Result<(), Box<dyn Error>> {
                 distance.distance[i]
             )?;
         }
+        let mut times = String::from("i\tcollide_bool_us\tcollide_all_us\tdistance_us\n");
+        for i in 0..poses.len() {
+            writeln!(
+                times,
+                "{i}\t{:.3}\t{:.3}\t{:.3}",
+                collide.time_bool[i], collide.time_all[i], distance.time_cold[i]
+            )?;
+        }
         std::fs::create_dir_all(&dir)?;
         std::fs::write(format!("{dir}/proxima.tsv"), dump)?;
+        std::fs::write(format!("{dir}/proxima_times.tsv"), times)?;
     }
     Ok(())
 }
