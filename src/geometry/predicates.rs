@@ -1,8 +1,9 @@
 //! Robust orientation predicates: the sign of a small determinant, always exact.
 //!
 //! These wrap Shewchuk's adaptive-precision predicates (the `robust` crate): a fast
-//! floating-point evaluation with a forward error bound, refined in exact expansion
-//! arithmetic only when the bound cannot certify the sign. The **sign** of every result is
+//! floating-point evaluation with a forward error bound (inlined here, the same operations
+//! as the crate's), refined in exact expansion arithmetic by the crate only when the bound
+//! cannot certify the sign. The **sign** of every result is
 //! exactly the sign of the real determinant of the (floating-point) inputs; the magnitude is
 //! an approximation of that determinant. Inputs must be finite and must not overflow or
 //! underflow when multiplied (coordinates below about `1e100` in magnitude).
@@ -26,8 +27,44 @@ use robust::{Coord, Coord3D};
 pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     // NOTE: `robust::orient3d` is positive when `d` is *below*; we negate to follow the
     // right-hand normal of `a, b, c`, like `Triangle::scaled_normal`.
-    -robust::orient3d(coord3(a), coord3(b), coord3(c), coord3(d))
+    -robust_orient3d(a, b, c, d)
 }
+
+/// `robust::orient3d(a, b, c, d)`, bit for bit, with its floating-point stage inlined here.
+///
+/// PERF(examples/fcl_peer, collide_all): the crate's function holds its exact stage too,
+/// whose 6 KB stack frame every call paid for (a page-touching probe) even when the first
+/// stage settles the sign, which it nearly always does: 42 % of the exact triangle test's
+/// time on env × rob. The crate is called only when this stage cannot certify the sign,
+/// and repeats the same stage first, so the value returned is the crate's in every case.
+#[inline]
+fn robust_orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    // The crate's expression, operation for operation (Shewchuk's `orient3d` first stage).
+    let (adx, bdx, cdx) = (a.x - d.x, b.x - d.x, c.x - d.x);
+    let (ady, bdy, cdy) = (a.y - d.y, b.y - d.y, c.y - d.y);
+    let (adz, bdz, cdz) = (a.z - d.z, b.z - d.z, c.z - d.z);
+    let (bdxcdy, cdxbdy) = (bdx * cdy, cdx * bdy);
+    let (cdxady, adxcdy) = (cdx * ady, adx * cdy);
+    let (adxbdy, bdxady) = (adx * bdy, bdx * ady);
+    let det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * adz.abs()
+        + (cdxady.abs() + adxcdy.abs()) * bdz.abs()
+        + (adxbdy.abs() + bdxady.abs()) * cdz.abs();
+    let errbound = O3D_ERRBOUND_A * permanent;
+    if det > errbound || -det > errbound {
+        return det;
+    }
+    robust::orient3d(coord3(a), coord3(b), coord3(c), coord3(d))
+}
+
+/// Half an ulp of 1.0 (Shewchuk's `epsilon`), as the `robust` crate defines it.
+const EPSILON: f64 = 0.000_000_000_000_000_111_022_302_462_515_65;
+
+/// Shewchuk's `o3derrboundA`: the first stage's relative error bound.
+const O3D_ERRBOUND_A: f64 = (7.0 + 56.0 * EPSILON) * EPSILON;
+
+/// The `robust` crate's first-stage bound for `orient2d` (Ozaki et al., 2016).
+const O2D_THETA: f64 = 3.330_669_062_177_372_2e-16;
 
 /// Orientation of `c` relative to the directed line `a → b` in the plane.
 ///
@@ -37,6 +74,15 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
 #[must_use]
 #[inline]
 pub fn orient2d(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    // PERF: the crate's first stage inlined, as in `robust_orient3d` (same reason, same
+    // value in every case).
+    let detleft = (a.x - c.x) * (b.y - c.y);
+    let detright = (a.y - c.y) * (b.x - c.x);
+    let det = detleft - detright;
+    let errbound = O2D_THETA * (detleft + detright).abs();
+    if det >= errbound || -det >= errbound {
+        return det;
+    }
     robust::orient2d(coord2(a), coord2(b), coord2(c))
 }
 
@@ -88,6 +134,57 @@ fn coord2(p: DVec2) -> Coord<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The inlined first stages return the crate's value bit for bit, on random points
+    /// and on points a few ulps from coplanar or collinear (where the exact stage runs).
+    #[test]
+    fn the_inlined_first_stages_return_the_crates_values() {
+        use crate::test_support::{point_in_cube, rng};
+        let mut r = rng(31);
+        let (mut exact_stage_3d, mut exact_stage_2d) = (0, 0);
+        for k in 0..20_000 {
+            let scale = [1e-3, 1.0, 1e3][k % 3];
+            let (a, b, c) = (
+                point_in_cube(&mut r, scale),
+                point_in_cube(&mut r, scale),
+                point_in_cube(&mut r, scale),
+            );
+            let free = point_in_cube(&mut r, scale);
+            // Near-coplanar: an affine mix of the three, nudged by a few ulps.
+            let (s, t) = (
+                rand::Rng::random::<f64>(&mut r),
+                rand::Rng::random::<f64>(&mut r),
+            );
+            let on = a + (b - a) * s + (c - a) * t;
+            let nudge = |x: f64, n: i64| f64::from_bits((x.to_bits() as i64 + n) as u64);
+            let near = DVec3::new(on.x, on.y, nudge(on.z, (k % 7) as i64 - 3));
+            for d in [free, near, a] {
+                let crate_value = robust::orient3d(coord3(a), coord3(b), coord3(c), coord3(d));
+                assert_eq!(robust_orient3d(a, b, c, d).to_bits(), crate_value.to_bits());
+            }
+            let flat = |p: DVec3| DVec2::new(p.x, p.y);
+            let line = flat(a) + (flat(b) - flat(a)) * s;
+            let near2 = DVec2::new(line.x, nudge(line.y, (k % 5) as i64 - 2));
+            for p in [flat(c), near2, flat(a)] {
+                let crate_value = robust::orient2d(coord2(flat(a)), coord2(flat(b)), coord2(p));
+                assert_eq!(
+                    orient2d(flat(a), flat(b), p).to_bits(),
+                    crate_value.to_bits()
+                );
+            }
+            // How often the first stage could not decide (the exact stage ran).
+            let (u, v, w) = (b - a, c - a, near - a);
+            let rough = u.cross(v).dot(w);
+            exact_stage_3d += usize::from(rough.abs() < 1e-12 * scale.powi(3));
+            exact_stage_2d += usize::from(
+                (flat(b) - flat(a)).perp_dot(near2 - flat(a)).abs() < 1e-12 * scale * scale,
+            );
+        }
+        assert!(
+            exact_stage_3d > 1_000 && exact_stage_2d > 1_000,
+            "{exact_stage_3d} {exact_stage_2d}"
+        );
+    }
 
     #[test]
     fn orient3d_is_positive_above_a_counter_clockwise_triangle() {
