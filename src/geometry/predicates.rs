@@ -39,7 +39,15 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
 /// and repeats the same stage first, so the value returned is the crate's in every case.
 #[inline]
 fn robust_orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
-    // The crate's expression, operation for operation (Shewchuk's `orient3d` first stage).
+    orient3d_first_stage(a, b, c, d)
+        .unwrap_or_else(|| robust::orient3d(coord3(a), coord3(b), coord3(c), coord3(d)))
+}
+
+/// The `robust` crate's `orient3d` floating-point stage, operation for operation
+/// (Shewchuk's first stage): its value when its error bound certifies the sign, else
+/// `None`.
+#[inline]
+fn orient3d_first_stage(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<f64> {
     let (adx, bdx, cdx) = (a.x - d.x, b.x - d.x, c.x - d.x);
     let (ady, bdy, cdy) = (a.y - d.y, b.y - d.y, c.y - d.y);
     let (adz, bdz, cdz) = (a.z - d.z, b.z - d.z, c.z - d.z);
@@ -51,10 +59,7 @@ fn robust_orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
         + (cdxady.abs() + adxcdy.abs()) * bdz.abs()
         + (adxbdy.abs() + bdxady.abs()) * cdz.abs();
     let errbound = O3D_ERRBOUND_A * permanent;
-    if det > errbound || -det > errbound {
-        return det;
-    }
-    robust::orient3d(coord3(a), coord3(b), coord3(c), coord3(d))
+    (det > errbound || -det > errbound).then_some(det)
 }
 
 /// Half an ulp of 1.0 (Shewchuk's `epsilon`), as the `robust` crate defines it.
@@ -76,14 +81,19 @@ const O2D_THETA: f64 = 3.330_669_062_177_372_2e-16;
 pub fn orient2d(a: DVec2, b: DVec2, c: DVec2) -> f64 {
     // PERF: the crate's first stage inlined, as in `robust_orient3d` (same reason, same
     // value in every case).
+    orient2d_first_stage(a, b, c)
+        .unwrap_or_else(|| robust::orient2d(coord2(a), coord2(b), coord2(c)))
+}
+
+/// The `robust` crate's `orient2d` floating-point stage, operation for operation: its
+/// value when its error bound certifies the sign, else `None`.
+#[inline]
+fn orient2d_first_stage(a: DVec2, b: DVec2, c: DVec2) -> Option<f64> {
     let detleft = (a.x - c.x) * (b.y - c.y);
     let detright = (a.y - c.y) * (b.x - c.x);
     let det = detleft - detright;
     let errbound = O2D_THETA * (detleft + detright).abs();
-    if det >= errbound || -det >= errbound {
-        return det;
-    }
-    robust::orient2d(coord2(a), coord2(b), coord2(c))
+    (det >= errbound || -det >= errbound).then_some(det)
 }
 
 /// [`orient2d`] of the projections of `a, b, c` onto the coordinate plane orthogonal to
@@ -141,6 +151,8 @@ mod tests {
     fn the_inlined_first_stages_return_the_crates_values() {
         use crate::test_support::{point_in_cube, rng};
         let mut r = rng(31);
+        // How often the first stage could not decide a near point, so that the crate's
+        // exact stage ran.
         let (mut exact_stage_3d, mut exact_stage_2d) = (0, 0);
         for k in 0..20_000 {
             let scale = [1e-3, 1.0, 1e3][k % 3];
@@ -162,6 +174,7 @@ mod tests {
                 let crate_value = robust::orient3d(coord3(a), coord3(b), coord3(c), coord3(d));
                 assert_eq!(robust_orient3d(a, b, c, d).to_bits(), crate_value.to_bits());
             }
+            exact_stage_3d += usize::from(orient3d_first_stage(a, b, c, near).is_none());
             let flat = |p: DVec3| DVec2::new(p.x, p.y);
             let line = flat(a) + (flat(b) - flat(a)) * s;
             let near2 = DVec2::new(line.x, nudge(line.y, (k % 5) as i64 - 2));
@@ -172,13 +185,7 @@ mod tests {
                     crate_value.to_bits()
                 );
             }
-            // How often the first stage could not decide (the exact stage ran).
-            let (u, v, w) = (b - a, c - a, near - a);
-            let rough = u.cross(v).dot(w);
-            exact_stage_3d += usize::from(rough.abs() < 1e-12 * scale.powi(3));
-            exact_stage_2d += usize::from(
-                (flat(b) - flat(a)).perp_dot(near2 - flat(a)).abs() < 1e-12 * scale * scale,
-            );
+            exact_stage_2d += usize::from(orient2d_first_stage(flat(a), flat(b), near2).is_none());
         }
         assert!(
             exact_stage_3d > 1_000 && exact_stage_2d > 1_000,

@@ -282,7 +282,12 @@ fn crossing_point(p: DVec3, q: DVec3, t: &ProperTriangle) -> DVec3 {
     p + (q - p) * along
 }
 
-fn coplanar_triangle_triangle(ta: &ProperTriangle, tb: &ProperTriangle) -> Option<DVec3> {
+/// A common point of two proper triangles of one plane, or `None` when they are exactly
+/// disjoint.
+pub(crate) fn coplanar_triangle_triangle(
+    ta: &ProperTriangle,
+    tb: &ProperTriangle,
+) -> Option<DVec3> {
     if let Some(&p) = tb.v.iter().find(|&&p| point_in_triangle(p, ta)) {
         return Some(p);
     }

@@ -31,7 +31,8 @@
 
 use super::closest_points::{HingeFrame, closest_points_segment_segment};
 use super::triangle_overlap::{
-    Hull, Planes, ProperTriangle, common_point, crossing_common_point, planes,
+    Hull, Planes, ProperTriangle, common_point, coplanar_triangle_triangle, crossing_common_point,
+    planes,
 };
 use crate::geometry::Triangle;
 use crate::math::DVec3;
@@ -77,12 +78,10 @@ pub fn intersection_segment_triangle_triangle(
         return common_point(&ha, &hb).map(|p| (p, p));
     };
     // The plane sides decide the pair and, when the planes cross, cut the intervals.
-    let Planes::Crossing {
-        a: (sa, da),
-        b: (sb, db),
-    } = planes(&ta, &tb)
-    else {
-        return common_point(&ha, &hb).map(|p| (p, p));
+    let ((sa, da), (sb, db)) = match planes(&ta, &tb) {
+        Planes::Apart => return None,
+        Planes::Coplanar => return coplanar_triangle_triangle(&ta, &tb).map(|p| (p, p)),
+        Planes::Crossing { a, b } => (a, b),
     };
     crossing_common_point(&ta, &tb, sa, sb)?;
     let line = plane_normal(&ta).cross(plane_normal(&tb));

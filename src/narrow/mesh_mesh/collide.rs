@@ -49,7 +49,7 @@ pub fn intersects_mesh_mesh_within<B: BoundingVolume>(
         a,
         b,
         &mut workspace.pairs,
-        |x, y| x.bv.overlaps(&y.bv, &iso) && !leaf.apart(x, y),
+        |x, y| leaf.overlaps(x, y),
         |la, lb| {
             if !clock_allows_leaf_pair(clock, (a, b), [la, lb], TRIANGLE_PAIR_WORK) {
                 stopped = true;
@@ -113,7 +113,7 @@ where
         a,
         b,
         &mut workspace.pairs,
-        |x, y| x.bv.overlaps(&y.bv, &iso) && !leaf.apart(x, y),
+        |x, y| leaf.overlaps(x, y),
         |la, lb| {
             if !clock_allows_leaf_pair(clock, (a, b), [la, lb], TRIANGLE_PAIR_WORK) {
                 stopped = true;

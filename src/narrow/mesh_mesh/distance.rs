@@ -7,8 +7,8 @@ use super::{
 };
 use crate::bounding::BoundingVolume;
 use crate::budget::WorkClock;
+use crate::bvh::Bvh;
 use crate::bvh::tandem::{for_each_leaf_pair, nearest_leaf_pairs};
-use crate::bvh::{Bvh, BvhNode};
 use crate::math::{Isometry, Pose, conservative_slack};
 use crate::narrow::{TriangleDistance, distance_triangle_triangle};
 use std::ops::ControlFlow;
@@ -79,14 +79,7 @@ pub fn distance_mesh_mesh_within<B: BoundingVolume>(
         &mut workspace.ranked,
         closest.0.distance,
         (
-            |x: &BvhNode<B>, y: &BvhNode<B>, limit| {
-                let bound = x.bv.distance_lower_bound_within(&y.bv, &iso, limit);
-                if bound >= limit {
-                    bound
-                } else {
-                    bound.max(leaf.lower_bound(x, y))
-                }
-            },
+            |x, y, limit| leaf.distance_lower_bound_within(x, y, limit),
             |bound, best| params.can_skip(bound, best),
         ),
         clock,
@@ -221,12 +214,7 @@ pub fn proximity_mesh_mesh_within<B: BoundingVolume>(
         b,
         &mut workspace.pairs,
         |x, y| {
-            let bound = x.bv.distance_lower_bound_within(&y.bv, &iso, max_distance);
-            let bound = if bound > max_distance {
-                bound
-            } else {
-                bound.max(leaf.lower_bound(x, y))
-            };
+            let bound = leaf.distance_lower_bound_within(x, y, max_distance);
             if bound > max_distance {
                 floor.set(floor.get().min(bound));
                 return false;

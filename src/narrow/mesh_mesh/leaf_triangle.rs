@@ -59,10 +59,30 @@ impl<B: BoundingVolume> LeafTriangles<'_, B> {
         }
     }
 
-    /// Whether the module's test puts the triangles under `x` and `y` apart.
+    /// The node test of the collision queries: the two volumes overlap and the module's
+    /// test does not put the triangles under `x` and `y` apart.
     #[inline]
-    pub fn apart(&self, x: &BvhNode<B>, y: &BvhNode<B>) -> bool {
-        self.lower_bound(x, y) > 0.0
+    pub fn overlaps(&self, x: &BvhNode<B>, y: &BvhNode<B>) -> bool {
+        x.bv.overlaps(&y.bv, self.iso) && self.lower_bound(x, y) <= 0.0
+    }
+
+    /// The node bound of the distance queries, metres: the volumes' bound
+    /// ([`BoundingVolume::distance_lower_bound_within`]), raised by the module's test.
+    #[inline]
+    pub fn distance_lower_bound_within(&self, x: &BvhNode<B>, y: &BvhNode<B>, limit: f64) -> f64 {
+        let bound = x.bv.distance_lower_bound_within(&y.bv, self.iso, limit);
+        self.raise(bound, x, y, limit)
+    }
+
+    /// `bound` (the volumes' bound of `x` and `y`, however computed) raised by the module's
+    /// test while it is under `limit`; at or past `limit` the pair is pruned either way.
+    #[inline]
+    pub fn raise(&self, bound: f64, x: &BvhNode<B>, y: &BvhNode<B>, limit: f64) -> f64 {
+        if bound >= limit {
+            bound
+        } else {
+            bound.max(self.lower_bound(x, y))
+        }
     }
 
     /// The distance from `triangle` to the ball of `radius` around `centre` (same frame,

@@ -6,8 +6,8 @@
 use super::super::leaf_triangle::LeafTriangles;
 use super::FrontierWitnesses;
 use crate::bounding::BoundingVolume;
+use crate::bvh::Bvh;
 use crate::bvh::tandem::descend_a;
-use crate::bvh::{Bvh, BvhNode};
 use crate::math::{Isometry, conservative_slack};
 use crate::narrow::distance_triangle_triangle;
 use crate::narrow::mesh_mesh::{precedes_in_ties, rounding_bound};
@@ -125,23 +125,18 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
     #[must_use]
     pub fn bound(&self, [a, b]: [u32; 2], limit: f64) -> f64 {
         let (x, y) = (&self.a.nodes()[a as usize], &self.b.nodes()[b as usize]);
-        let bound = x.bv.distance_lower_bound_within(&y.bv, self.pose_ab, limit);
-        self.refined(bound, (x, y), limit)
+        self.leaf_triangles()
+            .distance_lower_bound_within(x, y, limit)
     }
 
-    /// `bound` of nodes `x` (A) and `y` (B), raised by the test of a large triangle's leaf
-    /// against a small node (`leaf_triangle.rs`) when it is still under `limit`.
+    /// The two trees at their pose, for the large-triangle test (`leaf_triangle.rs`).
     #[inline]
-    fn refined(&self, bound: f64, (x, y): (&BvhNode<B>, &BvhNode<B>), limit: f64) -> f64 {
-        if bound >= limit {
-            return bound;
-        }
-        let leaf = LeafTriangles {
+    fn leaf_triangles(&self) -> LeafTriangles<'_, B> {
+        LeafTriangles {
             a: self.a,
             b: self.b,
             iso: self.pose_ab,
-        };
-        bound.max(leaf.lower_bound(x, y))
+        }
     }
 
     /// See [`PairTrees::upper_bound`].
@@ -182,15 +177,15 @@ impl<B: BoundingVolume> TreesAt<'_, B> {
             pose,
             limit,
         );
+        let leaf = self.leaf_triangles();
         [0, 1].map(|k| {
-            let c = children[k];
-            let child = &tree.nodes()[c];
-            let pair = if split_a { (child, y) } else { (x, child) };
-            let c = c as u32;
-            (
-                if split_a { [c, b] } else { [a, c] },
-                self.refined(bounds[k], pair, limit),
-            )
+            let child = &tree.nodes()[children[k]];
+            let c = children[k] as u32;
+            if split_a {
+                ([c, b], leaf.raise(bounds[k], child, y, limit))
+            } else {
+                ([a, c], leaf.raise(bounds[k], x, child, limit))
+            }
         })
     }
 
