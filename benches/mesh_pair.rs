@@ -8,8 +8,8 @@
 //! - `tori`: two tori of 10,000 triangles each under 64 random poses from a fixed seed,
 //!   exactly half of them intersecting (see [`common::mesh_scenes::tori`]).
 //!
-//! Everything is built before timing: Proxima's BVHs with [`BuildParams::BINNED_SAH`]
-//! (one triangle per leaf), parry's `TriMesh` shapes from the very same `f64` vertices and
+//! Everything is built before timing: Proxima's BVHs with [`MESH_TREE_PARAMS`], as the
+//! daemon builds them (binned SAH, up to two triangles a leaf), parry's `TriMesh` shapes from the very same `f64` vertices and
 //! index triples, and the poses (parry gets the same quaternion and translation, as
 //! `pos1 = identity`, `pos2 = pose_ab`, so its `pos12` is Proxima's `pose_ab`). Each timed
 //! iteration takes the next pose in order ([`common::cycle::cycle_bench`]).
@@ -58,9 +58,10 @@ use parry3d_f64::query::{
 };
 use parry3d_f64::shape::TriMesh as ParryMesh;
 use proxima::bounding::{Aabb, BoundingVolume, Obb, Rss};
-use proxima::bvh::{BuildParams, Bvh};
+use proxima::bvh::Bvh;
 use proxima::geometry::TriMesh;
 use proxima::math::Pose;
+use proxima::narrow::MESH_TREE_PARAMS;
 use proxima::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
     intersects_mesh_mesh,
@@ -80,8 +81,8 @@ struct ProximaPair<B> {
 impl<B: BoundingVolume> ProximaPair<B> {
     fn new(a: &TriMesh, b: &TriMesh) -> Self {
         Self {
-            a: Bvh::from_mesh(a, &BuildParams::BINNED_SAH),
-            b: Bvh::from_mesh(b, &BuildParams::BINNED_SAH),
+            a: Bvh::from_mesh(a, &MESH_TREE_PARAMS),
+            b: Bvh::from_mesh(b, &MESH_TREE_PARAMS),
         }
     }
 

@@ -3,15 +3,16 @@
 //! ```text
 //! cargo run --release --example pair_queries -- MESH1.obj MESH2.obj TRANSFORMS.txt \
 //!     [--scale1 S] [--scale2 S] [--center] [--dump DIR] [--repeats K]
-//!     [--collide-bv obb] [--distance-bv rss] [--build sah] [--leaf-size 1]
+//!     [--collide-bv obb] [--distance-bv rss] [--build sah] [--leaf-size 2]
 //! ```
 //!
 //! Mesh 1 takes each transform of TRANSFORMS.txt (`#` comment lines, then the count N, then
 //! N lines of a row-major 3×3 rotation and a translation); mesh 2 stays at identity.
 //! `--scale1/--scale2` multiply a mesh's vertices; `--center` then moves each mesh's
 //! bounding-box centre to the origin. BVHs are built once, outside the timing: by default
-//! binned-SAH trees of OBBs for the collision queries and of RSSs for distance (the fastest
-//! combination measured; other volume types, builders and leaf sizes by option). Per transform, each query runs twice to warm
+//! as the daemon builds them ([`MESH_TREE_PARAMS`]: binned SAH, up to two triangles a leaf),
+//! OBBs for the collision queries and RSSs for distance (the fastest combination measured;
+//! other volume types, builders and leaf sizes by option). Per transform, each query runs twice to warm
 //! up and is then timed over K runs (default 5); its time is the mean of those runs.
 //!
 //! stdout: one TSV row per query, `query n mean_us median_us p95_us max_us colliding tri_pairs
@@ -25,6 +26,7 @@ use proxima::bounding::{Aabb, BoundingSphere, BoundingVolume, Kdop18, Lss, Obb, 
 use proxima::bvh::{BuildParams, Bvh};
 use proxima::geometry::TriMesh;
 use proxima::math::{DMat3, DQuat, DVec3, Pose};
+use proxima::narrow::MESH_TREE_PARAMS;
 use proxima::narrow::mesh_mesh::{
     DistanceCache, DistanceParams, MeshMeshWorkspace, contacts_mesh_mesh, distance_mesh_mesh,
     intersects_mesh_mesh,
@@ -53,7 +55,7 @@ fn parse_args() -> Result<Args, Box<dyn Error>> {
     let mut positional = Vec::new();
     let (mut scales, mut center, mut dump, mut repeats) = ([1.0, 1.0], false, None, 5);
     let mut volumes = ["obb".to_string(), "rss".to_string()];
-    let (mut build, mut leaf_size) = (BuildParams::BINNED_SAH, 1);
+    let (mut build, mut leaf_size) = (MESH_TREE_PARAMS, MESH_TREE_PARAMS.leaf_size);
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
         let mut value = || it.next().ok_or_else(|| format!("{arg} needs a value"));

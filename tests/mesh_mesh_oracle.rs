@@ -32,7 +32,9 @@ use proxima::narrow::mesh_mesh::{
     TriangleContact, contacts_mesh_mesh, distance_mesh_mesh, intersects_mesh_mesh,
     within_distance_mesh_mesh,
 };
-use proxima::narrow::{TriangleDistance, distance_triangle_triangle, intersects_triangle_triangle};
+use proxima::narrow::{
+    MESH_TREE_PARAMS, TriangleDistance, distance_triangle_triangle, intersects_triangle_triangle,
+};
 use rand::Rng;
 use std::collections::HashSet;
 use std::fmt;
@@ -290,8 +292,9 @@ fn trees<B: BoundingVolume>(a: &TriMesh, b: &TriMesh, params: BuildParams) -> Bo
     })
 }
 
-/// The builds every pair is tested with.
-const BUILDS: [BuildParams; 4] = [
+/// The builds every pair is tested with: the daemon's ([`MESH_TREE_PARAMS`]) and others.
+const BUILDS: [BuildParams; 5] = [
+    MESH_TREE_PARAMS,
     BuildParams::MEAN_VARIANCE,
     BuildParams::MEAN_VARIANCE.with_leaf_size(4),
     BuildParams::BINNED_SAH,

@@ -67,7 +67,7 @@ pub use pairs::{
     manifold_cuboid_cuboid, manifold_cuboid_triangle, manifold_sphere_capsule,
     manifold_sphere_cuboid, manifold_sphere_sphere, manifold_sphere_triangle,
 };
-pub use shape::{MeshShape, QueryVolume, Shape};
+pub use shape::{MESH_TREE_PARAMS, MeshShape, QueryVolume, Shape};
 pub use triangle_triangle::{
     TriangleDistance, distance_triangle_triangle, intersection_segment_triangle_triangle,
     intersects_triangle_triangle,
