@@ -4,7 +4,7 @@
 //! with 2 cm margins each (4 cm thresholds).
 //!
 //! 64 frames of link poses from a fixed seed, built before timing with the OBB trees
-//! the pipeline uses. Each iteration answers the next frame with a fresh frontier
+//! the pipeline uses ([`MESH_TREE_PARAMS`]). Each iteration answers the next frame with a fresh frontier
 //! ([`query_frontier`]): `visits-250` under a counted budget of 250 visits (the work a
 //! quarter of an exact frame affords on the 2-core VM), `exact` without limit. The setup
 //! prints the mean visits per frame, so time per visit is the mean time divided by it.
@@ -24,9 +24,10 @@ use common::cycle::cycle_bench;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use proxima::bounding::Obb;
 use proxima::budget::VisitBudget;
-use proxima::bvh::{BuildParams, Bvh};
+use proxima::bvh::Bvh;
 use proxima::geometry::TriMesh;
 use proxima::math::{DVec3, Pose};
+use proxima::narrow::MESH_TREE_PARAMS;
 use proxima::narrow::mesh_mesh::frontier::{FrontierPair, FrontierWorkspace, query_frontier};
 
 /// Links per frame.
@@ -54,7 +55,7 @@ fn robot_chain() -> Option<RobotChain> {
             .scaled(0.001)
             .centered_on_bounds()
     };
-    let params = BuildParams::BINNED_SAH;
+    let params = MESH_TREE_PARAMS;
     let (env, link) = (
         Bvh::from_mesh(&load("env.obj"), &params),
         Bvh::from_mesh(&load("rob.obj"), &params),

@@ -9,8 +9,8 @@
 //!   exactly half of them intersecting (see [`common::mesh_scenes::tori`]).
 //!
 //! Everything is built before timing: Proxima's BVHs with [`MESH_TREE_PARAMS`], as the
-//! daemon builds them (binned SAH, up to two triangles a leaf), parry's `TriMesh` shapes from the very same `f64` vertices and
-//! index triples, and the poses (parry gets the same quaternion and translation, as
+//! daemon builds them (binned SAH, up to two triangles a leaf), parry's `TriMesh` shapes
+//! from the very same `f64` vertices and index triples, and the poses (parry gets the same quaternion and translation, as
 //! `pos1 = identity`, `pos2 = pose_ab`, so its `pos12` is Proxima's `pose_ab`). Each timed
 //! iteration takes the next pose in order ([`common::cycle::cycle_bench`]).
 //!

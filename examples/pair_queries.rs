@@ -12,8 +12,9 @@
 //! bounding-box centre to the origin. BVHs are built once, outside the timing: by default
 //! as the daemon builds them ([`MESH_TREE_PARAMS`]: binned SAH, up to two triangles a leaf),
 //! OBBs for the collision queries and RSSs for distance (the fastest combination measured;
-//! other volume types, builders and leaf sizes by option). Per transform, each query runs twice to warm
-//! up and is then timed over K runs (default 5); its time is the mean of those runs.
+//! other volume types, builders and leaf sizes by option). Per transform, each query runs
+//! twice to warm up and is then timed over K runs (default 5); its time is the mean of
+//! those runs.
 //!
 //! stdout: one TSV row per query, `query n mean_us median_us p95_us max_us colliding tri_pairs
 //! mean_dist`. `distance` starts every run cold (a fresh cache); `distance_warm` keeps the

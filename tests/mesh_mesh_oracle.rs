@@ -52,9 +52,9 @@ const MAIN_POSES_PER_PAIR: usize = 100;
 const MAIN_PAIRS: usize = 6;
 /// Random poses per procedural mesh pair in the tolerance test.
 const TOLERANCE_POSES_PER_PAIR: usize = 50;
-/// Tree configurations: 8 volume types × 4 builds, and the octree and medial-axis sphere
-/// trees (see [`all_configs`]).
-const CONFIG_COUNT: usize = 34;
+/// Tree configurations: 8 volume types × the [`BUILDS`], and the octree and medial-axis
+/// sphere trees (see [`all_configs`]).
+const CONFIG_COUNT: usize = 8 * BUILDS.len() + 2;
 /// Configurations each pose of the main tests is checked with.
 const CONFIGS_PER_POSE: usize = CONFIG_COUNT;
 /// Procedural pairs of the offset and scale stress tests (see [`stress_pairs`]).
@@ -294,9 +294,10 @@ fn trees<B: BoundingVolume>(a: &TriMesh, b: &TriMesh, params: BuildParams) -> Bo
 
 /// The builds every pair is tested with: the daemon's ([`MESH_TREE_PARAMS`], leaves of up
 /// to two) and others, leaves of one and of up to four.
-const BUILDS: [BuildParams; 4] = [
+const BUILDS: [BuildParams; 5] = [
     MESH_TREE_PARAMS,
     BuildParams::MEAN_VARIANCE,
+    BuildParams::MEAN_VARIANCE.with_leaf_size(4),
     BuildParams::BINNED_SAH,
     BuildParams::BINNED_SAH.with_leaf_size(4),
 ];

@@ -28,8 +28,9 @@ use std::sync::Arc;
 /// wastes far less. Measured against one a leaf on `examples/fcl_peer`'s four pairs
 /// (2026-12-02, same run, µs mean): distance 42.4 → 19.9 (env×rob), 39.3 → 29.5
 /// (tray×spot), 51.4 → 13.7 (plate×bunny), 170 → 166 (bunny×fandisk); all contacts
-/// 20–23 % faster on three pairs, 7 % on bunny×fandisk; boolean 0.6–3.3× faster. Three a
-/// leaf was even on the whole, four and six slower.
+/// 2 % (env×rob), 7 % (bunny×fandisk), 17 % (plate×bunny) and 21 % (tray×spot) faster;
+/// boolean 1.3–3.3× faster on three pairs, 7 % slower on bunny×fandisk. Three a leaf was
+/// even on the whole, four and six slower.
 pub const MESH_TREE_PARAMS: BuildParams = BuildParams::BINNED_SAH.with_leaf_size(2);
 
 /// A triangle mesh ready for queries: the mesh and its three BVHs (OBB trees answer overlap
