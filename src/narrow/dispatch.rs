@@ -461,7 +461,8 @@ fn beyond_along_centres(
 }
 
 /// A convex pair's answer from `certificate` when it has one, else from a cylinder's
-/// certificate when either shape is a cylinder ([`cylinder_certificate`]), else from GJK
+/// certificate when either shape is a cylinder ([`cylinder_certificate`]), else, for a
+/// cylinder apart from a box or cylinder, from its rim ([`rim_certificate`]), else from GJK
 /// and EPA.
 fn certified_or_gjk(
     a: &Shape,
@@ -484,7 +485,34 @@ fn certified_or_gjk(
             scratch.paths.separating_axes += 1;
             Reached::Exact(d)
         }
-        FaceCertificate::Unknown => convex_distance(a, b, pose_ab, limit, scratch),
+        FaceCertificate::Unknown => match rim_certificate(a, b, pose_ab) {
+            Some(d) => {
+                scratch.paths.closed_form += 1;
+                Reached::Exact(d)
+            }
+            None => convex_distance(a, b, pose_ab, limit, scratch),
+        },
+    }
+}
+
+/// [`pairs::certified_rim_distance`] for a cylinder apart from a box or a cylinder, the
+/// rim of either cylinder tried; `None` for other pairs or when no rim certifies.
+fn rim_certificate(a: &Shape, b: &Shape, pose_ab: &Isometry) -> Option<ShapeDistance> {
+    let rel_tol = GJK.rel_tol;
+    let flipped = |d: ShapeDistance| d.flipped(pose_ab);
+    match (a, b) {
+        (Shape::Cylinder(x), Shape::Cuboid(y)) => {
+            pairs::certified_rim_distance(x, y, pose_ab, rel_tol)
+        }
+        (Shape::Cuboid(x), Shape::Cylinder(y)) => {
+            pairs::certified_rim_distance(y, x, &pose_ab.inverse(), rel_tol).map(flipped)
+        }
+        (Shape::Cylinder(x), Shape::Cylinder(y)) => {
+            pairs::certified_rim_distance(x, y, pose_ab, rel_tol).or_else(|| {
+                pairs::certified_rim_distance(y, x, &pose_ab.inverse(), rel_tol).map(flipped)
+            })
+        }
+        _ => None,
     }
 }
 

@@ -24,7 +24,8 @@
 //! - `capsule_cylinder`: a certified search along the capsule's core while it stays out of
 //!   the cylinder;
 //! - `face_certificate`: a box's faces against any convex shape;
-//! - `cylinder_certificate`: a cylinder's caps and side against any convex shape.
+//! - `cylinder_certificate`: a cylinder's caps and side against any convex shape;
+//! - `cylinder_rim`: a cylinder's rim apart from a box or a cylinder.
 //!
 //! # Degenerate input, documented choices
 //! - Coincident sphere centres (and any pair whose cores touch in a point, segment or
@@ -48,6 +49,7 @@ mod capsule_triangle;
 mod cuboid_cuboid;
 mod cuboid_triangle;
 mod cylinder_certificate;
+mod cylinder_rim;
 mod face_certificate;
 mod sphere_capsule;
 mod sphere_cuboid;
@@ -76,6 +78,7 @@ pub use cuboid_triangle::{
     distance_cuboid_triangle, manifold_cuboid_triangle, manifold_cuboid_triangle_from,
 };
 pub use cylinder_certificate::certified_distance_cylinder_convex;
+pub use cylinder_rim::{NearestPoint, certified_rim_distance};
 pub use face_certificate::{FaceCertificate, face_distance_cuboid_convex};
 pub use sphere_capsule::{distance_sphere_capsule, manifold_sphere_capsule};
 pub use sphere_cuboid::{distance_sphere_cuboid, manifold_sphere_cuboid};

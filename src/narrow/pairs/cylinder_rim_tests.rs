@@ -1,0 +1,177 @@
+//! The rim certificate against GJK run to a tighter tolerance, on random cylinder–box and
+//! cylinder–cylinder pairs placed around the rim.
+
+use super::*;
+use crate::narrow::gjk::{GjkCache, GjkOutcome, GjkParams, gjk_distance};
+use crate::test_support::{rng, rotation};
+use rand::Rng;
+
+/// GJK as the oracle: a hundredth of the dispatcher's tolerance, iterations to spare.
+const ORACLE: GjkParams = GjkParams {
+    rel_tol: 1e-12,
+    epa_rel_tol: 1e-12,
+    abs_tol: 0.0,
+    max_iterations: 4_096,
+    accelerated: false,
+};
+
+/// Whether `p` (A's frame) lies on a rim of `a`, to `tol` metres.
+fn on_rim(a: &Cylinder, p: DVec3, tol: f64) -> bool {
+    let rho = DVec3::new(p.x, p.y, 0.0).length();
+    (p.z.abs() - a.half_height).abs() <= tol && (rho - a.radius).abs() <= tol
+}
+
+/// A random pose of B around cylinder A: B's centre at a random point of A's rim (either
+/// cap), pushed out along a random direction of the rim's normal cone by the two shapes'
+/// sizes times 0.5–1.3, so that B is near the rim, apart or overlapping, with a random
+/// rotation.
+fn around_the_rim(r: &mut crate::test_support::TestRng, a: &Cylinder, b_size: f64) -> Isometry {
+    let theta = r.random_range(0.0..std::f64::consts::TAU);
+    let cap = if r.random_bool(0.5) { 1.0 } else { -1.0 };
+    let radial = DVec3::new(theta.cos(), theta.sin(), 0.0);
+    let rim = radial * a.radius + DVec3::Z * (cap * a.half_height);
+    let phi = r.random_range(0.0..std::f64::consts::FRAC_PI_2);
+    let out = radial * phi.cos() + DVec3::Z * (cap * phi.sin());
+    let reach = b_size * r.random_range(0.5..1.3);
+    Isometry::new(
+        crate::math::DMat3::from_quat(rotation(r)),
+        rim + out * reach,
+    )
+}
+
+/// Checks one case: when the certificate answers, it agrees with the oracle to 1e-9
+/// relative, its witnesses are a rim point of A and a point of B that far apart, and its
+/// normal is their unit direction. Returns (answered, the oracle's nearest point of A on
+/// a rim with the shapes apart, the oracle's bounds within 1e-9 of each other).
+fn check<B: NearestPoint + std::fmt::Debug>(
+    a: &Cylinder,
+    b: &B,
+    pose: &Isometry,
+    case: usize,
+) -> (bool, bool, bool) {
+    let oracle = gjk_distance(a, b, pose, &ORACLE, &mut GjkCache::default());
+    let apart = oracle.outcome == GjkOutcome::Separated;
+    let scale = a.radius.max(a.half_height) + pose.translation.length();
+    let rim_case = apart && on_rim(a, oracle.point_a, 1e-7 * scale);
+    let Some(d) = certified_rim_distance(a, b, pose, 1e-10) else {
+        return (false, rim_case, false);
+    };
+    let ctx = format!("case {case}: {a:?} {b:?} {pose:?}: oracle {oracle:?}, rim {d:?}");
+    assert!(apart, "{ctx}: answered a pair that is not apart");
+    // The oracle's bounds: its witnesses' distance above, the support planes along its
+    // normal below. (Its |v| is not used: on a simplex of nearly equal points, as on a
+    // rim, the sub-distance's |v| fell 1e-8 short of its own witnesses' distance.)
+    let upper = (oracle.point_b - oracle.point_a).length();
+    let n = oracle.normal();
+    let lower =
+        n.dot(pose.transform_point(b.support(pose.inverse_transform_vector(-n))) - a.support(n));
+    let tol = 1e-9 * upper + 64.0 * f64::EPSILON * scale;
+    assert!(
+        d.distance >= lower - tol && d.distance <= upper + tol,
+        "{ctx}: outside the oracle's bounds [{lower:e}, {upper:e}]"
+    );
+    assert!(
+        on_rim(a, d.point_a, 1e-12 * scale),
+        "{ctx}: point_a off the rim"
+    );
+    let on_b = pose.inverse_transform_point(d.point_b);
+    assert!(
+        (b.nearest_point(on_b) - on_b).length() <= 1e-12 * scale,
+        "{ctx}: point_b outside B"
+    );
+    assert!(
+        ((d.point_b - d.point_a).length() - d.distance).abs() <= 1e-12 * scale,
+        "{ctx}: witnesses not the distance apart"
+    );
+    assert!(
+        (d.normal - (d.point_b - d.point_a) / d.distance).length() <= 1e-9,
+        "{ctx}: normal not along the witnesses"
+    );
+    (true, rim_case, upper - lower <= 1e-9 * upper)
+}
+
+/// Tallies of one kind of pair: certified, oracle rim cases, and rim cases certified.
+#[derive(Default, Debug)]
+struct Tally {
+    cases: usize,
+    answered: usize,
+    rim_cases: usize,
+    rim_answered: usize,
+    /// Answers checked against oracle bounds within 1e-9 of each other.
+    tight: usize,
+}
+
+impl Tally {
+    fn add(&mut self, (answered, rim_case, tight): (bool, bool, bool)) {
+        self.tight += usize::from(tight);
+        self.cases += 1;
+        self.answered += usize::from(answered);
+        self.rim_cases += usize::from(rim_case);
+        self.rim_answered += usize::from(answered && rim_case);
+    }
+
+    /// Both outcomes occur, the certificate answers most pairs nearest at a rim, and most
+    /// answers were checked against a tight bracket.
+    fn assert_useful(&self, what: &str) {
+        eprintln!("{what}: {self:?}");
+        assert!(self.answered > self.cases / 10, "{what}: {self:?}");
+        assert!(
+            self.cases - self.answered > self.cases / 10,
+            "{what}: {self:?}"
+        );
+        assert!(self.rim_cases > self.cases / 10, "{what}: {self:?}");
+        assert!(
+            self.rim_answered * 10 >= self.rim_cases * 9,
+            "{what}: {self:?}"
+        );
+        assert!(self.tight * 10 >= self.answered * 9, "{what}: {self:?}");
+    }
+}
+
+#[test]
+fn rim_distances_to_boxes_agree_with_gjk() {
+    let mut r = rng(0x51_4d);
+    let mut tally = Tally::default();
+    for case in 0..10_000 {
+        let a = Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03));
+        let b = Cuboid::new(DVec3::new(
+            r.random_range(0.002..0.03),
+            r.random_range(0.002..0.03),
+            r.random_range(0.002..0.03),
+        ));
+        let pose = around_the_rim(&mut r, &a, b.half_extents.length());
+        tally.add(check(&a, &b, &pose, case));
+    }
+    tally.assert_useful("cylinder–box");
+}
+
+#[test]
+fn rim_distances_to_cylinders_agree_with_gjk() {
+    let mut r = rng(0x51_4e);
+    let mut tally = Tally::default();
+    for case in 0..10_000 {
+        let a = Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03));
+        let b = Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03));
+        let pose = around_the_rim(&mut r, &a, b.half_height.hypot(b.radius));
+        tally.add(check(&a, &b, &pose, case));
+    }
+    tally.assert_useful("cylinder–cylinder");
+}
+
+/// Overlapping or touching pairs are never answered: the certificate is for pairs apart.
+#[test]
+fn overlapping_pairs_get_no_rim_answer() {
+    let mut r = rng(0x51_4f);
+    let mut overlapping = 0;
+    for _ in 0..5_000 {
+        let a = Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03));
+        let b = Cuboid::new(DVec3::splat(r.random_range(0.005..0.03)));
+        let pose = around_the_rim(&mut r, &a, 0.3 * b.half_extents.length());
+        let oracle = gjk_distance(&a, &b, &pose, &ORACLE, &mut GjkCache::default());
+        if oracle.outcome != GjkOutcome::Separated {
+            overlapping += 1;
+            assert!(certified_rim_distance(&a, &b, &pose, 1e-10).is_none());
+        }
+    }
+    assert!(overlapping > 1_000, "{overlapping} overlapping");
+}
