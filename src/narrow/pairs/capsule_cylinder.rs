@@ -23,11 +23,10 @@
 use crate::geometry::{Capsule, Cylinder};
 use crate::math::{DVec3, Isometry};
 use crate::narrow::contact::ShapeDistance;
+use crate::narrow::gjk::ROUNDING_ULPS;
 
 /// Most samples of the bracketed search after its two ends.
 const MAX_STEPS: usize = 48;
-/// Multiple of `f64::EPSILON × scale` under which a distance is rounding noise.
-const ROUNDING_ULPS: f64 = 64.0;
 
 /// One sample of `f`: the core's point `x` at `t`, its nearest cylinder point `c` (B's
 /// frame), `f = |x − c|` and the slope `f'(t)`.

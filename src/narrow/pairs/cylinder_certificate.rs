@@ -41,14 +41,13 @@ use super::face_certificate::FaceCertificate;
 use crate::geometry::{Cylinder, SupportMap};
 use crate::math::{DVec3, Isometry};
 use crate::narrow::contact::ShapeDistance;
+use crate::narrow::gjk::ROUNDING_ULPS;
 use std::cell::Cell;
 
 /// Most GJK steps towards B's shadow (each one support call of B).
 const SHADOW_STEPS: usize = 16;
 /// The shadow's GJK stops when `|v|² − v·w` is at most this share of `|v|²`.
 const SHADOW_REL_TOL: f64 = 1e-15;
-/// Multiple of `f64::EPSILON × scale` allowed between the bounds for rounding.
-const ROUNDING_ULPS: f64 = 64.0;
 
 /// One direction tried: the outward normal `n` of A, B's deepest point `p` along `−n`
 /// (A's frame), and the overlap `δ(n)` (negative: a gap).

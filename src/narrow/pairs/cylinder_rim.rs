@@ -118,16 +118,17 @@ pub fn certified_rim_distance<B: NearestPoint + ?Sized>(
         let u = c - nearest_b(c);
         u.dot(tangent) / u.length()
     };
-    let t = bracket_and_refine(&slope, 0.0)?;
+    let t = bracket_and_refine(&slope)?;
     let (point_a, _) = rim(t);
     let point_b = nearest_b(point_a);
     certify(a, b, pose_ab, (point_a, point_b), rel_tol)
 }
 
 /// The parameter where `slope` changes sign from negative to positive (a minimum of the
-/// distance), searched from `start`; `None` when no sign change is found within the
+/// distance), searched from 0 (the start); `None` when no sign change is found within the
 /// bracketing steps or the slope is not finite.
-fn bracket_and_refine(slope: &impl Fn(f64) -> f64, start: f64) -> Option<f64> {
+fn bracket_and_refine(slope: &impl Fn(f64) -> f64) -> Option<f64> {
+    let start = 0.0;
     let s0 = slope(start);
     if !s0.is_finite() {
         return None;

@@ -128,34 +128,49 @@ impl Tally {
     }
 }
 
-#[test]
-fn rim_distances_to_boxes_agree_with_gjk() {
-    let mut r = rng(0x51_4d);
+/// A random cylinder of the pile's sizes (radius 3–30 mm, half-height 5–30 mm).
+fn random_cylinder(r: &mut crate::test_support::TestRng) -> Cylinder {
+    Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03))
+}
+
+/// 10,000 seeded cases of a random cylinder A against `make_b`'s shape, placed around A's
+/// rim at B's size (the second value), each checked, then the tally's usefulness asserted.
+fn check_around_the_rim<B: NearestPoint + std::fmt::Debug>(
+    what: &str,
+    seed: u64,
+    make_b: impl Fn(&mut crate::test_support::TestRng) -> (B, f64),
+) {
+    let mut r = rng(seed);
     let mut tally = Tally::default();
     for case in 0..10_000 {
-        let a = Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03));
+        let a = random_cylinder(&mut r);
+        let (b, b_size) = make_b(&mut r);
+        let pose = around_the_rim(&mut r, &a, b_size);
+        tally.add(check(&a, &b, &pose, case));
+    }
+    tally.assert_useful(what);
+}
+
+#[test]
+fn rim_distances_to_boxes_agree_with_gjk() {
+    check_around_the_rim("cylinder–box", 0x51_4d, |r| {
         let b = Cuboid::new(DVec3::new(
             r.random_range(0.002..0.03),
             r.random_range(0.002..0.03),
             r.random_range(0.002..0.03),
         ));
-        let pose = around_the_rim(&mut r, &a, b.half_extents.length());
-        tally.add(check(&a, &b, &pose, case));
-    }
-    tally.assert_useful("cylinder–box");
+        let size = b.half_extents.length();
+        (b, size)
+    });
 }
 
 #[test]
 fn rim_distances_to_cylinders_agree_with_gjk() {
-    let mut r = rng(0x51_4e);
-    let mut tally = Tally::default();
-    for case in 0..10_000 {
-        let a = Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03));
-        let b = Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03));
-        let pose = around_the_rim(&mut r, &a, b.half_height.hypot(b.radius));
-        tally.add(check(&a, &b, &pose, case));
-    }
-    tally.assert_useful("cylinder–cylinder");
+    check_around_the_rim("cylinder–cylinder", 0x51_4e, |r| {
+        let b = random_cylinder(r);
+        let size = b.half_height.hypot(b.radius);
+        (b, size)
+    });
 }
 
 /// Overlapping or touching pairs are never answered: the certificate is for pairs apart.
@@ -164,7 +179,7 @@ fn overlapping_pairs_get_no_rim_answer() {
     let mut r = rng(0x51_4f);
     let mut overlapping = 0;
     for _ in 0..5_000 {
-        let a = Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03));
+        let a = random_cylinder(&mut r);
         let b = Cuboid::new(DVec3::splat(r.random_range(0.005..0.03)));
         let pose = around_the_rim(&mut r, &a, 0.3 * b.half_extents.length());
         let oracle = gjk_distance(&a, &b, &pose, &ORACLE, &mut GjkCache::default());
