@@ -76,6 +76,29 @@ pub fn isometry(rng: &mut TestRng, half: f64) -> Isometry {
     pose(rng, half).to_isometry()
 }
 
+/// A random cylinder of the pile's sizes (radius 3–30 mm, half-height 5–30 mm).
+pub fn random_cylinder(r: &mut TestRng) -> Cylinder {
+    Cylinder::new(r.random_range(0.003..0.03), r.random_range(0.005..0.03))
+}
+
+/// A random pose of B around cylinder A: B's centre at a random point of A's rim (either
+/// cap), pushed out along a random direction of the rim's normal cone by B's size `b_size`
+/// (metres) times 0.5–1.3, so that B is near the rim, apart or overlapping, with a random
+/// rotation.
+pub fn around_the_rim(r: &mut TestRng, a: &Cylinder, b_size: f64) -> Isometry {
+    let theta = r.random_range(0.0..std::f64::consts::TAU);
+    let cap = if r.random_bool(0.5) { 1.0 } else { -1.0 };
+    let radial = DVec3::new(theta.cos(), theta.sin(), 0.0);
+    let rim = radial * a.radius + DVec3::Z * (cap * a.half_height);
+    let phi = r.random_range(0.0..std::f64::consts::FRAC_PI_2);
+    let out = radial * phi.cos() + DVec3::Z * (cap * phi.sin());
+    let reach = b_size * r.random_range(0.5..1.3);
+    Isometry::new(
+        proxima::math::DMat3::from_quat(rotation(r)),
+        rim + out * reach,
+    )
+}
+
 /// The shapes of point cloud every fit and hull test runs over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum CloudKind {
