@@ -6,7 +6,7 @@
 //! as `crate::test_support` (see `src/lib.rs`). Items unused by one test file are allowed.
 #![allow(dead_code)]
 
-use proxima::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere};
+use proxima::geometry::{Capsule, Cone, ConvexPolyhedron, Cuboid, Cylinder, Sphere, SupportMap};
 use proxima::math::{DQuat, DVec3, Isometry, Pose};
 use proxima::narrow::Shape;
 use rand::{Rng, SeedableRng};
@@ -74,6 +74,17 @@ pub fn pose(rng: &mut TestRng, half: f64) -> Pose {
 /// A random isometry with its translation in `[-half, half]³`.
 pub fn isometry(rng: &mut TestRng, half: f64) -> Isometry {
     pose(rng, half).to_isometry()
+}
+
+/// The gap between A's support plane along the unit `n` (A's frame, pointing A→B) and B's
+/// along `−n`, B placed by `pose_ab`: a lower bound of the distance for every `n`, equal to
+/// it along the pair's true normal.
+pub fn support_gap<A, B>(a: &A, b: &B, pose_ab: &Isometry, n: DVec3) -> f64
+where
+    A: SupportMap + ?Sized,
+    B: SupportMap + ?Sized,
+{
+    n.dot(pose_ab.transform_point(b.support(pose_ab.inverse_transform_vector(-n))) - a.support(n))
 }
 
 /// A random cylinder of the pile's sizes (radius 3–30 mm, half-height 5–30 mm).

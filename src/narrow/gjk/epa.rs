@@ -31,7 +31,7 @@
 //! Buffers live in an [`EpaWorkspace`] of fixed capacity, so a query allocates nothing.
 
 use super::simplex::{Simplex, SupportPoint};
-use super::{GjkParams, ROUNDING_ULPS, support};
+use super::{GjkParams, floor, support};
 use crate::budget::WorkClock;
 use crate::geometry::SupportMap;
 use crate::math::{DVec3, Isometry, orthonormal_basis};
@@ -331,13 +331,6 @@ fn nearest_face(faces: &[Face]) -> Option<usize> {
         }
     }
     Some(best_i)
-}
-
-/// The smallest offset that counts at coordinates of magnitude `scale`: the absolute
-/// tolerance plus the rounding of `ROUNDING_ULPS` ulps.
-#[inline]
-fn floor(params: &GjkParams, scale: f64) -> f64 {
-    params.abs_tol + ROUNDING_ULPS * f64::EPSILON * scale
 }
 
 /// Grows `ws.vertices` (GJK's 1 to 4 points) to a tetrahedron by support points farthest

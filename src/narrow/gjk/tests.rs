@@ -330,7 +330,7 @@ fn best_plane(plane: &impl Fn(DVec3) -> f64, start: DVec3) -> f64 {
 /// (relative) short of its witnesses and 3 % of the searches stopped short.
 #[test]
 fn separated_answers_meet_the_tolerance_and_stalled_ones_say_so() {
-    use crate::test_support::{around_the_rim, random_cylinder};
+    use crate::test_support::{around_the_rim, random_cylinder, support_gap};
     use rand::Rng;
     let params = GjkParams::default();
     let mut r = rng(0x6a_6b);
@@ -349,10 +349,7 @@ fn separated_answers_meet_the_tolerance_and_stalled_ones_say_so() {
         let pose = around_the_rim(&mut r, &a, 0.03);
         let g = gjk_distance(&a, b.as_ref(), &pose, &params, &mut GjkCache::default());
         let witnessed = (g.point_b - g.point_a).length();
-        // Support planes, each a lower bound: along the reported normal and along −v.
-        let plane = |n: DVec3| {
-            n.dot(pose.transform_point(b.support(pose.inverse_transform_vector(-n))) - a.support(n))
-        };
+        let plane = |n: DVec3| support_gap(&a, b.as_ref(), &pose, n);
         let scale = 0.1 + pose.translation.length();
         let tol = params.rel_tol * g.distance + ROUNDING_ULPS * f64::EPSILON * scale;
         let ctx = format!("case {case}: {a:?}, pose {pose:?}: {g:?}, witnesses {witnessed:e}");

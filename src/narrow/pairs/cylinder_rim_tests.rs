@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::narrow::gjk::{GjkCache, GjkOutcome, GjkParams, gjk_distance};
-use crate::test_support::{TestRng, around_the_rim, random_cylinder, rng};
+use crate::test_support::{TestRng, around_the_rim, random_cylinder, rng, support_gap};
 use rand::Rng;
 
 /// GJK as the oracle: a hundredth of the dispatcher's tolerance, iterations to spare.
@@ -45,10 +45,7 @@ fn check<B: NearestPoint + std::fmt::Debug>(
     // The oracle's bounds: its witnesses' distance above; below, the support planes along
     // its normal, or the best plane it found.
     let upper = (oracle.point_b - oracle.point_a).length();
-    let n = oracle.normal();
-    let lower = n
-        .dot(pose.transform_point(b.support(pose.inverse_transform_vector(-n))) - a.support(n))
-        .max(oracle.lower_bound);
+    let lower = support_gap(a, b, pose, oracle.normal()).max(oracle.lower_bound);
     let tol = 1e-9 * upper + 64.0 * f64::EPSILON * scale;
     assert!(
         d.distance >= lower - tol && d.distance <= upper + tol,
