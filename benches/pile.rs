@@ -26,7 +26,7 @@
 //!   frame's pairs answered over and over with warm caches and branch history.)
 //! - `proxima/frame-settling-helped`: the same with the daemon's workspace, a worker pool
 //!   of one, whose helper thread answers convex pairs on the other core
-//!   (`src/pipeline/helper.rs`).
+//!   (`src/pipeline/helper.rs`); the printed `answered by the helper thread` says how many.
 //! - `proxima/narrow`: the narrow phase alone on frame `k`'s candidate pairs (the
 //!   all-pairs broad phase of `proxima::broad::brute_force`, equal to the pipeline's), as
 //!   the pipeline answers a pair: `dispatch::distance` exact up to the two margins, then
@@ -489,8 +489,9 @@ fn bench_pile(c: &mut Criterion) {
         frame(sets[0]);
         let report = frame(sets[1]);
         println!(
-            "pile: proxima/{name}: {} of {} candidate answers kept from the frame before",
-            report.reused_pairs, report.candidates
+            "pile: proxima/{name}: {} of {} candidate answers kept from the frame before, \
+             {} answered by the helper thread",
+            report.reused_pairs, report.candidates, report.helped_pairs
         );
         cycle_bench(
             &mut group,
